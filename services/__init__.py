@@ -1,0 +1,7 @@
+"""The boltwatch services: rig (simulated tool + sensors), acquisition,
+predictor, recorder, the line's zenoh router, and the ``boltwatch`` CLI.
+
+Services never import each other (import-linter checks it); they meet on
+zenoh key expressions (:mod:`shared.keys`). Only :mod:`services.cli` knows
+them all.
+"""

@@ -1,0 +1,1 @@
+"""The ``boltwatch`` command line: the one place that knows every service."""

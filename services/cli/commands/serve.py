@@ -1,0 +1,57 @@
+"""``boltwatch serve SERVICE --config FILE``: run one long-running service.
+
+Each service package ``services/<name>/`` provides ``arguments.py`` with
+``add_arguments(parser)`` (light: no heavy imports, so ``--help`` is fast) and
+``service.py`` with ``main(args) -> int``, which loads the station file named
+by ``args.config`` once and passes it down.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+from pathlib import Path
+
+NAME = "serve"
+HELP = "run one long-running service (rig, acquisition, predictor, recorder, router)"
+
+#: service name -> package that implements it
+SERVICES = {
+    "rig": "services.rig",
+    "acquisition": "services.acquisition",
+    "predictor": "services.predictor",
+    "recorder": "services.recorder",
+    "router": "services.router",
+}
+
+SERVICE_HELP = {
+    "rig": "the simulated tool controller and sensors on the CAN bus",
+    "acquisition": "CAN frames in, samples out on zenoh, stop decisions back to CAN",
+    "predictor": "the real-time stick-slip predictor: events, intensity, stop decisions",
+    "recorder": "MCAP files per run",
+    "router": "the line's zenoh router that stations connect to",
+}
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    services = parser.add_subparsers(dest="service", metavar="SERVICE", required=True)
+    for name, package in SERVICES.items():
+        sub = services.add_parser(name, help=SERVICE_HELP[name], description=SERVICE_HELP[name])
+        if name != "router":
+            sub.add_argument(
+                "--config",
+                type=Path,
+                default=Path("config/station.toml"),
+                help="station file (default: config/station.toml)",
+            )
+        sub.add_argument("--log-level", default=None, help="DEBUG, INFO (default), WARNING")
+        sub.set_defaults(service_package=package)
+        importlib.import_module(f"{package}.arguments").add_arguments(sub)
+
+
+def run(args: argparse.Namespace) -> int:
+    from shared.logging_setup import setup_logging
+
+    setup_logging(args.service, args.log_level)
+    service = importlib.import_module(f"{args.service_package}.service")
+    return int(service.main(args))

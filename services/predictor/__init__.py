@@ -1,0 +1,1 @@
+"""Predictor: the paper's real-time stick-slip algorithm (Section 6) on live samples."""

@@ -1,0 +1,1 @@
+"""Recorder: MCAP files per run, Rerun, and the machine-wear ledger."""

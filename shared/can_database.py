@@ -1,0 +1,72 @@
+"""The station's CAN database (``config/can/station.dbc``), checked against the contract.
+
+Message and signal names are the contract of DESIGN.md; ids, layout and
+scaling live in the DBC. :class:`StationDatabase` looks every contract message
+up once, so a DBC that lacks one fails at start-up with its file named,
+and the hot path encodes and decodes through prepared cantools messages.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import cantools
+import cantools.database
+
+from shared.errors import CanDatabaseError
+
+#: Contract messages and the signals each must carry (DESIGN.md, "CAN").
+CONTRACT: dict[str, tuple[str, ...]] = {
+    "ToolSensors": ("Torque", "Angle", "Counter"),
+    "JointSensors": ("Force", "Counter"),
+    "ToolStatus": ("RunId", "ToolId", "ProgramId", "State"),
+    "StopCommand": ("RunId", "Reason"),
+}
+
+COUNTER_MODULO = 1 << 16
+
+
+class StationDatabase:
+    """The contract messages of a DBC, with frame ids and lengths at hand."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        try:
+            database = cantools.database.load_file(str(path))
+        except FileNotFoundError as err:
+            raise CanDatabaseError(f"{path}: CAN database not found") from err
+        except Exception as err:  # cantools raises its own parse errors of many kinds
+            raise CanDatabaseError(f"{path}: not a valid DBC: {err}") from err
+        if not isinstance(database, cantools.database.can.Database):
+            raise CanDatabaseError(f"{path}: not a CAN database")
+        self._messages: dict[str, Any] = {}
+        for name, signals in CONTRACT.items():
+            try:
+                message = database.get_message_by_name(name)
+            except KeyError as err:
+                raise CanDatabaseError(f"{path}: message {name} missing (contract)") from err
+            missing = [s for s in signals if s not in {sig.name for sig in message.signals}]
+            if missing:
+                raise CanDatabaseError(f"{path}: {name} lacks signals {', '.join(missing)}")
+            self._messages[name] = message
+        self.tool_sensors_id: int = self._messages["ToolSensors"].frame_id
+        self.joint_sensors_id: int = self._messages["JointSensors"].frame_id
+        self.tool_status_id: int = self._messages["ToolStatus"].frame_id
+        self.stop_command_id: int = self._messages["StopCommand"].frame_id
+        #: frame id -> (message name, expected data length)
+        self.by_id: dict[int, tuple[str, int]] = {
+            m.frame_id: (name, m.length) for name, m in self._messages.items()
+        }
+
+    def encode(self, name: str, signals: dict[str, float | int]) -> bytes:
+        """Data bytes of contract message ``name`` (scaled, range-checked by cantools)."""
+        return bytes(self._messages[name].encode(signals, strict=False))
+
+    def decode(self, frame_id: int, data: bytes | bytearray) -> dict[str, float | int]:
+        """Physical signal values of a contract frame; raises on bad length or id."""
+        name, _ = self.by_id[frame_id]
+        return self._messages[name].decode(bytes(data), decode_choices=False)  # type: ignore[no-any-return]
+
+    def is_extended(self, name: str) -> bool:
+        return bool(self._messages[name].is_extended_frame)

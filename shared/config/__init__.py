@@ -1,0 +1,26 @@
+"""Station and joint configuration: TOML files, validated once at start-up.
+
+Load with :func:`load_station` (which also loads the joint it names) or
+:func:`load_joint`; pass the result down, never re-read it.
+"""
+
+from shared.config.joint import JointConfig, load_joint
+from shared.config.station import (
+    LoadedStation,
+    PredictorSection,
+    Program,
+    RigSection,
+    StationConfig,
+    load_station,
+)
+
+__all__ = [
+    "JointConfig",
+    "LoadedStation",
+    "PredictorSection",
+    "Program",
+    "RigSection",
+    "StationConfig",
+    "load_joint",
+    "load_station",
+]

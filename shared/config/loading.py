@@ -1,0 +1,109 @@
+"""Read a TOML file into a validated pydantic model, with errors a person can act on.
+
+Every failure becomes one :class:`~shared.errors.ConfigError` line of the form
+``<file>: <key>: <what was expected> (got <value>)``, e.g.::
+
+    config/station.toml: programs[0].target_force_n: Input should be greater than 0 (got -5)
+    config/station.toml: can.chanel: unknown key; expected one of: channel, dbc, interface, port
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any, TypeVar
+
+from pydantic import BaseModel, ConfigDict, ValidationError
+
+from shared.errors import ConfigError
+
+ModelT = TypeVar("ModelT", bound=BaseModel)
+
+
+class StrictModel(BaseModel):
+    """Base of every configuration section: unknown keys are errors, values immutable."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def read_toml(path: Path) -> dict[str, Any]:
+    """Parse ``path`` as TOML; a missing or malformed file is a ConfigError naming it."""
+    try:
+        with path.open("rb") as handle:
+            return tomllib.load(handle)
+    except FileNotFoundError as err:
+        raise ConfigError(f"{path}: file not found") from err
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(f"{path}: not valid TOML: {err}") from err
+    except OSError as err:
+        raise ConfigError(f"{path}: cannot be read: {err.strerror}") from err
+
+
+def validate(model: type[ModelT], data: dict[str, Any], path: Path) -> ModelT:
+    """Validate ``data`` against ``model``; the first problem becomes a ConfigError."""
+    try:
+        return model.model_validate(data, context={"source": path})
+    except ValidationError as err:
+        raise ConfigError(describe_validation_error(err, model, path)) from err
+
+
+def describe_validation_error(err: ValidationError, model: type[BaseModel], path: Path) -> str:
+    """One line per problem, ``file: key: message (got value)``; the first problem leads."""
+    lines = []
+    for problem in err.errors():
+        location = problem["loc"]
+        key = dotted_key(location)
+        if problem["type"] == "extra_forbidden":
+            allowed = allowed_keys(model, location[:-1])
+            hint = f"; expected one of: {', '.join(allowed)}" if allowed else ""
+            lines.append(f"{path}: {key}: unknown key{hint}")
+            continue
+        message = problem["msg"].removeprefix("Value error, ")
+        got = problem.get("input")
+        shown = "" if isinstance(got, dict) or problem["type"] == "missing" else f" (got {got!r})"
+        lines.append(f"{path}: {key or '(top level)'}: {message}{shown}")
+    return "\n".join(lines)
+
+
+def dotted_key(location: tuple[int | str, ...]) -> str:
+    """``("programs", 0, "target_force_n")`` -> ``programs[0].target_force_n``."""
+    text = ""
+    for part in location:
+        if isinstance(part, int):
+            text += f"[{part}]"
+        else:
+            text += f".{part}" if text else str(part)
+    return text
+
+
+def allowed_keys(model: type[BaseModel], location: tuple[int | str, ...]) -> list[str]:
+    """The field names of the (sub)model found by walking ``location`` from ``model``."""
+    current: Any = model
+    for part in location:
+        if isinstance(part, int):
+            continue
+        field = current.model_fields.get(part) if isinstance(current, type) else None
+        if field is None:
+            return []
+        current = _model_in(field.annotation)
+        if current is None:
+            return []
+    if isinstance(current, type) and issubclass(current, BaseModel):
+        return sorted(current.model_fields)
+    return []
+
+
+def _model_in(annotation: Any) -> type[BaseModel] | None:
+    """The BaseModel inside ``X``, ``list[X]``, ``X | None`` annotations, if any."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for argument in getattr(annotation, "__args__", ()):
+        found = _model_in(argument)
+        if found is not None:
+            return found
+    return None
+
+
+def resolve_relative(path: Path, base_file: Path) -> Path:
+    """A path from a config file, taken relative to that file's folder when not absolute."""
+    return path if path.is_absolute() else (base_file.parent / path).resolve()

@@ -1,0 +1,171 @@
+"""The station file: one tightening station and everything its services need.
+
+All services of a station read the same file (``config/station.toml`` for the
+embedded simulated station). Paths inside it (``station.joint``, ``can.dbc``,
+``recorder.folder``) are relative to the file itself.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+from pydantic import Field, model_validator
+
+from shared.config.joint import JointConfig, load_joint
+from shared.config.loading import StrictModel, read_toml, resolve_relative, validate
+from shared.errors import ConfigError
+
+StationId = str
+
+
+class StationSection(StrictModel):
+    id: StationId = Field(pattern=r"^[A-Za-z0-9_-]{1,64}$", description="key-expression safe")
+    tool_id: int = Field(ge=0, le=65535, description="the tool's id on the CAN bus (ToolStatus)")
+    joint: Path = Field(description="joint file, relative to this station file")
+    has_force_sensor: bool = Field(
+        default=True, description="false: no JointSensors on the bus, torque-only prediction"
+    )
+
+
+class CanSection(StrictModel):
+    interface: Literal["udp_multicast", "socketcan", "virtual"]
+    channel: str = Field(min_length=1, description="multicast group, can0, or a virtual bus name")
+    port: int | None = Field(default=None, ge=1, le=65535, description="udp_multicast only")
+    dbc: Path = Field(description="CAN database, relative to this station file")
+
+    @model_validator(mode="after")
+    def _port_only_for_multicast(self) -> CanSection:
+        if self.port is not None and self.interface != "udp_multicast":
+            raise ValueError("port applies only to interface = 'udp_multicast'")
+        return self
+
+
+class ZenohSection(StrictModel):
+    mode: Literal["peer", "client"] = "client"
+    connect: list[str] = Field(default_factory=list, description="e.g. tcp/127.0.0.1:7447")
+    listen: list[str] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _has_somewhere_to_go(self) -> ZenohSection:
+        if not self.connect and not self.listen:
+            raise ValueError("give connect or listen endpoints (multicast scouting is off)")
+        return self
+
+
+class Program(StrictModel):
+    """A tightening program of the tool controller, selected by ``ProgramId`` on CAN."""
+
+    id: int = Field(ge=1, le=255)
+    name: str
+    target_force_n: float | None = Field(default=None, gt=0)
+    target_torque_nm: float | None = Field(default=None, gt=0)
+    motor_speed_rad_s: float = Field(gt=0, le=50, description="constant motor speed, φ̇_m")
+    start_force_n: float = Field(
+        default=0.0, ge=0, description="preload when the run starts (after snug, paper: 10 kN)"
+    )
+    max_torque_nm: float = Field(gt=0, description="hard limit: the tool stops by itself")
+    max_force_n: float | None = Field(default=None, gt=0)
+    max_angle_deg: float = Field(gt=0)
+    max_time_s: float = Field(gt=0)
+
+    @model_validator(mode="after")
+    def _has_a_target(self) -> Program:
+        if self.target_force_n is None and self.target_torque_nm is None:
+            raise ValueError("give target_force_n, target_torque_nm, or both")
+        return self
+
+
+class PredictorSection(StrictModel):
+    window_samples: int = Field(default=12, ge=3, le=200, description="n of eqs. 43-45")
+    max_process_intensity: float | None = Field(
+        default=None, gt=0, description="I_max of eq. 70; none: no intensity stop"
+    )
+    constant_band: float | None = Field(
+        default=None, gt=0, description="S_i of eq. 71 as a fraction of the running mean"
+    )
+    constant_window: int = Field(default=5, ge=2, le=100, description="n_K of eq. 71")
+
+
+class RigSection(StrictModel):
+    """Knobs of the simulated tool and sensors (ignored by a real station)."""
+
+    inertia_kg_m2: float = Field(default=2.0e-4, gt=0, description="screw + socket")
+    damping_ratio: float = Field(default=0.15, ge=0, lt=1)
+    mu_stick_scatter: float = Field(default=0.01, ge=0, lt=0.5, description="relative σ per event")
+    torque_noise_nm: float = Field(default=0.2, ge=0)
+    force_noise_n: float = Field(default=30.0, ge=0)
+    angle_noise_deg: float = Field(default=0.01, ge=0)
+    settle_time_s: float = Field(default=0.03, gt=0, description="samples sent after the stop")
+    pause_between_runs_s: float = Field(default=0.5, ge=0)
+    seed: int | None = Field(default=None, description="none: a fresh seed per process")
+
+
+class RecorderSection(StrictModel):
+    folder: Path = Field(description="relative to this station file")
+    flush_interval_s: float = Field(default=1.0, gt=0, le=60)
+    max_file_bytes: int = Field(default=256 * 1024 * 1024, ge=1024 * 1024)
+    max_file_duration_s: float = Field(default=600.0, gt=0)
+
+
+class StationConfig(StrictModel):
+    station: StationSection
+    can: CanSection
+    zenoh: ZenohSection
+    programs: list[Program] = Field(min_length=1)
+    predictor: PredictorSection = PredictorSection()
+    rig: RigSection = RigSection()
+    recorder: RecorderSection
+
+    @model_validator(mode="after")
+    def _program_ids_unique(self) -> StationConfig:
+        ids = [program.id for program in self.programs]
+        if len(ids) != len(set(ids)):
+            raise ValueError(f"program ids must be unique (got {ids})")
+        return self
+
+    def program(self, program_id: int) -> Program:
+        """The program with ``program_id``; KeyError names the known ids."""
+        for program in self.programs:
+            if program.id == program_id:
+                return program
+        known = ", ".join(str(program.id) for program in self.programs)
+        raise KeyError(f"no program {program_id} in station {self.station.id} (known: {known})")
+
+
+class LoadedStation:
+    """A validated station file with its paths resolved and its joint loaded."""
+
+    def __init__(self, path: Path, config: StationConfig, joint: JointConfig) -> None:
+        self.path = path
+        self.config = config
+        self.joint = joint
+
+    @property
+    def station_id(self) -> str:
+        return self.config.station.id
+
+    @property
+    def dbc_path(self) -> Path:
+        return resolve_relative(self.config.can.dbc, self.path)
+
+    @property
+    def joint_path(self) -> Path:
+        return resolve_relative(self.config.station.joint, self.path)
+
+    @property
+    def recordings_folder(self) -> Path:
+        return resolve_relative(self.config.recorder.folder, self.path)
+
+
+def load_station(path: Path) -> LoadedStation:
+    """Load a station file and the joint file it names; every error names file and key."""
+    path = Path(path)
+    config = validate(StationConfig, read_toml(path), path)
+    joint_path = resolve_relative(config.station.joint, path)
+    if not joint_path.is_file():
+        raise ConfigError(f"{path}: station.joint: file not found: {joint_path}")
+    dbc_path = resolve_relative(config.can.dbc, path)
+    if not dbc_path.is_file():
+        raise ConfigError(f"{path}: can.dbc: file not found: {dbc_path}")
+    return LoadedStation(path, config, load_joint(joint_path))

@@ -1,0 +1,192 @@
+"""The messages boltwatch services exchange on zenoh (the payload contracts).
+
+Each message is a frozen dataclass; on the wire it is one JSON object (UTF-8)
+whose fields are exactly the dataclass fields, described by the JSON schema
+that :func:`shared.codec.json_schema` derives from the dataclass (the same
+schema goes into MCAP, so Foxglove and the mcap CLI decode recordings with no
+code of ours). Times are integer nanoseconds since the Unix epoch (``*_ns``)
+or float seconds since the start of the run (``*_s``); units are in names.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum
+from typing import Literal
+
+ToolStateName = Literal["idle", "running", "done", "aborted"]
+StopReasonName = Literal[
+    "unspecified",
+    "plateau_closest",
+    "target_reached",
+    "intensity_limit",
+    "constant_out_of_band",
+    "torque_limit",
+    "force_limit",
+    "angle_limit",
+    "input_fault",
+]
+
+
+class ToolRunState(IntEnum):
+    """``State`` of the CAN ``ToolStatus`` message (VAL_ table of the DBC)."""
+
+    IDLE = 0
+    RUNNING = 1
+    DONE = 2
+    ABORTED = 3
+
+
+class StopReason(IntEnum):
+    """``Reason`` of the CAN ``StopCommand`` message (VAL_ table of the DBC)."""
+
+    UNSPECIFIED = 0
+    PLATEAU_CLOSEST = 1  # eqs. 64/65: the next plateau would be farther from target
+    TARGET_REACHED = 2  # a joint with no stick-slip reached its target
+    INTENSITY_LIMIT = 3  # eq. 70
+    CONSTANT_OUT_OF_BAND = 4  # eq. 71
+    TORQUE_LIMIT = 5
+    FORCE_LIMIT = 6
+    ANGLE_LIMIT = 7
+    INPUT_FAULT = 8  # sensor input unusable for long enough that going on would be blind
+
+
+@dataclass(frozen=True, slots=True)
+class Sample:
+    """One 1 kHz sample: a ToolSensors frame paired with its JointSensors frame."""
+
+    station: str
+    run_id: int
+    sequence: int  # sample index within the run (the 16-bit CAN Counter, unrolled)
+    time_ns: int  # CAN receive time of the frame that completed the sample
+    torque_nm: float
+    angle_deg: float
+    force_n: float | None  # None on torque-only stations or when JointSensors was lost
+
+
+@dataclass(frozen=True, slots=True)
+class ToolState:
+    """The tool's run state (CAN ToolStatus), published when it changes."""
+
+    station: str
+    run_id: int
+    tool_id: int
+    program_id: int
+    state: ToolStateName
+    time_ns: int
+
+
+@dataclass(frozen=True, slots=True)
+class BusStats:
+    """Counters of the acquisition since it started; faults are counted, never fatal."""
+
+    station: str
+    time_ns: int
+    frames: int
+    samples: int
+    unknown_ids: int
+    wrong_length: int
+    decode_errors: int
+    error_frames: int
+    counter_gaps: int  # times the Counter did not follow its predecessor
+    missed_samples: int  # samples lost in those gaps
+    unpaired: int  # ToolSensors published without a JointSensors partner
+    stop_commands: int
+
+
+@dataclass(frozen=True, slots=True)
+class Prediction:
+    """A predicted stick-slip event, ``horizon`` events ahead (1 = the next)."""
+
+    horizon: int
+    time_s: float
+    peak_torque_nm: float
+    plateau_force_n: float | None
+
+
+@dataclass(frozen=True, slots=True)
+class StickSlipEvent:
+    """One detected stick-slip event j with its figures (paper Fig. 3, eqs. 31-33, 66-68)."""
+
+    station: str
+    run_id: int
+    index: int  # j, counting from 1 within the run
+    time_ns: int  # receive time of the peak sample
+    time_s: float  # time of the torque peak since run start
+    peak_torque_nm: float  # T_max,j
+    min_torque_nm: float | None  # T_min,j after the slip
+    torque_drop_nm: float | None  # ΔT_j
+    plateau_force_n: float | None  # F_j, the plateau the peak belongs to
+    force_step_n: float | None  # ΔF_j
+    period_s: float | None  # Δt_j to the previous peak
+    f_ss_hz: float | None
+    k1: float | None
+    k2: float | None
+    k3: float | None
+    intensity: float | None  # I_j, eq. 67
+    process_intensity: float  # I_process so far, eq. 68
+    predictions: list[Prediction] = field(default_factory=list)
+
+
+@dataclass(frozen=True, slots=True)
+class Intensity:
+    """Vibration intensity: of the last event and of the process so far (eqs. 67, 68)."""
+
+    station: str
+    run_id: int
+    time_ns: int
+    event_intensity: float
+    process_intensity: float
+
+
+@dataclass(frozen=True, slots=True)
+class StopDecision:
+    """The predictor's decision to stop the tool now, with its reason."""
+
+    station: str
+    run_id: int
+    time_ns: int  # receive time of the sample at which it was decided
+    time_s: float  # the same, since run start
+    reason: StopReasonName
+    detail: str
+    torque_nm: float
+    force_n: float | None
+    predicted_force_n: float | None
+    decided_ns: int  # wall clock when the decision was published
+
+
+@dataclass(frozen=True, slots=True)
+class RunSummary:
+    """One tightening run, start to end, as the predictor saw it."""
+
+    station: str
+    run_id: int
+    tool_id: int
+    program_id: int
+    tool_state: ToolStateName  # done or aborted
+    target_force_n: float | None
+    target_torque_nm: float | None
+    reached_force_n: float | None
+    reached_torque_nm: float
+    error_pct: float | None  # (reached - target) / target, of force if measured else torque
+    events: int
+    stop_reason: StopReasonName | None  # None: the tool stopped by itself
+    process_intensity: float
+    samples: int
+    started_ns: int
+    ended_ns: int
+
+
+#: Registry name of each message type: MCAP schema names and documentation.
+MESSAGE_TYPES: dict[str, type] = {
+    f"boltwatch.{cls.__name__}": cls
+    for cls in (
+        Sample,
+        ToolState,
+        BusStats,
+        StickSlipEvent,
+        Intensity,
+        StopDecision,
+        RunSummary,
+    )
+}
