@@ -66,7 +66,10 @@ class StationDatabase:
     def decode(self, frame_id: int, data: bytes | bytearray) -> dict[str, float | int]:
         """Physical signal values of a contract frame; raises on bad length or id."""
         name, _ = self.by_id[frame_id]
-        return self._messages[name].decode(bytes(data), decode_choices=False)  # type: ignore[no-any-return]
+        decoded: dict[str, float | int] = self._messages[name].decode(
+            bytes(data), decode_choices=False
+        )
+        return decoded
 
     def is_extended(self, name: str) -> bool:
         return bool(self._messages[name].is_extended_frame)

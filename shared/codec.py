@@ -51,7 +51,7 @@ def decode(message_type: type[MessageT], payload: bytes | bytearray | memoryview
 
 def from_dict(message_type: type[MessageT], data: dict[str, Any]) -> MessageT:
     """Build ``message_type`` from a field dict, nested dataclass lists included."""
-    nested = _nested_list_fields(message_type)
+    nested = _nested_list_fields(typing.cast(Any, message_type))
     if nested:
         data = dict(data)
         for name, item_type in nested.items():
@@ -60,19 +60,24 @@ def from_dict(message_type: type[MessageT], data: dict[str, Any]) -> MessageT:
     return message_type(**data)
 
 
-@cache
 def _field_names(message_type: type) -> tuple[str, ...]:
-    return tuple(f.name for f in dataclasses.fields(message_type))
+    names = _FIELD_NAMES.get(message_type)
+    if names is None:
+        names = _FIELD_NAMES[message_type] = tuple(f.name for f in dataclasses.fields(message_type))
+    return names
+
+
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
 
 
 @cache
-def _nested_list_fields(message_type: type) -> dict[str, type]:
+def _nested_list_fields(message_type: Any) -> dict[str, type]:
     hints = typing.get_type_hints(message_type)
-    found = {}
+    found: dict[str, type] = {}
     for name, hint in hints.items():
         if typing.get_origin(hint) is list:
             (item,) = typing.get_args(hint)
-            if dataclasses.is_dataclass(item):
+            if isinstance(item, type) and dataclasses.is_dataclass(item):
                 found[name] = item
     return found
 

@@ -88,9 +88,12 @@ class BusStats:
     wrong_length: int
     decode_errors: int
     error_frames: int
-    counter_gaps: int  # times the Counter did not follow its predecessor
+    receive_errors: int  # the bus driver raised on receive (bus-off, link down)
+    counter_gaps: int  # times the Counter skipped ahead
     missed_samples: int  # samples lost in those gaps
+    counter_faults: int  # repeated or backwards Counters, frames dropped
     unpaired: int  # ToolSensors published without a JointSensors partner
+    orphans: int  # JointSensors dropped: no ToolSensors partner in time
     stop_commands: int
 
 

@@ -50,7 +50,9 @@ def read_trace(path: Path) -> Trace:
             reader = csv.reader(handle)
             header = next(reader, None)
             if header is None or tuple(h.strip() for h in header) != HEADER:
-                raise InputError(f"{path}: line 1: expected header {','.join(HEADER)}, got {header}")
+                raise InputError(
+                    f"{path}: line 1: expected header {','.join(HEADER)}, got {header}"
+                )
             for line_number, row in enumerate(reader, start=2):
                 if not row:
                     continue
@@ -87,9 +89,7 @@ def _parse_cell(cell: str, path: Path, line_number: int, index: int) -> float:
         ) from err
 
 
-def write_trace(
-    path: Path, rows: Iterable[tuple[float, float, float, float | None]]
-) -> int:
+def write_trace(path: Path, rows: Iterable[tuple[float, float, float, float | None]]) -> int:
     """Write rows ``(time_s, torque_nm, angle_deg, force_n or None)``; returns the row count."""
     count = 0
     with Path(path).open("w", newline="") as handle:

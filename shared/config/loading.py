@@ -82,7 +82,8 @@ def allowed_keys(model: type[BaseModel], location: tuple[int | str, ...]) -> lis
     for part in location:
         if isinstance(part, int):
             continue
-        field = current.model_fields.get(part) if isinstance(current, type) else None
+        is_model = isinstance(current, type) and issubclass(current, BaseModel)
+        field = current.model_fields.get(part) if is_model else None
         if field is None:
             return []
         current = _model_in(field.annotation)

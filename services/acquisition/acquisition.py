@@ -1,0 +1,215 @@
+"""The acquisition loop: CAN frames in, samples and run states out (transport-agnostic).
+
+:class:`Acquisition` owns the bus reading and the fault counters; where its
+output goes is an :class:`Outlet` (zenoh in the service, a list in tests).
+``send_stop`` may be called from another thread (the zenoh decision callback)
+and turns a decision for the running run into one CAN ``StopCommand``.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import Counter
+from collections.abc import Callable
+from typing import Protocol
+
+import can
+
+from services.acquisition.frame_decoder import (
+    FrameDecoder,
+    JointSensorsFrame,
+    Rejected,
+    StopCommandFrame,
+    ToolSensorsFrame,
+    ToolStatusFrame,
+)
+from services.acquisition.pairing import AssembledSample, SampleAssembler
+from shared.can_database import StationDatabase
+from shared.messages import BusStats, Sample, StopDecision, StopReason, ToolRunState, ToolState
+
+LOG = logging.getLogger(__name__)
+
+RECEIVE_ERROR_BACKOFF_S = 0.05
+
+
+class Outlet(Protocol):
+    """Where the acquisition's output goes."""
+
+    def sample(self, sample: Sample) -> None: ...
+    def tool_state(self, state: ToolState) -> None: ...
+    def bus_stats(self, stats: BusStats) -> None: ...
+
+
+class Acquisition:
+    """Reads one station's CAN bus; pairs, stamps and forwards samples."""
+
+    def __init__(
+        self,
+        station_id: str,
+        has_force_sensor: bool,
+        bus: can.BusABC,
+        database: StationDatabase,
+        outlet: Outlet,
+        clock_ns: Callable[[], int] = time.time_ns,
+    ) -> None:
+        self.station_id = station_id
+        self._bus = bus
+        self._database = database
+        self._decoder = FrameDecoder(database)
+        self._outlet = outlet
+        self._clock_ns = clock_ns
+        self._assembler = SampleAssembler(has_force_sensor)
+        self._rejected: Counter[str] = Counter()
+        self._frames = 0
+        self._receive_errors = 0
+        self._stop_commands = 0
+        self._send_lock = threading.Lock()
+        self._tool: ToolStatusFrame | None = None
+        self._stopped_run: int | None = None
+
+    # -- receiving ---------------------------------------------------------------------
+
+    def poll(self, timeout_s: float) -> None:
+        """Receive and handle at most one frame, waiting up to ``timeout_s``."""
+        try:
+            message = self._bus.recv(timeout_s)
+        except can.CanError as err:
+            self._receive_errors += 1
+            if self._receive_errors in (1, 10, 100) or self._receive_errors % 1000 == 0:
+                LOG.warning("CAN receive error #%d: %s", self._receive_errors, err)
+            time.sleep(RECEIVE_ERROR_BACKOFF_S)
+            return
+        if message is not None:
+            self.handle(message)
+
+    def handle(self, message: can.Message) -> None:
+        """Handle one received frame; bad frames are counted, never raised."""
+        self._frames += 1
+        time_ns = round(message.timestamp * 1e9) if message.timestamp else self._clock_ns()
+        frame = self._decoder.decode(
+            message.arbitration_id,
+            message.data,
+            is_error_frame=message.is_error_frame,
+            is_remote_frame=message.is_remote_frame,
+        )
+        if isinstance(frame, ToolSensorsFrame):
+            self._emit(
+                self._assembler.tool_frame(frame.counter, frame.torque_nm, frame.angle_deg, time_ns)
+            )
+        elif isinstance(frame, JointSensorsFrame):
+            self._emit(self._assembler.joint_frame(frame.counter, frame.force_n, time_ns))
+        elif isinstance(frame, ToolStatusFrame):
+            self._tool_status(frame, time_ns)
+        elif isinstance(frame, Rejected):
+            self._rejected[frame.reason] += 1
+            if LOG.isEnabledFor(logging.DEBUG):
+                LOG.debug("rejected frame 0x%x: %s", message.arbitration_id, frame.reason)
+        elif isinstance(frame, StopCommandFrame):
+            LOG.debug("StopCommand from another node for run %d", frame.run_id)
+
+    def _emit(self, samples: list[AssembledSample]) -> None:
+        run_id = self._tool.run_id if self._tool is not None else 0
+        for sample in samples:
+            self._outlet.sample(
+                Sample(
+                    self.station_id,
+                    run_id,
+                    sample.sequence,
+                    sample.time_ns,
+                    sample.torque_nm,
+                    sample.angle_deg,
+                    sample.force_n,
+                )
+            )
+
+    def _tool_status(self, frame: ToolStatusFrame, time_ns: int) -> None:
+        previous = self._tool
+        if previous == frame:
+            return
+        starts_run = frame.state == ToolRunState.RUNNING and (
+            previous is None
+            or previous.run_id != frame.run_id
+            or previous.state != ToolRunState.RUNNING
+        )
+        if previous is not None and (starts_run or frame.state != ToolRunState.RUNNING):
+            self._emit(self._assembler.finish_run())  # leftovers belong to the old run
+        if starts_run:
+            self._assembler.start_run()
+        self._tool = frame
+        try:
+            state_name = ToolRunState(frame.state).name.lower()
+        except ValueError:
+            self._rejected["bad_state"] += 1
+            return
+        self._outlet.tool_state(
+            ToolState(
+                self.station_id,
+                frame.run_id,
+                frame.tool_id,
+                frame.program_id,
+                state_name,  # type: ignore[arg-type]
+                time_ns,
+            )
+        )
+        LOG.info("run %d: %s (program %d)", frame.run_id, state_name, frame.program_id)
+
+    # -- stopping ------------------------------------------------------------------------
+
+    def send_stop(self, decision: StopDecision) -> bool:
+        """Send StopCommand for ``decision`` if it is for the running run; once per run."""
+        tool = self._tool
+        if tool is None or tool.state != ToolRunState.RUNNING or decision.run_id != tool.run_id:
+            LOG.warning("decision for run %d ignored: the tool is not running it", decision.run_id)
+            return False
+        with self._send_lock:
+            if self._stopped_run == decision.run_id:
+                return False
+            reason = StopReason[decision.reason.upper()]
+            data = self._database.encode(
+                "StopCommand", {"RunId": decision.run_id, "Reason": int(reason)}
+            )
+            message = can.Message(
+                arbitration_id=self._database.stop_command_id,
+                data=data,
+                is_extended_id=self._database.is_extended("StopCommand"),
+            )
+            try:
+                self._bus.send(message)
+            except can.CanError as err:
+                LOG.error("StopCommand for run %d could not be sent: %s", decision.run_id, err)
+                return False
+            self._stopped_run = decision.run_id
+            self._stop_commands += 1
+        lag_ms = (self._clock_ns() - decision.time_ns) / 1e6
+        LOG.info(
+            "run %d: StopCommand sent (%s), %.2f ms after the deciding sample",
+            decision.run_id,
+            decision.reason,
+            lag_ms,
+        )
+        return True
+
+    # -- counters ------------------------------------------------------------------------
+
+    def stats(self) -> BusStats:
+        pairing = self._assembler.counters
+        rejected = self._rejected
+        return BusStats(
+            station=self.station_id,
+            time_ns=self._clock_ns(),
+            frames=self._frames,
+            samples=pairing.samples,
+            unknown_ids=rejected["unknown_id"] + rejected["remote_frame"],
+            wrong_length=rejected["wrong_length"],
+            decode_errors=rejected["decode_error"] + rejected["bad_state"],
+            error_frames=rejected["error_frame"],
+            receive_errors=self._receive_errors,
+            counter_gaps=pairing.counter_gaps,
+            missed_samples=pairing.missed_samples,
+            counter_faults=pairing.repeated + pairing.backwards,
+            unpaired=pairing.unpaired,
+            orphans=pairing.orphans,
+            stop_commands=self._stop_commands,
+        )

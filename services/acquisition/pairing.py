@@ -1,0 +1,151 @@
+"""Pair the two sensor frames of a sample and unroll the 16-bit Counter (pure).
+
+A sample is complete when its ``ToolSensors`` and ``JointSensors`` frames,
+which carry the same rolling ``Counter``, have both arrived (on a torque-only
+station the ``ToolSensors`` frame alone completes it). Samples leave in
+Counter order, as soon as they are complete: the stop path is latency-critical.
+
+Faults are counted, never raised:
+
+- a Counter that skips ahead is a gap; the skipped samples are counted as missed;
+- a repeated or backwards Counter (a replayed or confused node) is dropped;
+- a ``ToolSensors`` whose partner has not come by the time the tool is two
+  samples further leaves without force (``unpaired``); a partner arriving
+  after that, or a ``JointSensors`` with no tool frame, is dropped (``orphans``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from shared.can_database import COUNTER_MODULO
+
+#: How many samples a ToolSensors frame may wait for its JointSensors partner.
+PAIRING_TOLERANCE = 2
+
+#: Counter steps above this count as going backwards rather than a gap ahead.
+BACKWARDS_THRESHOLD = COUNTER_MODULO // 2
+
+
+@dataclass(frozen=True, slots=True)
+class AssembledSample:
+    sequence: int  # index in the run, from the unrolled Counter
+    time_ns: int  # receive time of the frame that completed the sample
+    torque_nm: float
+    angle_deg: float
+    force_n: float | None
+
+
+@dataclass(slots=True)
+class PairingCounters:
+    samples: int = 0
+    counter_gaps: int = 0
+    missed_samples: int = 0
+    repeated: int = 0
+    backwards: int = 0
+    unpaired: int = 0
+    orphans: int = 0
+
+
+@dataclass(slots=True)
+class _PendingTool:
+    sequence: int
+    counter: int
+    time_ns: int
+    torque_nm: float
+    angle_deg: float
+
+
+class SampleAssembler:
+    """Turns sensor frames of one run into ordered samples."""
+
+    def __init__(self, has_force_sensor: bool) -> None:
+        self.has_force_sensor = has_force_sensor
+        self.counters = PairingCounters()
+        self._last_counter: int | None = None
+        self._last_sequence = -1
+        self._pending_tools: list[_PendingTool] = []  # in sequence order
+        self._pending_forces: dict[int, float] = {}  # counter -> force of JointSensors
+
+    def finish_run(self) -> list[AssembledSample]:
+        """The run ended: tool frames still waiting leave without force, in order."""
+        out = self._flush_older_than(self._last_sequence + 1)
+        self.counters.orphans += len(self._pending_forces)
+        self._pending_forces.clear()
+        return out
+
+    def start_run(self) -> None:
+        """A new run: the next ToolSensors frame is sequence 0. Counters keep counting."""
+        self._last_counter = None
+        self._last_sequence = -1
+        self._pending_tools.clear()
+        self._pending_forces.clear()
+
+    def tool_frame(
+        self, counter: int, torque_nm: float, angle_deg: float, time_ns: int
+    ) -> list[AssembledSample]:
+        """A ToolSensors frame arrived; returns the samples it completes, in order."""
+        sequence = self._unroll(counter)
+        if sequence is None:
+            return []
+        pending = _PendingTool(sequence, counter, time_ns, torque_nm, angle_deg)
+        if not self.has_force_sensor:
+            return [self._complete(pending, None, time_ns)]
+        force_n = self._pending_forces.pop(counter, None)
+        if force_n is not None:
+            out = self._flush_older_than(sequence)
+            out.append(self._complete(pending, force_n, time_ns))
+            return out
+        self._pending_tools.append(pending)
+        return self._flush_older_than(sequence - PAIRING_TOLERANCE + 1)
+
+    def joint_frame(self, counter: int, force_n: float, time_ns: int) -> list[AssembledSample]:
+        """A JointSensors frame arrived; returns the samples it completes, in order."""
+        if not self.has_force_sensor:
+            return []
+        for pending in self._pending_tools:
+            if pending.counter == counter:
+                out = self._flush_older_than(pending.sequence)
+                self._pending_tools.pop(0)  # the matched frame is now the oldest
+                out.append(self._complete(pending, force_n, time_ns))
+                return out
+        # The tool frame has not come yet (or left unpaired already): keep it briefly.
+        if len(self._pending_forces) >= PAIRING_TOLERANCE:
+            oldest = next(iter(self._pending_forces))
+            del self._pending_forces[oldest]
+            self.counters.orphans += 1
+        self._pending_forces[counter] = force_n
+        return []
+
+    def _unroll(self, counter: int) -> int | None:
+        """Sequence number of a ToolSensors Counter, counting gaps; None to drop the frame."""
+        step = 1 if self._last_counter is None else (counter - self._last_counter) % COUNTER_MODULO
+        if step == 0:
+            self.counters.repeated += 1
+            return None
+        if step > BACKWARDS_THRESHOLD:
+            self.counters.backwards += 1
+            return None
+        if step > 1:
+            self.counters.counter_gaps += 1
+            self.counters.missed_samples += step - 1
+        self._last_counter = counter
+        self._last_sequence += step
+        return self._last_sequence
+
+    def _complete(
+        self, pending: _PendingTool, force_n: float | None, time_ns: int
+    ) -> AssembledSample:
+        self.counters.samples += 1
+        return AssembledSample(
+            pending.sequence, time_ns, pending.torque_nm, pending.angle_deg, force_n
+        )
+
+    def _flush_older_than(self, sequence: int) -> list[AssembledSample]:
+        """Pending tool frames before ``sequence`` leave without force, in order."""
+        out = []
+        while self._pending_tools and self._pending_tools[0].sequence < sequence:
+            pending = self._pending_tools.pop(0)
+            self.counters.unpaired += 1
+            out.append(self._complete(pending, None, pending.time_ns))
+        return out

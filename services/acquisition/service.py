@@ -1,0 +1,75 @@
+"""``boltwatch serve acquisition``: wire the CAN bus and zenoh to :class:`Acquisition`.
+
+Subscribes ``boltwatch/<station>/decision`` and turns each decision for the
+running run into a CAN ``StopCommand`` straight from the zenoh callback (the
+shortest stop path); publishes samples, run states and bus counters.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import threading
+import time
+
+import zenoh
+
+from services.acquisition.acquisition import Acquisition
+from services.acquisition.zenoh_outlet import ZenohOutlet
+from shared import keys
+from shared.can_bus import open_bus
+from shared.can_database import StationDatabase
+from shared.codec import decode
+from shared.config import load_station
+from shared.errors import BoltwatchError
+from shared.messages import StopDecision
+from shared.service_runtime import ServiceRunner
+from shared.zenoh_session import open_session
+
+LOG = logging.getLogger(__name__)
+
+POLL_TIMEOUT_S = 0.05  # the stop flag is checked at least this often
+
+
+def main(args: argparse.Namespace) -> int:
+    station = load_station(args.config)
+    database = StationDatabase(station.dbc_path)
+    station_id = station.station_id
+    with open_bus(station.config.can) as bus, open_session(station.config.zenoh) as session:
+        outlet = ZenohOutlet(session, station_id)
+        acquisition = Acquisition(
+            station_id, station.config.station.has_force_sensor, bus, database, outlet
+        )
+
+        def on_decision(sample: zenoh.Sample) -> None:
+            try:
+                acquisition.send_stop(decode(StopDecision, sample.payload.to_bytes()))
+            except BoltwatchError as err:
+                LOG.error("bad decision message on %s: %s", sample.key_expr, err)
+
+        decisions = session.declare_subscriber(
+            keys.station_key(station_id, keys.DECISION), on_decision
+        )
+        token = session.liveliness().declare_token(keys.health_key(station_id, "acquisition"))
+        LOG.info(
+            "acquisition of %s on %s:%s",
+            station_id,
+            station.config.can.interface,
+            station.config.can.channel,
+        )
+
+        def work(stop: threading.Event) -> None:
+            next_stats = time.monotonic() + args.stats_interval_s
+            while not stop.is_set():
+                acquisition.poll(POLL_TIMEOUT_S)
+                if time.monotonic() >= next_stats:
+                    outlet.bus_stats(acquisition.stats())
+                    next_stats += args.stats_interval_s
+
+        status = ServiceRunner("acquisition", work).run()
+        outlet.bus_stats(acquisition.stats())
+        LOG.info("acquisition stopped: %s", acquisition.stats())
+        decisions.undeclare()
+        token.undeclare()
+        outlet.close()
+    return status

@@ -1,0 +1,83 @@
+"""``boltwatch up``: the whole simulated station, end to end, with a table at the end.
+
+Starts the line's zenoh router and the station's services as separate
+processes (recorder, predictor, acquisition, then the simulated rig), waits
+until every service shows its liveliness token, lets the rig tighten
+``--runs`` joints, prints one row per run as it ends, then stops everything
+in order and prints the table, the bus counters and where the recordings are.
+A service that dies is reported with the end of its log, and the rest stop.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+from datetime import UTC, datetime
+from pathlib import Path
+from types import FrameType
+
+NAME = "up"
+HELP = "run the simulated station end to end (rig, acquisition, predictor, recorder, router)"
+
+
+class StoppedBySignalError(Exception):
+    """SIGTERM or SIGHUP reached ``boltwatch up``."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--config",
+        type=Path,
+        default=Path("config/station.toml"),
+        help="station file (default: config/station.toml)",
+    )
+    parser.add_argument("--runs", type=int, default=5, help="tightenings to run (default 5)")
+    parser.add_argument(
+        "--program", type=int, default=None, help="program id (default: the first program)"
+    )
+    parser.add_argument(
+        "--startup-timeout-s",
+        type=float,
+        default=60.0,
+        help="how long services may take to come up (default 60 s)",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from services.cli.station_run import StationRun
+    from shared.config import load_station
+    from shared.errors import ConfigError
+
+    if args.runs < 1:
+        raise ConfigError(f"--runs must be at least 1 (got {args.runs})")
+    station = load_station(args.config)
+    program = (
+        station.config.program(args.program)
+        if args.program is not None
+        else station.config.programs[0]
+    )
+    if station.config.zenoh.mode != "client" or not station.config.zenoh.connect:
+        raise ConfigError(
+            f"{station.path}: zenoh: boltwatch up runs a router and needs mode = 'client' "
+            "with connect = [its endpoint]"
+        )
+    stamp = datetime.now(UTC).strftime("%Y%m%d-%H%M%S")
+    log_dir = station.recordings_folder / "logs" / f"up-{stamp}"
+
+    def on_signal(signum: int, _frame: FrameType | None) -> None:
+        raise StoppedBySignalError(signal.Signals(signum).name)
+
+    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGTERM, signal.SIGHUP)}
+    station_run = StationRun(station, program, args.runs, log_dir, args.startup_timeout_s)
+    try:
+        return station_run.run()
+    except (KeyboardInterrupt, StoppedBySignalError):
+        print("\ninterrupted: stopping every process", file=sys.stderr)
+        station_run.stop_everything()
+        station_run.report()
+        return 130
+    finally:
+        station_run.stop_everything()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)

@@ -1,0 +1,60 @@
+"""The table ``boltwatch up`` prints: one row per tightening run, for a plant engineer."""
+
+from __future__ import annotations
+
+from shared.messages import RunSummary
+
+COLUMNS = (
+    ("run", 10),
+    ("prog", 4),
+    ("target", 10),
+    ("reached", 10),
+    ("error %", 8),
+    ("events", 6),
+    ("stop reason", 20),
+    ("intensity", 10),
+    ("samples", 7),
+)
+
+
+def header() -> str:
+    line = "  ".join(f"{title:>{width}}" for title, width in COLUMNS)
+    return f"{line}\n{'-' * len(line)}"
+
+
+def row(summary: RunSummary) -> str:
+    if summary.target_force_n is not None:
+        target = f"{summary.target_force_n / 1000:.2f} kN"
+        reached = _kilo(summary.reached_force_n, "kN")
+    else:
+        target = f"{summary.target_torque_nm or 0:.1f} Nm"
+        reached = f"{summary.reached_torque_nm:.1f} Nm"
+    error = "-" if summary.error_pct is None else f"{summary.error_pct:+.2f}"
+    reason = summary.stop_reason or f"tool ({summary.tool_state})"
+    cells = (
+        str(summary.run_id),
+        str(summary.program_id),
+        target,
+        reached,
+        error,
+        str(summary.events),
+        reason,
+        f"{summary.process_intensity:.3g}",
+        str(summary.samples),
+    )
+    return "  ".join(f"{cell:>{width}}" for cell, (_, width) in zip(cells, COLUMNS, strict=True))
+
+
+def _kilo(value: float | None, unit: str) -> str:
+    return "-" if value is None else f"{value / 1000:.2f} {unit}"
+
+
+def totals(summaries: list[RunSummary]) -> str:
+    """One line: runs, mean and worst |error|."""
+    errors = [abs(s.error_pct) for s in summaries if s.error_pct is not None]
+    if not errors:
+        return f"{len(summaries)} runs"
+    return (
+        f"{len(summaries)} runs, |error| mean {sum(errors) / len(errors):.2f} %, "
+        f"worst {max(errors):.2f} %"
+    )

@@ -1,0 +1,119 @@
+"""Start, watch and stop the processes of one station (what ``boltwatch up`` runs).
+
+Each service runs as ``python -m services.cli serve <name> --config FILE`` in
+its own session (so a terminal Ctrl-C reaches only the supervisor, which then
+stops the services in order: the tool first, the recorder last, so that the
+recording holds everything). Each service logs to its own file.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+LOG = logging.getLogger(__name__)
+
+STOP_GRACE_S = 8.0
+
+
+@dataclass
+class ManagedProcess:
+    name: str
+    process: subprocess.Popen[bytes]
+    log_path: Path
+
+    @property
+    def pid(self) -> int:
+        return self.process.pid
+
+    def exit_code(self) -> int | None:
+        return self.process.poll()
+
+    def log_tail(self, lines: int = 12) -> str:
+        try:
+            text = self.log_path.read_text(errors="replace")
+        except OSError:
+            return "(no log)"
+        return "\n".join(text.splitlines()[-lines:])
+
+
+class StationSupervisor:
+    """The child processes of a station, in start order."""
+
+    def __init__(self, config_path: Path, log_dir: Path) -> None:
+        self.config_path = config_path
+        self.log_dir = log_dir
+        self.processes: list[ManagedProcess] = []
+        log_dir.mkdir(parents=True, exist_ok=True)
+
+    def start(
+        self, service: str, extra_args: Sequence[str] = (), name: str | None = None
+    ) -> ManagedProcess:
+        """Start ``boltwatch serve <service>``; its output goes to ``<log_dir>/<name>.log``."""
+        name = name or service
+        command = [sys.executable, "-m", "services.cli", "serve", service]
+        if service != "router":
+            command += ["--config", str(self.config_path)]
+        command += list(extra_args)
+        log_path = self.log_dir / f"{name}.log"
+        with log_path.open("wb") as log:
+            process = subprocess.Popen(
+                command,
+                stdin=subprocess.DEVNULL,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
+                env={**os.environ, "PYTHONUNBUFFERED": "1"},
+            )
+        managed = ManagedProcess(name, process, log_path)
+        self.processes.append(managed)
+        LOG.debug("started %s (pid %d)", name, process.pid)
+        return managed
+
+    def find(self, name: str) -> ManagedProcess:
+        for managed in self.processes:
+            if managed.name == name:
+                return managed
+        raise KeyError(name)
+
+    def unexpected_exits(self, expected: set[str]) -> list[ManagedProcess]:
+        """Processes that ended although they were not expected to."""
+        return [p for p in self.processes if p.name not in expected and p.exit_code() is not None]
+
+    def stop(self, managed: ManagedProcess, grace_s: float = STOP_GRACE_S) -> int | None:
+        """SIGTERM, wait up to ``grace_s``, then SIGKILL; returns the exit code."""
+        if managed.exit_code() is None:
+            managed.process.send_signal(signal.SIGTERM)
+            try:
+                managed.process.wait(grace_s)
+            except subprocess.TimeoutExpired:
+                LOG.warning("%s did not stop within %.0f s: killed", managed.name, grace_s)
+                managed.process.kill()
+                managed.process.wait()
+        return managed.exit_code()
+
+    def stop_all(self, order: Sequence[str] | None = None) -> None:
+        """Stop every process: those named in ``order`` first, in that order, then the rest
+        in reverse start order."""
+        remaining = list(reversed(self.processes))
+        for name in order or ():
+            for managed in [p for p in remaining if p.name == name]:
+                self.stop(managed)
+                remaining.remove(managed)
+        for managed in remaining:
+            self.stop(managed)
+
+    def wait_any_exit(self, timeout_s: float) -> None:
+        """Sleep up to ``timeout_s``, returning early if any process ends."""
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            if any(p.exit_code() is not None for p in self.processes):
+                return
+            time.sleep(0.02)

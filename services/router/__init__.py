@@ -1,0 +1,1 @@
+"""The line's zenoh router: the rendezvous that station services connect to."""

@@ -1,0 +1,11 @@
+"""Where tests find the repository's files and the team handbook's data."""
+
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+CONFIG = REPO / "config"
+STATION_FILE = CONFIG / "station.toml"
+DBC_FILE = CONFIG / "can" / "station.dbc"
+JOINT_5_2 = CONFIG / "joints" / "paper-section-5-2.toml"
+#: ../shared beside the checkout (CI puts it there); never copied into the project.
+HANDBOOK_DATA = REPO.parent / "shared" / "data"

@@ -1,0 +1,123 @@
+"""The acquisition loop on a real python-can virtual bus."""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterator
+
+import can
+import pytest
+
+from services.acquisition.acquisition import Acquisition
+from shared.can_database import StationDatabase
+from shared.messages import BusStats, Sample, StopDecision, StopReason, ToolState
+from tests.paths import DBC_FILE
+
+DATABASE = StationDatabase(DBC_FILE)
+_channels = itertools.count()
+FRAME_IDS = {name: frame_id for frame_id, (name, _) in DATABASE.by_id.items()}
+
+
+class ListOutlet:
+    """Collects what the acquisition publishes (implements the Outlet protocol)."""
+
+    def __init__(self) -> None:
+        self.samples: list[Sample] = []
+        self.states: list[ToolState] = []
+        self.stats: list[BusStats] = []
+
+    def sample(self, sample: Sample) -> None:
+        self.samples.append(sample)
+
+    def tool_state(self, state: ToolState) -> None:
+        self.states.append(state)
+
+    def bus_stats(self, stats: BusStats) -> None:
+        self.stats.append(stats)
+
+
+@pytest.fixture
+def buses() -> Iterator[tuple[can.BusABC, can.BusABC]]:
+    channel = f"acq-test-{next(_channels)}"
+    with (
+        can.Bus(interface="virtual", channel=channel) as tool,
+        can.Bus(interface="virtual", channel=channel) as station,
+    ):
+        yield tool, station
+
+
+def frame(name: str, **signals: float) -> can.Message:
+    return can.Message(
+        arbitration_id=FRAME_IDS[name],
+        data=DATABASE.encode(name, signals),
+        is_extended_id=False,
+    )
+
+
+def status(run_id: int, state: int) -> can.Message:
+    return frame("ToolStatus", RunId=run_id, ToolId=7, ProgramId=1, State=state)
+
+
+def drain(acquisition: Acquisition, bus: can.BusABC) -> None:
+    """Poll until the bus has nothing more for us."""
+    while True:
+        message = bus.recv(0.05)
+        if message is None:
+            return
+        acquisition.handle(message)
+
+
+def decision(run_id: int) -> StopDecision:
+    return StopDecision("st1", run_id, 0, 0.1, "plateau_closest", "", 100.0, 5e4, 5.1e4, 0)
+
+
+def test_a_run_is_published_in_order_with_faults_counted(buses) -> None:  # type: ignore[no-untyped-def]
+    tool, station = buses
+    outlet = ListOutlet()
+    acquisition = Acquisition("st1", True, station, DATABASE, outlet)
+    tool.send(status(42, 1))
+    for counter in (0, 1, 2, 5, 6):  # 3 and 4 never sent: a gap
+        tool.send(frame("ToolSensors", Torque=counter * 10.0, Angle=counter * 0.5, Counter=counter))
+        tool.send(frame("JointSensors", Force=counter * 1000.0, Counter=counter))
+    tool.send(can.Message(arbitration_id=0x555, data=b"\x01\x02", is_extended_id=False))
+    tool.send(
+        can.Message(arbitration_id=DATABASE.tool_sensors_id, data=b"\x00", is_extended_id=False)
+    )
+    tool.send(status(42, 2))
+    drain(acquisition, station)
+
+    assert [s.sequence for s in outlet.samples] == [0, 1, 2, 5, 6]
+    assert {s.run_id for s in outlet.samples} == {42}
+    assert [s.force_n for s in outlet.samples] == [0.0, 1000.0, 2000.0, 5000.0, 6000.0]
+    assert all(s.time_ns > 0 for s in outlet.samples)
+    assert [(s.run_id, s.state) for s in outlet.states] == [(42, "running"), (42, "done")]
+    stats = acquisition.stats()
+    assert (stats.samples, stats.counter_gaps, stats.missed_samples) == (5, 1, 2)
+    assert (stats.unknown_ids, stats.wrong_length) == (1, 1)
+
+
+def test_stop_command_only_for_the_running_run_and_only_once(buses) -> None:  # type: ignore[no-untyped-def]
+    tool, station = buses
+    acquisition = Acquisition("st1", True, station, DATABASE, ListOutlet())
+    assert not acquisition.send_stop(decision(7))  # no run yet
+    tool.send(status(7, 1))
+    drain(acquisition, station)
+    assert not acquisition.send_stop(decision(8))  # another run
+    assert acquisition.send_stop(decision(7))
+    assert not acquisition.send_stop(decision(7))  # once per run
+    received = tool.recv(1.0)
+    assert received is not None and received.arbitration_id == DATABASE.stop_command_id
+    signals = DATABASE.decode(received.arbitration_id, received.data)
+    assert signals == {"RunId": 7, "Reason": int(StopReason.PLATEAU_CLOSEST)}
+    assert tool.recv(0.05) is None
+    assert acquisition.stats().stop_commands == 1
+
+
+def test_torque_only_station_publishes_without_force(buses) -> None:  # type: ignore[no-untyped-def]
+    tool, station = buses
+    outlet = ListOutlet()
+    acquisition = Acquisition("st1", False, station, DATABASE, outlet)
+    tool.send(status(1, 1))
+    tool.send(frame("ToolSensors", Torque=1.5, Angle=3.0, Counter=0))
+    drain(acquisition, station)
+    assert [(s.sequence, s.force_n) for s in outlet.samples] == [(0, None)]
