@@ -1,0 +1,87 @@
+"""Isolated station files for system tests: own zenoh port, own CAN multicast port,
+own recordings folder, so tests never see each other's (or a running station's) traffic."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import signal
+import socket
+from pathlib import Path
+
+from tests.paths import CONFIG, STATION_FILE
+
+
+def free_tcp_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("", 0))
+        return int(probe.getsockname()[1])
+
+
+def write_station(
+    folder: Path,
+    *,
+    zenoh_port: int | None = None,
+    zenoh_mode: str = "client",
+    replacements: dict[str, str] | None = None,
+) -> Path:
+    """A copy of config/station.toml isolated for one test; returns its path.
+
+    ``zenoh_mode="peer"`` makes the services listen on nothing and connect to
+    ``zenoh_port`` (where the test runs its own router or peer session).
+    """
+    zenoh_port = zenoh_port or free_tcp_port()
+    text = STATION_FILE.read_text()
+    text = text.replace('"joints/', f'"{CONFIG}/joints/').replace('"can/', f'"{CONFIG}/can/')
+    text = re.sub(r"^port = \d+", f"port = {free_udp_port()}", text, flags=re.MULTILINE)
+    text = text.replace('mode = "client"', f'mode = "{zenoh_mode}"')
+    text = text.replace("tcp/127.0.0.1:7447", f"tcp/127.0.0.1:{zenoh_port}")
+    text = text.replace('folder = "../recordings"', f'folder = "{folder / "recordings"}"')
+    for old, new in (replacements or {}).items():
+        if old not in text:
+            raise AssertionError(f"station template has no {old!r}")
+        text = text.replace(old, new)
+    path = folder / "station.toml"
+    path.write_text(text)
+    return path
+
+
+def child_pids(pid: int) -> list[int]:
+    """Direct children of ``pid`` (Linux /proc)."""
+    try:
+        text = Path(f"/proc/{pid}/task/{pid}/children").read_text()
+    except OSError:
+        return []
+    return [int(p) for p in text.split()]
+
+
+def command_line(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
+    except OSError:
+        return ""
+
+
+def is_running(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    status = Path(f"/proc/{pid}/status")
+    try:
+        return "State:\tZ" not in status.read_text()
+    except OSError:
+        return False
+
+
+def kill_all(pids: list[int]) -> None:
+    for pid in pids:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
