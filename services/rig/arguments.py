@@ -1,0 +1,29 @@
+"""Options of ``boltwatch serve rig`` (light imports only: ``--help`` must be fast)."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--runs",
+        type=int,
+        default=None,
+        help="tighten N joints, then exit 0 (default: until SIGINT/SIGTERM)",
+    )
+    parser.add_argument(
+        "--program", type=int, default=None, help="program id (default: the first program)"
+    )
+    parser.add_argument(
+        "--first-run-id",
+        type=int,
+        default=None,
+        help="RunId of the first run, +1 per run (default: the current Unix time in seconds)",
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=None,
+        help="seed of the first run, +1 per run (default: [rig] seed, else a fresh one)",
+    )

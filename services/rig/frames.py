@@ -1,0 +1,64 @@
+"""The rig's CAN frames, encoded through the station's DBC (contract names only).
+
+The tool controller sends ToolSensors and ToolStatus, the force sensor node
+JointSensors; both listen for StopCommand. Ids, layout and scaling come from
+:class:`~shared.can_database.StationDatabase`, never from this file.
+"""
+
+from __future__ import annotations
+
+import can
+
+from shared.can_database import COUNTER_MODULO, StationDatabase
+from shared.messages import ToolRunState
+
+
+class RigFrames:
+    """Builds the rig's outgoing frames and reads incoming StopCommands."""
+
+    def __init__(self, database: StationDatabase) -> None:
+        self._database = database
+        self._extended = {
+            name: database.is_extended(name)
+            for name in ("ToolSensors", "JointSensors", "ToolStatus")
+        }
+
+    def _message(self, name: str, frame_id: int, signals: dict[str, float | int]) -> can.Message:
+        return can.Message(
+            arbitration_id=frame_id,
+            data=self._database.encode(name, signals),
+            is_extended_id=self._extended[name],
+        )
+
+    def tool_sensors(self, torque_nm: float, angle_deg: float, counter: int) -> can.Message:
+        return self._message(
+            "ToolSensors",
+            self._database.tool_sensors_id,
+            {"Torque": torque_nm, "Angle": angle_deg, "Counter": counter % COUNTER_MODULO},
+        )
+
+    def joint_sensors(self, force_n: float, counter: int) -> can.Message:
+        return self._message(
+            "JointSensors",
+            self._database.joint_sensors_id,
+            {"Force": force_n, "Counter": counter % COUNTER_MODULO},
+        )
+
+    def tool_status(
+        self, run_id: int, tool_id: int, program_id: int, state: ToolRunState
+    ) -> can.Message:
+        return self._message(
+            "ToolStatus",
+            self._database.tool_status_id,
+            {"RunId": run_id, "ToolId": tool_id, "ProgramId": program_id, "State": int(state)},
+        )
+
+    def stop_command_run_id(self, message: can.Message) -> int | None:
+        """The RunId of a StopCommand frame; None for any other (or malformed) frame."""
+        if message.arbitration_id != self._database.stop_command_id or message.is_error_frame:
+            return None
+        try:
+            signals = self._database.decode(message.arbitration_id, message.data)
+        except Exception:  # cantools raises several kinds on a short or garbled frame
+            return None
+        return int(signals["RunId"])

@@ -1,0 +1,66 @@
+"""``boltwatch serve rig``: the simulated tool controller and sensors on the station's CAN bus.
+
+Loads the station file once, opens the configured bus (closed on exit) and
+runs :class:`~services.rig.realtime.RealtimeRig` in a
+:class:`~shared.service_runtime.ServiceRunner` worker: ``--runs N`` exits 0
+after N runs, otherwise it runs until SIGINT/SIGTERM (the loop looks at the
+stop flag every sample period, so no wake is needed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import threading
+import time
+
+from services.rig.frames import RigFrames
+from services.rig.realtime import RealtimeRig, ToolIdentity
+from services.rig.selection import choose_program, choose_seed
+from shared.can_bus import open_bus
+from shared.can_database import StationDatabase
+from shared.config import load_station
+from shared.errors import ConfigError
+from shared.model.stiffness import JointConstants
+from shared.service_runtime import ServiceRunner
+
+LOG = logging.getLogger(__name__)
+
+RUN_ID_MAX = 0xFFFF_FFFF  # RunId is 32 bits on CAN
+
+
+def main(args: argparse.Namespace) -> int:
+    station = load_station(args.config)
+    config = station.config
+    program = choose_program(config, args.program)
+    if args.runs is not None and args.runs < 1:
+        raise ConfigError(f"--runs must be at least 1 (got {args.runs})")
+    seed = choose_seed(args.seed, config.rig.seed)
+    first_run_id = args.first_run_id if args.first_run_id is not None else int(time.time())
+    last_run_id = first_run_id + (args.runs or 1) - 1
+    if first_run_id < 0 or last_run_id > RUN_ID_MAX:
+        raise ConfigError(f"--first-run-id must keep run ids within 0..{RUN_ID_MAX}")
+    frames = RigFrames(StationDatabase(station.dbc_path))
+    constants = JointConstants.of(station.joint)
+    LOG.info(
+        "rig: station %s, program %d (%s), first run %d, seed %d, runs %s",
+        config.station.id,
+        program.id,
+        program.name,
+        first_run_id,
+        seed,
+        args.runs if args.runs is not None else "until stopped",
+    )
+    with open_bus(config.can) as bus:
+        rig = RealtimeRig(
+            bus,
+            frames,
+            constants,
+            config.rig,
+            ToolIdentity(config.station.tool_id, config.station.has_force_sensor),
+        )
+
+        def work(stop: threading.Event) -> None:
+            rig.run_many(program, first_run_id, seed, stop, runs=args.runs)
+
+        return ServiceRunner("rig", work).run()
