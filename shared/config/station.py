@@ -77,7 +77,9 @@ class Program(StrictModel):
 
 
 class PredictorSection(StrictModel):
-    window_samples: int = Field(default=12, ge=3, le=200, description="n of eqs. 43-45")
+    window_samples: int = Field(
+        default=5, ge=3, le=200, description="n of eqs. 43-45 (why 5: predictor core settings)"
+    )
     max_process_intensity: float | None = Field(
         default=None, gt=0, description="I_max of eq. 70; none: no intensity stop"
     )
@@ -106,6 +108,11 @@ class RecorderSection(StrictModel):
     flush_interval_s: float = Field(default=1.0, gt=0, le=60)
     max_file_bytes: int = Field(default=256 * 1024 * 1024, ge=1024 * 1024)
     max_file_duration_s: float = Field(default=600.0, gt=0)
+    wear_service_threshold: float | None = Field(
+        default=None,
+        gt=0,
+        description="intensity since last service (eq. 69) at which the recorder alerts",
+    )
 
 
 class StationConfig(StrictModel):

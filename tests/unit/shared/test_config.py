@@ -41,7 +41,7 @@ def test_shipped_files_load() -> None:
         ('interface = "udp_multicast"', 'interface = "canbus"', "can.interface: Input should be"),
         ("tool_id = 7", 'tool_id = "seven"', "station.tool_id:"),
         ('id = "st1"', 'id = "st 1/x"', "station.id: String should match pattern"),
-        ("[predictor]\nwindow_samples = 12", "[predictor]\nwindow_samples = 1", "window_samples"),
+        ("[predictor]\nwindow_samples = 5", "[predictor]\nwindow_samples = 1", "window_samples"),
     ],
 )
 def test_bad_value_names_file_and_key(tmp_path: Path, old: str, new: str, expected: str) -> None:

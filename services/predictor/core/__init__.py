@@ -1,0 +1,27 @@
+"""The pure predictor core: samples in, stick-slip events and stop decisions out.
+
+No zenoh, no clock: the same :class:`PredictorCore` serves the live service,
+``boltwatch predict`` and the tests. Files, one concept each:
+
+- :mod:`.settings`           what one run is predicted against (program, targets, limits)
+- :mod:`.input_guard`        bad input (NaN, repeated / out-of-order times, gaps) made safe
+- :mod:`.inclination_window` the window of n samples and its mean inclination, eqs. 43-51
+- :mod:`.extremum_tracker`   maxima and minima paired into slips, with a noise floor
+- :mod:`.event_figures`      ΔT, ΔF, Δt, f_ss, K1-K3, I_j, I_process (eqs. 31-33, 66-68)
+- :mod:`.regression`         least-squares fits and next-event predictions (eqs. 52-56, 6.4)
+- :mod:`.scoring`            errors of past predictions (eqs. 57-63)
+- :mod:`.stop_policy`        when to stop and why (eqs. 64, 65, 70, 71, hard limits)
+- :mod:`.predictor_core`     the facade that joins them
+"""
+
+from services.predictor.core.outputs import CoreDecision, CoreEvent
+from services.predictor.core.predictor_core import PredictorCore
+from services.predictor.core.settings import DEFAULT_WINDOW_SAMPLES, PredictorSettings
+
+__all__ = [
+    "DEFAULT_WINDOW_SAMPLES",
+    "CoreDecision",
+    "CoreEvent",
+    "PredictorCore",
+    "PredictorSettings",
+]

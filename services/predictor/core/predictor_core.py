@@ -1,0 +1,247 @@
+"""The predictor core: one object per run, fed sample by sample (paper Fig. 16).
+
+::
+
+    core = PredictorCore(settings)
+    for t, torque, force, angle in samples:          # force NaN when there is none
+        for output in core.update(t, torque, force, angle):
+            ...                                     # CoreEvent or CoreDecision
+
+Per sample the work is O(1): the input guard, the window's running
+inclination sum (eqs. 46, 47), a noise estimate, a running force sum and the
+per-sample stop rules. Per event (tens of ms apart): the extremes of the
+window (eqs. 48-51), the event's figures, the fits and predictions
+(eqs. 52-56), the scores of past predictions (eqs. 57-63) and the per-event
+stop rules (eqs. 64, 65, 70, 71).
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+
+from services.predictor.core.event_figures import compute_figures
+from services.predictor.core.extremum_tracker import ExtremumTracker, Slip
+from services.predictor.core.force_history import ForceHistory
+from services.predictor.core.inclination_window import NO_FLIP, InclinationWindow
+from services.predictor.core.input_guard import InputGuard, InputReport
+from services.predictor.core.outputs import CoreDecision, CoreEvent
+from services.predictor.core.regression import predict_events
+from services.predictor.core.scoring import PredictionScores
+from services.predictor.core.settings import PredictorSettings
+from services.predictor.core.stop_policy import StopPolicy
+from shared.messages import Prediction
+
+LOG = logging.getLogger(__name__)
+
+HISTORY = 10  # events kept for the fits (the fits use at most 8)
+FIRST_PLATEAU_SAMPLES = 20  # stick samples looked at for the first event's plateau
+
+STAIRCASE_EVENTS = 3  # rising peaks in a row before torque peaks may decide (eq. 64)
+MAX_STEP_FRACTION = 0.25  # a predicted step larger than this share of the value: no decision
+
+CoreOutput = CoreEvent | CoreDecision
+
+
+class PredictorCore:
+    """Samples in, stick-slip events and (at most one) stop decision out."""
+
+    def __init__(self, settings: PredictorSettings) -> None:
+        self.settings = settings
+        self._guard = InputGuard(settings.has_force)
+        self._window = InclinationWindow(settings.window_samples)
+        self._tracker = ExtremumTracker()
+        self._forces = ForceHistory()
+        self.policy = StopPolicy(settings)
+        self.scores = PredictionScores()
+        self._count = 0
+        self._start_time_s = math.nan
+        self._start_angle_deg = math.nan
+        self._previous_trough_index = -1
+        self._times: list[float] = []
+        self._periods: list[float] = []
+        self._peaks: list[float] = []
+        self._plateaus: list[float] = []
+        self._previous_angle_deg = math.nan
+        self.events = 0
+        self.process_intensity = 0.0
+
+    @property
+    def input_report(self) -> InputReport:
+        """What the input guard did with bad input so far."""
+        return self._guard.report
+
+    @property
+    def decision(self) -> CoreDecision | None:
+        """The run's latched stop decision, if any."""
+        return self.policy.decision
+
+    def update(
+        self, time_s: float, torque_nm: float, force_n: float, angle_deg: float
+    ) -> list[CoreOutput]:
+        """Feed one sample (force NaN when none); the events and decision it produced."""
+        force = self._guard.check(time_s, torque_nm, force_n)
+        if force is None:
+            if self._guard.bad_run >= self.settings.fault_samples:
+                fault = self.policy.on_input_fault(time_s, self._guard.bad_run)
+                if fault is not None:
+                    return [fault]
+            return []
+        index = self._count
+        self._count = index + 1
+        if index == 0:
+            self._start_time_s = time_s
+            self._start_angle_deg = angle_deg
+        self._forces.add(force)
+        self._tracker.observe_torque(torque_nm)
+        out: list[CoreOutput] = []
+        flip = self._window.push(
+            index, time_s, torque_nm, force, angle_deg, self._guard.nominal_dt_s
+        )
+        if flip != NO_FLIP:
+            slip = self._tracker.on_flip(flip, self._window)
+            if slip is not None:
+                out.extend(self._on_slip(slip, time_s, torque_nm))
+        decision = self.policy.on_sample(
+            time_s, torque_nm, force, angle_deg - self._start_angle_deg
+        )
+        if decision is not None:
+            out.append(decision)
+        return out
+
+    def _on_slip(self, slip: Slip, now_s: float, torque_nm: float) -> list[CoreOutput]:
+        settings = self.settings
+        peak, trough = slip.peak, slip.trough
+        self.events += 1
+        j = self.events
+        previous_time = self._times[-1] if self._times else None
+        previous_plateau = self._plateaus[-1] if self._plateaus else None
+        plateau: float | None = None
+        force_now: float | None = None
+        if settings.has_force:
+            trough_before = self._previous_trough_index
+            if trough_before < 0:
+                trough_before = max(-1, peak.index - FIRST_PLATEAU_SAMPLES)
+            value = self._forces.plateau_before(trough_before, peak.index)
+            plateau = value if math.isfinite(value) else None
+            value = self._forces.plateau_after(trough.index)
+            force_now = value if math.isfinite(value) else None
+        speed = settings.motor_speed_rad_s
+        if speed is None and previous_time is not None and peak.time_s > previous_time:
+            speed = math.radians(peak.angle_deg - self._previous_angle_deg) / (
+                peak.time_s - previous_time
+            )
+        figures = compute_figures(
+            time_since_start_s=peak.time_s - self._start_time_s,
+            peak_torque_nm=peak.torque_nm,
+            min_torque_nm=trough.torque_nm,
+            plateau_force_n=plateau,
+            previous_time_s=previous_time,
+            previous_plateau_n=previous_plateau,
+            time_s=peak.time_s,
+            motor_speed_rad_s=speed,
+        )
+        if figures.intensity is not None:
+            self.process_intensity += figures.intensity  # eq. 68, from j = 2
+        self.scores.score(
+            j,
+            peak.time_s,
+            figures.period_s,
+            peak.torque_nm,
+            plateau,
+            self._peaks[-1] if self._peaks else None,
+            figures.force_step_n,
+        )
+        self._remember(peak.time_s, figures.period_s, peak.torque_nm, plateau)
+        self._previous_trough_index = trough.index
+        self._previous_angle_deg = peak.angle_deg
+        predictions = predict_events(
+            peak.time_s, self._periods, self._peaks, self._plateaus, settings.plateau_method
+        )
+        self.scores.remember(j, predictions)
+        event = CoreEvent(
+            index=j,
+            time_s=peak.time_s,
+            peak_torque_nm=peak.torque_nm,
+            min_torque_nm=trough.torque_nm,
+            torque_drop_nm=figures.torque_drop_nm,
+            plateau_force_n=plateau,
+            force_step_n=figures.force_step_n,
+            period_s=figures.period_s,
+            f_ss_hz=figures.f_ss_hz,
+            k1=figures.k1,
+            k2=figures.k2,
+            k3=figures.k3,
+            intensity=figures.intensity,
+            process_intensity=self.process_intensity,
+            current_force_n=force_now,
+            detected_at_s=now_s,
+            predictions=predictions,
+        )
+        out: list[CoreOutput] = [event]
+        decision = self._decide_on_event(
+            now_s, torque_nm, plateau, force_now, predictions, (figures.k1, figures.k2, figures.k3)
+        )
+        if decision is not None:
+            out.append(decision)
+        return out
+
+    def _decide_on_event(
+        self,
+        now_s: float,
+        torque_nm: float,
+        plateau: float | None,
+        force_now: float | None,
+        predictions: list[Prediction],
+        constants: tuple[float | None, float | None, float | None],
+    ) -> CoreDecision | None:
+        """The per-event stop rules, fed with plausible predictions only."""
+        force_next = None
+        if force_now is not None:
+            step = None
+            if len(predictions) >= 2:
+                p1, p2 = predictions[0].plateau_force_n, predictions[1].plateau_force_n
+                if p1 is not None and p2 is not None and p2 > p1:
+                    step = p2 - p1
+            if step is None and plateau is not None and force_now > plateau:
+                step = force_now - plateau  # the step just taken
+            if step is not None and step <= MAX_STEP_FRACTION * abs(force_now):
+                force_next = force_now + step
+        peak_now = peak_next = None
+        if len(predictions) >= 2 and self._is_staircase():
+            now, after = predictions[0].peak_torque_nm, predictions[1].peak_torque_nm
+            if 0.0 < after - now <= MAX_STEP_FRACTION * abs(now):
+                peak_now, peak_next = now, after
+        return self.policy.on_event(
+            now_s,
+            torque_nm,
+            force_now,
+            force_next,
+            peak_now,
+            peak_next,
+            self.process_intensity,
+            constants,
+        )
+
+    def _is_staircase(self) -> bool:
+        """Regular stick-slip: the youngest STAIRCASE_EVENTS peaks rise one after the other.
+
+        Wiggles of a joint without stick-slip (thread forming, noise) also make
+        events now and then; their predicted peaks are no ground to stop on.
+        """
+        peaks = self._peaks[-STAIRCASE_EVENTS:]
+        return len(peaks) == STAIRCASE_EVENTS and all(b > a for a, b in itertools.pairwise(peaks))
+
+    def _remember(
+        self, time_s: float, period_s: float | None, peak_nm: float, plateau_n: float | None
+    ) -> None:
+        self._times.append(time_s)
+        if period_s is not None:
+            self._periods.append(period_s)
+        self._peaks.append(peak_nm)
+        if plateau_n is not None:
+            self._plateaus.append(plateau_n)
+        for history in (self._times, self._periods, self._peaks, self._plateaus):
+            if len(history) > HISTORY:
+                del history[0]

@@ -1,0 +1,83 @@
+"""What one run is predicted against: targets, limits, window and thresholds.
+
+Built from the station's :class:`~shared.config.Program` and
+:class:`~shared.config.PredictorSection` with :meth:`PredictorSettings.of`, or
+directly (``boltwatch predict``, tests, benchmarks).
+
+Why the default window is 5 samples (n of eqs. 43-45)
+-------------------------------------------------------
+With even sampling the sum of slopes of eq. 46 telescopes:
+S = Σ ΔT_i/Δt = (T_newest - T_oldest)/Δt, so the inclination sign compares the
+newest sample with the one n-1 samples back. A maximum is seen only if that
+span is shorter than one stick phase: at the fastest stick-slip we must
+handle, 200 Hz at 1 kHz sampling, a period is 5 samples, so n - 1 ≤ 4, n ≤ 5.
+Any longer window sees the next tooth before the last one has left it and the
+sign stays positive (the upward trend wins): with the paper's n = 10-20 the
+detector is blind above 50-100 Hz. At the slow end (10 Hz, 100 samples per
+tooth) a short window is noisy, so a flip alone is not an event: the slip
+must also drop the torque by more than the noise floor (see
+:mod:`.extremum_tracker`). n = 5 therefore covers 10-200 Hz; a station whose
+stick-slip is known to be slow may raise it (``predictor.window_samples``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+from shared.config import PredictorSection, Program
+from shared.model import JointConstants
+
+DEFAULT_WINDOW_SAMPLES = 5
+
+PlateauMethod = Literal["poly2", "linear", "mean_step"]
+
+
+@dataclass(frozen=True, slots=True)
+class PredictorSettings:
+    """Everything the core needs for one run; None disables the check that uses it."""
+
+    target_force_n: float | None = None
+    target_torque_nm: float | None = None
+    has_force: bool = True
+    window_samples: int = DEFAULT_WINDOW_SAMPLES
+    max_process_intensity: float | None = None  # I_max, eq. 70
+    constant_band: float | None = None  # S_i of eq. 71, fraction of the running mean
+    constant_window: int = 5  # n_K of eq. 71
+    max_torque_nm: float | None = None
+    max_force_n: float | None = None
+    max_angle_deg: float | None = None  # of the angle turned since the run's first sample
+    motor_speed_rad_s: float | None = None  # φ̇_m of eqs. 32-33; None: measured from the angle
+    plateau_method: PlateauMethod = "poly2"
+    fault_samples: int = 100  # consecutive unusable samples before input_fault
+    limit_samples: int = 2  # consecutive samples beyond a hard limit before stopping
+    constants: JointConstants | None = None  # the expected joint, when one is configured
+
+    @property
+    def force_mode(self) -> bool:
+        """True: decide on force plateaus (eq. 65); False: on peak torques (eq. 64)."""
+        return self.has_force and self.target_force_n is not None
+
+    @classmethod
+    def of(
+        cls,
+        program: Program,
+        section: PredictorSection,
+        has_force: bool,
+        constants: JointConstants | None = None,
+    ) -> PredictorSettings:
+        """Settings for a run of ``program`` on a station with (or without) a force sensor."""
+        return cls(
+            target_force_n=program.target_force_n,
+            target_torque_nm=program.target_torque_nm,
+            has_force=has_force,
+            window_samples=section.window_samples,
+            max_process_intensity=section.max_process_intensity,
+            constant_band=section.constant_band,
+            constant_window=section.constant_window,
+            max_torque_nm=program.max_torque_nm,
+            max_force_n=program.max_force_n if has_force else None,
+            max_angle_deg=program.max_angle_deg,
+            motor_speed_rad_s=program.motor_speed_rad_s,
+            constants=constants,
+        )

@@ -1,0 +1,54 @@
+"""Run the predictor core over a whole offline trace (``boltwatch predict``, benchmarks).
+
+The same :class:`~services.predictor.core.PredictorCore` as the live service,
+sample by sample; the outputs become JSON-ready dicts (the
+``boltwatch predict`` contract in DESIGN.md).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterator
+from typing import Any
+
+from services.predictor.core import CoreDecision, CoreEvent, PredictorCore
+from shared.trace import Trace
+
+
+def replay(core: PredictorCore, trace: Trace) -> Iterator[CoreEvent | CoreDecision]:
+    """Feed every sample of ``trace`` to ``core``; yield the outputs in order."""
+    columns = zip(
+        trace.time_s.tolist(),
+        trace.torque_nm.tolist(),
+        trace.force_n.tolist(),
+        trace.angle_deg.tolist(),
+        strict=True,
+    )
+    update = core.update
+    for time_s, torque_nm, force_n, angle_deg in columns:
+        outputs = update(time_s, torque_nm, force_n, angle_deg)
+        if outputs:
+            yield from outputs
+
+
+def output_record(output: CoreEvent | CoreDecision) -> dict[str, Any]:
+    """The JSON Lines object of one output: ``{"type": "event"|"stop", "time_s": ..., ...}``."""
+    fields = dataclasses.asdict(output)
+    if isinstance(output, CoreEvent):
+        record: dict[str, Any] = {"type": "event"}
+    else:
+        record = {"type": "stop"}
+    record.update(fields)
+    return _finite(record)
+
+
+def _finite(value: Any) -> Any:
+    """NaN and infinities become null: JSON has no such numbers."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {key: _finite(item) for key, item in value.items()}
+    if isinstance(value, list):
+        return [_finite(item) for item in value]
+    return value

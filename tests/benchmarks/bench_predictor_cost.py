@@ -1,0 +1,67 @@
+"""CPU time per sample of the predictor core (not a test).
+
+Run: ``.venv/bin/python tests/benchmarks/bench_predictor_cost.py [--runs N]``
+
+Records long rig runs first (so the physics is not timed), then feeds each
+to a fresh core and reports the median over runs of CPU time per sample.
+Goal: < 5 µs per sample (the 1 kHz budget is 1000 µs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import time
+
+from services.predictor.core import PredictorCore, PredictorSettings
+from services.rig.physics import TighteningPhysics
+from shared.config import Program, RigSection
+from shared.model import JointConstants
+
+
+def record(seed: int, samples: int) -> list[tuple[float, float, float, float]]:
+    program = Program(
+        id=1,
+        name="cost",
+        target_force_n=1e9,
+        motor_speed_rad_s=0.3,
+        start_force_n=10_000.0,
+        max_torque_nm=1e6,
+        max_angle_deg=1e6,
+        max_time_s=1e3,
+    )
+    constants = JointConstants(600.0, 20_000.0, 0.011, 0.36, 0.34)
+    sim = TighteningPhysics(constants, program, RigSection(), seed=seed)
+    rows = []
+    for _ in range(samples):
+        m = sim.advance()
+        rows.append((m.time_s, m.torque_nm, m.force_n, m.angle_deg))
+    return rows
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--samples", type=int, default=20_000)
+    args = parser.parse_args()
+    per_sample_us = []
+    events = 0
+    for seed in range(args.runs):
+        rows = record(seed, args.samples)
+        core = PredictorCore(PredictorSettings(target_force_n=math.inf))
+        update = core.update
+        started = time.process_time()
+        for row in rows:
+            update(*row)
+        per_sample_us.append((time.process_time() - started) / len(rows) * 1e6)
+        events += core.events
+    print(
+        f"{args.runs} runs x {args.samples} samples, {events} events: CPU per sample "
+        f"median {statistics.median(per_sample_us):.2f} µs "
+        f"(min {min(per_sample_us):.2f}, max {max(per_sample_us):.2f})"
+    )
+
+
+if __name__ == "__main__":
+    main()
