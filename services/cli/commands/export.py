@@ -1,0 +1,45 @@
+"""``boltwatch export RUN.mcap [--out TRACE.csv] [--run ID]``: a recording's samples as CSV."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+NAME = "export"
+HELP = "write the samples of a recorded run as a trace CSV (what 'boltwatch predict' reads)"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.description = (
+        "Write the samples of one run of an MCAP recording as the trace CSV "
+        "time_s,torque_nm,angle_deg,force_n (time_s from the run's first sample). "
+        "A damaged recording (recorder killed) exports what is readable, with a warning."
+    )
+    parser.add_argument("recording", type=Path, metavar="RUN.mcap", help="the recording")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        metavar="TRACE.csv",
+        help="where to write the trace (default: RUN.csv beside the recording)",
+    )
+    parser.add_argument(
+        "--run",
+        type=int,
+        default=None,
+        metavar="ID",
+        help="run id to export (default: the run with the most samples in the file)",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from services.recorder.trace_export import export_trace
+
+    report = export_trace(args.recording, args.out, args.run)
+    if not report.complete:
+        print(
+            f"boltwatch export: warning: {report.state}; exported what is readable", file=sys.stderr
+        )
+    print(f"wrote {report.rows} samples of run {report.run_id} to {report.target}")
+    return 0

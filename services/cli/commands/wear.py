@@ -1,0 +1,69 @@
+"""``boltwatch wear``: the wear ledger (how much vibration each tool has taken).
+
+::
+
+    boltwatch wear [--recordings DIR]                     the table, one line per tool
+    boltwatch wear service TOOL --note TEXT               record a service of TOOL
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+NAME = "wear"
+HELP = "show the wear ledger per tool, or record a tool's service"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.description = (
+        "Show the accumulated stick-slip intensity per tool (I_total = Σ I_process, eq. 69), "
+        "its runs, intensity per run, worst runs and the intensity since the last service. "
+        "'boltwatch wear service TOOL --note TEXT' records a service: the interval count "
+        "restarts, the history stays."
+    )
+    parser.add_argument("action", nargs="?", choices=["service"], help="record a service")
+    parser.add_argument("tool", nargs="?", type=int, help="tool id (with 'service')")
+    parser.add_argument("--note", default="", help="what was done (with 'service')")
+    parser.add_argument(
+        "--recordings",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="recordings folder holding wear.sqlite (default: the station file's recorder.folder)",
+    )
+    parser.add_argument(
+        "--config",
+        type=Path,
+        default=Path("config/station.toml"),
+        help="station file, for its recorder.folder (default: config/station.toml)",
+    )
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+
+
+def run(args: argparse.Namespace) -> int:
+    import json
+    import time
+
+    from services.recorder.wear_ledger import WearLedger, ledger_path
+    from services.recorder.wear_table import format_table
+    from shared.config import load_station
+    from shared.errors import InputError
+
+    recordings = args.recordings or load_station(args.config).recordings_folder
+    path = ledger_path(recordings)
+    if args.action == "service":
+        if args.tool is None:
+            raise InputError("give the tool id: boltwatch wear service TOOL --note TEXT")
+        with WearLedger(path) as ledger:
+            ledger.record_service(args.tool, args.note, time.time_ns())
+            tools = [ledger.tool(args.tool)]
+        print(f"recorded a service of tool {args.tool} in {path}")
+    else:
+        with WearLedger(path, read_only=True) as ledger:
+            tools = ledger.tools()
+    if args.json:
+        print(json.dumps([tool.to_dict() for tool in tools], indent=2))
+    else:
+        print(format_table(tools))
+    return 0

@@ -1,0 +1,164 @@
+"""One MCAP file being written: schema'd JSON channels, zstd chunks, flush on demand.
+
+Every boltwatch topic becomes a channel whose topic is the zenoh key, with
+message encoding ``json`` and a ``jsonschema`` schema named after the
+registry name (``boltwatch.Sample`` ...), so Foxglove and the mcap CLI decode
+it with no code of ours. Payloads that are not boltwatch messages (unknown
+keys) or do not decode are kept byte for byte on a raw channel of the same
+topic (schema-less, message encoding :data:`RAW_ENCODING`).
+
+``log_time`` is the receive time in the recorder, ``publish_time`` the
+message's own time, ``sequence`` the Sample's sequence (else a per-channel
+counter). :meth:`McapSink.flush` closes the chunk in progress and hands it to
+the operating system, so a killed recorder loses only what came after.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from collections.abc import Mapping
+from pathlib import Path
+from typing import BinaryIO
+
+from mcap.well_known import MessageEncoding, SchemaEncoding
+from mcap.writer import CompressionType, Writer
+
+from services.recorder.incoming import RECORDED_TYPES, Received
+from shared.codec import json_schema
+
+LOG = logging.getLogger(__name__)
+
+RAW_ENCODING = "application/octet-stream"
+#: Channel metadata key saying why a raw channel exists.
+RAW_REASON = "boltwatch.raw"
+
+_CHUNK_BYTES = 1024 * 1024  # upper bound; flushes close chunks far earlier
+
+
+class McapSink:
+    """Write :class:`Received` payloads to one new MCAP file (never overwrites)."""
+
+    def __init__(
+        self,
+        path: Path,
+        metadata: Mapping[str, Mapping[str, str]],
+        run_id: int | None,
+        opened_ns: int,
+        library: str = "boltwatch",
+    ) -> None:
+        self.path = path
+        self.run_id = run_id
+        self.opened_ns = opened_ns
+        self.messages = 0
+        self.run_ids: set[int] = set()
+        self.last_write_ns = opened_ns
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self._file: BinaryIO = path.open("xb")
+        self._writer = Writer(self._file, chunk_size=_CHUNK_BYTES, compression=CompressionType.ZSTD)
+        self._writer.start(profile="", library=library)
+        for name, data in metadata.items():
+            self._writer.add_metadata(name, dict(data))
+        self._schemas: dict[str, int] = {}
+        self._channels: dict[tuple[str, str], int] = {}
+        self._counters: dict[int, int] = {}
+        self._unflushed_bytes = 0
+        self._closed = False
+
+    @property
+    def dirty(self) -> bool:
+        """True when messages were written since the last flush."""
+        return self._unflushed_bytes > 0
+
+    @property
+    def size_bytes(self) -> int:
+        """Bytes on disk plus (uncompressed) bytes waiting in the open chunk."""
+        return self._file.tell() + self._unflushed_bytes
+
+    def write(self, received: Received) -> None:
+        """Append one payload on its channel."""
+        channel_id = self._channel_for(received)
+        sequence = received.sequence
+        if sequence is None:
+            sequence = self._counters.get(channel_id, 0)
+            self._counters[channel_id] = sequence + 1
+        self._writer.add_message(
+            channel_id=channel_id,
+            log_time=received.log_time_ns,
+            data=received.payload,
+            publish_time=received.publish_time_ns,
+            sequence=sequence & 0xFFFFFFFF,  # MCAP sequence is uint32
+        )
+        self.messages += 1
+        self._unflushed_bytes += len(received.payload) + 31  # + message record header
+        self.last_write_ns = received.log_time_ns
+        run_id = received.run_id
+        if run_id is not None:
+            self.run_ids.add(run_id)
+
+    def flush(self) -> None:
+        """Close the chunk in progress and write it through to the OS (no fsync)."""
+        if self._closed or not self.dirty:
+            return
+        self._writer.flush()
+        self._unflushed_bytes = 0
+
+    def close(self) -> None:
+        """Finish the file (summary, index, footer); safe to call twice."""
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            self._writer.finish()
+        finally:
+            self._file.close()
+        LOG.info(
+            "closed %s: %d messages, runs %s",
+            self.path,
+            self.messages,
+            ",".join(str(run_id) for run_id in sorted(self.run_ids)) or "-",
+        )
+
+    def _channel_for(self, received: Received) -> int:
+        schema_name = received.schema_name if received.message is not None else None
+        if schema_name is None:
+            reason = "undecodable" if received.schema_name else "unknown key"
+            return self._raw_channel(received.key, reason)
+        channel_id = self._channels.get((received.key, schema_name))
+        if channel_id is None:
+            schema_id = self._schema_id(schema_name)
+            channel_id = self._writer.register_channel(
+                topic=received.key, message_encoding=MessageEncoding.JSON, schema_id=schema_id
+            )
+            self._channels[(received.key, schema_name)] = channel_id
+        return channel_id
+
+    def _raw_channel(self, key: str, reason: str) -> int:
+        channel_id = self._channels.get((key, reason))
+        if channel_id is None:
+            channel_id = self._writer.register_channel(
+                topic=key,
+                message_encoding=RAW_ENCODING,
+                schema_id=0,
+                metadata={RAW_REASON: reason},
+            )
+            self._channels[(key, reason)] = channel_id
+        return channel_id
+
+    def _schema_id(self, schema_name: str) -> int:
+        schema_id = self._schemas.get(schema_name)
+        if schema_id is None:
+            schema = json_schema(RECORDED_TYPES[schema_name])
+            schema_id = self._writer.register_schema(
+                name=schema_name,
+                encoding=SchemaEncoding.JSONSchema,
+                data=json.dumps(schema).encode(),
+            )
+            self._schemas[schema_name] = schema_id
+        return schema_id
+
+    def __enter__(self) -> McapSink:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.close()

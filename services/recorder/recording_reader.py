@@ -1,0 +1,113 @@
+"""Read every complete record of an MCAP file, damaged or not, in file order.
+
+A recorder that was killed leaves a file without its summary and footer, and
+possibly with a half-written chunk at the end. mcap's indexed reader needs
+the footer; its :class:`~mcap.stream_reader.StreamReader` reads record by
+record from the start, which is what this module does: it yields every record
+up to the first one that is incomplete or fails its CRC, then stops and says
+where and why (:attr:`RecordingScan.damage`). Intact files read the same way,
+so one code path serves ``recover``, ``export`` and ``inspect``.
+"""
+
+from __future__ import annotations
+
+import logging
+import struct
+from collections.abc import Iterator
+from pathlib import Path
+
+import zstandard
+from mcap.exceptions import EndOfFile, InvalidMagic, McapError
+from mcap.records import Channel, Message, Schema
+from mcap.stream_reader import StreamReader
+
+from shared.errors import InputError
+
+LOG = logging.getLogger(__name__)
+
+#: What a damaged tail can raise while a record is parsed or a chunk decompressed.
+_DAMAGE = (McapError, ValueError, struct.error, zstandard.ZstdError, EOFError)
+
+McapRecord = object
+
+
+class RecordingScan:
+    """One pass over the records of ``path``; afterwards, whether it was whole.
+
+    ``complete`` is True when the footer was reached; otherwise ``damage``
+    says what stopped the reading and ``good_bytes`` how far the complete
+    records reach.
+    """
+
+    def __init__(self, path: Path) -> None:
+        self.path = Path(path)
+        self.complete = False
+        self.damage: str | None = None
+        self.good_bytes = 0
+        self.file_bytes = 0
+        self.schemas: dict[int, Schema] = {}
+        self.channels: dict[int, Channel] = {}
+
+    def records(self) -> Iterator[McapRecord]:
+        """Every complete record (chunks opened up), in file order; stops at damage."""
+        try:
+            handle = self.path.open("rb")
+        except FileNotFoundError as err:
+            raise InputError(f"{self.path}: file not found") from err
+        except OSError as err:
+            raise InputError(f"{self.path}: cannot be read: {err.strerror}") from err
+        with handle:
+            self.file_bytes = self.path.stat().st_size
+            reader = StreamReader(handle, validate_crcs=True, record_size_limit=self.file_bytes)
+            iterator = iter(reader.records)
+            while True:
+                try:
+                    record = next(iterator)
+                except StopIteration:
+                    self.complete = True
+                    self.good_bytes = self.file_bytes
+                    return
+                except (InvalidMagic, *_DAMAGE) as err:
+                    if self.good_bytes == 0:  # not even magic and header
+                        raise self._not_mcap() from err
+                    if isinstance(err, EndOfFile):
+                        self.damage = f"the file ends inside a record after byte {self.good_bytes}"
+                    else:
+                        self.damage = f"damaged record after byte {self.good_bytes}: {err!r}"
+                    return
+                self.good_bytes = handle.tell()
+                if isinstance(record, Schema):
+                    self.schemas[record.id] = record
+                elif isinstance(record, Channel):
+                    self.channels[record.id] = record
+                yield record
+
+    def _not_mcap(self) -> InputError:
+        if self.file_bytes == 0:
+            return InputError(f"{self.path}: no MCAP data (empty file)")
+        return InputError(f"{self.path}: not an MCAP file")
+
+    def messages(
+        self, topic_suffix: str | None = None
+    ) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        """(schema, channel, message) of every complete message, optionally of topics
+        ending in ``topic_suffix``; a message on an unknown channel ends the scan as damage."""
+        for record in self.records():
+            if not isinstance(record, Message):
+                continue
+            channel = self.channels.get(record.channel_id)
+            if channel is None:
+                self.damage = f"message on channel {record.channel_id}, which was never defined"
+                return
+            if topic_suffix is not None and not channel.topic.endswith(topic_suffix):
+                continue
+            yield self.schemas.get(channel.schema_id), channel, record
+
+    def describe(self) -> str:
+        """One line on the file's state, e.g. for a warning."""
+        if self.complete:
+            return f"{self.path}: complete"
+        return (
+            f"{self.path}: incomplete, read {self.good_bytes} of {self.file_bytes} bytes "
+            f"({self.damage})"
+        )

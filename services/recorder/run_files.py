@@ -1,0 +1,170 @@
+"""The MCAP files of one station: one file per run, found by station, date and run.
+
+Layout (UTC)::
+
+    <recordings>/<station>/<YYYY-MM-DD>/<station>_run<run_id>_<HHMMSS>.mcap
+    <recordings>/<station>/<YYYY-MM-DD>/<station>_idle_<HHMMSS>.mcap      before the first run
+
+A run file is opened by the run's ``ToolState(state="running")`` and holds
+everything the station publishes until the next run starts, so the run's
+summary, its last bus statistics and the idle time after it stay with it.
+A file that reaches ``max_file_bytes`` or ``max_file_duration_s`` (a run that
+never ends) continues in ``..._part<N>.mcap``. After a rotation the previous
+run's file stays open for ``late_grace_s`` so late messages carrying its
+run id (a RunSummary racing the next run's start) still land in it.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+
+from services.recorder.file_metadata import FileMetadata
+from services.recorder.incoming import Received
+from services.recorder.mcap_sink import McapSink
+
+LOG = logging.getLogger(__name__)
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9_-]")
+_ENDED_STATES = ("done", "aborted")
+
+
+@dataclass(frozen=True, slots=True)
+class FileLimits:
+    """When files are flushed and rotated (integer nanoseconds)."""
+
+    flush_interval_ns: int
+    max_file_bytes: int
+    max_file_duration_ns: int
+    late_grace_ns: int = 2_000_000_000
+
+
+def file_path(
+    folder: Path, station: str, run_id: int | None, opened_ns: int, part: int = 1
+) -> Path:
+    """Where a file opened at ``opened_ns`` goes; never an existing file."""
+    opened = datetime.fromtimestamp(opened_ns / 1e9, UTC)
+    safe_station = _UNSAFE.sub("_", station) or "_"
+    label = "idle" if run_id is None else f"run{run_id}"
+    stem = f"{safe_station}_{label}_{opened:%H%M%S}"
+    if part > 1:
+        stem += f"_part{part}"
+    day = folder / safe_station / f"{opened:%Y-%m-%d}"
+    path = day / f"{stem}.mcap"
+    copy = 2
+    while path.exists():
+        path = day / f"{stem}_{copy}.mcap"
+        copy += 1
+    return path
+
+
+class StationFiles:
+    """Route one station's payloads into its run files; flush and rotate them."""
+
+    def __init__(
+        self, station: str, folder: Path, limits: FileLimits, metadata: FileMetadata
+    ) -> None:
+        self.station = station
+        self._folder = folder
+        self._limits = limits
+        self._metadata = metadata
+        self.current: McapSink | None = None
+        self.previous: McapSink | None = None
+        self._previous_until_ns = 0
+        self._part = 1
+        self._run_ended = False
+        self._tool_id: int | None = None
+        self._program_id: int | None = None
+        self._last_flush_ns = 0
+        self.closed_paths: list[Path] = []
+
+    def write(self, received: Received) -> None:
+        now_ns = received.log_time_ns
+        if received.run_started and self._is_new_run(received.run_id):
+            self._tool_id = received.message.tool_id
+            self._program_id = received.message.program_id
+            self._start_run(received.run_id, now_ns)
+        elif self.current is None:
+            self._open(received.run_id, now_ns, part=1)
+        elif self._over_limits(now_ns):
+            self._continue(now_ns)
+        assert self.current is not None
+        sink = self.current
+        run_id = received.run_id
+        previous = self.previous
+        if previous is not None and run_id is not None and run_id == previous.run_id != sink.run_id:
+            sink = previous
+        sink.write(received)
+        if sink is self.current and received.schema_name == "boltwatch.ToolState":
+            self._run_ended = received.message.state in _ENDED_STATES
+        if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
+            self.flush(now_ns)
+
+    def tick(self, now_ns: int) -> None:
+        """Flush when the flush interval has passed; close the previous file after its grace."""
+        if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
+            self.flush(now_ns)
+        if self.previous is not None and now_ns >= self._previous_until_ns:
+            self._close(self.previous)
+            self.previous = None
+
+    def flush(self, now_ns: int) -> None:
+        for sink in (self.current, self.previous):
+            if sink is not None:
+                sink.flush()
+        self._last_flush_ns = now_ns
+
+    def close(self) -> None:
+        """Finish every open file of the station."""
+        for sink in (self.previous, self.current):
+            if sink is not None:
+                self._close(sink)
+        self.previous = self.current = None
+
+    def _is_new_run(self, run_id: int | None) -> bool:
+        current = self.current
+        return current is None or current.run_id != run_id or self._run_ended
+
+    def _start_run(self, run_id: int | None, now_ns: int) -> None:
+        if self.previous is not None:
+            self._close(self.previous)
+        self.previous = self.current
+        self._previous_until_ns = now_ns + self._limits.late_grace_ns
+        self._open(run_id, now_ns, part=1)
+
+    def _continue(self, now_ns: int) -> None:
+        """The current file is full: go on with the same run in a new part."""
+        assert self.current is not None
+        run_id = self.current.run_id
+        LOG.info("%s reached its size or duration limit, continuing", self.current.path)
+        self._close(self.current)
+        self._open(run_id, now_ns, part=self._part + 1)
+
+    def _over_limits(self, now_ns: int) -> bool:
+        current = self.current
+        assert current is not None
+        return (
+            current.size_bytes >= self._limits.max_file_bytes
+            or now_ns - current.opened_ns >= self._limits.max_file_duration_ns
+        )
+
+    def _open(self, run_id: int | None, now_ns: int, part: int) -> None:
+        self._part = part
+        self._run_ended = False
+        path = file_path(self._folder, self.station, run_id, now_ns, part)
+        tool_id = self._tool_id if run_id is not None else None
+        program_id = self._program_id if run_id is not None else None
+        metadata = self._metadata.for_file(self.station, run_id, tool_id, program_id)
+        self.current = McapSink(
+            path, metadata, run_id, now_ns, library=f"boltwatch {self._metadata.version}"
+        )
+        LOG.debug("opened %s", path)
+
+    def _close(self, sink: McapSink) -> None:
+        try:
+            sink.close()
+        finally:
+            self.closed_paths.append(sink.path)

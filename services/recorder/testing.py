@@ -1,0 +1,126 @@
+"""Test helpers that ship with the recorder: station files on loopback, free ports.
+
+Used by the recorder's unit and system tests; nothing in the service imports it.
+"""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+import tomllib
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import zenoh
+
+from services.recorder.service import RecorderService
+from shared.config import LoadedStation
+from shared.zenoh_session import open_session
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+REPO_STATION_FILE = REPO_ROOT / "config" / "station.toml"
+
+
+WAIT_S = 10.0  # upper bound on waits for zenoh; tests never assert on time
+
+
+def wait_until(condition: Callable[[], bool], what: str, timeout_s: float = WAIT_S) -> None:
+    """Poll ``condition`` until true; AssertionError naming ``what`` after ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"gave up waiting for {what}")
+        time.sleep(0.01)
+
+
+def has_subscribers(publisher: zenoh.Publisher) -> bool:
+    """Whether a subscriber matches ``publisher`` somewhere.
+
+    zenoh 1.10's stubs type ``matching_status`` as bool, but it returns a
+    MatchingStatus object, which is always truthy: read its ``matching``.
+    """
+    status: Any = publisher.matching_status
+    return bool(getattr(status, "matching", status))
+
+
+class RunningRecorder:
+    """A RecorderService working in a thread of this process, as ServiceRunner runs it."""
+
+    def __init__(self, loaded: LoadedStation) -> None:
+        self.session = open_session(loaded.config.zenoh)
+        self.service = RecorderService(loaded, self.session)
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self.service.work, args=(self.stop,))
+        self.thread.start()
+
+    def finish(self) -> None:
+        """Stop as on SIGTERM (stop flag + wake), then close; safe to call twice."""
+        if self.thread.is_alive():
+            self.stop.set()
+            self.service.wake()
+            self.thread.join(WAIT_S)
+            if self.thread.is_alive():
+                raise AssertionError("the recorder did not stop")
+        self.service.close()
+        self.session.close()
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that nothing listens on right now."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def write_station_file(
+    path: Path,
+    recordings: Path,
+    listen: Sequence[str] = (),
+    connect: Sequence[str] = (),
+    recorder: Mapping[str, Any] | None = None,
+) -> Path:
+    """A copy of config/station.toml as a zenoh peer on the given endpoints.
+
+    ``can.dbc`` and ``station.joint`` point at the repository's files;
+    ``recorder.folder`` is ``recordings``; ``recorder`` overrides recorder keys.
+    """
+    with REPO_STATION_FILE.open("rb") as handle:
+        data = tomllib.load(handle)
+    base = REPO_STATION_FILE.parent
+    data["station"]["joint"] = str((base / data["station"]["joint"]).resolve())
+    data["can"]["dbc"] = str((base / data["can"]["dbc"]).resolve())
+    data["zenoh"] = {"mode": "peer", "connect": list(connect), "listen": list(listen)}
+    data["recorder"] = {**data["recorder"], "folder": str(recordings), **(recorder or {})}
+    path.write_text(to_toml(data))
+    return path
+
+
+def to_toml(data: Mapping[str, Any]) -> str:
+    """TOML text of a dict of tables and arrays of tables holding plain values."""
+    lines: list[str] = []
+    for name, value in data.items():
+        if isinstance(value, Mapping):
+            lines.append(f"[{name}]")
+            lines.extend(f"{key} = {_value(item)}" for key, item in value.items())
+        elif isinstance(value, list) and value and isinstance(value[0], Mapping):
+            for table in value:
+                lines.append(f"[[{name}]]")
+                lines.extend(f"{key} = {_value(item)}" for key, item in table.items())
+        else:
+            lines.insert(0, f"{name} = {_value(value)}")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return repr(value)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, list):
+        return "[" + ", ".join(_value(item) for item in value) + "]"
+    raise TypeError(f"cannot write {value!r} as TOML")

@@ -1,0 +1,190 @@
+"""The wear ledger: how much stick-slip vibration each tool has taken (SQLite, WAL).
+
+Every RunSummary adds its run's process intensity I_process (eq. 68) to its
+tool; a tool's accumulated intensity is the paper's eq. 69,
+``I_total = Σ_runs I_process``. Runs are keyed by (station, run_id), so a
+summary delivered twice, or seen again after a recorder restart, is counted
+once. A service (``boltwatch wear service TOOL``) starts a new interval:
+"intensity since service" counts runs that ended after it, while the run
+history and the all-time total stay.
+
+The file is ``<recordings>/wear.sqlite`` in WAL mode: the recorder writes,
+``boltwatch wear`` and the ``wear`` queryable read at the same time.
+"""
+
+from __future__ import annotations
+
+import logging
+import sqlite3
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from shared.errors import InputError
+from shared.messages import RunSummary
+
+LOG = logging.getLogger(__name__)
+
+LEDGER_FILE = "wear.sqlite"
+WORST_RUNS = 3
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS runs (
+    station TEXT NOT NULL,
+    run_id INTEGER NOT NULL,
+    tool_id INTEGER NOT NULL,
+    program_id INTEGER NOT NULL,
+    tool_state TEXT NOT NULL,
+    stop_reason TEXT,
+    events INTEGER NOT NULL,
+    process_intensity REAL NOT NULL,
+    started_ns INTEGER NOT NULL,
+    ended_ns INTEGER NOT NULL,
+    recorded_ns INTEGER NOT NULL,
+    PRIMARY KEY (station, run_id)
+);
+CREATE INDEX IF NOT EXISTS runs_by_tool ON runs (tool_id, ended_ns);
+CREATE TABLE IF NOT EXISTS services (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    tool_id INTEGER NOT NULL,
+    serviced_ns INTEGER NOT NULL,
+    note TEXT NOT NULL
+);
+"""
+
+
+@dataclass(frozen=True, slots=True)
+class RunWear:
+    station: str
+    run_id: int
+    process_intensity: float
+    ended_ns: int
+
+
+@dataclass(frozen=True, slots=True)
+class ToolWear:
+    """One tool's line of the ledger."""
+
+    tool_id: int
+    runs: int
+    total_intensity: float  # I_total, eq. 69
+    intensity_per_run: float
+    last_service_ns: int | None
+    last_service_note: str | None
+    runs_since_service: int
+    intensity_since_service: float
+    worst_runs: list[RunWear] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def ledger_path(recordings: Path) -> Path:
+    return Path(recordings) / LEDGER_FILE
+
+
+class WearLedger:
+    """The ledger file through one connection, for one thread at a time."""
+
+    def __init__(self, path: Path, read_only: bool = False) -> None:
+        self.path = Path(path)
+        try:
+            if read_only:
+                if not self.path.is_file():
+                    raise InputError(f"{self.path}: no wear ledger here (nothing recorded yet?)")
+                uri = f"{self.path.resolve().as_uri()}?mode=ro"
+                self._db = sqlite3.connect(uri, uri=True, timeout=10)
+            else:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                # Opened by the thread that builds the service, then used by its worker only.
+                self._db = sqlite3.connect(self.path, timeout=10, check_same_thread=False)
+                self._db.execute("PRAGMA journal_mode=WAL")
+                self._db.executescript(_SCHEMA)
+        except sqlite3.Error as err:
+            raise InputError(f"{self.path}: not a usable wear ledger: {err}") from err
+
+    def add_run(self, summary: RunSummary, recorded_ns: int) -> bool:
+        """Count a run once; False when (station, run_id) was already in the ledger."""
+        with self._db:
+            cursor = self._db.execute(
+                "INSERT OR IGNORE INTO runs VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                (
+                    summary.station,
+                    summary.run_id,
+                    summary.tool_id,
+                    summary.program_id,
+                    summary.tool_state,
+                    summary.stop_reason,
+                    summary.events,
+                    summary.process_intensity,
+                    summary.started_ns,
+                    summary.ended_ns,
+                    recorded_ns,
+                ),
+            )
+        return cursor.rowcount == 1
+
+    def record_service(self, tool_id: int, note: str, serviced_ns: int) -> None:
+        """A service of ``tool_id`` now: starts a new interval, keeps the history."""
+        with self._db:
+            self._db.execute(
+                "INSERT INTO services (tool_id, serviced_ns, note) VALUES (?, ?, ?)",
+                (tool_id, serviced_ns, note),
+            )
+
+    def tool_ids(self) -> list[int]:
+        rows = self._db.execute(
+            "SELECT tool_id FROM runs UNION SELECT tool_id FROM services ORDER BY tool_id"
+        )
+        return [int(tool_id) for (tool_id,) in rows]
+
+    def tools(self) -> list[ToolWear]:
+        """Every tool's line, by tool id."""
+        return [self.tool(tool_id) for tool_id in self.tool_ids()]
+
+    def tool(self, tool_id: int) -> ToolWear:
+        """One tool's line (zeros for a tool the ledger has never seen)."""
+        # One read transaction, so the figures agree with each other under a live writer.
+        with self._db:
+            self._db.execute("BEGIN")
+            runs, total = self._db.execute(
+                "SELECT COUNT(*), COALESCE(SUM(process_intensity), 0.0) FROM runs "
+                "WHERE tool_id = ?",
+                (tool_id,),
+            ).fetchone()
+            service = self._db.execute(
+                "SELECT serviced_ns, note FROM services WHERE tool_id = ? "
+                "ORDER BY serviced_ns DESC, id DESC LIMIT 1",
+                (tool_id,),
+            ).fetchone()
+            since_ns = service[0] if service else None
+            runs_since, total_since = self._db.execute(
+                "SELECT COUNT(*), COALESCE(SUM(process_intensity), 0.0) FROM runs "
+                "WHERE tool_id = ? AND ended_ns > ?",
+                (tool_id, since_ns if since_ns is not None else -1),
+            ).fetchone()
+            worst = self._db.execute(
+                "SELECT station, run_id, process_intensity, ended_ns FROM runs "
+                "WHERE tool_id = ? ORDER BY process_intensity DESC, ended_ns LIMIT ?",
+                (tool_id, WORST_RUNS),
+            ).fetchall()
+        return ToolWear(
+            tool_id=tool_id,
+            runs=int(runs),
+            total_intensity=float(total),
+            intensity_per_run=float(total) / runs if runs else 0.0,
+            last_service_ns=since_ns,
+            last_service_note=service[1] if service else None,
+            runs_since_service=int(runs_since),
+            intensity_since_service=float(total_since),
+            worst_runs=[RunWear(str(s), int(r), float(i), int(e)) for s, r, i, e in worst],
+        )
+
+    def close(self) -> None:
+        self._db.close()
+
+    def __enter__(self) -> WearLedger:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.close()

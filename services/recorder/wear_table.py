@@ -1,0 +1,59 @@
+"""The wear ledger as a table for people (``boltwatch wear``)."""
+
+from __future__ import annotations
+
+from datetime import UTC, datetime
+
+from services.recorder.wear_ledger import ToolWear
+
+HEADER = (
+    "tool",
+    "runs",
+    "I_total",
+    "I/run",
+    "I since service",
+    "runs since",
+    "last service",
+    "worst runs",
+)
+
+
+def utc_text(time_ns: int | None) -> str:
+    if time_ns is None:
+        return "never"
+    return f"{datetime.fromtimestamp(time_ns / 1e9, UTC):%Y-%m-%d %H:%M} UTC"
+
+
+def row(wear: ToolWear) -> tuple[str, ...]:
+    worst = ", ".join(
+        f"{run.station}/run{run.run_id} {run.process_intensity:.3g}" for run in wear.worst_runs
+    )
+    service = utc_text(wear.last_service_ns)
+    if wear.last_service_note:
+        service += f" ({wear.last_service_note})"
+    return (
+        str(wear.tool_id),
+        str(wear.runs),
+        f"{wear.total_intensity:.4g}",
+        f"{wear.intensity_per_run:.3g}",
+        f"{wear.intensity_since_service:.4g}",
+        str(wear.runs_since_service),
+        service,
+        worst or "-",
+    )
+
+
+def format_table(tools: list[ToolWear]) -> str:
+    """Aligned text table, one line per tool; says so when the ledger is empty."""
+    if not tools:
+        return "the wear ledger has no runs yet"
+    rows = [HEADER, *(row(tool) for tool in tools)]
+    widths = [max(len(r[i]) for r in rows) for i in range(len(HEADER) - 1)]
+    lines = []
+    for r in rows:
+        cells = [
+            cell.rjust(width) if i < 6 else cell.ljust(width)
+            for i, (cell, width) in enumerate(zip(r, widths, strict=False))
+        ]
+        lines.append("  ".join([*cells, r[-1]]))
+    return "\n".join(lines)

@@ -1,0 +1,199 @@
+"""A run published on real zenoh lands in one MCAP file per run, decodable without our code."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import zenoh
+from mcap.reader import make_reader
+
+from services.recorder.json_decoder import JsonDecoderFactory
+from services.recorder.mcap_sink import RAW_ENCODING, RAW_REASON
+from services.recorder.testing import RunningRecorder, has_subscribers, wait_until
+from shared import keys
+from shared.codec import encode, json_schema
+from shared.config import LoadedStation
+from shared.messages import (
+    Intensity,
+    RunSummary,
+    Sample,
+    StickSlipEvent,
+    StopDecision,
+    ToolState,
+)
+
+T0_NS = 1_700_000_000_000_000_000
+SAMPLES = 300
+EVENTS = 3
+
+
+def run_messages(run_id: int, samples: int) -> list[tuple[str, Any]]:
+    """(topic, message) of one whole run, in publishing order."""
+    t = T0_NS + run_id * 10_000_000_000
+    out: list[tuple[str, Any]] = [("tool", ToolState("st1", run_id, 7, 1, "running", t))]
+    for n in range(samples):
+        force = None if n % 50 == 0 else 10_000.0 + n
+        out.append(
+            ("samples", Sample("st1", run_id, n, t + n * 1_000_000, 1.0 + n, 0.1 * n, force))
+        )
+        if n % 100 == 99:
+            j = n // 100 + 1
+            event = StickSlipEvent(
+                "st1",
+                run_id,
+                j,
+                t + n * 1_000_000,
+                n / 1000,
+                100.0,
+                90.0,
+                10.0,
+                20_000.0,
+                500.0,
+                0.1,
+                10.0,
+                1.0,
+                2.0,
+                3.0,
+                0.5,
+                0.5 * j,
+            )
+            out.append(("events", event))
+            out.append(("intensity", Intensity("st1", run_id, t + n * 1_000_000, 0.5, 0.5 * j)))
+    end = t + samples * 1_000_000
+    out.append(
+        (
+            "decision",
+            StopDecision(
+                "st1",
+                run_id,
+                end,
+                samples / 1000,
+                "plateau_closest",
+                "",
+                120.0,
+                55_000.0,
+                56_000.0,
+                end + 5,
+            ),
+        )
+    )
+    out.append(("tool", ToolState("st1", run_id, 7, 1, "done", end + 1)))
+    out.append(
+        (
+            "runs",
+            RunSummary(
+                "st1",
+                run_id,
+                7,
+                1,
+                "done",
+                56_000.0,
+                None,
+                55_000.0,
+                120.0,
+                -1.8,
+                EVENTS,
+                "plateau_closest",
+                1.5,
+                samples,
+                t,
+                end + 1,
+            ),
+        )
+    )
+    return out
+
+
+def publish(session: zenoh.Session, items: list[tuple[str, Any]]) -> int:
+    publishers = {
+        topic: session.declare_publisher(keys.station_key("st1", topic))
+        for topic in {topic for topic, _ in items}
+    }
+    wait_until(lambda: all(has_subscribers(p) for p in publishers.values()), "the recorder")
+    for topic, message in items:
+        publishers[topic].put(message if isinstance(message, bytes) else encode(message))
+    for publisher in publishers.values():
+        publisher.undeclare()
+    return len(items)
+
+
+def recorded_files(loaded: LoadedStation) -> list[Path]:
+    return sorted(loaded.recordings_folder.glob("st1/*/*.mcap"))
+
+
+def test_a_run_becomes_one_decodable_mcap_file(
+    station: LoadedStation, recorder: RunningRecorder, publisher_session: zenoh.Session
+) -> None:
+    run1 = run_messages(1, SAMPLES)
+    extras: list[tuple[str, Any]] = [("custom", b"\x00\x01raw"), ("events", b"not json")]
+    run2 = run_messages(2, 10)
+    sent = publish(publisher_session, run1 + extras) + publish(publisher_session, run2)
+    wait_until(lambda: recorder.service.recorder.messages == sent, "every message recorded")
+    recorder.finish()
+
+    files = recorded_files(station)
+    assert [f.name.split("_")[1] for f in files] == ["run1", "run2"]
+    assert files[0].parent.name.count("-") == 2  # <YYYY-MM-DD>
+    with files[0].open("rb") as handle:
+        reader = make_reader(handle, decoder_factories=[JsonDecoderFactory()])
+        summary = reader.get_summary()
+        assert summary is not None and summary.statistics is not None
+        assert summary.statistics.message_count == len(run1) + len(extras)
+        schemas = {schema.name: schema for schema in summary.schemas.values()}
+        sample_schema = schemas["boltwatch.Sample"]
+        assert sample_schema.encoding == "jsonschema"
+        assert json.loads(sample_schema.data) == json_schema(Sample)
+        assert set(schemas) == {
+            "boltwatch.Sample",
+            "boltwatch.ToolState",
+            "boltwatch.StickSlipEvent",
+            "boltwatch.Intensity",
+            "boltwatch.StopDecision",
+            "boltwatch.RunSummary",
+        }
+        channels = {(c.topic, c.message_encoding) for c in summary.channels.values()}
+        assert ("boltwatch/st1/samples", "json") in channels
+        assert ("boltwatch/st1/custom", RAW_ENCODING) in channels
+        raw_reasons = {
+            c.topic: c.metadata[RAW_REASON]
+            for c in summary.channels.values()
+            if c.message_encoding == RAW_ENCODING
+        }
+        assert raw_reasons == {
+            "boltwatch/st1/custom": "unknown key",
+            "boltwatch/st1/events": "undecodable",
+        }
+
+        samples = [
+            (message, data)
+            for _, channel, message, data in reader.iter_decoded_messages(
+                topics=["boltwatch/st1/samples"], log_time_order=False
+            )
+        ]
+    assert [m.sequence for m, _ in samples] == list(range(SAMPLES))
+    assert [m.publish_time for m, _ in samples] == [d["time_ns"] for _, d in samples]
+    assert all(m.log_time > m.publish_time for m, _ in samples)  # received after acquisition
+    assert samples[0][1]["force_n"] is None and samples[1][1]["force_n"] == 10_001.0
+
+    with files[0].open("rb") as handle:
+        metadata = {record.name: record.metadata for record in make_reader(handle).iter_metadata()}
+    assert metadata["station"]["station"] == "st1"
+    assert metadata["station"]["tool_id"] == "7"
+    assert metadata["station"]["software_version"]
+    assert metadata["run"] == {"run_id": "1", "tool_id": "7", "program_id": "1"}
+    assert metadata["program"]["target_force_n"] == "56000.0"
+    assert metadata["joint"]["screw.pitch_mm"] == "1.5"
+
+    with files[0].open("rb") as handle:
+        by_topic: dict[str, list[int]] = {}
+        for _, channel, message in make_reader(handle).iter_messages(log_time_order=False):
+            by_topic.setdefault(channel.topic, []).append(message.sequence)
+    assert by_topic["boltwatch/st1/events"][:EVENTS] == list(range(EVENTS))
+    assert by_topic["boltwatch/st1/runs"] == [0]
+
+    with files[1].open("rb") as handle:
+        summary = make_reader(handle).get_summary()
+    assert summary is not None and summary.statistics is not None
+    assert summary.statistics.message_count == len(run2)

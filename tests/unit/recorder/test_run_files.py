@@ -1,0 +1,131 @@
+"""Run files: naming, rotation on run start and on limits, late messages of the previous run."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Any
+
+from mcap.reader import make_reader
+
+from services.recorder.file_metadata import FileMetadata
+from services.recorder.incoming import classify
+from services.recorder.run_files import FileLimits, StationFiles, file_path
+from shared.codec import encode
+from shared.config import LoadedStation
+from shared.messages import BusStats, RunSummary, Sample, ToolState
+
+T0_NS = 1_700_000_000_000_000_000  # 2023-11-14T22:13:20Z
+SECOND_NS = 1_000_000_000
+LIMITS = FileLimits(
+    flush_interval_ns=SECOND_NS, max_file_bytes=1 << 40, max_file_duration_ns=3600 * SECOND_NS
+)
+
+
+def tool(run_id: int, state: str, t_ns: int) -> bytes:
+    return encode(ToolState("st1", run_id, 7, 2, state, t_ns))  # type: ignore[arg-type]
+
+
+def sample(run_id: int, n: int, t_ns: int) -> bytes:
+    return encode(Sample("st1", run_id, n, t_ns, 1.0, 2.0, None))
+
+
+def bus(t_ns: int) -> bytes:
+    counters: dict[str, Any] = {field.name: 0 for field in dataclasses.fields(BusStats)}
+    return encode(BusStats(**{**counters, "station": "st1", "time_ns": t_ns}))
+
+
+def summary(run_id: int, t_ns: int) -> bytes:
+    return encode(
+        RunSummary(
+            "st1", run_id, 7, 2, "done", 1.0, None, 1.0, 1.0, 0.0, 0, None, 0.0, 1, t_ns, t_ns
+        )
+    )
+
+
+def feed(files: StationFiles, items: list[tuple[str, bytes, int]]) -> None:
+    for topic, payload, t_ns in items:
+        files.write(classify(f"boltwatch/st1/{topic}", payload, t_ns))
+
+
+def counts(path: Path) -> dict[str, int]:
+    with path.open("rb") as handle:
+        found: dict[str, int] = {}
+        for _, channel, _ in make_reader(handle).iter_messages(log_time_order=False):
+            found[channel.topic.rsplit("/", 1)[1]] = (
+                found.get(channel.topic.rsplit("/", 1)[1], 0) + 1
+            )
+    return found
+
+
+def test_file_path_is_station_date_run_time(tmp_path: Path) -> None:
+    path = file_path(tmp_path, "st1", 42, T0_NS)
+    assert path == tmp_path / "st1" / "2023-11-14" / "st1_run42_221320.mcap"
+    path.parent.mkdir(parents=True)
+    path.touch()
+    assert file_path(tmp_path, "st1", 42, T0_NS).name == "st1_run42_221320_2.mcap"
+    assert file_path(tmp_path, "a/b", None, T0_NS, part=3).name == "a_b_idle_221320_part3.mcap"
+
+
+def test_idle_then_runs_with_a_late_summary(tmp_path: Path, station: LoadedStation) -> None:
+    files = StationFiles("st1", tmp_path, LIMITS, FileMetadata(station))
+    t = T0_NS
+    feed(
+        files,
+        [
+            ("bus", bus(t), t),
+            ("tool", tool(1, "running", t + 1), t + 1),
+            ("samples", sample(1, 0, t + 2), t + 2),
+            ("tool", tool(1, "done", t + 3), t + 3),
+            ("bus", bus(t + 4), t + 4),
+            ("tool", tool(2, "running", t + SECOND_NS), t + SECOND_NS),
+            ("runs", summary(1, t + 3), t + SECOND_NS + 1),  # late: belongs to run 1
+            ("samples", sample(2, 0, t + SECOND_NS + 2), t + SECOND_NS + 2),
+        ],
+    )
+    files.tick(t + 10 * SECOND_NS)  # the grace of run 1's file is over
+    assert len(files.closed_paths) == 2  # idle (at run 2's start) and run 1 (after grace)
+    files.close()
+    names = sorted(p.name for p in files.closed_paths)
+    assert names == ["st1_idle_221320.mcap", "st1_run1_221320.mcap", "st1_run2_221321.mcap"]
+    by_name = {p.name: counts(p) for p in files.closed_paths}
+    assert by_name["st1_idle_221320.mcap"] == {"bus": 1}
+    assert by_name["st1_run1_221320.mcap"] == {"tool": 2, "samples": 1, "bus": 1, "runs": 1}
+    assert by_name["st1_run2_221321.mcap"] == {"tool": 1, "samples": 1}
+
+
+def test_a_run_that_never_ends_continues_in_parts(tmp_path: Path, station: LoadedStation) -> None:
+    limits = FileLimits(
+        flush_interval_ns=SECOND_NS, max_file_bytes=1 << 40, max_file_duration_ns=10 * SECOND_NS
+    )
+    files = StationFiles("st1", tmp_path, limits, FileMetadata(station))
+    feed(files, [("tool", tool(5, "running", T0_NS), T0_NS)])
+    feed(
+        files,
+        [
+            ("samples", sample(5, n, T0_NS + n * SECOND_NS), T0_NS + n * SECOND_NS)
+            for n in range(25)
+        ],
+    )
+    files.close()
+    names = sorted(p.name for p in files.closed_paths)
+    assert names == [
+        "st1_run5_221320.mcap",
+        "st1_run5_221330_part2.mcap",
+        "st1_run5_221340_part3.mcap",
+    ]
+    total = sum(counts(p).get("samples", 0) for p in files.closed_paths)
+    assert total == 25
+
+
+def test_a_file_over_its_byte_limit_continues(tmp_path: Path, station: LoadedStation) -> None:
+    limits = FileLimits(
+        flush_interval_ns=SECOND_NS, max_file_bytes=20_000, max_file_duration_ns=3600 * SECOND_NS
+    )
+    files = StationFiles("st1", tmp_path, limits, FileMetadata(station))
+    feed(files, [("tool", tool(5, "running", T0_NS), T0_NS)])
+    feed(files, [("samples", sample(5, n, T0_NS + n), T0_NS + n) for n in range(1000)])
+    files.close()
+    assert len(files.closed_paths) > 1
+    assert sum(counts(p).get("samples", 0) for p in files.closed_paths) == 1000
+    assert all(p.stat().st_size < 40_000 for p in files.closed_paths)

@@ -1,0 +1,117 @@
+"""The wear ledger: eq. 69 totals, counted once per run across restarts, services, readers."""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import pytest
+
+from services.cli.main import main
+from services.recorder.wear_ledger import WearLedger, ledger_path
+from shared.errors import InputError
+from shared.messages import RunSummary
+
+T0_NS = 1_700_000_000_000_000_000
+S_NS = 1_000_000_000
+
+
+def summary(run_id: int, intensity: float, tool_id: int = 7, station: str = "st1") -> RunSummary:
+    ended = T0_NS + run_id * S_NS
+    return RunSummary(
+        station, run_id, tool_id, 1, "done", 56e3, None, 55e3, 120.0, -1.8, 4,
+        "plateau_closest", intensity, 3000, ended - S_NS // 2, ended,
+    )  # fmt: skip
+
+
+def test_totals_follow_eq_69_and_worst_runs_lead(tmp_path: Path) -> None:
+    with WearLedger(tmp_path / "wear.sqlite") as ledger:
+        for run_id, intensity in enumerate([0.5, 2.0, 1.0, 0.25], start=1):
+            assert ledger.add_run(summary(run_id, intensity), T0_NS)
+        assert ledger.add_run(summary(1, 9.0, tool_id=8, station="st2"), T0_NS)
+        wear = ledger.tool(7)
+    assert (wear.runs, wear.total_intensity, wear.intensity_per_run) == (4, 3.75, 3.75 / 4)
+    worst = [(r.run_id, r.process_intensity) for r in wear.worst_runs]
+    assert worst == [(2, 2.0), (3, 1.0), (1, 0.5)]
+    assert wear.last_service_ns is None
+    assert (wear.runs_since_service, wear.intensity_since_service) == (4, 3.75)
+
+
+def test_a_repeated_summary_or_a_restart_never_counts_twice(tmp_path: Path) -> None:
+    path = tmp_path / "wear.sqlite"
+    with WearLedger(path) as ledger:
+        assert ledger.add_run(summary(1, 1.0), T0_NS)
+        assert not ledger.add_run(summary(1, 1.0), T0_NS + 1)  # redelivered
+    with WearLedger(path) as ledger:  # the recorder restarted and sees run 1 again
+        assert not ledger.add_run(summary(1, 1.0), T0_NS + 2)
+        assert ledger.add_run(summary(2, 0.5), T0_NS + 3)
+        assert (ledger.tool(7).runs, ledger.tool(7).total_intensity) == (2, 1.5)
+
+
+def test_a_service_restarts_the_interval_and_keeps_history(tmp_path: Path) -> None:
+    with WearLedger(tmp_path / "wear.sqlite") as ledger:
+        ledger.add_run(summary(1, 1.0), T0_NS)
+        ledger.add_run(summary(2, 2.0), T0_NS)
+        ledger.record_service(7, "new socket", T0_NS + 2 * S_NS + 1)  # after run 2 ended
+        ledger.add_run(summary(3, 0.5), T0_NS)
+        wear = ledger.tool(7)
+        assert ledger.tool_ids() == [7]
+    assert (wear.runs, wear.total_intensity) == (3, 3.5)
+    assert (wear.runs_since_service, wear.intensity_since_service) == (1, 0.5)
+    assert (wear.last_service_ns, wear.last_service_note) == (T0_NS + 2 * S_NS + 1, "new socket")
+
+
+def test_a_reader_sees_consistent_lines_while_the_recorder_writes(tmp_path: Path) -> None:
+    path = tmp_path / "wear.sqlite"
+    runs = 200
+    writer = WearLedger(path)
+    seen: list[tuple[int, float]] = []
+    errors: list[BaseException] = []
+    done = threading.Event()
+
+    def read() -> None:
+        try:
+            with WearLedger(path, read_only=True) as reader:
+                while not done.is_set():
+                    wear = reader.tool(7)
+                    seen.append((wear.runs, wear.total_intensity))
+        except BaseException as err:
+            errors.append(err)
+
+    thread = threading.Thread(target=read)
+    thread.start()
+    try:
+        for run_id in range(1, runs + 1):
+            writer.add_run(summary(run_id, 1.0), T0_NS)
+    finally:
+        done.set()
+        thread.join(10)
+        writer.close()
+    assert not errors
+    assert all(total == float(count) for count, total in seen)  # each line is one snapshot
+    assert [count for count, _ in seen] == sorted(count for count, _ in seen)
+    with WearLedger(path, read_only=True) as reader:
+        assert reader.tool(7).runs == runs
+
+
+def test_cli_prints_the_table_and_records_services(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with WearLedger(ledger_path(tmp_path)) as ledger:
+        ledger.add_run(summary(1, 1.5), T0_NS)
+    assert main(["wear", "--recordings", str(tmp_path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split()[:4] == ["tool", "runs", "I_total", "I/run"]
+    assert lines[1].split()[:4] == ["7", "1", "1.5", "1.5"]
+    service = ["wear", "service", "7", "--note", "new socket"]
+    assert main([*service, "--recordings", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "recorded a service of tool 7" in out and "(new socket)" in out
+    assert main(["wear", "service", "--recordings", str(tmp_path)]) == 2
+    assert main(["wear", "--recordings", str(tmp_path / "nowhere")]) == 2
+    assert "no wear ledger here" in capsys.readouterr().err
+
+
+def test_read_only_needs_an_existing_ledger(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="no wear ledger here"):
+        WearLedger(tmp_path / "wear.sqlite", read_only=True)

@@ -1,0 +1,87 @@
+"""The recorder keeps the wear ledger from RunSummaries on zenoh, answers ``wear``, alerts."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import zenoh
+from mcap.reader import make_reader
+
+from services.recorder.testing import (
+    RunningRecorder,
+    has_subscribers,
+    wait_until,
+    write_station_file,
+)
+from shared import keys
+from shared.codec import encode
+from shared.config import LoadedStation, load_station
+from shared.messages import RunSummary, ToolState
+
+T0_NS = 1_700_000_000_000_000_000
+THRESHOLD = 2.0
+
+
+@pytest.fixture
+def station(tmp_path: Path, endpoint: str) -> LoadedStation:
+    path = write_station_file(
+        tmp_path / "station.toml",
+        tmp_path / "recordings",
+        listen=[endpoint],
+        recorder={"wear_service_threshold": THRESHOLD},
+    )
+    return load_station(path)
+
+
+def summary(run_id: int, intensity: float) -> bytes:
+    return encode(
+        RunSummary(
+            "st1", run_id, 7, 1, "done", 56e3, None, 55e3, 120.0, -1.8, 4, None, intensity,
+            3000, T0_NS + run_id, T0_NS + run_id + 1,
+        )
+    )  # fmt: skip
+
+
+def test_summaries_count_once_and_a_due_tool_raises_an_alert(
+    station: LoadedStation, recorder: RunningRecorder, publisher_session: zenoh.Session
+) -> None:
+    alerts: list[dict[str, object]] = []
+    alert_key = keys.station_key("st1", "wear/alert")
+    subscriber = publisher_session.declare_subscriber(
+        alert_key, lambda sample: alerts.append(json.loads(sample.payload.to_bytes()))
+    )
+    tool = publisher_session.declare_publisher(keys.station_key("st1", keys.TOOL))
+    runs = publisher_session.declare_publisher(keys.station_key("st1", keys.RUNS))
+    wait_until(lambda: has_subscribers(runs) and has_subscribers(tool), "the recorder")
+    tool.put(encode(ToolState("st1", 1, 7, 1, "running", T0_NS)))
+    runs.put(summary(1, 1.5))
+    runs.put(summary(1, 1.5))  # redelivered
+    runs.put(summary(2, 1.0))  # 2.5 >= threshold
+    wear = recorder.service.wear
+    wait_until(lambda: wear.counted + wear.repeated == 3, "the summaries")
+    assert (wear.counted, wear.repeated) == (2, 1)
+    wait_until(lambda: len(alerts) == 1, "the wear alert")
+    assert alerts[0]["tool_id"] == 7
+    assert alerts[0]["intensity_since_service"] == 2.5
+    assert alerts[0]["threshold"] == THRESHOLD
+
+    replies = list(publisher_session.get(keys.station_key("st1", keys.WEAR), timeout=10))
+    assert len(replies) == 1 and replies[0].ok is not None
+    answer = json.loads(replies[0].ok.payload.to_bytes())
+    assert answer["station"] == "st1"
+    (line,) = answer["tools"]
+    assert (line["tool_id"], line["runs"], line["total_intensity"]) == (7, 2, 2.5)
+    assert [run["run_id"] for run in line["worst_runs"]] == [1, 2]
+    subscriber.undeclare()
+    tool.undeclare()
+    runs.undeclare()
+
+    recorder.finish()
+    (path,) = station.recordings_folder.glob("st1/*/*.mcap")
+    with path.open("rb") as handle:
+        summary_record = make_reader(handle).get_summary()
+    assert summary_record is not None
+    schemas = {schema.name for schema in summary_record.schemas.values()}
+    assert "boltwatch.WearAlert" in schemas  # the alert is recorded, schema'd
