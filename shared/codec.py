@@ -82,16 +82,22 @@ def _nested_list_fields(message_type: Any) -> dict[str, type]:
     return found
 
 
-@cache
 def json_schema(message_type: type) -> dict[str, Any]:
-    """JSON schema (draft 2020-12) of a message dataclass."""
+    """JSON schema (draft 2020-12) of a message dataclass (computed once per type)."""
+    cached = _SCHEMAS.get(message_type)
+    if cached is not None:
+        return cached
     schema = _object_schema(message_type)
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = f"boltwatch.{message_type.__name__}"
     doc = (message_type.__doc__ or "").strip().splitlines()
     if doc:
         schema["description"] = doc[0]
+    _SCHEMAS[message_type] = schema
     return schema
+
+
+_SCHEMAS: dict[type, dict[str, Any]] = {}
 
 
 def _object_schema(message_type: type) -> dict[str, Any]:

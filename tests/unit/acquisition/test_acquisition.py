@@ -71,7 +71,9 @@ def decision(run_id: int) -> StopDecision:
     return StopDecision("st1", run_id, 0, 0.1, "plateau_closest", "", 100.0, 5e4, 5.1e4, 0)
 
 
-def test_a_run_is_published_in_order_with_faults_counted(buses) -> None:  # type: ignore[no-untyped-def]
+def test_a_run_is_published_in_order_with_faults_counted(
+    buses: tuple[can.BusABC, can.BusABC],
+) -> None:
     tool, station = buses
     outlet = ListOutlet()
     acquisition = Acquisition("st1", True, station, DATABASE, outlet)
@@ -96,7 +98,9 @@ def test_a_run_is_published_in_order_with_faults_counted(buses) -> None:  # type
     assert (stats.unknown_ids, stats.wrong_length) == (1, 1)
 
 
-def test_stop_command_only_for_the_running_run_and_only_once(buses) -> None:  # type: ignore[no-untyped-def]
+def test_stop_command_only_for_the_running_run_and_only_once(
+    buses: tuple[can.BusABC, can.BusABC],
+) -> None:
     tool, station = buses
     acquisition = Acquisition("st1", True, station, DATABASE, ListOutlet())
     assert not acquisition.send_stop(decision(7))  # no run yet
@@ -113,7 +117,7 @@ def test_stop_command_only_for_the_running_run_and_only_once(buses) -> None:  # 
     assert acquisition.stats().stop_commands == 1
 
 
-def test_torque_only_station_publishes_without_force(buses) -> None:  # type: ignore[no-untyped-def]
+def test_torque_only_station_publishes_without_force(buses: tuple[can.BusABC, can.BusABC]) -> None:
     tool, station = buses
     outlet = ListOutlet()
     acquisition = Acquisition("st1", False, station, DATABASE, outlet)

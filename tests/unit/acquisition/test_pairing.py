@@ -95,7 +95,9 @@ def test_finish_run_flushes_waiting_tool_frames_and_start_run_resets_sequence() 
         max_size=200,
     )
 )
-def test_any_frame_sequence_yields_strictly_increasing_sequences(frames) -> None:  # type: ignore[no-untyped-def]
+def test_any_frame_sequence_yields_strictly_increasing_sequences(
+    frames: list[tuple[str, int, float]],
+) -> None:
     """Fuzz: whatever order, repeats or garbage counters arrive, nothing raises,
     sequence numbers only increase and every published sample was counted."""
     assembler = SampleAssembler(has_force_sensor=True)

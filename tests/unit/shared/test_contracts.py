@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import json
 import typing
+from pathlib import Path
+from typing import Any
 
 import jsonschema
 import pytest
@@ -74,11 +77,9 @@ EXAMPLES = [
 
 
 @pytest.mark.parametrize("message", EXAMPLES, ids=lambda m: type(m).__name__)
-def test_round_trip_and_schema_validates_the_payload(message: object) -> None:
+def test_round_trip_and_schema_validates_the_payload(message: Any) -> None:
     payload = encode(message)
     assert decode(type(message), payload) == message
-    import json
-
     schema = json_schema(type(message))
     jsonschema.Draft202012Validator.check_schema(schema)
     jsonschema.validate(json.loads(payload), schema)
@@ -100,18 +101,20 @@ def test_dbc_enums_match_the_code() -> None:
     import cantools
 
     database = cantools.database.load_file(str(DBC_FILE))
+    assert isinstance(database, cantools.database.can.Database)
     states = database.get_message_by_name("ToolStatus").get_signal_by_name("State").choices
+    reasons = database.get_message_by_name("StopCommand").get_signal_by_name("Reason").choices
+    assert states is not None and reasons is not None
     assert {int(k): str(v) for k, v in states.items()} == {
         s.value: s.name.lower() for s in ToolRunState
     }
-    reasons = database.get_message_by_name("StopCommand").get_signal_by_name("Reason").choices
     assert {int(k): str(v) for k, v in reasons.items()} == {
         r.value: r.name.lower() for r in StopReason
     }
     assert set(typing.get_args(StopReasonName)) == {r.name.lower() for r in StopReason}
 
 
-def test_dbc_missing_a_contract_message_is_an_error(tmp_path) -> None:  # type: ignore[no-untyped-def]
+def test_dbc_missing_a_contract_message_is_an_error(tmp_path: Path) -> None:
     text = DBC_FILE.read_text().replace("BO_ 257 JointSensors", "BO_ 257 JointSensorz")
     broken = tmp_path / "broken.dbc"
     broken.write_text(text)

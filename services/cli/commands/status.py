@@ -1,0 +1,136 @@
+"""``boltwatch status [--config FILE | --connect ENDPOINT] [--listen-s S] [--json]``.
+
+Joins the line's zenoh router as a client, listens to ``boltwatch/*/*`` for
+``--listen-s`` seconds, then asks which liveliness tokens
+``boltwatch/*/health/*`` exist, and prints every station seen (see
+:mod:`services.cli.station_status` for what each figure means). Exit 0 when
+the router answered (even if no station is alive), 2 when it is unreachable.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from services.cli.station_status import StatusReport
+
+NAME = "status"
+HELP = "which stations and services are alive, sample rate, bus faults, last run and decision"
+
+DEFAULT_CONFIG = Path("config/station.toml")
+CONNECT_TIMEOUT_MS = 2000
+LIVELINESS_TIMEOUT_S = 2.0
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.description = (
+        "Connect to the zenoh router (the endpoint of the station file's [zenoh] connect, "
+        "or --connect), listen to every station for a moment and print, per station: "
+        "services alive, samples per second, bus gaps and bad frames, the last run, the "
+        "last stop decision and the last run summary. Runs, decisions and summaries are "
+        "shown only if they happened while listening; lengthen --listen-s to catch one."
+    )
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument(
+        "--config",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help=f"station file whose [zenoh] connect names the router (default: {DEFAULT_CONFIG})",
+    )
+    where.add_argument(
+        "--connect",
+        default=None,
+        metavar="ENDPOINT",
+        help="router endpoint, e.g. tcp/127.0.0.1:7447 (instead of a station file)",
+    )
+    parser.add_argument(
+        "--listen-s",
+        type=float,
+        default=2.0,
+        metavar="S",
+        help="seconds to listen for messages (default: 2.0; BusStats come once a second)",
+    )
+    parser.add_argument("--json", action="store_true", help="print one JSON object instead")
+
+
+def run(args: argparse.Namespace) -> int:
+    from services.cli.station_status import format_report, to_json
+    from shared.errors import InputError
+
+    if not args.listen_s > 0:
+        raise InputError(f"--listen-s must be a positive number of seconds (got {args.listen_s})")
+    endpoint = args.connect or _endpoint_from(args.config or DEFAULT_CONFIG)
+    report = _watch(endpoint, args.listen_s)
+    if args.json:
+        print(json.dumps(to_json(report), indent=2))
+    else:
+        print(format_report(report))
+    return 0
+
+
+def _endpoint_from(config: Path) -> str:
+    from shared.config import load_station
+    from shared.errors import ConfigError
+
+    section = load_station(config).config.zenoh
+    if not section.connect:
+        raise ConfigError(
+            f"{config}: zenoh.connect is empty (a peer that only listens); "
+            "give the router with --connect ENDPOINT"
+        )
+    return section.connect[0]
+
+
+def _watch(endpoint: str, listen_s: float) -> StatusReport:
+    """Listen on ``endpoint`` for ``listen_s`` seconds; the StatusReport of what came."""
+    import threading
+    import time
+
+    import zenoh
+
+    from services.cli.station_status import StatusCollector
+    from shared import keys
+    from shared.errors import TransportError
+    from shared.zenoh_session import zenoh_config
+
+    try:
+        session = zenoh.open(
+            zenoh_config("client", [endpoint], connect_timeout_ms=CONNECT_TIMEOUT_MS)
+        )
+    except zenoh.ZError as err:
+        reason = str(err).split(" at ", 1)[0]  # drop the Rust source location
+        raise TransportError(
+            f"cannot reach the zenoh router at {endpoint} within "
+            f"{CONNECT_TIMEOUT_MS / 1000:.0f} s ({reason}); is 'boltwatch serve router' "
+            "running there?"
+        ) from err
+
+    collector = StatusCollector()
+    lock = threading.Lock()
+
+    def on_message(sample: zenoh.Sample) -> None:
+        payload = sample.payload.to_bytes()
+        with lock:
+            collector.message(str(sample.key_expr), payload, time.time_ns())
+
+    with session:
+        started = time.monotonic()
+        subscriber = session.declare_subscriber(keys.ALL_STATION_TOPICS, on_message)
+        try:
+            time.sleep(listen_s)
+            replies = session.liveliness().get(
+                keys.health_key("*", "*"), timeout=LIVELINESS_TIMEOUT_S
+            )
+            for reply in replies:
+                if reply.ok is not None:
+                    with lock:
+                        collector.alive(str(reply.ok.key_expr))
+        finally:
+            subscriber.undeclare()
+        listened_s = time.monotonic() - started
+        with lock:
+            return collector.report(endpoint, round(listened_s, 2), time.time_ns())

@@ -1,0 +1,396 @@
+"""What ``boltwatch status`` saw of each station: pure aggregation and formatting.
+
+The command (``services/cli/commands/status.py``) owns the zenoh session; it
+feeds this module what arrives, and asks it for a report at the end of the
+listening window. Nothing here knows about zenoh or clocks: receive times and
+"now" are passed in (integer nanoseconds since the Unix epoch).
+
+Per station:
+
+- services alive: the liveliness tokens ``boltwatch/<st>/health/<service>``;
+- sample rate: Sample messages received per second over the window, and, when
+  two or more BusStats arrived, the acquisition's own count (``samples``
+  delta over ``time_ns`` delta) -- the second tells a slow link from a slow bus;
+- bus faults: from the latest BusStats (counters since the acquisition started);
+  ``bad_frames`` = wrong_length + decode_errors + error_frames + counter_faults
+  (frames that were on our bus and unusable; foreign ``unknown_ids`` are not);
+- last run: the latest ToolState; failing that the run of the latest Sample
+  (then running), failing that the latest RunSummary;
+- last decision, last run summary: the latest of each, with its age;
+- recorder lag: not measurable yet (the recorder publishes nothing about itself).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+from shared import keys
+from shared.codec import decode
+from shared.errors import InputError
+from shared.messages import BusStats, RunSummary, Sample, StopDecision, ToolState
+
+#: The services of a station, in display order; others are shown if alive.
+KNOWN_SERVICES = ("acquisition", "predictor", "recorder", "rig")
+
+_NS = 1_000_000_000
+
+
+@dataclass
+class _Seen:
+    """Everything received from one station during the window."""
+
+    services: set[str] = field(default_factory=set)
+    samples: int = 0
+    last_sample_payload: bytes | None = None
+    first_bus: BusStats | None = None
+    bus: BusStats | None = None
+    bus_received_ns: int = 0
+    tool: ToolState | None = None
+    decision: StopDecision | None = None
+    summary: RunSummary | None = None
+    unreadable: int = 0
+
+
+@dataclass(frozen=True)
+class BusHealth:
+    age_s: float  # since the latest BusStats was received
+    frames: int
+    samples: int
+    counter_gaps: int
+    missed_samples: int
+    bad_frames: int
+    unknown_ids: int
+    receive_errors: int
+    unpaired: int
+    orphans: int
+    stop_commands: int
+
+
+@dataclass(frozen=True)
+class LastRun:
+    run_id: int
+    state: str  # idle | running | done | aborted
+    tool_id: int | None
+    program_id: int | None
+    source: str  # "tool" (ToolState), "samples" (inferred: running), "runs" (RunSummary)
+
+
+@dataclass(frozen=True)
+class LastDecision:
+    run_id: int
+    reason: str
+    detail: str
+    age_s: float  # since the predictor published it (its wall clock)
+
+
+@dataclass(frozen=True)
+class LastSummary:
+    run_id: int
+    unit: str  # "N" (force target) or "Nm" (torque target)
+    target: float | None
+    reached: float | None
+    error_pct: float | None
+    stop_reason: str | None  # None: the tool stopped by itself
+    tool_state: str
+    events: int
+    age_s: float  # since the run ended
+
+
+@dataclass(frozen=True)
+class StationStatus:
+    station: str
+    services: dict[str, bool]
+    samples_per_s: float  # Sample messages received per second of the window
+    bus_samples_per_s: float | None  # from BusStats deltas; None: fewer than two
+    bus: BusHealth | None
+    last_run: LastRun | None
+    last_decision: LastDecision | None
+    last_summary: LastSummary | None
+    recorder_lag_s: float | None  # always None: not published by the recorder yet
+    unreadable_messages: int
+
+
+@dataclass(frozen=True)
+class StatusReport:
+    endpoint: str
+    listened_s: float
+    stations: list[StationStatus]
+
+
+class StatusCollector:
+    """Accumulates liveliness replies and messages; not thread-safe (the caller locks)."""
+
+    def __init__(self) -> None:
+        self._stations: dict[str, _Seen] = {}
+
+    def _station(self, station: str) -> _Seen:
+        seen = self._stations.get(station)
+        if seen is None:
+            seen = self._stations[station] = _Seen()
+        return seen
+
+    def alive(self, key: str) -> None:
+        """A liveliness token ``boltwatch/<st>/health/<service>`` exists."""
+        try:
+            station, rest = keys.split_key(key)
+        except ValueError:
+            return
+        topic, _, service = rest.partition("/")
+        if topic == keys.HEALTH and service:
+            self._station(station).services.add(service)
+
+    def message(self, key: str, payload: bytes, received_ns: int) -> None:
+        """One message on ``boltwatch/<st>/<topic>``; unknown topics only mark the station seen."""
+        try:
+            station, topic = keys.split_key(key)
+        except ValueError:
+            return
+        seen = self._station(station)
+        try:
+            if topic == keys.SAMPLES:
+                # 1 kHz: count only; the latest is decoded once, at report time.
+                seen.samples += 1
+                seen.last_sample_payload = payload
+            elif topic == keys.BUS:
+                stats = decode(BusStats, payload)
+                if seen.first_bus is None:
+                    seen.first_bus = stats
+                seen.bus = stats
+                seen.bus_received_ns = received_ns
+            elif topic == keys.TOOL:
+                seen.tool = decode(ToolState, payload)
+            elif topic == keys.DECISION:
+                seen.decision = decode(StopDecision, payload)
+            elif topic == keys.RUNS:
+                seen.summary = decode(RunSummary, payload)
+        except InputError:
+            seen.unreadable += 1
+
+    def report(self, endpoint: str, listened_s: float, now_ns: int) -> StatusReport:
+        """Every station seen, by name."""
+        stations = [
+            _status(name, seen, listened_s, now_ns) for name, seen in sorted(self._stations.items())
+        ]
+        return StatusReport(endpoint=endpoint, listened_s=listened_s, stations=stations)
+
+
+def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationStatus:
+    services = {service: service in seen.services for service in KNOWN_SERVICES}
+    services.update(dict.fromkeys(sorted(seen.services - set(KNOWN_SERVICES)), True))
+    last_sample = _decode_sample(seen.last_sample_payload)
+    unreadable = seen.unreadable + (1 if seen.last_sample_payload and last_sample is None else 0)
+    return StationStatus(
+        station=name,
+        services=services,
+        samples_per_s=round(seen.samples / listened_s, 1) if listened_s > 0 else 0.0,
+        bus_samples_per_s=_bus_rate(seen.first_bus, seen.bus),
+        bus=_bus_health(seen.bus, seen.bus_received_ns, now_ns),
+        last_run=_last_run(seen.tool, last_sample, seen.summary),
+        last_decision=_last_decision(seen.decision, now_ns),
+        last_summary=_last_summary(seen.summary, now_ns),
+        recorder_lag_s=None,
+        unreadable_messages=unreadable,
+    )
+
+
+def _decode_sample(payload: bytes | None) -> Sample | None:
+    if payload is None:
+        return None
+    try:
+        return decode(Sample, payload)
+    except InputError:
+        return None
+
+
+def _bus_rate(first: BusStats | None, latest: BusStats | None) -> float | None:
+    """Samples per second the acquisition counted between two BusStats."""
+    if first is None or latest is None or latest.time_ns <= first.time_ns:
+        return None
+    if latest.samples < first.samples:  # the acquisition restarted in the window
+        return None
+    return round((latest.samples - first.samples) / ((latest.time_ns - first.time_ns) / _NS), 1)
+
+
+def _bus_health(stats: BusStats | None, received_ns: int, now_ns: int) -> BusHealth | None:
+    if stats is None:
+        return None
+    return BusHealth(
+        age_s=_age_s(received_ns, now_ns),
+        frames=stats.frames,
+        samples=stats.samples,
+        counter_gaps=stats.counter_gaps,
+        missed_samples=stats.missed_samples,
+        bad_frames=stats.wrong_length
+        + stats.decode_errors
+        + stats.error_frames
+        + stats.counter_faults,
+        unknown_ids=stats.unknown_ids,
+        receive_errors=stats.receive_errors,
+        unpaired=stats.unpaired,
+        orphans=stats.orphans,
+        stop_commands=stats.stop_commands,
+    )
+
+
+def _last_run(
+    tool: ToolState | None, sample: Sample | None, summary: RunSummary | None
+) -> LastRun | None:
+    if tool is not None:
+        return LastRun(tool.run_id, tool.state, tool.tool_id, tool.program_id, "tool")
+    if sample is not None:
+        return LastRun(sample.run_id, "running", None, None, "samples")
+    if summary is not None:
+        return LastRun(
+            summary.run_id, summary.tool_state, summary.tool_id, summary.program_id, "runs"
+        )
+    return None
+
+
+def _last_decision(decision: StopDecision | None, now_ns: int) -> LastDecision | None:
+    if decision is None:
+        return None
+    return LastDecision(
+        run_id=decision.run_id,
+        reason=decision.reason,
+        detail=decision.detail,
+        age_s=_age_s(decision.decided_ns, now_ns),
+    )
+
+
+def _last_summary(summary: RunSummary | None, now_ns: int) -> LastSummary | None:
+    if summary is None:
+        return None
+    target: float | None
+    reached: float | None
+    if summary.target_force_n is not None:
+        unit, target, reached = "N", summary.target_force_n, summary.reached_force_n
+    else:
+        unit, target, reached = "Nm", summary.target_torque_nm, summary.reached_torque_nm
+    return LastSummary(
+        run_id=summary.run_id,
+        unit=unit,
+        target=target,
+        reached=reached,
+        error_pct=summary.error_pct,
+        stop_reason=summary.stop_reason,
+        tool_state=summary.tool_state,
+        events=summary.events,
+        age_s=_age_s(summary.ended_ns, now_ns),
+    )
+
+
+def _age_s(then_ns: int, now_ns: int) -> float:
+    return round((now_ns - then_ns) / _NS, 3)
+
+
+# -- output ------------------------------------------------------------------------------
+
+
+def to_json(report: StatusReport) -> dict[str, Any]:
+    """The report as one JSON-ready object; stations keyed by id."""
+    return {
+        "endpoint": report.endpoint,
+        "listened_s": report.listened_s,
+        "stations": {
+            status.station: {
+                name: value
+                for name, value in dataclasses.asdict(status).items()
+                if name != "station"
+            }
+            for status in report.stations
+        },
+    }
+
+
+def format_report(report: StatusReport) -> str:
+    """The report for a person at a terminal: one block per station."""
+    lines = [f"connected to {report.endpoint}, listened {report.listened_s:.1f} s"]
+    if not report.stations:
+        lines.append(
+            "no station seen: no liveliness tokens and no messages under boltwatch/ "
+            "(is anything running? 'boltwatch up' starts the simulated station)"
+        )
+        return "\n".join(lines)
+    for status in report.stations:
+        lines.append("")
+        lines.extend(_station_lines(status))
+    return "\n".join(lines)
+
+
+_LABEL = 14
+
+
+def _station_lines(status: StationStatus) -> list[str]:
+    def line(label: str, text: str) -> str:
+        return f"  {label:<{_LABEL}}{text}"
+
+    services = ", ".join(
+        f"{name} {'up' if alive else 'DOWN'}" for name, alive in status.services.items()
+    )
+    rate = f"{status.samples_per_s:.0f} received"
+    if status.bus_samples_per_s is not None:
+        rate += f" (bus {status.bus_samples_per_s:.0f})"
+    out = [
+        f"station {status.station}",
+        line("services", services),
+        line("samples/s", rate),
+        line("bus", _bus_text(status.bus)),
+        line("last run", _run_text(status.last_run)),
+        line("last decision", _decision_text(status.last_decision)),
+        line("last summary", _summary_text(status.last_summary)),
+        line("recorder lag", "n/a (the recorder does not publish it yet)"),
+    ]
+    if status.unreadable_messages:
+        out.append(line("unreadable", f"{status.unreadable_messages} messages"))
+    return out
+
+
+def _bus_text(bus: BusHealth | None) -> str:
+    if bus is None:
+        return "- (no BusStats in the window: acquisition down?)"
+    return (
+        f"{bus.counter_gaps} gaps, {bus.missed_samples} missed samples, "
+        f"{bus.bad_frames} bad frames, {bus.receive_errors} receive errors "
+        f"({bus.frames} frames since start, {bus.age_s:.1f} s ago)"
+    )
+
+
+def _run_text(run: LastRun | None) -> str:
+    if run is None:
+        return "- (no tool state, sample or summary in the window)"
+    text = f"{run.run_id} {run.state}"
+    if run.tool_id is not None:
+        text += f" (tool {run.tool_id}, program {run.program_id})"
+    if run.source == "samples":
+        text += " (from samples)"
+    elif run.source == "runs":
+        text += " (from its summary)"
+    return text
+
+
+def _decision_text(decision: LastDecision | None) -> str:
+    if decision is None:
+        return "- (none in the window)"
+    return f"{decision.reason} for run {decision.run_id}, {decision.age_s:.1f} s ago"
+
+
+def _summary_text(summary: LastSummary | None) -> str:
+    if summary is None:
+        return "- (none in the window)"
+    error = "-" if summary.error_pct is None else f"{summary.error_pct:+.2f} %"
+    how = summary.stop_reason or f"tool stopped itself ({summary.tool_state})"
+    return (
+        f"run {summary.run_id}: {_amount(summary.reached, summary.unit)} of "
+        f"{_amount(summary.target, summary.unit)} target, error {error}, {how}, "
+        f"{summary.events} events, {summary.age_s:.1f} s ago"
+    )
+
+
+def _amount(value: float | None, unit: str) -> str:
+    if value is None:
+        return "-"
+    if unit == "N":
+        return f"{value / 1000:.2f} kN"
+    return f"{value:.1f} {unit}"
