@@ -125,6 +125,11 @@ class Acquisition:
             )
 
     def _tool_status(self, frame: ToolStatusFrame, time_ns: int) -> None:
+        try:
+            state_name = ToolRunState(frame.state).name.lower()
+        except ValueError:
+            self._rejected["bad_state"] += 1  # never let a corrupt state restart the run
+            return
         previous = self._tool
         if previous == frame:
             return
@@ -138,11 +143,6 @@ class Acquisition:
         if starts_run:
             self._assembler.start_run()
         self._tool = frame
-        try:
-            state_name = ToolRunState(frame.state).name.lower()
-        except ValueError:
-            self._rejected["bad_state"] += 1
-            return
         self._outlet.tool_state(
             ToolState(
                 self.station_id,

@@ -1,28 +1,88 @@
-"""A PNG of one recorded run: torque and force over time, detected peaks and plateaus.
+"""The post-mortem PNG of one recorded run: the paper's figures for that run.
 
-Like the paper's Figures 10-23: torque (Nm) on the left axis, preload force
-(N) on the right, each stick-slip event's peak torque T_max,j and plateau
-force F_j marked, the stop decision as a vertical line. Time counts from the
-run's first sample (``Sample.time_ns``, the same clock as the events').
+One page, a grid of panels, all over run time (s since the run's first
+sample, the clock of ``Sample.time_ns``):
+
+    row 1   torque with peaks T_max,j and the stop decision        Figure 10 (top)
+    row 2   preload force with plateaus F_j and the stop decision  Figure 10 (bottom)
+    row 3   f_ss, ΔF, ΔT per event                                 Figures 13-15 (top)
+    row 4   K1, K2, K3 per event                                   Figures 13-15 (bottom)
+    row 5   absolute prediction errors of T, F, t                  Figure 22
+    row 6   relative prediction errors, eqs. 61-63                 Figure 23
+
+With the joint (``joint`` metadata) and the motor speed (``program``) in the
+file, the analytical envelopes (Figure 10), bounds (eqs. 21-26) and K bands
+(eqs. 34-39) are drawn, at model time = run time + a shift anchored at the
+first plateau (:class:`~services.recorder.post_mortem_run.ModelClock`); the
+caption says so, and says when they are missing. matplotlib (Agg) is
+imported inside the functions: nothing at import time.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
-from services.recorder.recording_reader import RecordingScan
-from services.recorder.trace_export import SAMPLE_SCHEMA
-from shared.errors import InputError
+from services.recorder.post_mortem_errors import prediction_errors
+from services.recorder.post_mortem_panels import (
+    Bounds,
+    draw_constants,
+    draw_error_panels,
+    draw_event_figures,
+    draw_force,
+    draw_torque,
+)
+from services.recorder.post_mortem_run import RecordedRun, read_run
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+FIGSIZE_IN = (18.0, 25.0)
+DPI = 80
 
 
-def _decoded(scan: RecordingScan) -> dict[str, list[dict[str, Any]]]:
-    by_schema: dict[str, list[dict[str, Any]]] = {}
-    for schema, _, message in scan.messages():
-        if schema is not None:
-            by_schema.setdefault(schema.name, []).append(json.loads(message.data))
-    return by_schema
+def build_figure(run: RecordedRun) -> Figure:
+    """The report's figure of ``run`` (not drawn to a file; the caller closes it)."""
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=FIGSIZE_IN, dpi=DPI)
+    grid = figure.add_gridspec(6, 3, height_ratios=(1.4, 1.4, 1, 1, 1, 1), hspace=0.5, wspace=0.28)
+    bounds = Bounds.of(run)
+    draw_torque(figure.add_subplot(grid[0, :]), run, bounds)
+    force_axis = figure.add_subplot(grid[1, :])
+    draw_force(force_axis, run, bounds)
+    event_axes = [figure.add_subplot(grid[2, column]) for column in range(3)]
+    draw_event_figures(event_axes, run, bounds)
+    constant_axes = [figure.add_subplot(grid[3, column]) for column in range(3)]
+    draw_constants(constant_axes, run, bounds)
+    errors = prediction_errors(run.events)
+    absolute = [figure.add_subplot(grid[4, column]) for column in range(3)]
+    relative = [figure.add_subplot(grid[5, column]) for column in range(3)]
+    draw_error_panels(absolute, relative, run, errors)
+    for axis in figure.axes:
+        axis.grid(True, alpha=0.3)
+    figure.suptitle(_caption(run, bounds), fontsize=12, x=0.02, ha="left", y=0.997)
+    figure.subplots_adjust(left=0.05, right=0.95, top=0.95, bottom=0.03)
+    return figure
+
+
+def _caption(run: RecordedRun, bounds: Bounds) -> str:
+    state = "" if run.complete else "   DAMAGED FILE: its readable part only"
+    force = "" if run.has_force else ", torque only (no preload force measured)"
+    first = (
+        f"{run.source.name}: run {run.run_id}, {len(run.samples)} samples, "
+        f"{len(run.events)} stick-slip events{force}{state}"
+    )
+    if bounds.model is None or bounds.clock is None:
+        why = run.model_missing or "no event to anchor model time"
+        return f"{first}\nNo analytical bounds ({why}): measured values only."
+    joint = run.joint.name if run.joint is not None else "?"
+    return (
+        f"{first}\nBounds: analytical model (Baramsky et al. 2018, eqs. 21-26, 34-39) of "
+        f"'{joint}'\nat φ̇_m = {bounds.model.motor_speed_rad_s:g} rad/s; model time t = run time "
+        f"{bounds.clock.offset_s:+.3f} s, anchored at the first event's {bounds.clock.anchor} "
+        f"(Sec. 5.2 shifts by hand). Run time: s since the run's first sample."
+    )
 
 
 def plot_run(source: Path, target: Path, run_id: int | None = None) -> tuple[int, int]:
@@ -30,60 +90,8 @@ def plot_run(source: Path, target: Path, run_id: int | None = None) -> tuple[int
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
-    scan = RecordingScan(source)
-    decoded = _decoded(scan)
-    samples = decoded.get(SAMPLE_SCHEMA, [])
-    if run_id is None and samples:
-        run_id = max({s["run_id"] for s in samples}, key=[s["run_id"] for s in samples].count)
-    samples = [s for s in samples if s["run_id"] == run_id]
-    if not samples:
-        raise InputError(f"{source}: no samples to plot")
-    events = [e for e in decoded.get("boltwatch.StickSlipEvent", []) if e["run_id"] == run_id]
-    decisions = [d for d in decoded.get("boltwatch.StopDecision", []) if d["run_id"] == run_id]
-    t0_ns = samples[0]["time_ns"]
-
-    def seconds(time_ns: int) -> float:
-        return (time_ns - t0_ns) / 1e9
-
-    figure, torque_axis = plt.subplots(figsize=(10, 5), dpi=100)
-    time_s = [seconds(s["time_ns"]) for s in samples]
-    torque_axis.plot(time_s, [s["torque_nm"] for s in samples], color="tab:blue", lw=0.8)
-    torque_axis.set_xlabel("time since first sample (s)")
-    torque_axis.set_ylabel("torque (Nm)", color="tab:blue")
-    if events:
-        torque_axis.plot(
-            [seconds(e["time_ns"]) for e in events],
-            [e["peak_torque_nm"] for e in events],
-            "v",
-            color="tab:red",
-            label="peak torque T_max,j",
-        )
-    forces = [(t, s["force_n"]) for t, s in zip(time_s, samples, strict=True) if s["force_n"]]
-    if forces:
-        force_axis = torque_axis.twinx()
-        force_axis.plot(*zip(*forces, strict=True), color="tab:green", lw=0.8)
-        force_axis.set_ylabel("preload force (N)", color="tab:green")
-        plateaus = [e for e in events if e["plateau_force_n"] is not None]
-        if plateaus:
-            force_axis.plot(
-                [seconds(e["time_ns"]) for e in plateaus],
-                [e["plateau_force_n"] for e in plateaus],
-                "_",
-                ms=14,
-                mew=2,
-                color="black",
-                label="plateau F_j",
-            )
-            force_axis.legend(loc="lower right")
-    for decision in decisions:
-        torque_axis.axvline(seconds(decision["time_ns"]), color="gray", ls="--", lw=1)
-    if events:
-        torque_axis.legend(loc="upper left")
-    state = "" if scan.complete else " (damaged file: readable part)"
-    torque_axis.set_title(f"{source.name}: run {run_id}, {len(events)} stick-slip events{state}")
-    figure.tight_layout()
+    run = read_run(source, run_id)
+    figure = build_figure(run)
     figure.savefig(target)
-    plt.close(figure)
-    return len(samples), len(events)
+    return len(run.samples), len(run.events)

@@ -5,11 +5,18 @@ runs :class:`~services.rig.realtime.RealtimeRig` in a
 :class:`~shared.service_runtime.ServiceRunner` worker: ``--runs N`` exits 0
 after N runs, otherwise it runs until SIGINT/SIGTERM (the loop looks at the
 stop flag every sample period, so no wake is needed).
+
+Like every service, the rig holds the liveliness token
+``boltwatch/<station>/health/rig`` on a zenoh session opened from the station
+file, so ``boltwatch up`` and ``status`` see it. A rig on a ``virtual`` bus is
+the exception: that bus lives inside one process, no station service can
+reach the rig, so it announces nothing (and needs no zenoh: unit tests).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import threading
 import time
@@ -17,12 +24,14 @@ import time
 from services.rig.frames import RigFrames
 from services.rig.realtime import RealtimeRig, ToolIdentity
 from services.rig.selection import choose_program, choose_seed
+from shared import keys
 from shared.can_bus import open_bus
 from shared.can_database import StationDatabase
 from shared.config import load_station
 from shared.errors import ConfigError
 from shared.model.stiffness import JointConstants
 from shared.service_runtime import ServiceRunner
+from shared.zenoh_session import open_session
 
 LOG = logging.getLogger(__name__)
 
@@ -51,7 +60,12 @@ def main(args: argparse.Namespace) -> int:
         seed,
         args.runs if args.runs is not None else "until stopped",
     )
-    with open_bus(config.can) as bus:
+    with contextlib.ExitStack() as resources:
+        bus = resources.enter_context(open_bus(config.can))
+        if config.can.interface != "virtual":
+            session = resources.enter_context(open_session(config.zenoh))
+            token = session.liveliness().declare_token(keys.health_key(config.station.id, "rig"))
+            resources.callback(token.undeclare)
         rig = RealtimeRig(
             bus,
             frames,

@@ -6,14 +6,17 @@ import argparse
 from pathlib import Path
 
 NAME = "inspect"
-HELP = "plot a recorded run (torque, force, detected peaks and plateaus) as a PNG"
+HELP = "draw a recorded run as a post-mortem PNG of the paper's figures (10, 13-15, 22, 23)"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.description = (
-        "Draw torque and preload force over time of one run of an MCAP recording, with each "
-        "detected stick-slip peak and plateau and the stop decision, into a PNG. For "
-        "interactive viewing open the .mcap in Foxglove (it needs no plug-in)."
+        "Draw one run of an MCAP recording into a one-page PNG report after the paper's "
+        "figures: torque and preload with detected peaks, plateaus and the stop decision "
+        "(Fig. 10); f_ss, force step, torque drop and K1-K3 per event (Figs. 13-15); the "
+        "errors of the 1st-3rd predictions (Figs. 22, 23, eqs. 61-63). With the joint and "
+        "program metadata in the file, the analytical bounds are drawn too. For interactive "
+        "viewing open the .mcap in Foxglove (it needs no plug-in)."
     )
     parser.add_argument("recording", type=Path, metavar="RUN.mcap", help="the recording")
     parser.add_argument(

@@ -10,6 +10,8 @@ No zenoh, no clock: the same :class:`PredictorCore` serves the live service,
 - :mod:`.event_figures`      ΔT, ΔF, Δt, f_ss, K1-K3, I_j, I_process (eqs. 31-33, 66-68)
 - :mod:`.regression`         least-squares fits and next-event predictions (eqs. 52-56, 6.4)
 - :mod:`.scoring`            errors of past predictions (eqs. 57-63)
+- :mod:`.ramp_estimator`     where a steady ramp will be when the motor has stopped
+- :mod:`.screw_plateaus`     torque-only plateaus from the screw angle (eqs. 8, 9)
 - :mod:`.stop_policy`        when to stop and why (eqs. 64, 65, 70, 71, hard limits)
 - :mod:`.predictor_core`     the facade that joins them
 """

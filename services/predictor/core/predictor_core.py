@@ -29,6 +29,7 @@ from services.predictor.core.input_guard import InputGuard, InputReport
 from services.predictor.core.outputs import CoreDecision, CoreEvent
 from services.predictor.core.regression import predict_events
 from services.predictor.core.scoring import PredictionScores
+from services.predictor.core.screw_plateaus import ScrewPlateaus
 from services.predictor.core.settings import PredictorSettings
 from services.predictor.core.stop_policy import StopPolicy
 from shared.messages import Prediction
@@ -53,6 +54,7 @@ class PredictorCore:
         self._window = InclinationWindow(settings.window_samples)
         self._tracker = ExtremumTracker()
         self._forces = ForceHistory()
+        self._screw = ScrewPlateaus()
         self.policy = StopPolicy(settings)
         self.scores = PredictionScores()
         self._count = 0
@@ -180,8 +182,19 @@ class PredictorCore:
             predictions=predictions,
         )
         out: list[CoreOutput] = [event]
+        by_angle = None
+        if not settings.force_mode:
+            by_angle = self._screw.on_event(
+                peak.angle_deg, peak.torque_nm, trough.angle_deg, trough.torque_nm
+            )
         decision = self._decide_on_event(
-            now_s, torque_nm, plateau, force_now, predictions, (figures.k1, figures.k2, figures.k3)
+            now_s,
+            torque_nm,
+            plateau,
+            force_now,
+            predictions,
+            (figures.k1, figures.k2, figures.k3),
+            by_angle,
         )
         if decision is not None:
             out.append(decision)
@@ -195,8 +208,14 @@ class PredictorCore:
         force_now: float | None,
         predictions: list[Prediction],
         constants: tuple[float | None, float | None, float | None],
+        by_angle: tuple[float, float] | None = None,
     ) -> CoreDecision | None:
-        """The per-event stop rules, fed with plausible predictions only."""
+        """The per-event stop rules, fed with plausible predictions only.
+
+        Torque-only: the plateaus in torque units from the screw angle
+        (:mod:`.screw_plateaus`) when there are enough events for them, else
+        the line through the youngest peaks (Sec. 6.4).
+        """
         force_next = None
         if force_now is not None:
             step = None
@@ -209,7 +228,11 @@ class PredictorCore:
             if step is not None and step <= MAX_STEP_FRACTION * abs(force_now):
                 force_next = force_now + step
         peak_now = peak_next = None
-        if len(predictions) >= 2 and self._is_staircase():
+        if by_angle is not None and self._is_staircase(rising=False):
+            now, after = by_angle
+            if after - now <= MAX_STEP_FRACTION * now:
+                peak_now, peak_next = now, after
+        elif len(predictions) >= 2 and self._is_staircase():
             now, after = predictions[0].peak_torque_nm, predictions[1].peak_torque_nm
             if 0.0 < after - now <= MAX_STEP_FRACTION * abs(now):
                 peak_now, peak_next = now, after
@@ -224,14 +247,16 @@ class PredictorCore:
             constants,
         )
 
-    def _is_staircase(self) -> bool:
+    def _is_staircase(self, rising: bool = True) -> bool:
         """Regular stick-slip: the youngest STAIRCASE_EVENTS peaks rise one after the other.
 
         Wiggles of a joint without stick-slip (thread forming, noise) also make
         events now and then; their predicted peaks are no ground to stop on.
         """
         peaks = self._peaks[-STAIRCASE_EVENTS:]
-        return len(peaks) == STAIRCASE_EVENTS and all(b > a for a, b in itertools.pairwise(peaks))
+        if len(peaks) < STAIRCASE_EVENTS:
+            return False
+        return not rising or all(b > a for a, b in itertools.pairwise(peaks))
 
     def _remember(
         self, time_s: float, period_s: float | None, peak_nm: float, plateau_n: float | None

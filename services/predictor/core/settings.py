@@ -51,6 +51,7 @@ class PredictorSettings:
     plateau_method: PlateauMethod = "poly2"
     fault_samples: int = 100  # consecutive unusable samples before input_fault
     limit_samples: int = 2  # consecutive samples beyond a hard limit before stopping
+    reaction_samples: float = 1.0  # samples the motor still turns after the deciding sample
     constants: JointConstants | None = None  # the expected joint, when one is configured
 
     @property

@@ -7,7 +7,11 @@ Checked on every sample (O(1)):
 - target_reached: the measured force (torque on torque-only stations) at or
   above its target for :data:`TARGET_SAMPLES` samples in a row. This is the
   conventional stop, and it is what stops a joint without stick-slip; with
-  stick-slip the plateau rule below usually decides first.
+  stick-slip the plateau rule below usually decides first. On a steady ramp
+  (a joint sliding smoothly, or the torque of a long stick phase) the value
+  the motor will stop at is projected over the station's reaction
+  (:mod:`.ramp_estimator`), and the rule fires when that reaches the target:
+  waiting for the measurement would overshoot by the reaction's worth of ramp.
 
 Checked once per stick-slip event j (after its slip, on the new plateau):
 
@@ -31,6 +35,7 @@ import math
 from collections import deque
 
 from services.predictor.core.outputs import CoreDecision
+from services.predictor.core.ramp_estimator import RampEstimator
 from services.predictor.core.settings import PredictorSettings
 from shared.messages import StopReasonName
 
@@ -47,6 +52,8 @@ class StopPolicy:
         self._over_force = 0
         self._over_angle = 0
         self._over_target = 0
+        self._ramp = RampEstimator()
+        self._lead_samples = settings.reaction_samples + 0.5
         self._constants: tuple[deque[float], deque[float], deque[float]] = (
             deque(maxlen=settings.constant_window),
             deque(maxlen=settings.constant_window),
@@ -101,17 +108,26 @@ class StopPolicy:
                 time_s, "angle_limit", f"angle turned ≥ {self._max_angle:g}°", torque_nm, force_n
             )
         if self._target_force is not None:
-            over = force_n >= self._target_force
-            target, unit = self._target_force, "N force"
+            value, target, unit = force_n, self._target_force, "N force"
         elif self._target_torque is not None:
-            over = torque_nm >= self._target_torque
-            target, unit = self._target_torque, "Nm torque"
+            value, target, unit = torque_nm, self._target_torque, "Nm torque"
         else:
             return None
-        self._over_target = self._over_target + 1 if over else 0
+        self._ramp.add(value)
+        self._over_target = self._over_target + 1 if value >= target else 0
         if self._over_target >= TARGET_SAMPLES:
             return self._decide(
                 time_s, "target_reached", f"{unit} ≥ target {target:g}", torque_nm, force_n
+            )
+        projected = self._ramp.projected(self._lead_samples)
+        if projected >= target:
+            return self._decide(
+                time_s,
+                "target_reached",
+                f"ramp projected to {projected:.5g} {unit} at the halt ≥ target {target:g}",
+                torque_nm,
+                force_n,
+                projected,
             )
         return None
 

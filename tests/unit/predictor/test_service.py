@@ -7,6 +7,7 @@ import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 import zenoh
@@ -101,6 +102,15 @@ def wait_for_token(session: zenoh.Session, key: str) -> None:
     raise AssertionError(f"no liveliness token {key}")
 
 
+def wait_for_subscriber(publisher: zenoh.Publisher) -> None:
+    for _ in range(200):
+        status: Any = publisher.matching_status  # stubs say bool; it is a MatchingStatus
+        if status.matching:
+            return
+        time.sleep(0.02)
+    raise AssertionError(f"no subscriber for {publisher.key_expr}")
+
+
 def test_service_publishes_events_decision_and_summary(
     service: PredictorService, endpoint: str
 ) -> None:
@@ -113,6 +123,8 @@ def test_service_publishes_events_decision_and_summary(
         tool = session.declare_publisher(keys.station_key("pt1", keys.TOOL))
         samples = session.declare_publisher(keys.station_key("pt1", keys.SAMPLES))
         start_ns = 1_700_000_000_000_000_000
+        for publisher in (tool, samples):  # the predictor's subscriber must be known here
+            wait_for_subscriber(publisher)
 
         def state(name: str, at_ns: int) -> bytes:
             return codec.encode(ToolState("pt1", 42, 3, 1, name, at_ns))  # type: ignore[arg-type]

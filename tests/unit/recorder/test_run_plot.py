@@ -3,14 +3,21 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 from services.cli.main import main
+from services.recorder.file_metadata import flatten
 from services.recorder.incoming import classify
 from services.recorder.mcap_sink import McapSink
+from services.recorder.post_mortem_errors import prediction_errors
+from services.recorder.post_mortem_panels import plateau_bars
+from services.recorder.post_mortem_run import read_run
+from services.recorder.run_plot import build_figure
 from shared.codec import encode
-from shared.messages import Sample, StickSlipEvent, StopDecision
+from shared.config.joint import load_joint
+from shared.messages import Prediction, Sample, StickSlipEvent, StopDecision
 
 T0_NS = 1_700_000_000_000_000_000
 MS_NS = 1_000_000
@@ -35,3 +42,102 @@ def test_inspect_writes_a_png(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     png = tmp_path / "run1.png"
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "200 samples, 3 stick-slip events" in capsys.readouterr().out
+
+
+JOINT_FILE = Path(__file__).resolve().parents[3] / "config" / "joints" / "paper-section-5-2.toml"
+PEAKS = (100, 130, 158, 184, 208)  # sample numbers of the stick-slip peaks
+
+
+def _synthetic_run(path: Path, *, with_force: bool, metadata: dict[str, dict[str, str]]) -> Path:
+    """A run of 250 samples whose peaks at PEAKS carry 1st-3rd predictions of the next ones."""
+    with McapSink(path, metadata, 1, T0_NS) as sink:
+        for n in range(250):
+            force = 1e4 + n * 40.0 if with_force else None
+            sample = Sample("st1", 1, n, T0_NS + n * MS_NS, 40.0 + n * 0.3, n * 0.03, force)
+            sink.write(classify("boltwatch/st1/samples", encode(sample), T0_NS + n * MS_NS))
+        for j, n in enumerate(PEAKS, start=1):
+            period = None if j == 1 else (n - PEAKS[j - 2]) / 1e3
+            later = [
+                Prediction(h, PEAKS[j - 1 + h] / 1e3 + 0.001, 40.0 + PEAKS[j - 1 + h] * 0.3 - 0.5,
+                           1e4 + PEAKS[j - 1 + h] * 40.0 - 100.0 if with_force else None)
+                for h in (1, 2, 3) if j - 1 + h < len(PEAKS)
+            ]  # fmt: skip
+            plateau = 1e4 + (n - 10) * 40.0 if with_force else None
+            event = StickSlipEvent(
+                "st1", 1, j, T0_NS + n * MS_NS, n / 1e3, 40.0 + n * 0.3, 38.0 + n * 0.3, 2.0,
+                plateau, 800.0 if with_force and j > 1 else None, period,
+                1 / period if period else None, 3.0 if period else None, 1e4 if period else None,
+                5.0, 1.0, 1.0, later,
+            )  # fmt: skip
+            sink.write(classify("boltwatch/st1/events", encode(event), T0_NS + n * MS_NS))
+        decision = StopDecision(
+            "st1", 1, T0_NS + 230 * MS_NS, 0.23, "plateau_closest", "", 109.0, 1.9e4, None, 0
+        )
+        sink.write(classify("boltwatch/st1/decision", encode(decision), T0_NS + 230 * MS_NS))
+    return path
+
+
+PANEL_TITLES = (
+    "Fig. 10 (top)",
+    "Fig. 10 (bottom)",
+    "Fig. 13",
+    "Fig. 14",
+    "Fig. 15",
+    "K1",
+    "K2",
+    "K3",
+    "Fig. 22: prediction error, peak torque",
+    "Fig. 22: prediction error, plateau force",
+    "Fig. 22: prediction error, time",
+    "Fig. 23: relative prediction error, peak torque",
+    "Fig. 23: relative prediction error, plateau force",
+    "Fig. 23: relative prediction error, time",
+)
+
+
+def _titles(figure: Any) -> list[str]:
+    return [axis.get_title() for axis in figure.axes]
+
+
+def test_report_has_the_papers_panels_with_bounds(tmp_path: Path) -> None:
+    joint = flatten(load_joint(JOINT_FILE).model_dump(mode="json"))
+    metadata = {"joint": joint, "program": {"motor_speed_rad_s": "0.5", "target_force_n": "2e4"}}
+    run = read_run(_synthetic_run(tmp_path / "run.mcap", with_force=True, metadata=metadata))
+    figure = build_figure(run)
+    titles = _titles(figure)
+    assert len(titles) == len(PANEL_TITLES)
+    for expected, title in zip(PANEL_TITLES, titles, strict=True):
+        assert title.startswith(expected)
+    caption = figure.get_suptitle()
+    assert "model time t = run time" in caption and "t(F_1 = 13.6 kN)" in caption
+    torque_labels = figure.axes[0].get_legend_handles_labels()[1]
+    assert any(label.startswith("T_max") for label in torque_labels)
+    # each 1st/2nd/3rd prediction that a later event can be checked against, eqs. 61-63
+    errors = prediction_errors(run.events)
+    assert [(e.horizon, e.index) for e in errors] == [
+        (1, 2), (1, 3), (1, 4), (1, 5), (2, 3), (2, 4), (2, 5), (3, 4), (3, 5),
+    ]  # fmt: skip
+    first = errors[0]
+    assert first.time_error_s == pytest.approx(0.001)
+    assert first.torque_error_nm == pytest.approx(0.5)
+    assert first.relative_time == pytest.approx(0.001 / 0.030)
+
+
+def test_plateaus_span_the_stick_phase_before_their_peak(tmp_path: Path) -> None:
+    run = read_run(_synthetic_run(tmp_path / "run.mcap", with_force=True, metadata={}))
+    bars = plateau_bars(run)
+    assert [(round(start, 3), round(end, 3)) for _, start, end in bars] == [
+        (0.07, 0.1), (0.1, 0.13), (0.13, 0.158), (0.158, 0.184), (0.184, 0.208),
+    ]  # fmt: skip
+    assert bars[1][0] == pytest.approx(1e4 + 120 * 40.0)
+
+
+def test_torque_only_run_without_metadata_says_there_are_no_bounds(tmp_path: Path) -> None:
+    run = read_run(_synthetic_run(tmp_path / "run.mcap", with_force=False, metadata={}))
+    figure = build_figure(run)
+    assert len(_titles(figure)) == len(PANEL_TITLES)
+    caption = figure.get_suptitle()
+    assert "No analytical bounds (no joint metadata" in caption
+    assert "torque only" in caption
+    notes = [text.get_text() for text in figure.axes[1].texts]
+    assert notes == ["no preload force in this run (torque-only recording)"]
