@@ -4,10 +4,41 @@ from __future__ import annotations
 
 import argparse
 
+DEFAULT_RERUN_GRPC_PORT = 9876
+DEFAULT_RERUN_WEB_PORT = 9090
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The recorder takes everything from the station file (``--config``); nothing more."""
+    """Everything comes from the station file (``--config``) except the Rerun options."""
     parser.epilog = (
-        "Writes one MCAP file per run under <recorder.folder>/<station>/<YYYY-MM-DD>/ "
-        "and keeps the wear ledger <recorder.folder>/wear.sqlite."
+        "Writes one MCAP file per run under <recorder.folder>/<station>/<YYYY-MM-DD>/, "
+        "a Rerun .rrd beside each (same name), and keeps the wear ledger "
+        "<recorder.folder>/wear.sqlite."
+    )
+    rerun = parser.add_argument_group("Rerun")
+    rerun.add_argument(
+        "--no-rerun", action="store_true", help="write MCAP only, no .rrd beside each run file"
+    )
+    rerun.add_argument(
+        "--rerun-serve",
+        action="store_true",
+        help="also stream every run live to a Rerun gRPC server "
+        "(view it: rerun rerun+http://HOST:PORT/proxy)",
+    )
+    rerun.add_argument(
+        "--rerun-web",
+        action="store_true",
+        help="also serve the Rerun web viewer from the installed wheel (implies --rerun-serve)",
+    )
+    rerun.add_argument(
+        "--rerun-port",
+        type=int,
+        default=DEFAULT_RERUN_GRPC_PORT,
+        help=f"gRPC port of --rerun-serve (default {DEFAULT_RERUN_GRPC_PORT})",
+    )
+    rerun.add_argument(
+        "--rerun-web-port",
+        type=int,
+        default=DEFAULT_RERUN_WEB_PORT,
+        help=f"HTTP port of --rerun-web (default {DEFAULT_RERUN_WEB_PORT})",
     )

@@ -11,10 +11,14 @@ from __future__ import annotations
 import logging
 from collections import Counter
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from services.recorder.file_metadata import FileMetadata
 from services.recorder.incoming import Received
 from services.recorder.run_files import FileLimits, StationFiles
+
+if TYPE_CHECKING:
+    from services.recorder.rerun_sink import RerunOptions
 
 LOG = logging.getLogger(__name__)
 
@@ -22,8 +26,15 @@ LOG = logging.getLogger(__name__)
 class Recorder:
     """File every received payload into its station's run files."""
 
-    def __init__(self, folder: Path, limits: FileLimits, metadata: FileMetadata) -> None:
+    def __init__(
+        self,
+        folder: Path,
+        limits: FileLimits,
+        metadata: FileMetadata,
+        rerun: RerunOptions | None = None,
+    ) -> None:
         self._folder = folder
+        self._rerun = rerun
         self._limits = limits
         self._metadata = metadata
         self._stations: dict[str, StationFiles] = {}
@@ -34,7 +45,9 @@ class Recorder:
     def write(self, received: Received) -> None:
         files = self._stations.get(received.station)
         if files is None:
-            files = StationFiles(received.station, self._folder, self._limits, self._metadata)
+            files = StationFiles(
+                received.station, self._folder, self._limits, self._metadata, self._rerun
+            )
             self._stations[received.station] = files
         if not received.decodable:
             self._count(self.undecodable, received, "does not decode as %s")

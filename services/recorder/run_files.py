@@ -12,6 +12,10 @@ A file that reaches ``max_file_bytes`` or ``max_file_duration_s`` (a run that
 never ends) continues in ``..._part<N>.mcap``. After a rotation the previous
 run's file stays open for ``late_grace_s`` so late messages carrying its
 run id (a RunSummary racing the next run's start) still land in it.
+
+With ``rerun`` options each run file (not the idle ones) has a companion
+:class:`RerunSink` writing ``<same stem>.rrd``; it receives what its MCAP
+file receives, is flushed and closed with it, and never stops the MCAP file.
 """
 
 from __future__ import annotations
@@ -21,10 +25,14 @@ import re
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from services.recorder.file_metadata import FileMetadata
 from services.recorder.incoming import Received
 from services.recorder.mcap_sink import McapSink
+
+if TYPE_CHECKING:  # rerun is imported only when .rrd files are wanted
+    from services.recorder.rerun_sink import RerunOptions, RerunSink
 
 LOG = logging.getLogger(__name__)
 
@@ -65,7 +73,12 @@ class StationFiles:
     """Route one station's payloads into its run files; flush and rotate them."""
 
     def __init__(
-        self, station: str, folder: Path, limits: FileLimits, metadata: FileMetadata
+        self,
+        station: str,
+        folder: Path,
+        limits: FileLimits,
+        metadata: FileMetadata,
+        rerun: RerunOptions | None = None,
     ) -> None:
         self.station = station
         self._folder = folder
@@ -80,12 +93,16 @@ class StationFiles:
         self._program_id: int | None = None
         self._last_flush_ns = 0
         self.closed_paths: list[Path] = []
+        self._rerun = rerun
+        self._rerun_sinks: dict[McapSink, RerunSink] = {}
+        self._run_started: tuple[int | None, int] = (None, 0)  # (run_id, ToolState time_ns)
 
     def write(self, received: Received) -> None:
         now_ns = received.log_time_ns
         if received.run_started and self._is_new_run(received.run_id):
             self._tool_id = received.message.tool_id
             self._program_id = received.message.program_id
+            self._run_started = (received.run_id, received.message.time_ns)
             self._start_run(received.run_id, now_ns)
         elif self.current is None:
             self._open(received.run_id, now_ns, part=1)
@@ -98,6 +115,9 @@ class StationFiles:
         if previous is not None and run_id is not None and run_id == previous.run_id != sink.run_id:
             sink = previous
         sink.write(received)
+        companion = self._rerun_sinks.get(sink)
+        if companion is not None:
+            companion.write(received)
         if sink is self.current and received.schema_name == "boltwatch.ToolState":
             self._run_ended = received.message.state in _ENDED_STATES
         if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
@@ -115,6 +135,9 @@ class StationFiles:
         for sink in (self.current, self.previous):
             if sink is not None:
                 sink.flush()
+                companion = self._rerun_sinks.get(sink)
+                if companion is not None:
+                    companion.flush()
         self._last_flush_ns = now_ns
 
     def close(self) -> None:
@@ -162,9 +185,28 @@ class StationFiles:
             path, metadata, run_id, now_ns, library=f"boltwatch {self._metadata.version}"
         )
         LOG.debug("opened %s", path)
+        if self._rerun is not None and run_id is not None:
+            self._open_rerun(path, run_id, now_ns, self._rerun)
+
+    def _open_rerun(self, path: Path, run_id: int, now_ns: int, options: RerunOptions) -> None:
+        try:
+            from services.recorder.rerun_sink import open_rerun_sink
+        except ImportError:
+            LOG.exception("Rerun is unusable; recording MCAP only from now on")
+            self._rerun = None
+            return
+        started_run, started_ns = self._run_started
+        if started_run != run_id:  # joined mid-run: the run's start is unknown
+            started_ns = now_ns
+        companion = open_rerun_sink(path, self.station, run_id, started_ns, options)
+        if companion is not None and self.current is not None:
+            self._rerun_sinks[self.current] = companion
 
     def _close(self, sink: McapSink) -> None:
         try:
             sink.close()
         finally:
             self.closed_paths.append(sink.path)
+            companion = self._rerun_sinks.pop(sink, None)
+            if companion is not None:
+                companion.close()  # never raises: a Rerun failure is logged, not fatal

@@ -7,6 +7,11 @@ keys drive it without leaving the process: ``boltwatch/_local/wake`` (stop
 now) and ``boltwatch/_local/tick`` (put every half flush interval so files
 are flushed even when the line is quiet). On SIGTERM the channel is drained
 and every file finished, so it is readable without recovery.
+
+Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
+``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
+(:class:`services.recorder.rerun_sink.RerunLive`). Rerun failing never stops
+the MCAP recording: it is logged and the recorder goes on without it.
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ import json
 import logging
 import threading
 import time
+from typing import TYPE_CHECKING
 
 import zenoh
 
@@ -31,6 +37,9 @@ from shared.codec import encode
 from shared.config import LoadedStation, load_station
 from shared.service_runtime import ServiceRunner
 from shared.zenoh_session import open_session
+
+if TYPE_CHECKING:
+    from services.recorder.rerun_sink import RerunLive, RerunOptions
 
 LOG = logging.getLogger(__name__)
 
@@ -52,10 +61,19 @@ def limits_of(loaded: LoadedStation) -> FileLimits:
 class RecorderService:
     """The recorder wired to one zenoh session (which the caller opens and closes)."""
 
-    def __init__(self, loaded: LoadedStation, session: zenoh.Session) -> None:
+    def __init__(
+        self,
+        loaded: LoadedStation,
+        session: zenoh.Session,
+        rerun_files: bool = True,
+        rerun_live_url: str | None = None,
+    ) -> None:
         self._session = session
         self._tick_s = loaded.config.recorder.flush_interval_s / 2
-        self.recorder = Recorder(loaded.recordings_folder, limits_of(loaded), FileMetadata(loaded))
+        rerun = rerun_options(rerun_live_url) if rerun_files else None
+        self.recorder = Recorder(
+            loaded.recordings_folder, limits_of(loaded), FileMetadata(loaded), rerun
+        )
         self._station_id = loaded.station_id
         self._ledger_file = ledger_path(loaded.recordings_folder)
         self.wear = WearWatch(
@@ -140,14 +158,46 @@ class RecorderService:
             LOG.debug("local put on %s failed: %s", key, err)
 
 
+def rerun_options(live_url: str | None) -> RerunOptions | None:
+    """Options of the per-run .rrd files; None (logged) when Rerun cannot be imported."""
+    try:
+        from services.recorder.rerun_sink import RerunOptions
+    except ImportError:
+        LOG.exception("Rerun is unusable; recording MCAP only")
+        return None
+    return RerunOptions(live_url=live_url)
+
+
+def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
+    """The live Rerun server (and web viewer) when asked for; None when off or failing."""
+    web = bool(getattr(args, "rerun_web", False))
+    if not (web or getattr(args, "rerun_serve", False)):
+        return None
+    try:
+        from services.recorder.rerun_sink import RerunLive
+
+        return RerunLive(args.rerun_port, args.rerun_web_port if web else None)
+    except Exception:
+        LOG.exception("cannot start the Rerun live view; recording goes on without it")
+        return None
+
+
 def main(args: argparse.Namespace) -> int:
     loaded = load_station(args.config)
     session = open_session(loaded.config.zenoh)
+    live = start_rerun_live(args)
     try:
-        service = RecorderService(loaded, session)
+        service = RecorderService(
+            loaded,
+            session,
+            rerun_files=not getattr(args, "no_rerun", False),
+            rerun_live_url=live.url if live is not None else None,
+        )
         try:
             return ServiceRunner("recorder", service.work, service.wake).run()
         finally:
             service.close()
     finally:
         session.close()
+        if live is not None:
+            live.close()

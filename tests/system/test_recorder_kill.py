@@ -153,3 +153,5 @@ def test_sigterm_leaves_a_complete_file(
         assert summary.statistics.channel_message_counts[sample_channels[0]] == sent
     scan = RecordingScan(path)
     assert len(recorded_sequences(scan)) == sent and scan.complete
+    verify = [str(Path(sys.executable).parent / "rerun"), "rrd", "verify"]
+    assert subprocess.run([*verify, str(path.with_suffix(".rrd"))], check=False).returncode == 0

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -135,6 +137,10 @@ def test_a_run_becomes_one_decodable_mcap_file(
 
     files = recorded_files(station)
     assert [f.name.split("_")[1] for f in files] == ["run1", "run2"]
+    rerun_verify = [str(Path(sys.executable).parent / "rerun"), "rrd", "verify"]
+    for mcap in files:  # the Rerun recording beside each run file (test_rerun_sink.py)
+        rrd = str(mcap.with_suffix(".rrd"))
+        assert subprocess.run([*rerun_verify, rrd], check=False).returncode == 0
     assert files[0].parent.name.count("-") == 2  # <YYYY-MM-DD>
     with files[0].open("rb") as handle:
         reader = make_reader(handle, decoder_factories=[JsonDecoderFactory()])
