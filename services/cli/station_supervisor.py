@@ -17,10 +17,24 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 LOG = logging.getLogger(__name__)
 
 STOP_GRACE_S = 8.0
+
+
+def stop_process(process: subprocess.Popen[Any], grace_s: float = STOP_GRACE_S) -> int | None:
+    """SIGTERM, wait up to ``grace_s``, then SIGKILL; returns the exit code."""
+    if process.poll() is None:
+        process.send_signal(signal.SIGTERM)
+        try:
+            process.wait(grace_s)
+        except subprocess.TimeoutExpired:
+            LOG.warning("pid %d did not stop within %.0f s: killed", process.pid, grace_s)
+            process.kill()
+            process.wait()
+    return process.poll()
 
 
 @dataclass
@@ -88,16 +102,8 @@ class StationSupervisor:
         return [p for p in self.processes if p.name not in expected and p.exit_code() is not None]
 
     def stop(self, managed: ManagedProcess, grace_s: float = STOP_GRACE_S) -> int | None:
-        """SIGTERM, wait up to ``grace_s``, then SIGKILL; returns the exit code."""
-        if managed.exit_code() is None:
-            managed.process.send_signal(signal.SIGTERM)
-            try:
-                managed.process.wait(grace_s)
-            except subprocess.TimeoutExpired:
-                LOG.warning("%s did not stop within %.0f s: killed", managed.name, grace_s)
-                managed.process.kill()
-                managed.process.wait()
-        return managed.exit_code()
+        """Stop one process (see :func:`stop_process`); returns the exit code."""
+        return stop_process(managed.process, grace_s)
 
     def stop_all(self, order: Sequence[str] | None = None) -> None:
         """Stop every process: those named in ``order`` first, in that order, then the rest

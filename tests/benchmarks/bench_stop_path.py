@@ -45,6 +45,7 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
+from services.cli.station_supervisor import stop_process  # noqa: E402
 from shared import keys  # noqa: E402
 from shared.can_database import StationDatabase  # noqa: E402
 from shared.codec import decode  # noqa: E402
@@ -219,13 +220,7 @@ def run(runs: int, folder: Path) -> int:
             stops = listener.heard
     finally:
         for process in reversed(processes):
-            if process.poll() is None:
-                process.terminate()
-                try:
-                    process.wait(10)
-                except subprocess.TimeoutExpired:
-                    process.kill()
-                    process.wait(5)
+            stop_process(process, grace_s=10.0)
 
     with heard.lock:
         rows, notes = figures(heard, stops)

@@ -10,13 +10,8 @@ import signal
 import socket
 from pathlib import Path
 
+from services.recorder.testing import free_port as free_tcp_port
 from tests.paths import CONFIG, STATION_FILE
-
-
-def free_tcp_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
 
 
 def free_udp_port() -> int:

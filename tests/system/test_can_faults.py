@@ -26,6 +26,7 @@ from pathlib import Path
 import pytest
 import zenoh
 
+from services.cli.station_supervisor import stop_process
 from shared import keys
 from shared.can_database import StationDatabase
 from shared.codec import decode, encode
@@ -149,13 +150,7 @@ def station(tmp_path: Path) -> Iterator[Station]:
         )
     finally:
         for process in reversed(processes):
-            if process.poll() is None:
-                process.terminate()
-                try:
-                    process.wait(10)
-                except subprocess.TimeoutExpired:
-                    process.kill()
-                    process.wait(5)
+            stop_process(process, grace_s=10.0)
 
 
 @dataclass

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import socket
 import threading
 import time
 from collections.abc import Iterator
@@ -13,6 +12,7 @@ import pytest
 import zenoh
 
 from services.predictor.service import PredictorService
+from services.recorder.testing import free_port
 from shared import codec, keys
 from shared.config import LoadedStation, load_station
 from shared.messages import (
@@ -28,12 +28,6 @@ from tests.unit.predictor.synthetic import staircase
 
 REPO = Path(__file__).resolve().parents[3]
 TARGET_N = 30_400.0
-
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
 
 
 @pytest.fixture
