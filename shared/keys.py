@@ -12,12 +12,13 @@ key                        publisher                    payload (see :mod:`share
 ``intensity``              predictor                    :class:`Intensity`
 ``decision``               predictor                    :class:`StopDecision`
 ``runs``                   predictor                    :class:`RunSummary`, one per run
+``recorder``               recorder                     :class:`RecorderStats`, once a second
 ``wear``                   recorder (queryable)         wear ledger rows
 ``health/<service>``       every service (liveliness)   -
 =========================  ===========================  =================================
 
-``tool`` and ``bus`` are additions to DESIGN.md's list: services need run
-boundaries and bus fault counters, and those are neither samples nor runs.
+``tool``, ``bus`` and ``recorder`` are additions to DESIGN.md's list: services need run
+boundaries, bus fault counters and recorder health, and those are neither samples nor runs.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ EVENTS = "events"
 INTENSITY = "intensity"
 DECISION = "decision"
 RUNS = "runs"
+RECORDER = "recorder"
 WEAR = "wear"
 HEALTH = "health"
 

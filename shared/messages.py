@@ -95,6 +95,7 @@ class BusStats:
     unpaired: int  # ToolSensors published without a JointSensors partner
     orphans: int  # JointSensors dropped: no ToolSensors partner in time
     stop_commands: int
+    unsent_samples: int = 0  # published while the session had no router: lost, counted
 
 
 @dataclass(frozen=True, slots=True)
@@ -180,6 +181,20 @@ class RunSummary:
     ended_ns: int
 
 
+@dataclass(frozen=True, slots=True)
+class RecorderStats:
+    """The recorder's view of one station, once a second: is it keeping up and writing?"""
+
+    station: str
+    time_ns: int
+    messages: int  # messages of this station written since the recorder started
+    lag_p50_ms: float | None  # receive time minus acquisition time of samples, last second
+    lag_max_ms: float | None
+    write_errors: int  # failed writes (disk full, read-only folder, ...) since start
+    last_error: str | None  # the newest write error, None when writing is healthy
+    recording: bool  # False while the recordings folder cannot be written
+
+
 #: Registry name of each message type: MCAP schema names and documentation.
 MESSAGE_TYPES: dict[str, type] = {
     f"boltwatch.{cls.__name__}": cls
@@ -191,5 +206,6 @@ MESSAGE_TYPES: dict[str, type] = {
         Intensity,
         StopDecision,
         RunSummary,
+        RecorderStats,
     )
 }

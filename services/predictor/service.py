@@ -160,7 +160,7 @@ class PredictorService:
 
 def main(args: argparse.Namespace) -> int:
     """Load the station file once, open the session, serve until a signal."""
-    station = load_station(args.config)
+    station = load_station(args.config[0])  # TODO(multi-station)
     with (
         open_session(station.config.zenoh) as session,
         PredictorService(session, station) as service,

@@ -183,7 +183,7 @@ def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
 
 
 def main(args: argparse.Namespace) -> int:
-    loaded = load_station(args.config)
+    loaded = load_station(args.config[0])  # TODO(multi-station)
     session = open_session(loaded.config.zenoh)
     live = start_rerun_live(args)
     try:

@@ -39,8 +39,10 @@ def test_command_is_a_valid_boltwatch_command(name: str) -> None:
         source = volume.split(":")[0]
         assert (REPO / source).exists(), f"{name}: mounted {source} does not exist"
     if name != "router":
-        station = load_station(host_path(str(args.config), service["volumes"]))
-        assert station.config.zenoh.connect == ["tcp/router:7447"]
+        files = args.config if isinstance(args.config, list) else [args.config]
+        for file in files:
+            station = load_station(host_path(str(file), service["volumes"]))
+            assert station.config.zenoh.connect == ["tcp/router:7447"]
     for dependency in service.get("depends_on", []):
         assert dependency in SERVICES
 

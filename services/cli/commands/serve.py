@@ -3,7 +3,9 @@
 Each service package ``services/<name>/`` provides ``arguments.py`` with
 ``add_arguments(parser)`` (light: no heavy imports, so ``--help`` is fast) and
 ``service.py`` with ``main(args) -> int``, which loads the station file named
-by ``args.config`` once and passes it down.
+by ``args.config`` once and passes it down. The predictor and the recorder
+take several station files (``args.config`` is then a list): one process
+serves every station named.
 """
 
 from __future__ import annotations
@@ -24,6 +26,9 @@ SERVICES = {
     "router": "services.router",
 }
 
+#: services of the line that one process runs for several stations (``--config A B ...``)
+MULTI_STATION = ("predictor", "recorder")
+
 SERVICE_HELP = {
     "rig": "the simulated tool controller and sensors on the CAN bus",
     "acquisition": "CAN frames in, samples out on zenoh, stop decisions back to CAN",
@@ -37,7 +42,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     services = parser.add_subparsers(dest="service", metavar="SERVICE", required=True)
     for name, package in SERVICES.items():
         sub = services.add_parser(name, help=SERVICE_HELP[name], description=SERVICE_HELP[name])
-        if name != "router":
+        if name in MULTI_STATION:
+            sub.add_argument(
+                "--config",
+                type=Path,
+                nargs="+",
+                default=[Path("config/station.toml")],
+                metavar="FILE",
+                help="station file(s): one process serves every station named "
+                "(default: config/station.toml)",
+            )
+        elif name != "router":
             sub.add_argument(
                 "--config",
                 type=Path,
