@@ -9,6 +9,7 @@ everywhere.
 from __future__ import annotations
 
 import logging
+import socket
 from typing import Any
 
 import can
@@ -17,6 +18,12 @@ from shared.config.station import CanSection
 from shared.errors import TransportError
 
 LOG = logging.getLogger(__name__)
+
+#: Receive buffer asked for on a ``udp_multicast`` bus: the kernel's default
+#: (about 200 KiB, some 270 frames, 0.1 s at 1 kHz) loses samples whenever the
+#: acquisition is descheduled that long on a busy box; 4 MiB rides out
+#: seconds. The kernel caps it at ``net.core.rmem_max``.
+UDP_RECEIVE_BUFFER_BYTES = 4 * 1024 * 1024
 
 
 def open_bus(section: CanSection, *, receive_own_messages: bool = False) -> can.BusABC:
@@ -36,5 +43,21 @@ def open_bus(section: CanSection, *, receive_own_messages: bool = False) -> can.
         raise TransportError(
             f"cannot open CAN bus {section.interface}:{section.channel}: {err}"
         ) from err
+    if section.interface == "udp_multicast":
+        _enlarge_receive_buffer(bus)
     LOG.info("CAN bus open: %s %s", section.interface, section.channel)
     return bus
+
+
+def _enlarge_receive_buffer(bus: can.BusABC) -> None:
+    """Ask for :data:`UDP_RECEIVE_BUFFER_BYTES` on the bus's socket; log what was granted."""
+    view = socket.socket(fileno=bus.fileno())  # the bus's own socket, not a new one
+    try:
+        view.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, UDP_RECEIVE_BUFFER_BYTES)
+        granted = view.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+    except OSError as err:
+        LOG.warning("cannot enlarge the CAN socket's receive buffer: %s", err)
+        return
+    finally:
+        view.detach()  # the bus owns the descriptor
+    LOG.info("CAN socket receive buffer: %d KiB", granted // 1024)

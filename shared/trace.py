@@ -2,13 +2,15 @@
 
 ``force_n`` may be empty (torque-only stations, imported controller runs).
 This is what ``boltwatch predict`` reads, what ``boltwatch simulate`` and
-``boltwatch export`` write. Reading is strict: a bad header, a non-number or a
-missing column is an InputError that names the file and the line.
+``boltwatch export`` write. Reading is strict: an empty file, a bad header, a
+non-number (or nan/inf), a missing column or a last line cut off is an
+InputError that names the file, the line and the column.
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -44,49 +46,67 @@ class Trace:
 
 def read_trace(path: Path) -> Trace:
     """Read a CSV trace; any malformed line is an InputError naming file and line."""
+    text = _read_text(Path(path))
+    if not text.strip():
+        raise InputError(f"{path}: empty file (expected the header {','.join(HEADER)})")
+    last_line = text.count("\n") + (0 if text.endswith("\n") else 1)
+    cut_off = not text.endswith(("\n", "\r"))
     columns: list[list[float]] = [[], [], [], []]
-    try:
-        with Path(path).open(newline="") as handle:
-            reader = csv.reader(handle)
-            header = next(reader, None)
-            if header is None or tuple(h.strip() for h in header) != HEADER:
+    reader = csv.reader(io.StringIO(text, newline=""))
+    header = next(reader)
+    if tuple(h.strip() for h in header) != HEADER:
+        raise InputError(
+            f"{path}: line 1: expected the header {','.join(HEADER)}, got {','.join(header)!r}"
+        )
+    for row in reader:
+        line_number = reader.line_num
+        if not row:
+            continue
+        if len(row) != len(HEADER):
+            where = f"{path}: line {line_number}"
+            if cut_off and line_number == last_line and len(row) < len(HEADER):
                 raise InputError(
-                    f"{path}: line 1: expected header {','.join(HEADER)}, got {header}"
+                    f"{where}: the last line is cut off ({len(row)} of {len(HEADER)} columns, "
+                    "no newline at the end of the file)"
                 )
-            for line_number, row in enumerate(reader, start=2):
-                if not row:
-                    continue
-                if len(row) != len(HEADER):
-                    raise InputError(
-                        f"{path}: line {line_number}: expected {len(HEADER)} columns, "
-                        f"got {len(row)}"
-                    )
-                for index, cell in enumerate(row):
-                    columns[index].append(_parse_cell(cell, path, line_number, index))
-    except FileNotFoundError as err:
-        raise InputError(f"{path}: file not found") from err
-    except UnicodeDecodeError as err:
-        raise InputError(f"{path}: not a text file ({err.reason})") from err
-    except OSError as err:
-        raise InputError(f"{path}: cannot be read: {err.strerror}") from err
+            raise InputError(f"{where}: expected {len(HEADER)} columns, got {len(row)}")
+        for index, cell in enumerate(row):
+            columns[index].append(_parse_cell(cell, path, line_number, index))
     if not columns[0]:
         raise InputError(f"{path}: no samples after the header")
     time_s, torque_nm, angle_deg, force_n = (np.asarray(c, dtype=np.float64) for c in columns)
     return Trace(time_s, torque_nm, angle_deg, force_n)
 
 
+def _read_text(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError as err:
+        raise InputError(f"{path}: file not found") from err
+    except UnicodeDecodeError as err:
+        raise InputError(f"{path}: not a text file (byte {err.start}: {err.reason})") from err
+    except OSError as err:
+        raise InputError(f"{path}: cannot be read: {err.strerror}") from err
+
+
 def _parse_cell(cell: str, path: Path, line_number: int, index: int) -> float:
     text = cell.strip()
+    name = HEADER[index]
     if text == "":
-        if HEADER[index] == "force_n":
+        if name == "force_n":
             return math.nan
-        raise InputError(f"{path}: line {line_number}: {HEADER[index]} is empty")
+        raise InputError(f"{path}: line {line_number}: {name} (column {index + 1}) is empty")
     try:
-        return float(text)
+        value = float(text)
     except ValueError as err:
         raise InputError(
-            f"{path}: line {line_number}: {HEADER[index]} is not a number: {text!r}"
+            f"{path}: line {line_number}: {name} (column {index + 1}) is not a number: {text!r}"
         ) from err
+    if not math.isfinite(value):
+        raise InputError(
+            f"{path}: line {line_number}: {name} (column {index + 1}) is not finite: {text!r}"
+        )
+    return value
 
 
 def write_trace(path: Path, rows: Iterable[tuple[float, float, float, float | None]]) -> int:

@@ -53,8 +53,11 @@ class Acquisition:
         database: StationDatabase,
         outlet: Outlet,
         clock_ns: Callable[[], int] = time.time_ns,
+        unsent_samples: Callable[[], int] = lambda: 0,
     ) -> None:
+        """``unsent_samples``: how many samples the outlet could not deliver (no router)."""
         self.station_id = station_id
+        self._unsent_samples = unsent_samples
         self._bus = bus
         self._database = database
         self._decoder = FrameDecoder(database)
@@ -212,4 +215,5 @@ class Acquisition:
             unpaired=pairing.unpaired,
             orphans=pairing.orphans,
             stop_commands=self._stop_commands,
+            unsent_samples=self._unsent_samples(),
         )

@@ -38,7 +38,12 @@ def main(args: argparse.Namespace) -> int:
     with open_bus(station.config.can) as bus, open_session(station.config.zenoh) as session:
         outlet = ZenohOutlet(session, station_id)
         acquisition = Acquisition(
-            station_id, station.config.station.has_force_sensor, bus, database, outlet
+            station_id,
+            station.config.station.has_force_sensor,
+            bus,
+            database,
+            outlet,
+            unsent_samples=lambda: outlet.unsent_samples,
         )
 
         def on_decision(sample: zenoh.Sample) -> None:

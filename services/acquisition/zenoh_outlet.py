@@ -1,12 +1,24 @@
-"""Publish the acquisition's output on zenoh (``samples``, ``tool``, ``bus``)."""
+"""Publish the acquisition's output on zenoh (``samples``, ``tool``, ``bus``).
+
+While the session has no router (it restarts, the network is cut) zenoh has
+nowhere to send a sample: it is lost. The outlet counts those samples
+(``unsent_samples``, reported in BusStats) and logs each outage once when it
+starts and once, with its length and its count, when it ends. The check on
+the 1 kHz path is one attribute read (:class:`~shared.zenoh_session.RouterLink`).
+"""
 
 from __future__ import annotations
+
+import logging
 
 import zenoh
 
 from shared import keys
 from shared.codec import encode
 from shared.messages import BusStats, Sample, ToolState
+from shared.zenoh_session import RouterLink
+
+LOG = logging.getLogger(__name__)
 
 
 class ZenohOutlet:
@@ -24,8 +36,15 @@ class ZenohOutlet:
         self._samples = publisher(keys.SAMPLES)
         self._tool = publisher(keys.TOOL)
         self._bus = publisher(keys.BUS)
+        self.unsent_samples = 0
+        self._unsent_at_outage_start = 0
+        self.link = RouterLink(session, self._link_changed)
+        if not self.link.connected:
+            LOG.warning("zenoh: no router yet; samples are counted as unsent until one is reached")
 
     def sample(self, sample: Sample) -> None:
+        if not self.link.connected:
+            self.unsent_samples += 1
         self._samples.put(encode(sample))
 
     def tool_state(self, state: ToolState) -> None:
@@ -34,6 +53,20 @@ class ZenohOutlet:
     def bus_stats(self, stats: BusStats) -> None:
         self._bus.put(encode(stats))
 
+    def _link_changed(self, connected: bool, outage_s: float) -> None:
+        if connected:
+            lost = self.unsent_samples - self._unsent_at_outage_start
+            LOG.warning(
+                "zenoh: router back after %.1f s; %d samples unsent in that outage (%d in all)",
+                outage_s,
+                lost,
+                self.unsent_samples,
+            )
+        else:
+            self._unsent_at_outage_start = self.unsent_samples
+            LOG.warning("zenoh: router lost; reconnecting, samples are counted as unsent meanwhile")
+
     def close(self) -> None:
+        self.link.close()
         for publisher in (self._samples, self._tool, self._bus):
             publisher.undeclare()

@@ -1,4 +1,7 @@
-"""The table ``boltwatch up`` prints: one row per tightening run, for a plant engineer."""
+"""The table ``boltwatch up`` prints: one row per tightening run, for a plant engineer.
+
+With several stations (``--stations N``) the first column names the station.
+"""
 
 from __future__ import annotations
 
@@ -17,12 +20,17 @@ COLUMNS = (
 )
 
 
-def header() -> str:
+STATION_WIDTH = 8
+
+
+def header(station_column: bool = False) -> str:
     line = "  ".join(f"{title:>{width}}" for title, width in COLUMNS)
+    if station_column:
+        line = f"{'station':>{STATION_WIDTH}}  {line}"
     return f"{line}\n{'-' * len(line)}"
 
 
-def row(summary: RunSummary) -> str:
+def row(summary: RunSummary, station_column: bool = False) -> str:
     if summary.target_force_n is not None:
         target = f"{summary.target_force_n / 1000:.2f} kN"
         reached = _kilo(summary.reached_force_n, "kN")
@@ -42,7 +50,8 @@ def row(summary: RunSummary) -> str:
         f"{summary.process_intensity:.3g}",
         str(summary.samples),
     )
-    return "  ".join(f"{cell:>{width}}" for cell, (_, width) in zip(cells, COLUMNS, strict=True))
+    line = "  ".join(f"{cell:>{width}}" for cell, (_, width) in zip(cells, COLUMNS, strict=True))
+    return f"{summary.station:>{STATION_WIDTH}}  {line}" if station_column else line
 
 
 def _kilo(value: float | None, unit: str) -> str:

@@ -1,7 +1,10 @@
-"""One ``boltwatch up``: bring a simulated station up, run tightenings, report.
+"""One ``boltwatch up``: bring simulated stations up, run tightenings, report.
 
-Watches the station from its own zenoh client session: liveliness tokens for
-readiness, ``runs`` for the table, ``bus`` for the acquisition's counters.
+One station (the default) or a line of N (``--stations N``): one router, ONE
+recorder and ONE predictor serving every station file, and per station an
+acquisition and a rig. Watches the line from its own zenoh client session:
+liveliness tokens for readiness, ``runs`` for the table, ``bus`` for each
+acquisition's counters.
 """
 
 from __future__ import annotations
@@ -9,6 +12,7 @@ from __future__ import annotations
 import logging
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import zenoh
@@ -24,10 +28,14 @@ from shared.zenoh_session import open_from, zenoh_config
 
 LOG = logging.getLogger(__name__)
 
-SERVICES = ("recorder", "predictor", "acquisition")
-STOP_ORDER = ("rig", "acquisition", "predictor", "recorder", "router")
+LINE_SERVICES = ("recorder", "predictor")
+STATION_SERVICES = ("acquisition",)
+#: every service whose liveliness token each station must show before the rigs start
+SERVICES = (*LINE_SERVICES, *STATION_SERVICES)
 SUMMARY_WAIT_S = 5.0
 RECORDER_DRAIN_S = 1.0
+#: above this many files the report counts recordings per station instead of listing them
+LISTED_RECORDINGS = 20
 
 
 class ServiceDiedError(BoltwatchError):
@@ -37,67 +45,118 @@ class ServiceDiedError(BoltwatchError):
 class StationRun:
     def __init__(
         self,
-        station: LoadedStation,
+        stations: LoadedStation | Sequence[LoadedStation],
         program: Program,
         runs: int,
         log_dir: Path,
         startup_timeout_s: float,
     ) -> None:
-        self.station = station
+        self.stations = [stations] if isinstance(stations, LoadedStation) else list(stations)
+        self.station = self.stations[0]
         self.program = program
         self.runs = runs
         self.startup_timeout_s = startup_timeout_s
-        self.supervisor = StationSupervisor(station.path, log_dir)
-        self.summaries: list[RunSummary] = []
-        self.bus_stats: BusStats | None = None
+        self.line = len(self.stations) > 1
+        self.supervisor = StationSupervisor([s.path for s in self.stations], log_dir)
+        self.summaries: dict[str, list[RunSummary]] = {s.station_id: [] for s in self.stations}
+        self.bus_stats: dict[str, BusStats] = {}
         self.started_s = time.time()
         self._session: zenoh.Session | None = None
         self._stopped = False
 
+    def process_name(self, service: str, station_id: str) -> str:
+        """``rig`` for the one station of ``up``; ``rig-st2`` on a line."""
+        return f"{service}-{station_id}" if self.line else service
+
+    @property
+    def station_ids(self) -> list[str]:
+        return [s.station_id for s in self.stations]
+
+    def stop_order(self) -> list[list[str]]:
+        """The tools first, the recorder last (so that the recording holds everything)."""
+        per_station = [
+            [self.process_name(service, station_id) for station_id in self.station_ids]
+            for service in ("rig", "acquisition")
+        ]
+        return [*per_station, ["predictor"], ["recorder"], ["router"]]
+
     # -- the whole thing -----------------------------------------------------------------
 
     def run(self) -> int:
-        station_id = self.station.station_id
         router_endpoint = self.station.config.zenoh.connect[0]
-        print(
-            f"boltwatch up: station {station_id}, program {self.program.id} "
-            f"({self.program.name}), {self.runs} runs"
-        )
-        print(f"logs: {self.supervisor.log_dir}")
+        self._print_banner()
         self.supervisor.start("router", ["--listen", router_endpoint])
         self._session = self._open_watch_session(router_endpoint)
-        subscriber = self._session.declare_subscriber(
-            keys.station_key(station_id, "*"), zenoh.handlers.FifoChannel(10000)
-        )
-        for service in SERVICES:
+        subscribers = [
+            self._session.declare_subscriber(
+                keys.station_key("*", topic), zenoh.handlers.FifoChannel(10000)
+            )
+            for topic in (keys.RUNS, keys.BUS)
+        ]
+        for service in LINE_SERVICES:
             self.supervisor.start(service)
+        for station in self.stations:
+            for service in STATION_SERVICES:
+                name = self.process_name(service, station.station_id)
+                self.supervisor.start(service, name=name, config_paths=[station.path])
         self._wait_until_alive()
         print(f"services up after {time.time() - self.started_s:.1f} s; tightening...\n")
-        print(run_table.header())
-        rig = self.supervisor.start(
-            "rig", ["--runs", str(self.runs), "--program", str(self.program.id)]
-        )
-        rig_done_at: float | None = None
-        while len(self.summaries) < self.runs:
-            self._drain(subscriber)
-            self._check_alive(expected_exits={"rig"})
-            if rig_done_at is None and rig.exit_code() is not None:
-                if rig.exit_code() != 0:
+        print(run_table.header(self.line))
+        rigs = [
+            self.supervisor.start(
+                "rig",
+                ["--runs", str(self.runs), "--program", str(self.program.id)],
+                name=self.process_name("rig", station.station_id),
+                config_paths=[station.path],
+            )
+            for station in self.stations
+        ]
+        rig_names = {rig.name for rig in rigs}
+        rigs_done_at: float | None = None
+        while not self._every_station_has_its_runs():
+            for subscriber in subscribers:
+                self._drain(subscriber)
+            self._check_alive(expected_exits=rig_names)
+            for rig in rigs:
+                if rig.exit_code() not in (None, 0):
                     raise ServiceDiedError(self._death_note(rig))
-                rig_done_at = time.monotonic()
-            if rig_done_at is not None and time.monotonic() - rig_done_at > SUMMARY_WAIT_S:
-                print(
-                    f"only {len(self.summaries)} of {self.runs} run summaries arrived",
-                    file=sys.stderr,
-                )
+            if rigs_done_at is None and all(rig.exit_code() is not None for rig in rigs):
+                rigs_done_at = time.monotonic()
+            if rigs_done_at is not None and time.monotonic() - rigs_done_at > SUMMARY_WAIT_S:
+                print(f"only {self._count_note()} run summaries arrived", file=sys.stderr)
                 break
             time.sleep(0.02)
         time.sleep(RECORDER_DRAIN_S)
-        self._drain(subscriber)
-        subscriber.undeclare()
+        for subscriber in subscribers:
+            self._drain(subscriber)
+            subscriber.undeclare()
         self.stop_everything()
         self.report()
-        return 0 if len(self.summaries) == self.runs else 1
+        return 0 if self._every_station_has_its_runs() else 1
+
+    def _every_station_has_its_runs(self) -> bool:
+        return all(len(runs) >= self.runs for runs in self.summaries.values())
+
+    def _count_note(self) -> str:
+        if not self.line:
+            return f"{len(self.summaries[self.station.station_id])} of {self.runs}"
+        return ", ".join(
+            f"{station_id} {len(runs)} of {self.runs}"
+            for station_id, runs in self.summaries.items()
+        )
+
+    def _print_banner(self) -> None:
+        program = f"program {self.program.id} ({self.program.name})"
+        if self.line:
+            ids = self.station_ids
+            print(
+                f"boltwatch up: {len(ids)} stations {ids[0]}..{ids[-1]}, {program}, "
+                f"{self.runs} runs each"
+            )
+            print(f"station files: {self.station.path.parent}")
+        else:
+            print(f"boltwatch up: station {self.station.station_id}, {program}, {self.runs} runs")
+        print(f"logs: {self.supervisor.log_dir}")
 
     # -- pieces --------------------------------------------------------------------------
 
@@ -116,17 +175,21 @@ class StationRun:
 
     def _wait_until_alive(self) -> None:
         assert self._session is not None
-        station_id = self.station.station_id
         deadline = time.monotonic() + self.startup_timeout_s
-        missing = set(SERVICES)
+        missing = {(station_id, service) for station_id in self.station_ids for service in SERVICES}
         while missing:
             self._check_alive(expected_exits=set())
-            for reply in self._session.liveliness().get(keys.health_key(station_id, "*")):
+            for reply in self._session.liveliness().get(keys.health_key("*", "*")):
                 if reply.ok is not None:
-                    missing.discard(str(reply.ok.key_expr).rsplit("/", 1)[-1])
+                    station_id, tail = keys.split_key(str(reply.ok.key_expr))
+                    missing.discard((station_id, tail.rsplit("/", 1)[-1]))
             if time.monotonic() > deadline:
+                names = sorted(
+                    service if not self.line else f"{service} of {station_id}"
+                    for station_id, service in missing
+                )
                 raise ServiceDiedError(
-                    f"not alive after {self.startup_timeout_s:.0f} s: {', '.join(sorted(missing))}"
+                    f"not alive after {self.startup_timeout_s:.0f} s: {', '.join(names)}"
                     f" (logs in {self.supervisor.log_dir})"
                 )
             if missing:
@@ -134,14 +197,19 @@ class StationRun:
 
     def _drain(self, subscriber: zenoh.Subscriber) -> None:
         while (sample := subscriber.try_recv()) is not None:
-            topic = str(sample.key_expr).rsplit("/", 1)[-1]
+            try:
+                station_id, topic = keys.split_key(str(sample.key_expr))
+            except ValueError:
+                continue
+            if station_id not in self.summaries:
+                continue  # another station on the same router: not ours to report
             try:
                 if topic == keys.RUNS:
                     summary = decode(RunSummary, sample.payload.to_bytes())
-                    self.summaries.append(summary)
-                    print(run_table.row(summary), flush=True)
+                    self.summaries[station_id].append(summary)
+                    print(run_table.row(summary, self.line), flush=True)
                 elif topic == keys.BUS:
-                    self.bus_stats = decode(BusStats, sample.payload.to_bytes())
+                    self.bus_stats[station_id] = decode(BusStats, sample.payload.to_bytes())
             except BoltwatchError as err:
                 LOG.warning("unreadable %s message: %s", topic, err)
 
@@ -161,7 +229,7 @@ class StationRun:
         if self._stopped:
             return
         self._stopped = True
-        self.supervisor.stop_all(order=STOP_ORDER)
+        self.supervisor.stop_all(order=self.stop_order())
         if self._session is not None:
             self._session.close()
             self._session = None
@@ -170,26 +238,36 @@ class StationRun:
 
     def report(self) -> None:
         print()
-        if self.summaries:
-            print(run_table.header())
-            for summary in self.summaries:
-                print(run_table.row(summary))
-            print(run_table.totals(self.summaries))
-        if self.bus_stats is not None:
-            stats = self.bus_stats
-            print(
-                f"CAN: {stats.frames} frames, {stats.samples} samples, "
-                f"{stats.missed_samples} missed in {stats.counter_gaps} gaps, "
-                f"{stats.unknown_ids + stats.wrong_length + stats.decode_errors} bad frames, "
-                f"{stats.stop_commands} stop commands sent"
-            )
-        recordings = sorted(
-            path
-            for path in self.station.recordings_folder.rglob("*.mcap")
-            if path.stat().st_mtime >= self.started_s
-        )
-        print(f"recordings: {self.station.recordings_folder}")
-        for path in recordings:
-            print(f"  {path.relative_to(self.station.recordings_folder)}")
+        every_summary = [s for runs in self.summaries.values() for s in runs]
+        if every_summary:
+            print(run_table.header(self.line))
+            for summary in every_summary:
+                print(run_table.row(summary, self.line))
+            print(run_table.totals(every_summary))
+        for station_id in self.station_ids:
+            stats = self.bus_stats.get(station_id)
+            if stats is not None:
+                label = f"CAN {station_id}" if self.line else "CAN"
+                print(
+                    f"{label}: {stats.frames} frames, {stats.samples} samples, "
+                    f"{stats.missed_samples} missed in {stats.counter_gaps} gaps, "
+                    f"{stats.unknown_ids + stats.wrong_length + stats.decode_errors} bad frames, "
+                    f"{stats.stop_commands} stop commands sent"
+                )
+        self._report_recordings()
         print(f"logs: {self.supervisor.log_dir}")
         print(f"took {time.time() - self.started_s:.1f} s")
+
+    def _report_recordings(self) -> None:
+        folder = self.station.recordings_folder
+        recordings = sorted(
+            path for path in folder.rglob("*.mcap") if path.stat().st_mtime >= self.started_s
+        )
+        print(f"recordings: {folder}")
+        if len(recordings) <= LISTED_RECORDINGS:
+            for path in recordings:
+                print(f"  {path.relative_to(folder)}")
+            return
+        for station_id in self.station_ids:
+            count = sum(1 for p in recordings if p.relative_to(folder).parts[0] == station_id)
+            print(f"  {station_id}/: {count} files")

@@ -17,7 +17,10 @@ Per station:
 - last run: the latest ToolState; failing that the run of the latest Sample
   (then running), failing that the latest RunSummary;
 - last decision, last run summary: the latest of each, with its age;
-- recorder lag: not measurable yet (the recorder publishes nothing about itself).
+- recorder: the latest RecorderStats (``boltwatch/<st>/recorder``, once a
+  second): lag of samples into the recorder (p50/max over its last second,
+  None when no samples came), messages written, write errors and whether
+  it is recording.
 """
 
 from __future__ import annotations
@@ -29,7 +32,14 @@ from typing import Any
 from shared import keys
 from shared.codec import decode
 from shared.errors import InputError
-from shared.messages import BusStats, RunSummary, Sample, StopDecision, ToolState
+from shared.messages import (
+    BusStats,
+    RecorderStats,
+    RunSummary,
+    Sample,
+    StopDecision,
+    ToolState,
+)
 
 #: The services of a station, in display order; others are shown if alive.
 KNOWN_SERVICES = ("acquisition", "predictor", "recorder", "rig")
@@ -50,6 +60,8 @@ class _Seen:
     tool: ToolState | None = None
     decision: StopDecision | None = None
     summary: RunSummary | None = None
+    recorder: RecorderStats | None = None
+    recorder_received_ns: int = 0
     unreadable: int = 0
 
 
@@ -99,6 +111,19 @@ class LastSummary:
 
 
 @dataclass(frozen=True)
+class RecorderHealth:
+    """The recorder's own view of the station (latest RecorderStats)."""
+
+    recording: bool  # False while the recordings folder cannot be written
+    lag_p50_ms: float | None  # sample receive time in the recorder minus CAN time
+    lag_max_ms: float | None
+    messages: int  # written for this station since the recorder started
+    write_errors: int
+    last_error: str | None
+    age_s: float  # since the latest RecorderStats was received
+
+
+@dataclass(frozen=True)
 class StationStatus:
     station: str
     services: dict[str, bool]
@@ -108,7 +133,7 @@ class StationStatus:
     last_run: LastRun | None
     last_decision: LastDecision | None
     last_summary: LastSummary | None
-    recorder_lag_s: float | None  # always None: not published by the recorder yet
+    recorder: RecorderHealth | None  # None: no RecorderStats in the window
     unreadable_messages: int
 
 
@@ -165,6 +190,9 @@ class StatusCollector:
                 seen.decision = decode(StopDecision, payload)
             elif topic == keys.RUNS:
                 seen.summary = decode(RunSummary, payload)
+            elif topic == keys.RECORDER:
+                seen.recorder = decode(RecorderStats, payload)
+                seen.recorder_received_ns = received_ns
         except InputError:
             seen.unreadable += 1
 
@@ -190,7 +218,7 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
         last_run=_last_run(seen.tool, last_sample, seen.summary),
         last_decision=_last_decision(seen.decision, now_ns),
         last_summary=_last_summary(seen.summary, now_ns),
-        recorder_lag_s=None,
+        recorder=_recorder_health(seen.recorder, seen.recorder_received_ns, now_ns),
         unreadable_messages=unreadable,
     )
 
@@ -231,6 +259,22 @@ def _bus_health(stats: BusStats | None, received_ns: int, now_ns: int) -> BusHea
         unpaired=stats.unpaired,
         orphans=stats.orphans,
         stop_commands=stats.stop_commands,
+    )
+
+
+def _recorder_health(
+    stats: RecorderStats | None, received_ns: int, now_ns: int
+) -> RecorderHealth | None:
+    if stats is None:
+        return None
+    return RecorderHealth(
+        recording=stats.recording,
+        lag_p50_ms=stats.lag_p50_ms,
+        lag_max_ms=stats.lag_max_ms,
+        messages=stats.messages,
+        write_errors=stats.write_errors,
+        last_error=stats.last_error,
+        age_s=_age_s(received_ns, now_ns),
     )
 
 
@@ -340,7 +384,7 @@ def _station_lines(status: StationStatus) -> list[str]:
         line("last run", _run_text(status.last_run)),
         line("last decision", _decision_text(status.last_decision)),
         line("last summary", _summary_text(status.last_summary)),
-        line("recorder lag", "n/a (the recorder does not publish it yet)"),
+        line("recorder", _recorder_text(status.recorder)),
     ]
     if status.unreadable_messages:
         out.append(line("unreadable", f"{status.unreadable_messages} messages"))
@@ -355,6 +399,25 @@ def _bus_text(bus: BusHealth | None) -> str:
         f"{bus.bad_frames} bad frames, {bus.receive_errors} receive errors "
         f"({bus.frames} frames since start, {bus.age_s:.1f} s ago)"
     )
+
+
+def _recorder_text(recorder: RecorderHealth | None) -> str:
+    if recorder is None:
+        return "- (no recorder stats in the window: recorder down or not serving it?)"
+    if recorder.lag_p50_ms is None or recorder.lag_max_ms is None:
+        lag = "lag - (no samples)"
+    else:
+        lag = f"lag p50 {recorder.lag_p50_ms:.1f} ms, max {recorder.lag_max_ms:.1f} ms"
+    counts = (
+        f"{recorder.messages} messages, {recorder.write_errors} write errors, "
+        f"{recorder.age_s:.1f} s ago"
+    )
+    if not recorder.recording:
+        return f"NOT RECORDING: {recorder.last_error or 'write failing'} ({lag}, {counts})"
+    text = f"recording, {lag}, {counts}"
+    if recorder.last_error:
+        text += f"; last error: {recorder.last_error}"
+    return text
 
 
 def _run_text(run: LastRun | None) -> str:

@@ -1,13 +1,17 @@
-"""``boltwatch serve predictor``: the predictor core wired to zenoh.
+"""``boltwatch serve predictor``: the predictor core wired to zenoh, for one or more stations.
 
-One session, ONE subscriber on ``boltwatch/*/*`` (a FIFO channel of 10 000
-messages, drained by a blocking ``recv()`` in the ServiceRunner's worker):
-``samples`` go to the core of their run, ``tool`` marks run boundaries,
-every other topic is ignored. Out: ``events`` and ``intensity`` per
-stick-slip event, ``decision`` (REAL_TIME priority, express, blocking
-congestion control: a stop must never be dropped), ``runs`` per run. The
-liveliness token ``boltwatch/<station>/health/predictor`` says it is up.
-To stop, ``wake`` puts a session-local message that unblocks ``recv()``.
+One process serves the stations named by ``--config FILE [FILE ...]`` and
+only those: per served station it subscribes to ``boltwatch/<st>/samples``
+and ``boltwatch/<st>/tool`` (never ``boltwatch/*/*``: another station's data
+must never reach this process's decisions) through one FIFO drained by
+ONE worker thread (:mod:`services.predictor.station_inbox`). Each run is
+predicted with its own station's programs, force sensor, joint constants
+and ``[predictor]`` section. Out, per station: ``events`` and ``intensity``
+per stick-slip event, ``decision`` (REAL_TIME priority, express, blocking
+congestion control: a stop must never be dropped), ``runs`` per run. One
+liveliness token ``boltwatch/<st>/health/predictor`` per served station; a
+station that already has a predictor on the line is refused at start-up, so
+two predictors never both decide for one station.
 """
 
 from __future__ import annotations
@@ -16,50 +20,78 @@ import argparse
 import logging
 import threading
 import time
+from collections.abc import Sequence
 from typing import Any
 
 import zenoh
 
 from services.predictor.active_run import ActiveRun, Outgoing
-from services.predictor.core import PredictorSettings
+from services.predictor.served_station import ServedStation
+from services.predictor.station_inbox import Delivery, StationInbox
 from shared import codec, keys
-from shared.config import LoadedStation, load_station
-from shared.errors import InputError
+from shared.config import LoadedStation, load_line
+from shared.errors import ConfigError, InputError
 from shared.messages import Intensity, Sample, StopDecision, ToolState
-from shared.model import JointConstants
 from shared.service_runtime import ServiceRunner
 from shared.zenoh_session import open_session
 
 LOG = logging.getLogger(__name__)
 
-WAKE_KEY = "boltwatch/_local/wake"
-QUEUE_MESSAGES = 10_000
+#: how long to ask the line whether another predictor already serves a station
+PEER_CHECK_TIMEOUT_S = 1.0
 
 
 class PredictorService:
-    """Runs of every station on the subscription, one :class:`ActiveRun` each."""
+    """Runs of the served stations, one :class:`ActiveRun` per (station, run id)."""
 
-    def __init__(self, session: zenoh.Session, station: LoadedStation) -> None:
+    def __init__(
+        self, session: zenoh.Session, stations: LoadedStation | Sequence[LoadedStation]
+    ) -> None:
+        served = [stations] if isinstance(stations, LoadedStation) else list(stations)
         self._session = session
-        self._station = station
-        self._constants = JointConstants.of(station.joint)
+        self._stations = {s.station_id: ServedStation(s) for s in served}
+        if len(self._stations) != len(served):
+            raise ConfigError("a station is named twice (use shared.config.load_line)")
+        self._refuse_stations_served_elsewhere()
         self._runs: dict[tuple[str, int], ActiveRun] = {}
         self._publishers: dict[tuple[str, str], Any] = {}
         self.dropped_samples = 0
         self.bad_payloads = 0
-        self._subscriber = session.declare_subscriber(
-            keys.ALL_STATION_TOPICS, zenoh.handlers.FifoChannel(QUEUE_MESSAGES)
+        self._inbox = StationInbox(session, self._stations)
+        self._tokens = [
+            session.liveliness().declare_token(keys.health_key(station_id, "predictor"))
+            for station_id in self._stations
+        ]
+
+    @property
+    def station_ids(self) -> list[str]:
+        return list(self._stations)
+
+    def _refuse_stations_served_elsewhere(self) -> None:
+        served_elsewhere = set()
+        replies = self._session.liveliness().get(
+            keys.health_key("*", "predictor"), timeout=PEER_CHECK_TIMEOUT_S
         )
-        self._token = session.liveliness().declare_token(
-            keys.health_key(station.station_id, "predictor")
-        )
+        for reply in replies:
+            if reply.ok is not None:
+                station_id, _ = keys.split_key(str(reply.ok.key_expr))
+                served_elsewhere.add(station_id)
+        clash = sorted(served_elsewhere & set(self._stations))
+        if clash:
+            raise ConfigError(
+                f"station(s) {', '.join(clash)} already have a predictor on the line "
+                f"({keys.health_key(clash[0], 'predictor')} is alive); "
+                "two predictors must not decide for one station"
+            )
 
     def close(self) -> None:
+        self._inbox.close()
         for publisher in self._publishers.values():
             publisher.undeclare()
         self._publishers.clear()
-        self._token.undeclare()
-        self._subscriber.undeclare()
+        for token in self._tokens:
+            token.undeclare()
+        self._tokens.clear()
 
     def __enter__(self) -> PredictorService:
         return self
@@ -68,47 +100,63 @@ class PredictorService:
         self.close()
 
     def wake(self) -> None:
-        """Unblock ``recv()`` without sending anything beyond this process."""
-        self._session.put(WAKE_KEY, b"", allowed_destination=zenoh.Locality.SESSION_LOCAL)
+        """Unblock the worker's wait for the next message."""
+        self._inbox.wake()
 
     def work(self, stop: threading.Event) -> None:
         """The worker loop: receive, dispatch, until ``stop`` is set."""
-        LOG.info("predictor up for station %s", self._station.station_id)
+        LOG.info("predictor up for station(s) %s", ", ".join(self._stations))
         while not stop.is_set():
-            try:
-                message = self._subscriber.recv()
-            except zenoh.ZError:
-                break  # the subscriber was closed
-            self.handle(str(message.key_expr), message.payload.to_bytes())
+            delivery = self._inbox.receive()
+            if delivery is None:
+                continue
+            self.handle(delivery)
 
-    def handle(self, key: str, payload: bytes) -> None:
-        """Dispatch one received message by the last chunk of its key."""
-        topic = key.rsplit("/", 1)[-1]
+    def handle(self, delivery: Delivery) -> None:
+        """Dispatch one received message of a served station by its topic."""
+        served = self._stations.get(delivery.station_id)
+        if served is None:  # cannot happen: the inbox only subscribes to served stations
+            return
         try:
-            if topic == keys.SAMPLES:
-                self._on_sample(codec.decode(Sample, payload))
-            elif topic == keys.TOOL:
-                self._on_tool(codec.decode(ToolState, payload))
+            if delivery.topic == keys.SAMPLES:
+                sample = codec.decode(Sample, delivery.payload)
+                if self._belongs(sample.station, delivery):
+                    self._on_sample(sample)
+            elif delivery.topic == keys.TOOL:
+                state = codec.decode(ToolState, delivery.payload)
+                if self._belongs(state.station, delivery):
+                    self._on_tool(served, state)
         except InputError as err:
             self.bad_payloads += 1
-            LOG.warning("ignored a bad %s payload: %s", topic, err)
+            LOG.warning(
+                "ignored a bad %s payload of %s: %s", delivery.topic, delivery.station_id, err
+            )
 
-    def _on_tool(self, state: ToolState) -> None:
+    def _belongs(self, station_in_payload: str, delivery: Delivery) -> bool:
+        """A payload naming another station than its key is counted and ignored."""
+        if station_in_payload == delivery.station_id:
+            return True
+        self.bad_payloads += 1
+        LOG.warning(
+            "ignored a %s message on %s that names station %s",
+            delivery.topic,
+            keys.station_key(delivery.station_id, delivery.topic),
+            station_in_payload,
+        )
+        return False
+
+    def _on_tool(self, served: ServedStation, state: ToolState) -> None:
         run_key = (state.station, state.run_id)
         if state.state == "running":
             if run_key in self._runs:
                 return
             try:
-                program = self._station.config.program(state.program_id)
+                program = served.program(state.program_id)
             except KeyError as err:
                 LOG.error("run %s: %s; not predicting this run", state.run_id, err.args[0])
                 return
-            config = self._station.config
-            settings = PredictorSettings.of(
-                program, config.predictor, config.station.has_force_sensor, self._constants
-            )
-            self._runs[run_key] = ActiveRun(state, program, settings)
-            LOG.debug("run %s started (program %s)", state.run_id, program.id)
+            self._runs[run_key] = ActiveRun(state, program, served.settings(program))
+            LOG.debug("%s run %s started (program %s)", state.station, state.run_id, program.id)
         elif state.state in ("done", "aborted"):
             run = self._runs.pop(run_key, None)
             if run is None:
@@ -116,7 +164,8 @@ class PredictorService:
             summary = run.summary(state)
             self._publish(state.station, keys.RUNS, summary)
             LOG.info(
-                "run %s %s: %d events, stop %s, error %s %%, %s",
+                "%s run %s %s: %d events, stop %s, error %s %%, %s",
+                state.station,
                 state.run_id,
                 state.state,
                 summary.events,
@@ -136,7 +185,9 @@ class PredictorService:
     def _send(self, station: str, message: Outgoing) -> None:
         if isinstance(message, StopDecision):
             self._publish(station, keys.DECISION, message)
-            LOG.info("run %s: stop (%s) %s", message.run_id, message.reason, message.detail)
+            LOG.info(
+                "%s run %s: stop (%s) %s", station, message.run_id, message.reason, message.detail
+            )
         elif isinstance(message, Intensity):
             self._publish(station, keys.INTENSITY, message)
         else:
@@ -159,10 +210,10 @@ class PredictorService:
 
 
 def main(args: argparse.Namespace) -> int:
-    """Load the station file once, open the session, serve until a signal."""
-    station = load_station(args.config[0])  # TODO(multi-station)
+    """Load every station file once, open one session, serve until a signal."""
+    stations = load_line(args.config)
     with (
-        open_session(station.config.zenoh) as session,
-        PredictorService(session, station) as service,
+        open_session(stations[0].config.zenoh) as session,
+        PredictorService(session, stations) as service,
     ):
         return ServiceRunner("predictor", service.work, service.wake).run()

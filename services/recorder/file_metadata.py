@@ -7,17 +7,24 @@ Each file carries (MCAP metadata records, string to string):
 ``program``   the program's parameters from the station file (run files)
 ``joint``     the joint parameters (JointConfig, nested keys dotted)
 
-Files of a station other than the configured one get ``station`` only: its
-configuration is not known here.
+One recorder serves several stations (``serve recorder --config A B ...``):
+each station's records come from its own station file. A station with no
+file here (its messages are still recorded) gets ``station`` and ``run``
+only, and a warning once. ``extra`` records (e.g. ``controller`` of an
+imported controller run) are added to every file.
 """
 
 from __future__ import annotations
 
 import importlib.metadata
-from collections.abc import Mapping
+import logging
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from shared.config import LoadedStation
+from shared.errors import ConfigError
+
+LOG = logging.getLogger(__name__)
 
 Metadata = dict[str, dict[str, str]]
 
@@ -42,28 +49,57 @@ def flatten(data: Mapping[str, Any], prefix: str = "") -> dict[str, str]:
     return flat
 
 
-class FileMetadata:
-    """Builds the metadata records of each new file from the loaded station."""
+def stations_by_id(loaded: LoadedStation | Sequence[LoadedStation]) -> dict[str, LoadedStation]:
+    """Station id -> its loaded file; ConfigError naming both files when an id repeats."""
+    stations = [loaded] if isinstance(loaded, LoadedStation) else list(loaded)
+    by_id: dict[str, LoadedStation] = {}
+    for station in stations:
+        other = by_id.get(station.station_id)
+        if other is not None:
+            raise ConfigError(
+                f"{station.path}: station.id: {station.station_id!r} is already served from "
+                f"{other.path}; each station file of one recorder needs its own id"
+            )
+        by_id[station.station_id] = station
+    return by_id
 
-    def __init__(self, loaded: LoadedStation) -> None:
-        self._loaded = loaded
+
+class FileMetadata:
+    """Builds the metadata records of each new file from the loaded station files."""
+
+    def __init__(
+        self,
+        loaded: LoadedStation | Sequence[LoadedStation],
+        extra: Mapping[str, Mapping[str, str]] | None = None,
+        warn_unknown: bool = True,
+    ) -> None:
+        self._stations = stations_by_id(loaded)
+        self._extra: Metadata = {name: dict(data) for name, data in (extra or {}).items()}
         self._version = software_version()
+        self._warned: set[str] = set()
+        self._warn_unknown_stations = warn_unknown
 
     @property
     def version(self) -> str:
         return self._version
 
+    @property
+    def station_ids(self) -> list[str]:
+        """The stations with a station file here, in the order given."""
+        return list(self._stations)
+
     def for_file(
         self, station: str, run_id: int | None, tool_id: int | None, program_id: int | None
     ) -> Metadata:
         """The records of a new file of ``station`` (``run_id`` None: between runs)."""
-        config = self._loaded.config
-        own = station == config.station.id
+        loaded = self._stations.get(station)
+        if loaded is None:
+            self._warn_unknown(station)
         records: Metadata = {
             "station": {
                 "station": station,
-                "tool_id": str(config.station.tool_id) if own else "",
-                "station_file": str(self._loaded.path) if own else "",
+                "tool_id": str(loaded.config.station.tool_id) if loaded else "",
+                "station_file": str(loaded.path) if loaded else "",
                 "software_version": self._version,
             }
         }
@@ -73,14 +109,33 @@ class FileMetadata:
                 "tool_id": "" if tool_id is None else str(tool_id),
                 "program_id": "" if program_id is None else str(program_id),
             }
-        if not own:
-            return records
-        if program_id is not None:
-            try:
-                program = config.program(program_id)
-            except KeyError:
-                records["program"] = {"id": str(program_id), "error": "not in the station file"}
-            else:
-                records["program"] = flatten(program.model_dump(mode="json"))
-        records["joint"] = flatten(self._loaded.joint.model_dump(mode="json"))
+        if loaded is not None:
+            records.update(_configured(loaded, program_id))
+        records.update(self._extra)
         return records
+
+    def _warn_unknown(self, station: str) -> None:
+        if station in self._warned or not self._warn_unknown_stations:
+            return
+        self._warned.add(station)
+        served = ", ".join(self._stations) or "none"
+        LOG.warning(
+            "station %s has no station file in this recorder (served: %s); recording its "
+            "messages with minimal metadata (no program, no joint)",
+            station,
+            served,
+        )
+
+
+def _configured(loaded: LoadedStation, program_id: int | None) -> Metadata:
+    """``program`` and ``joint`` records from the station's own file."""
+    records: Metadata = {}
+    if program_id is not None:
+        try:
+            program = loaded.config.program(program_id)
+        except KeyError:
+            records["program"] = {"id": str(program_id), "error": "not in the station file"}
+        else:
+            records["program"] = flatten(program.model_dump(mode="json"))
+    records["joint"] = flatten(loaded.joint.model_dump(mode="json"))
+    return records

@@ -30,6 +30,7 @@ TOPIC_TYPES: dict[str, str] = {
     keys.INTENSITY: "boltwatch.Intensity",
     keys.DECISION: "boltwatch.StopDecision",
     keys.RUNS: "boltwatch.RunSummary",
+    keys.RECORDER: "boltwatch.RecorderStats",
     ALERT_TOPIC: "boltwatch.WearAlert",
 }
 

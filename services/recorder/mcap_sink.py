@@ -9,14 +9,24 @@ topic (schema-less, message encoding :data:`RAW_ENCODING`).
 
 ``log_time`` is the receive time in the recorder, ``publish_time`` the
 message's own time, ``sequence`` the Sample's sequence (else a per-channel
-counter). :meth:`McapSink.flush` closes the chunk in progress and hands it to
-the operating system, so a killed recorder loses only what came after.
+counter). :meth:`McapSink.flush` closes the chunk in progress, hands it to
+the operating system and (``fsync=True``, the default) waits until it is on
+the disk, so a killed recorder, and a power cut too, loses only what came
+after. The header and metadata are flushed the same way when the file is
+opened: a disk that cannot take them fails at once, not a second later.
+
+A disk that fails (full, read-only, I/O error) raises :class:`OSError` from
+any method; the owner then calls :meth:`McapSink.abandon`, which lets go of
+the file without writing more (what was flushed stays readable with
+``boltwatch recover``) and says how many messages were lost with it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
+import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import BinaryIO
@@ -25,7 +35,9 @@ from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 
 from services.recorder.incoming import RECORDED_TYPES, Received
+from services.recorder.recording_reader import RecordingScan
 from shared.codec import json_schema
+from shared.errors import InputError
 
 LOG = logging.getLogger(__name__)
 
@@ -46,24 +58,38 @@ class McapSink:
         run_id: int | None,
         opened_ns: int,
         library: str = "boltwatch",
+        fsync: bool = True,
     ) -> None:
         self.path = path
         self.run_id = run_id
         self.opened_ns = opened_ns
         self.messages = 0
+        self.flushed_messages = 0  # on disk (or at least handed to the OS when fsync is off)
         self.run_ids: set[int] = set()
         self.last_write_ns = opened_ns
-        path.parent.mkdir(parents=True, exist_ok=True)
-        self._file: BinaryIO = path.open("xb")
-        self._writer = Writer(self._file, chunk_size=_CHUNK_BYTES, compression=CompressionType.ZSTD)
-        self._writer.start(profile="", library=library)
-        for name, data in metadata.items():
-            self._writer.add_metadata(name, dict(data))
+        self._fsync = fsync
         self._schemas: dict[str, int] = {}
         self._channels: dict[tuple[str, str], int] = {}
         self._counters: dict[int, int] = {}
         self._unflushed_bytes = 0
         self._closed = False
+        self._abandoned = False
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self._file: BinaryIO = path.open("xb")
+        try:
+            self._writer = Writer(
+                self._file, chunk_size=_CHUNK_BYTES, compression=CompressionType.ZSTD
+            )
+            self._writer.start(profile="", library=library)
+            for name, data in metadata.items():
+                self._writer.add_metadata(name, dict(data))
+            self._writer.flush()
+            self._sync()
+            if fsync:
+                _sync_folder(path.parent)  # the new file's name survives a power cut too
+        except BaseException:
+            self.abandon()
+            raise
 
     @property
     def dirty(self) -> bool:
@@ -96,28 +122,68 @@ class McapSink:
         if run_id is not None:
             self.run_ids.add(run_id)
 
+    @property
+    def unflushed_messages(self) -> int:
+        """Messages written since the last flush: what a failing disk loses."""
+        return self.messages - self.flushed_messages
+
     def flush(self) -> None:
-        """Close the chunk in progress and write it through to the OS (no fsync)."""
+        """Close the chunk in progress, write it through to the OS and (fsync) to the disk."""
         if self._closed or not self.dirty:
             return
         self._writer.flush()
+        self._sync()
         self._unflushed_bytes = 0
+        self.flushed_messages = self.messages
 
     def close(self) -> None:
-        """Finish the file (summary, index, footer); safe to call twice."""
+        """Finish the file (summary, index, footer) and sync it; safe to call twice."""
         if self._closed:
             return
         self._closed = True
         try:
             self._writer.finish()
+            self._sync()
         finally:
             self._file.close()
+        self.flushed_messages = self.messages
         LOG.info(
             "closed %s: %d messages, runs %s",
             self.path,
             self.messages,
             ",".join(str(run_id) for run_id in sorted(self.run_ids)) or "-",
         )
+
+    def abandon(self) -> int:
+        """Let go of the file without writing more (its disk failed); messages lost with it.
+
+        Never raises. What was flushed stays in the file (``boltwatch recover``
+        makes it valid); a file that holds no message is removed.
+        """
+        if self._abandoned:
+            return 0
+        self._abandoned = self._closed = True
+        with contextlib.suppress(OSError):
+            self._file.close()  # its buffered bytes may fail again: the fd is closed anyway
+        self.flushed_messages = self._readable_messages()
+        if self.flushed_messages == 0:
+            with contextlib.suppress(OSError):
+                self.path.unlink()
+        return self.messages - self.flushed_messages
+
+    def _readable_messages(self) -> int:
+        """Messages a reader finds in the file now: a failed flush may have written them
+        all, some, or none (only on the fault path: it reads the file back)."""
+        if self.flushed_messages == 0 and self.messages == 0:
+            return 0
+        try:
+            return sum(1 for _ in RecordingScan(self.path).messages())
+        except (InputError, OSError):
+            return 0
+
+    def _sync(self) -> None:
+        if self._fsync:
+            os.fsync(self._file.fileno())
 
     def _channel_for(self, received: Received) -> int:
         schema_name = received.schema_name if received.message is not None else None
@@ -162,3 +228,12 @@ class McapSink:
 
     def __exit__(self, *_exc: object) -> None:
         self.close()
+
+
+def _sync_folder(folder: Path) -> None:
+    """fsync a folder, so the names of the files just created in it are on the disk."""
+    handle = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        os.fsync(handle)
+    finally:
+        os.close(handle)

@@ -64,6 +64,7 @@ class RecordedRun:
     joint: JointConfig | None = None
     motor_speed_rad_s: float | None = None
     model_missing: str = ""  # why there is no model ("" when there is one)
+    state: str = ""  # RecordingScan.describe() of the source: complete, or what was lost
 
     @property
     def t0_ns(self) -> int:
@@ -137,7 +138,8 @@ def read_run(source: Path, run_id: int | None = None) -> RecordedRun:
         run_id = max(counts, key=counts.__getitem__)
     samples = [s for s in samples if s.run_id == run_id]
     if run_id is None or not samples:
-        raise InputError(f"{source}: no samples to plot")
+        damage = "" if scan.damage is None else f" ({scan.damage})"
+        raise InputError(f"{source}: no samples to plot{damage}")
     run = RecordedRun(
         source,
         run_id,
@@ -146,6 +148,7 @@ def read_run(source: Path, run_id: int | None = None) -> RecordedRun:
         [d for d in decisions if d.run_id == run_id],
         metadata,
         scan.complete,
+        state=scan.describe(),
     )
     run.joint, run.motor_speed_rad_s, run.model_missing = _model_inputs(metadata)
     return run

@@ -4,10 +4,22 @@
 recorder subscribes to the whole line), counts payloads that do not decode
 (logged once per key, still recorded raw) and is driven by a clock tick so
 files are flushed even when nothing arrives.
+
+Recording is not on the stop path: a disk that fails under it (full,
+read-only, an I/O error: any :class:`OSError` on open, write, flush or close)
+never stops the recorder. The station's open files are abandoned (what was
+flushed stays, ``boltwatch recover`` makes it valid), messages are dropped
+and counted, and writing is tried again at the next run's start or every
+:data:`RETRY_INTERVAL_NS`. It logs one ERROR when the fault starts (file and
+errno text), a reminder with the count of dropped messages at most every
+:data:`REMINDER_INTERVAL_NS`, and one INFO when writing works again (a flush
+reached the disk). ``write_errors``, ``last_write_error`` and
+``recording_ok`` say the same to whoever publishes the recorder's state.
 """
 
 from __future__ import annotations
 
+import errno
 import logging
 from collections import Counter
 from pathlib import Path
@@ -21,6 +33,16 @@ if TYPE_CHECKING:
     from services.recorder.rerun_sink import RerunOptions
 
 LOG = logging.getLogger(__name__)
+
+RETRY_INTERVAL_NS = 3_000_000_000
+REMINDER_INTERVAL_NS = 10_000_000_000
+
+
+def describe_os_error(err: OSError, path: Path | None) -> str:
+    """``<file>: <errno text> (<ERRNO>)``, e.g. ``a.mcap: No space left on device (ENOSPC)``."""
+    where = err.filename if err.filename is not None else (path or "?")
+    code = errno.errorcode.get(err.errno, str(err.errno)) if err.errno is not None else "?"
+    return f"{where}: {err.strerror or err} ({code})"
 
 
 class Recorder:
@@ -41,6 +63,14 @@ class Recorder:
         self.messages = 0
         self.undecodable: Counter[str] = Counter()
         self.unknown_keys: Counter[str] = Counter()
+        self.write_errors = 0  # OSErrors met on open/write/flush/close
+        self.last_write_error: str | None = None
+        self.recording_ok = True
+        self.dropped_messages = 0  # received but not recorded, because the disk failed
+        self._fault_started_ns = 0
+        self._fault_dropped = 0
+        self._retry_at_ns = 0
+        self._remind_at_ns = 0
 
     def write(self, received: Received) -> None:
         files = self._stations.get(received.station)
@@ -53,22 +83,107 @@ class Recorder:
             self._count(self.undecodable, received, "does not decode as %s")
         elif received.schema_name is None:
             self._count(self.unknown_keys, received, "is not a boltwatch message key%s")
-        files.write(received)
         self.messages += 1
+        now_ns = received.log_time_ns
+        waiting = files.current is None and now_ns < self._retry_at_ns  # abandoned, not retried
+        if not self.recording_ok and waiting and not received.run_started:
+            self._drop(1, now_ns)
+            return
+        written_before = files.written
+        try:
+            files.write(received)
+        except OSError as err:  # a message already in the file is counted by abandon()
+            self._fault(files, err, now_ns, this_message_lost=files.written == written_before)
+            return
+        self._maybe_recovered(files, now_ns)
 
     def tick(self, now_ns: int) -> None:
         for files in self._stations.values():
-            files.tick(now_ns)
+            try:
+                files.tick(now_ns)
+            except OSError as err:
+                self._fault(files, err, now_ns, this_message_lost=False)
+            else:
+                self._maybe_recovered(files, now_ns)
+        if not self.recording_ok:
+            self._remind(now_ns)
 
     def close(self) -> list[Path]:
         """Finish every open file; the paths of every file closed so far."""
         closed: list[Path] = []
         for files in self._stations.values():
-            files.close()
+            try:
+                files.close()
+            except OSError as err:
+                self._fault(files, err, self._fault_started_ns, this_message_lost=False)
             closed.extend(files.closed_paths)
         if self.undecodable:
             LOG.warning("undecodable payloads, recorded raw: %s", dict(self.undecodable))
+        if self.dropped_messages:
+            LOG.error(
+                "%d messages were not recorded because writing failed (last: %s); "
+                "incomplete files: %s",
+                self.dropped_messages,
+                self.last_write_error,
+                ", ".join(str(path) for path in self.abandoned_files) or "-",
+            )
         return closed
+
+    @property
+    def abandoned_files(self) -> list[Path]:
+        """Files left incomplete by a write fault (``boltwatch recover`` makes them valid)."""
+        return [path for files in self._stations.values() for path in files.abandoned_paths]
+
+    def _fault(
+        self, files: StationFiles, err: OSError, now_ns: int, *, this_message_lost: bool
+    ) -> None:
+        path = files.current.path if files.current is not None else None
+        self.write_errors += 1
+        self.last_write_error = describe_os_error(err, path)
+        lost = files.abandon() + (1 if this_message_lost else 0)
+        self._retry_at_ns = now_ns + RETRY_INTERVAL_NS
+        if self.recording_ok:
+            self.recording_ok = False
+            self._fault_started_ns = now_ns
+            self._fault_dropped = 0
+            self._remind_at_ns = now_ns + REMINDER_INTERVAL_NS
+            LOG.error(
+                "recording failed: %s; station %s: messages are dropped and counted, "
+                "writing is retried at the next run or every %.0f s "
+                "(the incomplete file: boltwatch recover FILE)",
+                self.last_write_error,
+                files.station,
+                RETRY_INTERVAL_NS / 1e9,
+            )
+        self._drop(lost, now_ns)
+
+    def _drop(self, count: int, now_ns: int) -> None:
+        self.dropped_messages += count
+        self._fault_dropped += count
+        self._remind(now_ns)
+
+    def _remind(self, now_ns: int) -> None:
+        if now_ns < self._remind_at_ns:
+            return
+        self._remind_at_ns = now_ns + REMINDER_INTERVAL_NS
+        LOG.error(
+            "recording still failing for %.0f s: %d messages dropped so far (last error: %s)",
+            (now_ns - self._fault_started_ns) / 1e9,
+            self._fault_dropped,
+            self.last_write_error,
+        )
+
+    def _maybe_recovered(self, files: StationFiles, now_ns: int) -> None:
+        """Writing works again once a file is open and everything in it reached the disk."""
+        if self.recording_ok or files.current is None or files.unflushed_messages:
+            return
+        self.recording_ok = True
+        LOG.info(
+            "recording works again into %s after %.1f s; %d messages were dropped meanwhile",
+            files.current.path,
+            (now_ns - self._fault_started_ns) / 1e9,
+            self._fault_dropped,
+        )
 
     def _count(self, counter: Counter[str], received: Received, what: str) -> None:
         if counter[received.key] == 0:

@@ -20,6 +20,7 @@ import zstandard
 from mcap.exceptions import EndOfFile, InvalidMagic, McapError
 from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
+from mcap.writer import MCAP0_MAGIC as MCAP_MAGIC
 
 from shared.errors import InputError
 
@@ -69,11 +70,17 @@ class RecordingScan:
                     return
                 except (InvalidMagic, *_DAMAGE) as err:
                     if self.good_bytes == 0:  # not even magic and header
-                        raise self._not_mcap() from err
-                    if isinstance(err, EndOfFile):
-                        self.damage = f"the file ends inside a record after byte {self.good_bytes}"
+                        raise self._not_mcap(err) from err
+                    cut = isinstance(err, EndOfFile | struct.error | EOFError)
+                    if cut and handle.tell() >= self.file_bytes:
+                        self.damage = (
+                            f"the file is cut off inside a record after byte {self.good_bytes}"
+                        )
                     else:
-                        self.damage = f"damaged record after byte {self.good_bytes}: {err!r}"
+                        self.damage = (
+                            f"damaged record after byte {self.good_bytes} "
+                            f"({type(err).__name__}: {err}); nothing after it can be read"
+                        )
                     return
                 self.good_bytes = handle.tell()
                 if isinstance(record, Schema):
@@ -82,10 +89,24 @@ class RecordingScan:
                     self.channels[record.id] = record
                 yield record
 
-    def _not_mcap(self) -> InputError:
+    def _not_mcap(self, err: Exception) -> InputError:
         if self.file_bytes == 0:
             return InputError(f"{self.path}: no MCAP data (empty file)")
-        return InputError(f"{self.path}: not an MCAP file")
+        with self.path.open("rb") as handle:
+            start = handle.read(len(MCAP_MAGIC))
+        if start != MCAP_MAGIC[: len(start)]:
+            return InputError(
+                f"{self.path}: not an MCAP file (byte 0: {start!r}, expected the MCAP magic "
+                f"{MCAP_MAGIC!r})"
+            )
+        if self.file_bytes <= len(MCAP_MAGIC):
+            return InputError(
+                f"{self.path}: cut off after {self.file_bytes} bytes, inside the MCAP magic"
+            )
+        return InputError(
+            f"{self.path}: the MCAP header at byte {len(MCAP_MAGIC)} is unreadable "
+            f"({type(err).__name__}: {err})"
+        )
 
     def messages(
         self, topic_suffix: str | None = None
@@ -108,6 +129,6 @@ class RecordingScan:
         if self.complete:
             return f"{self.path}: complete"
         return (
-            f"{self.path}: incomplete, read {self.good_bytes} of {self.file_bytes} bytes "
-            f"({self.damage})"
+            f"{self.path}: incomplete, read {self.good_bytes} of {self.file_bytes} bytes, "
+            f"{self.file_bytes - self.good_bytes} bytes lost ({self.damage})"
         )

@@ -1,8 +1,9 @@
 """One run's Rerun recording: an ``.rrd`` beside the run's MCAP, written in column batches.
 
-Each run file gets its own :class:`rerun.RecordingStream` (application
-``boltwatch``, recording id ``<station>/run<run_id>``) saved to
-``<same stem>.rrd``, so runs and stations never mix; with live viewing on it
+Each run file borrows one of its station's :class:`rerun.RecordingStream`
+(application ``boltwatch``, recording id ``<station>``; why streams are
+pooled: :mod:`services.recorder.rerun_streams`) and points it at its own
+``<same stem>.rrd``, with the layout once per folder in ``boltwatch.rbl``; with live viewing on it
 also streams to the process's gRPC server (:class:`RerunLive`). Samples are
 buffered in plain lists and sent with ``send_columns`` every
 ``batch_samples`` samples, at each flush tick and at close: nothing per
@@ -30,6 +31,7 @@ import rerun as rr
 
 from services.recorder import rerun_blueprint as bp
 from services.recorder.incoming import Received
+from services.recorder.rerun_streams import borrow_stream, ensure_layout_file, return_stream
 
 LOG = logging.getLogger(__name__)
 
@@ -104,14 +106,14 @@ class RerunSink:
         self._angle = self._series[bp.ANGLE]
         self._force = self._series[bp.FORCE]
         path.parent.mkdir(parents=True, exist_ok=True)
-        self._stream = rr.RecordingStream(
-            bp.APPLICATION_ID, recording_id=f"{station}/run{run_id}", send_properties=True
-        )
+        ensure_layout_file(path.parent)
+        self._station = station
+        self._stream = borrow_stream(station)
         sinks: list[Any] = [rr.FileSink(path)]
         if options.live_url is not None:
             sinks.append(rr.GrpcSink(options.live_url))
         try:
-            self._stream.set_sinks(*sinks, default_blueprint=bp.run_blueprint())
+            self._stream.set_sinks(*sinks)
         except Exception:
             self._stream.disconnect()  # drop the buffered sink, not "dropping data" at exit
             raise
@@ -169,9 +171,11 @@ class RerunSink:
             if not self.failed:
                 self._send()
                 self._stream.flush()
-            self._stream.disconnect()
+            self._stream.disconnect()  # finishes the file
         except Exception:
             self._fail("close")
+        if not self.failed:
+            return_stream(self._station, self._stream)
         LOG.info("closed %s: %d samples%s", self.path, self.samples, " (FAILED)" * self.failed)
 
     def _event(self, event: Any) -> None:

@@ -16,6 +16,10 @@ run id (a RunSummary racing the next run's start) still land in it.
 With ``rerun`` options each run file (not the idle ones) has a companion
 :class:`RerunSink` writing ``<same stem>.rrd``; it receives what its MCAP
 file receives, is flushed and closed with it, and never stops the MCAP file.
+
+When the disk fails under a file (an :class:`OSError` out of any method),
+the owner (:class:`~services.recorder.recorder.Recorder`) calls
+:meth:`StationFiles.abandon`; the next write opens a new part of the same run.
 """
 
 from __future__ import annotations
@@ -48,6 +52,7 @@ class FileLimits:
     max_file_bytes: int
     max_file_duration_ns: int
     late_grace_ns: int = 2_000_000_000
+    fsync: bool = True  # each flush reaches the disk: a power cut loses one interval at most
 
 
 def file_path(
@@ -93,6 +98,9 @@ class StationFiles:
         self._program_id: int | None = None
         self._last_flush_ns = 0
         self.closed_paths: list[Path] = []
+        self.abandoned_paths: list[Path] = []
+        self.written = 0  # messages handed to a file (flushed or not)
+        self._resume: tuple[int | None, int] | None = None  # (run_id, part) after abandon()
         self._rerun = rerun
         self._rerun_sinks: dict[McapSink, RerunSink] = {}
         self._run_started: tuple[int | None, int] = (None, 0)  # (run_id, ToolState time_ns)
@@ -103,9 +111,11 @@ class StationFiles:
             self._tool_id = received.message.tool_id
             self._program_id = received.message.program_id
             self._run_started = (received.run_id, received.message.time_ns)
+            self._resume = (received.run_id, 1)  # should the disk fail before the file opens
             self._start_run(received.run_id, now_ns)
         elif self.current is None:
-            self._open(received.run_id, now_ns, part=1)
+            run_id, part = self._resume or (received.run_id, 1)
+            self._open(run_id, now_ns, part)
         elif self._over_limits(now_ns):
             self._continue(now_ns)
         assert self.current is not None
@@ -115,6 +125,7 @@ class StationFiles:
         if previous is not None and run_id is not None and run_id == previous.run_id != sink.run_id:
             sink = previous
         sink.write(received)
+        self.written += 1
         companion = self._rerun_sinks.get(sink)
         if companion is not None:
             companion.write(received)
@@ -147,6 +158,32 @@ class StationFiles:
                 self._close(sink)
         self.previous = self.current = None
 
+    def abandon(self) -> int:
+        """Let go of every open file without writing more (the disk failed); messages lost.
+
+        Never raises. The next write opens a new part of the run that was
+        being recorded (what was flushed stays in the abandoned file).
+        """
+        lost = 0
+        for sink in (self.previous, self.current):
+            if sink is None:
+                continue
+            lost += sink.abandon()
+            if sink.flushed_messages:
+                self.abandoned_paths.append(sink.path)
+            companion = self._rerun_sinks.pop(sink, None)
+            if companion is not None:
+                companion.close()  # never raises
+        if self._resume is None and self.current is not None:
+            self._resume = (self.current.run_id, self._part + 1)
+        self.previous = self.current = None
+        return lost
+
+    @property
+    def unflushed_messages(self) -> int:
+        """Messages of the open files not yet on the disk."""
+        return sum(s.unflushed_messages for s in (self.previous, self.current) if s is not None)
+
     def _is_new_run(self, run_id: int | None) -> bool:
         current = self.current
         return current is None or current.run_id != run_id or self._run_ended
@@ -177,13 +214,21 @@ class StationFiles:
     def _open(self, run_id: int | None, now_ns: int, part: int) -> None:
         self._part = part
         self._run_ended = False
+        self._resume = (run_id, part)  # until the file is open: a failed open is retried as is
+        self.current = None
         path = file_path(self._folder, self.station, run_id, now_ns, part)
         tool_id = self._tool_id if run_id is not None else None
         program_id = self._program_id if run_id is not None else None
         metadata = self._metadata.for_file(self.station, run_id, tool_id, program_id)
         self.current = McapSink(
-            path, metadata, run_id, now_ns, library=f"boltwatch {self._metadata.version}"
+            path,
+            metadata,
+            run_id,
+            now_ns,
+            library=f"boltwatch {self._metadata.version}",
+            fsync=self._limits.fsync,
         )
+        self._resume = None
         LOG.debug("opened %s", path)
         if self._rerun is not None and run_id is not None:
             self._open_rerun(path, run_id, now_ns, self._rerun)
@@ -206,7 +251,7 @@ class StationFiles:
         try:
             sink.close()
         finally:
-            self.closed_paths.append(sink.path)
             companion = self._rerun_sinks.pop(sink, None)
             if companion is not None:
                 companion.close()  # never raises: a Rerun failure is logged, not fatal
+        self.closed_paths.append(sink.path)

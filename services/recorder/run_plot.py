@@ -85,8 +85,9 @@ def _caption(run: RecordedRun, bounds: Bounds) -> str:
     )
 
 
-def plot_run(source: Path, target: Path, run_id: int | None = None) -> tuple[int, int]:
-    """Draw the run into ``target`` (PNG); (samples, events) drawn."""
+def draw_run(source: Path, target: Path, run_id: int | None = None) -> RecordedRun:
+    """Draw the run into ``target`` (PNG); the run drawn (``complete``/``state``: was the
+    file whole, and if not, how much of it was lost)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -94,4 +95,10 @@ def plot_run(source: Path, target: Path, run_id: int | None = None) -> tuple[int
     run = read_run(source, run_id)
     figure = build_figure(run)
     figure.savefig(target)
+    return run
+
+
+def plot_run(source: Path, target: Path, run_id: int | None = None) -> tuple[int, int]:
+    """Draw the run into ``target`` (PNG); (samples, events) drawn."""
+    run = draw_run(source, target, run_id)
     return len(run.samples), len(run.events)

@@ -2,11 +2,18 @@
 
 One zenoh session, one subscriber on :data:`shared.keys.EVERYTHING` with a
 deep FIFO channel, read with a blocking ``recv()`` in the service's worker
-thread (:class:`shared.service_runtime.ServiceRunner`). Two session-local
-keys drive it without leaving the process: ``boltwatch/_local/wake`` (stop
-now) and ``boltwatch/_local/tick`` (put every half flush interval so files
-are flushed even when the line is quiet). On SIGTERM the channel is drained
-and every file finished, so it is readable without recovery.
+thread (:class:`shared.service_runtime.ServiceRunner`). Session-local keys
+drive it without leaving the process: ``boltwatch/_local/wake`` (stop now),
+``boltwatch/_local/tick`` (put every half flush interval so files are flushed
+even when the line is quiet) and ``boltwatch/_local/stats`` (once a second:
+publish :class:`~shared.messages.RecorderStats` per station). On SIGTERM the
+channel is drained and every file finished, so it is readable without recovery.
+
+One process serves several stations (``--config A.toml B.toml``): each
+served station gets its metadata from its own file, its own ``wear``
+queryable and its own health token; they share the recordings folder and
+the ``[recorder]`` settings (an error when the files disagree). Messages of
+a station with no file are recorded too, with minimal metadata.
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
@@ -22,19 +29,23 @@ import json
 import logging
 import threading
 import time
-from typing import TYPE_CHECKING
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
 
 import zenoh
 
 from services.recorder.file_metadata import FileMetadata
-from services.recorder.incoming import LOCAL_PREFIX, classify
+from services.recorder.incoming import LOCAL_PREFIX, OTHER_STATION, classify
 from services.recorder.recorder import Recorder
+from services.recorder.recorder_health import RecorderHealth
 from services.recorder.run_files import FileLimits
 from services.recorder.wear_ledger import WearLedger, ledger_path
 from services.recorder.wear_watch import ALERT_TOPIC, WearAlert, WearWatch
 from shared import keys
 from shared.codec import encode
 from shared.config import LoadedStation, load_station
+from shared.errors import ConfigError
+from shared.messages import RecorderStats
 from shared.service_runtime import ServiceRunner
 from shared.zenoh_session import open_session
 
@@ -45,8 +56,11 @@ LOG = logging.getLogger(__name__)
 
 WAKE_KEY = f"{LOCAL_PREFIX}wake"
 TICK_KEY = f"{LOCAL_PREFIX}tick"
+STATS_KEY = f"{LOCAL_PREFIX}stats"
+STATS_PERIOD_S = 1.0
 CHANNEL_DEPTH = 100_000  # 100 s of samples at 1 kHz
 _DRAIN_LIMIT = CHANNEL_DEPTH
+_SAMPLE = "boltwatch.Sample"
 
 
 def limits_of(loaded: LoadedStation) -> FileLimits:
@@ -58,37 +72,71 @@ def limits_of(loaded: LoadedStation) -> FileLimits:
     )
 
 
+def served_stations(loaded: LoadedStation | Sequence[LoadedStation]) -> list[LoadedStation]:
+    """The station files of one recorder; ConfigError when their [recorder] sections differ."""
+    stations = [loaded] if isinstance(loaded, LoadedStation) else list(loaded)
+    if not stations:
+        raise ConfigError("the recorder needs at least one station file")
+    first = stations[0]
+    settings = first.config.recorder.model_dump(exclude={"folder"})
+    for other in stations[1:]:
+        if other.recordings_folder.resolve() != first.recordings_folder.resolve():
+            raise ConfigError(
+                f"{other.path}: recorder.folder: {other.recordings_folder} differs from "
+                f"{first.recordings_folder} of {first.path}; one recorder writes one folder"
+            )
+        for name, value in other.config.recorder.model_dump(exclude={"folder"}).items():
+            if settings[name] != value:
+                raise ConfigError(
+                    f"{other.path}: recorder.{name}: {value} differs from {settings[name]} "
+                    f"of {first.path}; one recorder has one [recorder] section"
+                )
+    return stations
+
+
 class RecorderService:
     """The recorder wired to one zenoh session (which the caller opens and closes)."""
 
     def __init__(
         self,
-        loaded: LoadedStation,
+        loaded: LoadedStation | Sequence[LoadedStation],
         session: zenoh.Session,
         rerun_files: bool = True,
         rerun_live_url: str | None = None,
     ) -> None:
+        stations = served_stations(loaded)
+        first = stations[0]
         self._session = session
-        self._tick_s = loaded.config.recorder.flush_interval_s / 2
+        self._tick_s = first.config.recorder.flush_interval_s / 2
         rerun = rerun_options(rerun_live_url) if rerun_files else None
-        self.recorder = Recorder(
-            loaded.recordings_folder, limits_of(loaded), FileMetadata(loaded), rerun
-        )
-        self._station_id = loaded.station_id
-        self._ledger_file = ledger_path(loaded.recordings_folder)
+        metadata = FileMetadata(stations)
+        self.station_ids = metadata.station_ids
+        self.recorder = Recorder(first.recordings_folder, limits_of(first), metadata, rerun)
+        self.health = RecorderHealth(self.station_ids)
+        self._ledger_file = ledger_path(first.recordings_folder)
         self.wear = WearWatch(
-            self._ledger_file, loaded.config.recorder.wear_service_threshold, self._publish_alert
+            self._ledger_file, first.config.recorder.wear_service_threshold, self._publish_alert
         )
         self._subscriber = session.declare_subscriber(
             keys.EVERYTHING, zenoh.handlers.FifoChannel(CHANNEL_DEPTH)
         )
-        self._queryable = session.declare_queryable(
-            keys.station_key(loaded.station_id, keys.WEAR), self._reply_wear
+        self._queryables = [
+            session.declare_queryable(
+                keys.station_key(station, keys.WEAR), self._wear_replier(station)
+            )
+            for station in self.station_ids
+        ]
+        liveliness = session.liveliness()
+        self._tokens = [
+            liveliness.declare_token(keys.health_key(station, "recorder"))
+            for station in self.station_ids
+        ]
+        LOG.info(
+            "recording %s into %s (station files: %s)",
+            keys.EVERYTHING,
+            first.recordings_folder,
+            ", ".join(self.station_ids),
         )
-        self._token = session.liveliness().declare_token(
-            keys.health_key(loaded.station_id, "recorder")
-        )
-        LOG.info("recording %s into %s", keys.EVERYTHING, loaded.recordings_folder)
 
     def wake(self) -> None:
         """Unblock ``recv()`` in :meth:`work` (a put that never leaves the process)."""
@@ -112,13 +160,27 @@ class RecorderService:
             self.wear.close()
             closed = self.recorder.close()
             LOG.info("recorder stopped: %d messages, %d files", self.recorder.messages, len(closed))
-            ticker.join(self._tick_s + 1.0)
+            ticker.join(self._tick_s + STATS_PERIOD_S + 1.0)
 
     def close(self) -> None:
-        """Undeclare the subscriber and the health token; safe to call twice."""
-        for entity in (self._token, self._queryable, self._subscriber):
+        """Undeclare the subscriber, queryables and health tokens; safe to call twice."""
+        entities: list[zenoh.LivelinessToken | zenoh.Queryable[None] | zenoh.Subscriber[Any]] = [
+            *self._tokens,
+            *self._queryables,
+            self._subscriber,
+        ]
+        for entity in entities:
             with contextlib.suppress(zenoh.ZError):
                 entity.undeclare()
+
+    def stats(self, now_ns: int) -> list[RecorderStats]:
+        """RecorderStats of every station now (starts the next lag window)."""
+        recorder, wear = self.recorder, self.wear
+        write_errors = recorder.write_errors + wear.ledger_errors
+        last_error = recorder.last_write_error or (
+            f"wear ledger: {wear.last_ledger_error}" if wear.last_ledger_error else None
+        )
+        return self.health.report(now_ns, write_errors, last_error, recorder.recording_ok)
 
     def _handle(self, sample: zenoh.Sample) -> None:
         now_ns = time.time_ns()
@@ -126,30 +188,65 @@ class RecorderService:
         if key.startswith(LOCAL_PREFIX):
             if key == TICK_KEY:
                 self.recorder.tick(now_ns)
+            elif key == STATS_KEY:
+                self._publish_stats(now_ns)
             return
         received = classify(key, sample.payload.to_bytes(), now_ns)
         self.recorder.write(received)
+        if received.station != OTHER_STATION:
+            sample_time_ns = (
+                received.publish_time_ns
+                if received.schema_name == _SAMPLE and received.message is not None
+                else None
+            )
+            self.health.written(received.station, now_ns, sample_time_ns)
         if received.schema_name == "boltwatch.RunSummary" and received.message is not None:
             self.wear.on_summary(received.message, now_ns)
+
+    def _publish_stats(self, now_ns: int) -> None:
+        """Put each station's RecorderStats for everyone but this recorder (not recorded)."""
+        for stats in self.stats(now_ns):
+            try:
+                self._session.put(
+                    keys.station_key(stats.station, keys.RECORDER),
+                    encode(stats),
+                    allowed_destination=zenoh.Locality.REMOTE,
+                )
+            except zenoh.ZError as err:  # session closing
+                LOG.debug("recorder stats of %s not published: %s", stats.station, err)
 
     def _publish_alert(self, alert: WearAlert) -> None:
         self._session.put(keys.station_key(alert.station, ALERT_TOPIC), encode(alert))
 
-    def _reply_wear(self, query: zenoh.Query) -> None:
-        """``boltwatch/<station>/wear``: every tool's line of the ledger as one JSON object."""
+    def _wear_replier(self, station: str) -> Callable[[zenoh.Query], None]:
+        def reply(query: zenoh.Query) -> None:
+            self._reply_wear(station, query)
+
+        return reply
+
+    def _reply_wear(self, station: str, query: zenoh.Query) -> None:
+        """``boltwatch/<station>/wear``: the lines of the tools that ran at ``station``."""
         try:
             with WearLedger(self._ledger_file, read_only=True) as ledger:
-                tools = [tool.to_dict() for tool in ledger.tools()]
+                tools = [tool.to_dict() for tool in ledger.tools(station=station)]
         except Exception as err:  # a reply, never a dead queryable thread
-            LOG.warning("wear query failed: %s", err)
+            LOG.warning("wear query of %s failed: %s", station, err)
             query.reply_err(str(err).encode())
             return
-        reply = {"station": self._station_id, "ledger": str(self._ledger_file), "tools": tools}
+        reply = {"station": station, "ledger": str(self._ledger_file), "tools": tools}
         query.reply(query.key_expr, json.dumps(reply).encode())
 
     def _tick_until(self, stop: threading.Event) -> None:
-        while not stop.wait(self._tick_s):
-            self._local_put(TICK_KEY)
+        """Flush ticks every half flush interval, stats ticks every second."""
+        next_tick = next_stats = time.monotonic()
+        while not stop.wait(max(0.0, min(next_tick, next_stats) - time.monotonic())):
+            now = time.monotonic()
+            if now >= next_tick:
+                self._local_put(TICK_KEY)
+                next_tick = now + self._tick_s
+            if now >= next_stats:
+                self._local_put(STATS_KEY)
+                next_stats = now + STATS_PERIOD_S
 
     def _local_put(self, key: str) -> None:
         try:
@@ -183,8 +280,12 @@ def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
 
 
 def main(args: argparse.Namespace) -> int:
-    loaded = load_station(args.config[0])  # TODO(multi-station)
-    session = open_session(loaded.config.zenoh)
+    paths = args.config if isinstance(args.config, list) else [args.config]
+    loaded = [load_station(path) for path in paths]
+    served_stations(loaded)  # bad combinations fail before zenoh is opened
+    if len(loaded) > 1:
+        LOG.info("zenoh settings from %s", loaded[0].path)
+    session = open_session(loaded[0].config.zenoh)
     live = start_rerun_live(args)
     try:
         service = RecorderService(

@@ -4,12 +4,19 @@ Every RunSummary adds its run's process intensity I_process (eq. 68) to its
 tool; a tool's accumulated intensity is the paper's eq. 69,
 ``I_total = Σ_runs I_process``. Runs are keyed by (station, run_id), so a
 summary delivered twice, or seen again after a recorder restart, is counted
-once. A service (``boltwatch wear service TOOL``) starts a new interval:
-"intensity since service" counts runs that ended after it, while the run
-history and the all-time total stay.
+once. Tools are physical assets (a tool id is unique in the plant): a tool's
+totals count its runs at every station, and each run keeps the station it
+ran at, so a station's view (``tools(station=...)``, the
+``boltwatch/<st>/wear`` queryable, ``boltwatch wear --station``) is the tools
+that ran there, with their whole totals. A service (``boltwatch wear service
+TOOL``) starts a new interval: "intensity since service" counts runs that
+ended after it, while the run history and the all-time total stay.
 
 The file is ``<recordings>/wear.sqlite`` in WAL mode: the recorder writes,
-``boltwatch wear`` and the ``wear`` queryable read at the same time.
+``boltwatch wear`` and the ``wear`` queryable read at the same time: a
+reader holding a read transaction never blocks the writer, nor the writer a
+reader. Each run is one transaction: a writer killed mid-run loses that run
+only, and the file stays consistent (``tests/system/test_wear_ledger_kill.py``).
 """
 
 from __future__ import annotations
@@ -44,6 +51,7 @@ CREATE TABLE IF NOT EXISTS runs (
     PRIMARY KEY (station, run_id)
 );
 CREATE INDEX IF NOT EXISTS runs_by_tool ON runs (tool_id, ended_ns);
+CREATE INDEX IF NOT EXISTS runs_by_station ON runs (station, tool_id);
 CREATE TABLE IF NOT EXISTS services (
     id INTEGER PRIMARY KEY AUTOINCREMENT,
     tool_id INTEGER NOT NULL,
@@ -74,6 +82,7 @@ class ToolWear:
     runs_since_service: int
     intensity_since_service: float
     worst_runs: list[RunWear] = field(default_factory=list)
+    stations: list[str] = field(default_factory=list)  # where its runs were, by name
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -86,18 +95,20 @@ def ledger_path(recordings: Path) -> Path:
 class WearLedger:
     """The ledger file through one connection, for one thread at a time."""
 
-    def __init__(self, path: Path, read_only: bool = False) -> None:
+    def __init__(self, path: Path, read_only: bool = False, busy_timeout_s: float = 10.0) -> None:
         self.path = Path(path)
         try:
             if read_only:
                 if not self.path.is_file():
                     raise InputError(f"{self.path}: no wear ledger here (nothing recorded yet?)")
                 uri = f"{self.path.resolve().as_uri()}?mode=ro"
-                self._db = sqlite3.connect(uri, uri=True, timeout=10)
+                self._db = sqlite3.connect(uri, uri=True, timeout=busy_timeout_s)
             else:
                 self.path.parent.mkdir(parents=True, exist_ok=True)
                 # Opened by the thread that builds the service, then used by its worker only.
-                self._db = sqlite3.connect(self.path, timeout=10, check_same_thread=False)
+                self._db = sqlite3.connect(
+                    self.path, timeout=busy_timeout_s, check_same_thread=False
+                )
                 self._db.execute("PRAGMA journal_mode=WAL")
                 self._db.executescript(_SCHEMA)
         except sqlite3.Error as err:
@@ -132,15 +143,21 @@ class WearLedger:
                 (tool_id, serviced_ns, note),
             )
 
-    def tool_ids(self) -> list[int]:
-        rows = self._db.execute(
-            "SELECT tool_id FROM runs UNION SELECT tool_id FROM services ORDER BY tool_id"
-        )
+    def tool_ids(self, station: str | None = None) -> list[int]:
+        """Every tool in the ledger, or those that ran at ``station``; by id."""
+        if station is not None:
+            rows = self._db.execute(
+                "SELECT DISTINCT tool_id FROM runs WHERE station = ? ORDER BY tool_id", (station,)
+            )
+        else:
+            rows = self._db.execute(
+                "SELECT tool_id FROM runs UNION SELECT tool_id FROM services ORDER BY tool_id"
+            )
         return [int(tool_id) for (tool_id,) in rows]
 
-    def tools(self) -> list[ToolWear]:
-        """Every tool's line, by tool id."""
-        return [self.tool(tool_id) for tool_id in self.tool_ids()]
+    def tools(self, station: str | None = None) -> list[ToolWear]:
+        """Every tool's line (or of the tools that ran at ``station``, whole totals), by id."""
+        return [self.tool(tool_id) for tool_id in self.tool_ids(station)]
 
     def tool(self, tool_id: int) -> ToolWear:
         """One tool's line (zeros for a tool the ledger has never seen)."""
@@ -168,6 +185,9 @@ class WearLedger:
                 "WHERE tool_id = ? ORDER BY process_intensity DESC, ended_ns LIMIT ?",
                 (tool_id, WORST_RUNS),
             ).fetchall()
+            stations = self._db.execute(
+                "SELECT DISTINCT station FROM runs WHERE tool_id = ? ORDER BY station", (tool_id,)
+            ).fetchall()
         return ToolWear(
             tool_id=tool_id,
             runs=int(runs),
@@ -178,6 +198,7 @@ class WearLedger:
             runs_since_service=int(runs_since),
             intensity_since_service=float(total_since),
             worst_runs=[RunWear(str(s), int(r), float(i), int(e)) for s, r, i, e in worst],
+            stations=[str(name) for (name,) in stations],
         )
 
     def close(self) -> None:

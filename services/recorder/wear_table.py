@@ -14,6 +14,7 @@ HEADER = (
     "I since service",
     "runs since",
     "last service",
+    "stations",
     "worst runs",
 )
 
@@ -39,13 +40,16 @@ def row(wear: ToolWear) -> tuple[str, ...]:
         f"{wear.intensity_since_service:.4g}",
         str(wear.runs_since_service),
         service,
+        ",".join(wear.stations) or "-",
         worst or "-",
     )
 
 
-def format_table(tools: list[ToolWear]) -> str:
-    """Aligned text table, one line per tool; says so when the ledger is empty."""
+def format_table(tools: list[ToolWear], station: str | None = None) -> str:
+    """Aligned text table, one line per tool; says so when the ledger (or station) is empty."""
     if not tools:
+        if station is not None:
+            return f"the wear ledger has no runs at station {station}"
         return "the wear ledger has no runs yet"
     rows = [HEADER, *(row(tool) for tool in tools)]
     widths = [max(len(r[i]) for r in rows) for i in range(len(HEADER) - 1)]

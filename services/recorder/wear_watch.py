@@ -4,11 +4,18 @@ After each new run the tool's intensity since its last service is compared
 with ``recorder.wear_service_threshold``; at or above it a :class:`WearAlert`
 is published on ``boltwatch/<station>/wear/alert`` after every run until the
 tool is serviced (and logged once per crossing).
+
+A ledger that cannot be written (disk full, read-only folder) never stops the
+recorder: the summaries wait in memory, in order, and go in with the next
+one that can be written (logged at ERROR when it starts failing, INFO when it
+works again). SQLite's transactions keep the counted runs intact meanwhile.
 """
 
 from __future__ import annotations
 
 import logging
+import sqlite3
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,6 +27,7 @@ from shared.messages import RunSummary
 LOG = logging.getLogger(__name__)
 
 ALERT_TOPIC = f"{keys.WEAR}/alert"
+PENDING_LIMIT = 100_000  # summaries kept while the ledger cannot be written (days of runs)
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,15 +52,52 @@ class WearWatch:
         threshold: float | None,
         alert: Callable[[WearAlert], None],
     ) -> None:
-        self._ledger = WearLedger(ledger_file)
+        self._ledger_file = ledger_file
+        self._ledger: WearLedger | None = None
         self._threshold = threshold
         self._alert = alert
         self._due: set[int] = set()
+        self._pending: deque[tuple[RunSummary, int]] = deque(maxlen=PENDING_LIMIT)
         self.counted = 0
         self.repeated = 0
+        self.ledger_errors = 0
+        self.last_ledger_error: str | None = None
 
     def on_summary(self, summary: RunSummary, now_ns: int) -> ToolWear | None:
-        """Count the run (once); the tool's new line, or None for a repeated summary."""
+        """Count the run (once); the tool's new line, or None (repeated, or ledger failing)."""
+        if len(self._pending) == PENDING_LIMIT:
+            LOG.error("wear ledger: %d summaries waiting, dropping the oldest", PENDING_LIMIT)
+        self._pending.append((summary, now_ns))
+        wear = None
+        while self._pending:
+            try:
+                wear = self._count(*self._pending[0])
+            except (sqlite3.Error, OSError) as err:
+                self._failed(err)
+                return None
+            self._pending.popleft()
+        if self.last_ledger_error is not None:
+            LOG.info("wear ledger %s writable again; every waiting run counted", self._ledger_file)
+            self.last_ledger_error = None
+        return wear
+
+    def _failed(self, err: Exception) -> None:
+        self.ledger_errors += 1
+        if self.last_ledger_error is None:
+            LOG.error(
+                "wear ledger %s cannot be written: %s; %d run(s) wait in memory",
+                self._ledger_file,
+                err,
+                len(self._pending),
+            )
+        self.last_ledger_error = str(err)
+        if self._ledger is not None:
+            self._ledger.close()
+            self._ledger = None  # reopened on the next summary
+
+    def _count(self, summary: RunSummary, now_ns: int) -> ToolWear | None:
+        if self._ledger is None:
+            self._ledger = WearLedger(self._ledger_file)
         if not self._ledger.add_run(summary, now_ns):
             self.repeated += 1
             LOG.debug("run %s/%d already in the ledger", summary.station, summary.run_id)
@@ -88,4 +133,7 @@ class WearWatch:
         return wear
 
     def close(self) -> None:
-        self._ledger.close()
+        if self._pending:
+            LOG.error("wear ledger: %d run(s) could not be counted", len(self._pending))
+        if self._ledger is not None:
+            self._ledger.close()

@@ -3,6 +3,11 @@
 Stations connect to it as clients (``[zenoh] mode = "client"``). In a plant
 the official ``eclipse/zenoh`` router image does the same job (see
 docker-compose.yml); this one needs nothing but the Python wheel.
+
+With ``--tls-*`` it takes only TLS connections from services whose
+certificate the line's CA signed (mutual TLS); with ``--access-control`` it
+enforces zenoh's access control, e.g. only a station's predictor may put
+its decisions (README, Security).
 """
 
 from __future__ import annotations
@@ -10,19 +15,79 @@ from __future__ import annotations
 import argparse
 import logging
 import threading
+from pathlib import Path
 
+import zenoh
+
+from shared.errors import ConfigError
 from shared.service_runtime import ServiceRunner
-from shared.zenoh_session import open_from, zenoh_config
+from shared.zenoh_session import TlsFiles, open_from, zenoh_config
 
 LOG = logging.getLogger(__name__)
 
 DEFAULT_LISTEN = "tcp/127.0.0.1:7447"
 
 
-def main(args: argparse.Namespace) -> int:
+def router_config(args: argparse.Namespace) -> zenoh.Config:
+    """The router's zenoh.Config; bad TLS or access-control options are ConfigErrors."""
     endpoints = args.listen or [DEFAULT_LISTEN]
-    with open_from(zenoh_config("router", listen=endpoints)):
+    tls = _tls_files(args, endpoints)
+    config = zenoh_config("router", listen=endpoints, tls=tls)
+    if args.access_control is not None:
+        _insert_access_control(config, args.access_control)
+    return config
+
+
+def _tls_files(args: argparse.Namespace, endpoints: list[str]) -> TlsFiles | None:
+    given = {
+        "--tls-root-ca": args.tls_root_ca,
+        "--tls-cert": args.tls_cert,
+        "--tls-key": args.tls_key,
+    }
+    uses_tls = any(endpoint.startswith("tls/") for endpoint in endpoints)
+    if not any(given.values()):
+        if uses_tls:
+            raise ConfigError("a tls/ endpoint needs --tls-root-ca, --tls-cert and --tls-key")
+        return None
+    missing = [option for option, path in given.items() if path is None]
+    if missing:
+        raise ConfigError(f"TLS needs {', '.join(missing)} as well")
+    if not uses_tls:
+        raise ConfigError("--tls-* options given but no --listen tls/HOST:PORT endpoint")
+    for option, path in given.items():
+        _check_readable(option, path)
+    return TlsFiles(args.tls_root_ca, args.tls_cert, args.tls_key)
+
+
+def _check_readable(option: str, path: Path) -> None:
+    try:
+        with path.open("rb") as handle:
+            handle.read(1)
+    except OSError as err:
+        raise ConfigError(f"{option} {path}: cannot be read: {err.strerror}") from err
+
+
+def _insert_access_control(config: zenoh.Config, path: Path) -> None:
+    try:
+        text = path.read_text()
+    except OSError as err:
+        raise ConfigError(f"--access-control {path}: cannot be read: {err.strerror}") from err
+    try:
+        config.insert_json5("access_control", text)
+    except zenoh.ZError as err:
+        raise ConfigError(
+            f"{path}: not a zenoh access_control section (enabled, default_permission, "
+            f"rules, subjects, policies): {err}"
+        ) from err
+
+
+def main(args: argparse.Namespace) -> int:
+    config = router_config(args)
+    endpoints = args.listen or [DEFAULT_LISTEN]
+    with open_from(config):
         LOG.info("zenoh router listening on %s", ", ".join(endpoints))
+        if args.access_control is not None:
+            LOG.info("access control from %s", args.access_control)
 
         def work(stop: threading.Event) -> None:
             stop.wait()

@@ -5,6 +5,7 @@ Load with :func:`load_station` (which also loads the joint it names) or
 """
 
 from shared.config.joint import JointConfig, load_joint
+from shared.config.line import derive_stations, derived_ids, load_line
 from shared.config.station import (
     LoadedStation,
     PredictorSection,
@@ -21,6 +22,9 @@ __all__ = [
     "Program",
     "RigSection",
     "StationConfig",
+    "derive_stations",
+    "derived_ids",
     "load_joint",
+    "load_line",
     "load_station",
 ]

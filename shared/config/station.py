@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from shared.config.joint import JointConfig, load_joint
 from shared.config.loading import StrictModel, read_toml, resolve_relative, validate
@@ -42,15 +42,65 @@ class CanSection(StrictModel):
 
 
 class ZenohSection(StrictModel):
+    """How a service joins the line: its router, reconnection, and TLS (see README, Security)."""
+
     mode: Literal["peer", "client"] = "client"
     connect: list[str] = Field(default_factory=list, description="e.g. tcp/127.0.0.1:7447")
     listen: list[str] = Field(default_factory=list)
+    connect_timeout_s: float | None = Field(
+        default=None,
+        gt=0,
+        description="how long a service waits for its router at start; none: for ever",
+    )
+    reconnect_period_max_s: float = Field(
+        default=2.0,
+        gt=0,
+        le=60,
+        description="longest pause between two attempts to reach a lost router (never gives up)",
+    )
+    tls_root_ca: Path | None = Field(
+        default=None, description="CA certificate (PEM) of the line, relative to this station file"
+    )
+    tls_cert: Path | None = Field(
+        default=None, description="this service's certificate (PEM), for mutual TLS"
+    )
+    tls_key: Path | None = Field(default=None, description="its private key (PEM)")
+
+    @field_validator("tls_root_ca", "tls_cert", "tls_key")
+    @classmethod
+    def _readable_file(cls, path: Path | None, info: ValidationInfo) -> Path | None:
+        """Resolve against the station file and fail now, not at the first TLS handshake."""
+        if path is None:
+            return None
+        source = (info.context or {}).get("source")
+        resolved = resolve_relative(path, Path(source)) if source is not None else path
+        try:
+            with resolved.open("rb") as handle:
+                handle.read(1)
+        except OSError as err:
+            raise ValueError(f"cannot read {resolved}: {err.strerror}") from err
+        return resolved
 
     @model_validator(mode="after")
     def _has_somewhere_to_go(self) -> ZenohSection:
         if not self.connect and not self.listen:
             raise ValueError("give connect or listen endpoints (multicast scouting is off)")
         return self
+
+    @model_validator(mode="after")
+    def _tls_is_complete(self) -> ZenohSection:
+        if (self.tls_cert is None) != (self.tls_key is None):
+            raise ValueError("give tls_cert and tls_key together (mutual TLS needs both)")
+        uses_tls = any(e.startswith("tls/") for e in [*self.connect, *self.listen])
+        if uses_tls and self.tls_root_ca is None:
+            raise ValueError("tls/ endpoints need tls_root_ca (the CA that signed the router)")
+        if not uses_tls and (self.tls_root_ca or self.tls_cert):
+            raise ValueError("tls_* keys are set but no endpoint is tls/ (e.g. tls/host:7447)")
+        return self
+
+    @property
+    def uses_tls(self) -> bool:
+        return self.tls_root_ca is not None
 
 
 class Program(StrictModel):

@@ -187,8 +187,63 @@ def test_status_json_shows_the_fake_station(router: str, tmp_path: Path) -> None
     summary = status["last_summary"]
     assert (summary["run_id"], summary["target"], summary["reached"]) == (11, 56000.0, 55900.0)
     assert summary["error_pct"] == -0.18
-    assert status["recorder_lag_s"] is None
+    assert status["recorder"] is None  # no recorder serves it
     assert status["unreadable_messages"] == 0
+
+
+@pytest.fixture
+def recorder_process(router: str, tmp_path: Path) -> Iterator[subprocess.Popen[bytes]]:
+    """A real ``boltwatch serve recorder`` for STATION, a client of ``router``, once it is up."""
+    station_file = write_station(
+        tmp_path,
+        zenoh_port=int(router.rsplit(":", 1)[1]),
+        replacements={'id = "st1"': f'id = "{STATION}"'},
+    )
+    log_path = tmp_path / "recorder.log"
+    log = log_path.open("w")
+    process = subprocess.Popen(
+        [sys.executable, "-m", "services.cli", "serve", "recorder", "--config", str(station_file),
+         "--no-rerun"],
+        cwd=REPO, stdout=log, stderr=subprocess.STDOUT,
+    )  # fmt: skip
+    watcher = open_from(zenoh_config("client", [router], connect_timeout_ms=5000))
+    try:
+        deadline = time.monotonic() + 30
+        token = keys.health_key(STATION, "recorder")
+        while not any(r.ok is not None for r in watcher.liveliness().get(token, timeout=1)):
+            assert process.poll() is None, log_path.read_text()
+            assert time.monotonic() < deadline, "the recorder never came up"
+            time.sleep(0.1)
+        yield process
+    finally:
+        watcher.close()
+        process.terminate()
+        try:
+            process.wait(10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(10)
+        log.close()
+
+
+def test_status_shows_the_recorder_lag_and_health(
+    router: str, recorder_process: subprocess.Popen[bytes]
+) -> None:
+    with FakeStation(router):
+        json_run = boltwatch("status", "--connect", router, "--listen-s", "2.5", "--json")
+        text_run = boltwatch("status", "--connect", router, "--listen-s", "2.5")
+
+    assert json_run.returncode == 0, json_run.stderr
+    status = json.loads(json_run.stdout)["stations"][STATION]
+    assert status["services"]["recorder"] is True
+    recorder = status["recorder"]
+    assert recorder is not None, status
+    assert recorder["recording"] is True and recorder["write_errors"] == 0
+    assert recorder["last_error"] is None
+    assert recorder["messages"] > 0
+    assert 0 <= recorder["lag_p50_ms"] <= recorder["lag_max_ms"]
+    assert text_run.returncode == 0, text_run.stderr
+    assert "recorder      recording, lag p50 " in text_run.stdout
 
 
 def test_status_with_nothing_alive_connects_and_says_so(router: str) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 NAME = "inspect"
@@ -26,9 +27,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from services.recorder.run_plot import plot_run
+    from services.recorder.run_plot import draw_run
 
     target = args.out or args.recording.with_suffix(".png")
-    samples, events = plot_run(args.recording, target, args.run)
-    print(f"wrote {target}: {samples} samples, {events} stick-slip events")
+    run = draw_run(args.recording, target, args.run)
+    if not run.complete:
+        print(f"boltwatch inspect: warning: {run.state}; drew what is readable", file=sys.stderr)
+    print(f"wrote {target}: {len(run.samples)} samples, {len(run.events)} stick-slip events")
     return 0

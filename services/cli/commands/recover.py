@@ -1,4 +1,9 @@
-"""``boltwatch recover FILE [--out OUT]``: make a truncated recording readable again."""
+"""``boltwatch recover FILE [--out OUT]``: make a truncated recording readable again.
+
+``.mcap`` files are read record by record (:mod:`services.recorder.recovery`);
+``.rrd`` files are copied chunk by chunk by the ``rerun`` CLI of the wheel
+(:mod:`services.recorder.rrd_recovery`).
+"""
 
 from __future__ import annotations
 
@@ -6,28 +11,33 @@ import argparse
 from pathlib import Path
 
 NAME = "recover"
-HELP = "turn a truncated MCAP recording (recorder killed) into a valid file"
+HELP = "turn a truncated recording (.mcap or .rrd, recorder killed) into a valid file"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.description = (
         "Copy every complete message, schema, channel and metadata record of FILE "
-        "into a new valid MCAP file (FILE itself is never changed). A recorder killed "
-        "with kill -9 loses at most its last flush interval of data."
+        "(every complete chunk of an .rrd) into a new valid file (FILE itself is never "
+        "changed). A recorder killed with kill -9 loses at most its last flush interval "
+        "of data."
     )
-    parser.add_argument("file", type=Path, metavar="FILE", help="the damaged .mcap file")
+    parser.add_argument("file", type=Path, metavar="FILE", help="the damaged .mcap or .rrd file")
     parser.add_argument(
         "--out",
         type=Path,
         default=None,
         metavar="OUT",
-        help="where to write the recovered file (default: FILE with .recovered.mcap)",
+        help="where to write the recovered file (default: FILE with .recovered.mcap/.rrd)",
     )
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.file.suffix == ".rrd":
+        from services.recorder.rrd_recovery import recover_rrd
+
+        print(recover_rrd(args.file, args.out).describe())
+        return 0
     from services.recorder.recovery import recover
 
-    report = recover(args.file, args.out)
-    print(report.describe())
+    print(recover(args.file, args.out).describe())
     return 0

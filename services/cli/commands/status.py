@@ -18,7 +18,10 @@ if TYPE_CHECKING:
     from services.cli.station_status import StatusReport
 
 NAME = "status"
-HELP = "which stations and services are alive, sample rate, bus faults, last run and decision"
+HELP = (
+    "which stations and services are alive, sample rate, bus faults, last run and "
+    "decision, recorder lag and health"
+)
 
 DEFAULT_CONFIG = Path("config/station.toml")
 CONNECT_TIMEOUT_MS = 2000
@@ -30,7 +33,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "Connect to the zenoh router (the endpoint of the station file's [zenoh] connect, "
         "or --connect), listen to every station for a moment and print, per station: "
         "services alive, samples per second, bus gaps and bad frames, the last run, the "
-        "last stop decision and the last run summary. Runs, decisions and summaries are "
+        "last stop decision, the last run summary, and the recorder's lag and write "
+        "health (its RecorderStats, once a second). Runs, decisions and summaries are "
         "shown only if they happened while listening; lengthen --listen-s to catch one."
     )
     where = parser.add_mutually_exclusive_group()

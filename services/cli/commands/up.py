@@ -6,6 +6,14 @@ until every service shows its liveliness token, lets the rig tighten
 ``--runs`` joints, prints one row per run as it ends, then stops everything
 in order and prints the table, the bus counters and where the recordings are.
 A service that dies is reported with the end of its log, and the rest stop.
+
+``--stations N`` runs a line of N simulated stations on one router: N
+station files derived from ``--config`` (ids ``st1..stN`` when the base id is
+``st1``, each with its own CAN multicast port, tool id and rig seed; see
+:mod:`shared.config.line`) are written into the run's log folder; ONE
+recorder and ONE predictor serve them all, each station has its own
+acquisition and rig. The exit status is 0 only if every station got all
+its runs.
 """
 
 from __future__ import annotations
@@ -18,7 +26,7 @@ from pathlib import Path
 from types import FrameType
 
 NAME = "up"
-HELP = "run the simulated station end to end (rig, acquisition, predictor, recorder, router)"
+HELP = "run the simulated station (or --stations N) end to end: rig, acquisition, predictor, ..."
 
 
 class StoppedBySignalError(Exception):
@@ -32,7 +40,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=Path("config/station.toml"),
         help="station file (default: config/station.toml)",
     )
-    parser.add_argument("--runs", type=int, default=5, help="tightenings to run (default 5)")
+    parser.add_argument(
+        "--runs", type=int, default=5, help="tightenings to run per station (default 5)"
+    )
+    parser.add_argument(
+        "--stations",
+        type=int,
+        default=1,
+        help="simulated stations on the line, derived from --config (default 1)",
+    )
     parser.add_argument(
         "--program", type=int, default=None, help="program id (default: the first program)"
     )
@@ -46,11 +62,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from services.cli.station_run import StationRun
-    from shared.config import load_station
+    from shared.config import derive_stations, load_line, load_station
     from shared.errors import ConfigError
 
     if args.runs < 1:
         raise ConfigError(f"--runs must be at least 1 (got {args.runs})")
+    if args.stations < 1:
+        raise ConfigError(f"--stations must be at least 1 (got {args.stations})")
     station = load_station(args.config)
     program = (
         station.config.program(args.program)
@@ -64,12 +82,17 @@ def run(args: argparse.Namespace) -> int:
         )
     stamp = datetime.now(UTC).strftime("%Y%m%d-%H%M%S")
     log_dir = station.recordings_folder / "logs" / f"up-{stamp}"
+    stations = (
+        [station]
+        if args.stations == 1
+        else load_line(derive_stations(args.config, args.stations, log_dir / "stations"))
+    )
 
     def on_signal(signum: int, _frame: FrameType | None) -> None:
         raise StoppedBySignalError(signal.Signals(signum).name)
 
     previous = {s: signal.signal(s, on_signal) for s in (signal.SIGTERM, signal.SIGHUP)}
-    station_run = StationRun(station, program, args.runs, log_dir, args.startup_timeout_s)
+    station_run = StationRun(stations, program, args.runs, log_dir, args.startup_timeout_s)
     try:
         return station_run.run()
     except (KeyboardInterrupt, StoppedBySignalError):

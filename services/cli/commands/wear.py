@@ -2,7 +2,7 @@
 
 ::
 
-    boltwatch wear [--recordings DIR]                     the table, one line per tool
+    boltwatch wear [--recordings DIR] [--station ST]      the table, one line per tool
     boltwatch wear service TOOL --note TEXT               record a service of TOOL
 """
 
@@ -20,7 +20,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "Show the accumulated stick-slip intensity per tool (I_total = Σ I_process, eq. 69), "
         "its runs, intensity per run, worst runs and the intensity since the last service. "
         "'boltwatch wear service TOOL --note TEXT' records a service: the interval count "
-        "restarts, the history stays."
+        "restarts, the history stays. Tools are plant assets: a tool's totals count its "
+        "runs at every station; --station ST lists the tools that ran at ST."
     )
     parser.add_argument("action", nargs="?", choices=["service"], help="record a service")
     parser.add_argument("tool", nargs="?", type=int, help="tool id (with 'service')")
@@ -37,6 +38,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         default=Path("config/station.toml"),
         help="station file, for its recorder.folder (default: config/station.toml)",
+    )
+    parser.add_argument(
+        "--station",
+        default=None,
+        metavar="ST",
+        help="only the tools that ran at station ST (their totals still count every station)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
 
@@ -61,9 +68,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"recorded a service of tool {args.tool} in {path}")
     else:
         with WearLedger(path, read_only=True) as ledger:
-            tools = ledger.tools()
+            tools = ledger.tools(station=args.station)
     if args.json:
         print(json.dumps([tool.to_dict() for tool in tools], indent=2))
     else:
-        print(format_table(tools))
+        print(format_table(tools, args.station))
     return 0

@@ -26,6 +26,7 @@ from services.predictor.core.extremum_tracker import ExtremumTracker, Slip
 from services.predictor.core.force_history import ForceHistory
 from services.predictor.core.inclination_window import NO_FLIP, InclinationWindow
 from services.predictor.core.input_guard import InputGuard, InputReport
+from services.predictor.core.model_bands import BandVerdict, ModelBandCheck
 from services.predictor.core.outputs import CoreDecision, CoreEvent
 from services.predictor.core.regression import predict_events
 from services.predictor.core.scoring import PredictionScores
@@ -56,6 +57,11 @@ class PredictorCore:
         self._forces = ForceHistory()
         self._screw = ScrewPlateaus()
         self.policy = StopPolicy(settings)
+        self.model_bands = (
+            ModelBandCheck(settings.constants, settings.constant_window)
+            if settings.constants is not None
+            else None
+        )
         self.scores = PredictionScores()
         self._count = 0
         self._start_time_s = math.nan
@@ -182,6 +188,19 @@ class PredictorCore:
             predictions=predictions,
         )
         out: list[CoreOutput] = [event]
+        if not settings.force_mode:
+            regular = predictions and self._is_staircase()
+            self.policy.expect_peak(predictions[0].peak_torque_nm if regular else None)
+        verdict = None
+        if self.model_bands is not None:
+            verdict = self.model_bands.on_event(
+                peak.torque_nm,
+                figures.torque_drop_nm,
+                figures.period_s,
+                figures.force_step_n,
+                speed,
+                self._tracker.noise_d2_nm,
+            )
         by_angle = None
         if not settings.force_mode:
             by_angle = self._screw.on_event(
@@ -195,6 +214,7 @@ class PredictorCore:
             predictions,
             (figures.k1, figures.k2, figures.k3),
             by_angle,
+            verdict,
         )
         if decision is not None:
             out.append(decision)
@@ -209,6 +229,7 @@ class PredictorCore:
         predictions: list[Prediction],
         constants: tuple[float | None, float | None, float | None],
         by_angle: tuple[float, float] | None = None,
+        verdict: BandVerdict | None = None,
     ) -> CoreDecision | None:
         """The per-event stop rules, fed with plausible predictions only.
 
@@ -228,7 +249,9 @@ class PredictorCore:
             if step is not None and step <= MAX_STEP_FRACTION * abs(force_now):
                 force_next = force_now + step
         peak_now = peak_next = None
-        if by_angle is not None and self._is_staircase(rising=False):
+        if not self.settings.torque_plateau_rule:
+            pass
+        elif by_angle is not None and self._is_staircase(rising=False):
             now, after = by_angle
             if after - now <= MAX_STEP_FRACTION * now:
                 peak_now, peak_next = now, after
@@ -245,6 +268,7 @@ class PredictorCore:
             peak_next,
             self.process_intensity,
             constants,
+            verdict,
         )
 
     def _is_staircase(self, rising: bool = True) -> bool:

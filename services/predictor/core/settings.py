@@ -53,6 +53,8 @@ class PredictorSettings:
     limit_samples: int = 2  # consecutive samples beyond a hard limit before stopping
     reaction_samples: float = 1.0  # samples the motor still turns after the deciding sample
     constants: JointConstants | None = None  # the expected joint, when one is configured
+    # torque target: also stop on the peak-torque plateau rule of eq. 64 (see stop_policy)
+    torque_plateau_rule: bool = False
 
     @property
     def force_mode(self) -> bool:

@@ -25,6 +25,9 @@ Checked once per stick-slip event j (after its slip, on the new plateau):
 - intensity_limit, eq. 70: I_process > I_max;
 - constant_out_of_band, eq. 71: |mean(K_i of the n_K events before) - K_i,now|
   ≥ S_i, with S_i given as a fraction of that mean; only when configured.
+  And, when the station's joint is known, the median of the last n_K K_i
+  outside the model's band widened by its known uncertainty
+  (:mod:`.model_bands`).
 
 The first decision is latched: one decision per run.
 """
@@ -34,12 +37,16 @@ from __future__ import annotations
 import math
 from collections import deque
 
+from services.predictor.core.model_bands import BandVerdict
 from services.predictor.core.outputs import CoreDecision
 from services.predictor.core.ramp_estimator import RampEstimator
 from services.predictor.core.settings import PredictorSettings
 from shared.messages import StopReasonName
 
 TARGET_SAMPLES = 3
+#: torque target: a stick phase whose predicted peak is within this share of the
+#: target may slip while the stop is on its way (see :meth:`StopPolicy.expect_peak`)
+SLIP_GUARD = 0.015
 
 
 class StopPolicy:
@@ -65,6 +72,20 @@ class StopPolicy:
         self._max_torque = s.max_torque_nm if s.max_torque_nm is not None else math.inf
         self._max_force = s.max_force_n if s.has_force and s.max_force_n is not None else math.inf
         self._max_angle = s.max_angle_deg if s.max_angle_deg is not None else math.inf
+        self._expected_peak_nm = math.nan
+
+    def expect_peak(self, peak_nm: float | None) -> None:
+        """The predicted peak torque of the stick phase now under way (torque target only).
+
+        The settled torque of a halted tool is the torque at the halt if the
+        joint sticks, but the trough after the slip if the slip starts before
+        the motor has stopped. When this phase's peak is predicted within
+        SLIP_GUARD of the target, the target is crossed right before the slip:
+        the stop is held back, and the next stick phase, which starts below
+        and ends above the target, crosses it far from its slip. If the joint
+        goes on sticking after all, the stop comes at SLIP_GUARD past the target.
+        """
+        self._expected_peak_nm = peak_nm if peak_nm is not None else math.nan
 
     def _decide(
         self,
@@ -115,6 +136,8 @@ class StopPolicy:
             return None
         self._ramp.add(value)
         self._over_target = self._over_target + 1 if value >= target else 0
+        if self._target_torque is not None and self._holds_back(value, target):
+            return None
         if self._over_target >= TARGET_SAMPLES:
             return self._decide(
                 time_s, "target_reached", f"{unit} ≥ target {target:g}", torque_nm, force_n
@@ -130,6 +153,13 @@ class StopPolicy:
                 projected,
             )
         return None
+
+    def _holds_back(self, value: float, target: float) -> bool:
+        """Torque target: this stick phase's predicted slip is too close to the target."""
+        peak = self._expected_peak_nm
+        if not abs(peak - target) <= SLIP_GUARD * target:
+            return False
+        return value < target * (1.0 + SLIP_GUARD)
 
     def on_input_fault(self, time_s: float, bad_samples: int) -> CoreDecision | None:
         if self.decision is not None:
@@ -152,6 +182,7 @@ class StopPolicy:
         peak_next_nm: float | None,
         process_intensity: float,
         constants: tuple[float | None, float | None, float | None],
+        band_verdict: BandVerdict | None = None,
     ) -> CoreDecision | None:
         """Rules evaluated after each event's slip (eqs. 64, 65, 70, 71)."""
         if self.decision is not None:
@@ -165,6 +196,10 @@ class StopPolicy:
                 f"I_process {process_intensity:.4g} > I_max {limit:.4g} (eq. 70)",
                 torque_nm,
                 force,
+            )
+        if band_verdict is not None:
+            return self._decide(
+                time_s, "constant_out_of_band", band_verdict.detail(), torque_nm, force
             )
         band = self.settings.constant_band
         if band is not None:

@@ -8,7 +8,14 @@ from typing import Any
 from services.cli.station_status import LastRun, StatusCollector, format_report, to_json
 from shared import keys
 from shared.codec import encode
-from shared.messages import BusStats, RunSummary, Sample, StopDecision, ToolState
+from shared.messages import (
+    BusStats,
+    RecorderStats,
+    RunSummary,
+    Sample,
+    StopDecision,
+    ToolState,
+)
 
 S = 1_000_000_000
 T0 = 1_700_000_000 * S
@@ -172,7 +179,7 @@ def test_last_decision_and_summary_with_their_ages() -> None:
     last = status.last_summary
     assert (last.unit, last.target, last.reached, last.error_pct) == ("N", 56000, 55800, -0.357)
     assert last.age_s == 2.5
-    assert status.recorder_lag_s is None
+    assert status.recorder is None
 
 
 def test_torque_only_summary_reports_torque() -> None:
@@ -222,7 +229,7 @@ def test_json_is_one_object_keyed_by_station() -> None:
         "program_id": 1,
         "source": "tool",
     }
-    assert st1["last_decision"] is None and st1["recorder_lag_s"] is None
+    assert st1["last_decision"] is None and st1["recorder"] is None
 
 
 def test_table_reads_per_station() -> None:
@@ -242,10 +249,65 @@ def test_table_reads_per_station() -> None:
     assert "1000 received (bus 1000)" in text
     assert "2 gaps, 3 missed samples, 0 bad frames" in text
     assert "run 3: 55.80 kN of 56.00 kN target, error -0.36 %, plateau_closest" in text
-    assert "recorder lag  n/a" in text
+    assert "recorder      - (no recorder stats in the window" in text
 
 
 def test_nothing_seen_says_so() -> None:
     text = format_report(StatusCollector().report("tcp/127.0.0.1:7447", 2.0, T0))
     assert "no station seen" in text
     assert to_json(StatusCollector().report("e", 2.0, T0))["stations"] == {}
+
+
+def recorder_stats(time_ns: int, **changes: Any) -> RecorderStats:
+    fields: dict[str, Any] = {
+        "station": "st1",
+        "time_ns": time_ns,
+        "messages": 12_345,
+        "lag_p50_ms": 1.25,
+        "lag_max_ms": 7.5,
+        "write_errors": 0,
+        "last_error": None,
+        "recording": True,
+    }
+    fields.update(changes)
+    return RecorderStats(**fields)
+
+
+def test_recorder_lag_and_health_come_from_the_latest_recorder_stats() -> None:
+    collector = StatusCollector()
+    feed(collector, keys.RECORDER, recorder_stats(T0, lag_p50_ms=9.0), at_ns=T0)
+    feed(collector, keys.RECORDER, recorder_stats(T0 + S), at_ns=T0 + S)
+
+    report = collector.report("e", 2.0, T0 + 2 * S)
+    (status,) = report.stations
+
+    assert status.recorder is not None
+    assert (status.recorder.lag_p50_ms, status.recorder.lag_max_ms) == (1.25, 7.5)
+    assert (status.recorder.messages, status.recorder.recording) == (12_345, True)
+    assert status.recorder.age_s == 1.0
+    text = format_report(report)
+    assert "recorder      recording, lag p50 1.2 ms, max 7.5 ms, 12345 messages, " in text
+    assert to_json(report)["stations"]["st1"]["recorder"]["lag_max_ms"] == 7.5
+
+
+def test_a_recorder_that_cannot_write_says_so_and_why() -> None:
+    collector = StatusCollector()
+    failing = recorder_stats(
+        T0,
+        lag_p50_ms=None,
+        lag_max_ms=None,
+        write_errors=3,
+        last_error="[Errno 28] No space left on device",
+        recording=False,
+    )
+    feed(collector, keys.RECORDER, failing)
+    collector.message("boltwatch/st1/recorder", b"{broken", T0)
+
+    report = collector.report("e", 2.0, T0)
+    (status,) = report.stations
+
+    assert status.recorder is not None and not status.recorder.recording
+    assert status.unreadable_messages == 1
+    text = format_report(report)
+    assert "NOT RECORDING: [Errno 28] No space left on device (lag - (no samples)" in text
+    assert "3 write errors" in text

@@ -62,7 +62,9 @@ def test_events_found_from_slow_to_fast_stick_slip(k_e: float, speed: float) -> 
 
 def test_torque_only_stops_near_the_torque_target() -> None:
     trace = staircase(torque_noise_nm=0.2)
-    core = PredictorCore(PredictorSettings(target_torque_nm=120.0, has_force=False))
+    core = PredictorCore(
+        PredictorSettings(target_torque_nm=120.0, has_force=False, torque_plateau_rule=True)
+    )
     rows = [(t, tq, math.nan, a) for t, tq, _, a in trace.rows()]
     (decision,) = decisions(run(core, rows))
     assert decision.reason == "plateau_closest"
@@ -175,3 +177,27 @@ def test_one_decision_per_run() -> None:
     core = PredictorCore(PredictorSettings(target_force_n=20_000.0, max_torque_nm=1.0))
     outputs = run(core, smooth_ramp().rows())
     assert len(decisions(outputs)) == 1
+
+
+def test_torque_target_stops_on_a_stick_ramp_at_the_target() -> None:
+    """Without eq. 64 (the default) a torque target is met on a stick ramp, not at a trough."""
+    trace = staircase(torque_noise_nm=0.2)
+    core = PredictorCore(PredictorSettings(target_torque_nm=120.0, has_force=False))
+    rows = [(t, tq, math.nan, a) for t, tq, _, a in trace.rows()]
+    (decision,) = decisions(run(core, rows))
+    assert decision.reason == "target_reached"
+    assert decision.torque_nm == pytest.approx(120.0, abs=1.5)
+
+
+def test_a_slip_expected_at_the_torque_target_holds_the_stop_back() -> None:
+    from services.predictor.core.stop_policy import SLIP_GUARD, StopPolicy
+
+    policy = StopPolicy(PredictorSettings(target_torque_nm=100.0, has_force=False))
+    policy.expect_peak(100.5)  # this stick phase is predicted to slip at the target
+    ramp = [(i * 1e-3, 95.0 + 0.5 * i) for i in range(30)]
+    stop = next((t, tq) for t, tq in ramp if policy.on_sample(t, tq, math.nan, 0.0) is not None)
+    assert stop[1] >= 100.0 * (1.0 + SLIP_GUARD)
+    other = StopPolicy(PredictorSettings(target_torque_nm=100.0, has_force=False))
+    other.expect_peak(110.0)  # the slip is far above: stop at the target
+    stop = next((t, tq) for t, tq in ramp if other.on_sample(t, tq, math.nan, 0.0) is not None)
+    assert stop[1] < 100.0 * (1.0 + SLIP_GUARD)

@@ -1,4 +1,9 @@
-"""The predictor service on real zenoh: samples and tool states in, messages out."""
+"""The predictor service on real zenoh: samples and tool states in, messages out.
+
+One service serves two stations (pt1: program 1; pt2: only program 2, so a
+pt2 run predicted with pt1's configuration would not be predicted at all);
+pt3 is on the same zenoh network but not served.
+"""
 
 from __future__ import annotations
 
@@ -14,7 +19,8 @@ import zenoh
 from services.predictor.service import PredictorService
 from services.recorder.testing import free_port
 from shared import codec, keys
-from shared.config import LoadedStation, load_station
+from shared.config import LoadedStation, load_line
+from shared.errors import ConfigError
 from shared.messages import (
     Intensity,
     RunSummary,
@@ -24,35 +30,30 @@ from shared.messages import (
     ToolState,
 )
 from shared.zenoh_session import zenoh_config
-from tests.unit.predictor.synthetic import staircase
+from tests.unit.predictor.synthetic import SyntheticTrace, staircase
 
 REPO = Path(__file__).resolve().parents[3]
 TARGET_N = 30_400.0
+START_NS = 1_700_000_000_000_000_000
+#: station id -> its only program id
+PROGRAM_OF = {"pt1": 1, "pt2": 2}
 
 
-@pytest.fixture
-def endpoint() -> str:
-    return f"tcp/127.0.0.1:{free_port()}"
-
-
-@pytest.fixture
-def station(tmp_path: Path, endpoint: str) -> LoadedStation:
-    path = tmp_path / "station.toml"
-    path.write_text(
-        f"""
+def station_text(tmp_path: Path, station_id: str, program_id: int, endpoint: str) -> str:
+    return f"""
 [station]
-id = "pt1"
+id = "{station_id}"
 tool_id = 3
 joint = "{REPO / "config/joints/paper-section-5-2.toml"}"
 [can]
 interface = "virtual"
-channel = "pt1"
+channel = "{station_id}"
 dbc = "{REPO / "config/can/station.dbc"}"
 [zenoh]
 mode = "peer"
 listen = ["{endpoint}"]
 [[programs]]
-id = 1
+id = {program_id}
 name = "test"
 target_force_n = {TARGET_N}
 motor_speed_rad_s = 0.5
@@ -66,15 +67,28 @@ window_samples = 5
 [recorder]
 folder = "{tmp_path / "rec"}"
 """
-    )
-    return load_station(path)
 
 
 @pytest.fixture
-def service(station: LoadedStation) -> Iterator[PredictorService]:
-    session = zenoh.open(zenoh_config("peer", listen=station.config.zenoh.listen))
+def endpoint() -> str:
+    return f"tcp/127.0.0.1:{free_port()}"
+
+
+@pytest.fixture
+def stations(tmp_path: Path, endpoint: str) -> list[LoadedStation]:
+    paths = []
+    for station_id, program_id in PROGRAM_OF.items():
+        path = tmp_path / f"{station_id}.toml"
+        path.write_text(station_text(tmp_path, station_id, program_id, endpoint))
+        paths.append(path)
+    return load_line(paths)
+
+
+@pytest.fixture
+def service(stations: list[LoadedStation]) -> Iterator[PredictorService]:
+    session = zenoh.open(zenoh_config("peer", listen=stations[0].config.zenoh.listen))
     stop = threading.Event()
-    predictor = PredictorService(session, station)
+    predictor = PredictorService(session, stations)
     worker = threading.Thread(target=predictor.work, args=(stop,), daemon=True)
     worker.start()
     try:
@@ -105,55 +119,132 @@ def wait_for_subscriber(publisher: zenoh.Publisher) -> None:
     raise AssertionError(f"no subscriber for {publisher.key_expr}")
 
 
-def test_service_publishes_events_decision_and_summary(
-    service: PredictorService, endpoint: str
-) -> None:
-    trace = staircase(torque_noise_nm=0.2, force_noise_n=30.0)
-    with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
-        wait_for_token(session, keys.health_key("pt1", "predictor"))
-        received = session.declare_subscriber(
-            "boltwatch/pt1/**", zenoh.handlers.FifoChannel(10_000)
+class StationFeed:
+    """Publishers of one station's ``tool`` and ``samples``, as its acquisition would."""
+
+    def __init__(self, session: zenoh.Session, station_id: str, wait: bool = True) -> None:
+        self.station_id = station_id
+        self.tool = session.declare_publisher(keys.station_key(station_id, keys.TOOL))
+        self.samples = session.declare_publisher(keys.station_key(station_id, keys.SAMPLES))
+        if wait:  # the predictor's subscribers must be known before the first put
+            for publisher in (self.tool, self.samples):
+                wait_for_subscriber(publisher)
+
+    def state(self, run_id: int, program_id: int, name: str, at_ns: int) -> None:
+        state = ToolState(self.station_id, run_id, 3, program_id, name, at_ns)  # type: ignore[arg-type]
+        self.tool.put(codec.encode(state))
+
+    def sample(self, run_id: int, sequence: int, row: tuple[float, float, float, float]) -> None:
+        t, torque, force, angle = row
+        sample = Sample(
+            self.station_id, run_id, sequence, START_NS + round(t * 1e9), torque, angle, force
         )
-        tool = session.declare_publisher(keys.station_key("pt1", keys.TOOL))
-        samples = session.declare_publisher(keys.station_key("pt1", keys.SAMPLES))
-        start_ns = 1_700_000_000_000_000_000
-        for publisher in (tool, samples):  # the predictor's subscriber must be known here
-            wait_for_subscriber(publisher)
+        self.samples.put(codec.encode(sample))
 
-        def state(name: str, at_ns: int) -> bytes:
-            return codec.encode(ToolState("pt1", 42, 3, 1, name, at_ns))  # type: ignore[arg-type]
+    def close(self) -> None:
+        self.tool.undeclare()
+        self.samples.undeclare()
 
-        samples.put(codec.encode(Sample("pt1", 41, 0, start_ns, 1.0, 0.0, 1.0)))  # no run: dropped
-        tool.put(state("running", start_ns))
-        for i, (t, torque, force, angle) in enumerate(trace.rows()):
-            sample = Sample("pt1", 42, i, start_ns + round(t * 1e9), torque, angle, force)
-            samples.put(codec.encode(sample))
-        tool.put(state("done", start_ns + 2_000_000_000))
-        by_topic: dict[str, list[bytes]] = {}
-        deadline = time.monotonic() + 30.0
-        while keys.RUNS not in by_topic and time.monotonic() < deadline:
-            message = received.try_recv()
-            if message is None:
-                time.sleep(0.01)
-                continue
-            topic = str(message.key_expr).rsplit("/", 1)[-1]
-            by_topic.setdefault(topic, []).append(message.payload.to_bytes())
-        received.undeclare()
-        tool.undeclare()
-        samples.undeclare()
-    events = [codec.decode(StickSlipEvent, p) for p in by_topic.get(keys.EVENTS, [])]
-    intensities = [codec.decode(Intensity, p) for p in by_topic.get(keys.INTENSITY, [])]
-    decisions = [codec.decode(StopDecision, p) for p in by_topic.get(keys.DECISION, [])]
-    (summary,) = [codec.decode(RunSummary, p) for p in by_topic[keys.RUNS]]
+
+def collect(
+    subscriber: zenoh.Subscriber, until: set[str], timeout_s: float = 30.0, settle_s: float = 0.3
+) -> dict[str, list[bytes]]:
+    """Messages by ``<station>/<topic>`` until every key of ``until`` has one, then
+    ``settle_s`` more (for whatever else was on its way), or until the timeout."""
+    by_key: dict[str, list[bytes]] = {}
+    deadline = time.monotonic() + timeout_s
+    settled_at: float | None = None
+    while time.monotonic() < deadline:
+        if settled_at is None and until <= set(by_key):
+            settled_at = time.monotonic() + settle_s
+        if settled_at is not None and time.monotonic() > settled_at:
+            break
+        message = subscriber.try_recv()
+        if message is None:
+            time.sleep(0.01)
+            continue
+        station, topic = keys.split_key(str(message.key_expr))
+        by_key.setdefault(f"{station}/{topic}", []).append(message.payload.to_bytes())
+    return by_key
+
+
+def check_run(by_key: dict[str, list[bytes]], station: str, trace: SyntheticTrace) -> None:
+    events = [codec.decode(StickSlipEvent, p) for p in by_key.get(f"{station}/events", [])]
+    intensities = [codec.decode(Intensity, p) for p in by_key.get(f"{station}/intensity", [])]
+    decisions = [codec.decode(StopDecision, p) for p in by_key.get(f"{station}/decision", [])]
+    (summary,) = [codec.decode(RunSummary, p) for p in by_key[f"{station}/runs"]]
     assert len(events) == len(trace.plateaus_n) - 1
     assert len(intensities) == len(events)
     assert events[-1].predictions and events[-1].run_id == 42
+    assert {event.station for event in events} == {station}
     (decision,) = decisions
+    assert decision.station == station and decision.run_id == 42
     assert decision.reason == "plateau_closest"
     assert decision.force_n == pytest.approx(30_056.0, abs=150.0)
+    assert summary.station == station and summary.program_id == PROGRAM_OF[station]
     assert summary.stop_reason == "plateau_closest"
     assert summary.events == len(events)
-    assert summary.samples == len(trace.rows())
+    assert summary.samples == len(trace.rows())  # no sample of another station counted
     assert summary.error_pct is not None
     assert summary.reached_force_n == pytest.approx(trace.force_n[-1])
+
+
+def test_one_service_predicts_each_station_with_its_own_configuration(
+    service: PredictorService, endpoint: str
+) -> None:
+    """pt1 and pt2 tighten run 42 at the same time; pt3 (not served) too."""
+    trace = staircase(torque_noise_nm=0.2, force_noise_n=30.0)
+    rows = trace.rows()
+    with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
+        for station_id in PROGRAM_OF:
+            wait_for_token(session, keys.health_key(station_id, "predictor"))
+        assert not list(session.liveliness().get(keys.health_key("pt3", "predictor")))
+        received = session.declare_subscriber("boltwatch/**", zenoh.handlers.FifoChannel(10_000))
+        feeds = [StationFeed(session, "pt1"), StationFeed(session, "pt2")]
+        unserved = StationFeed(session, "pt3", wait=False)
+        feeds[0].sample(41, 0, rows[0])  # no run yet: dropped
+        for feed in feeds:
+            feed.state(42, PROGRAM_OF[feed.station_id], "running", START_NS)
+        unserved.state(42, 1, "running", START_NS)
+        for i, row in enumerate(rows):
+            for feed in (*feeds, unserved):
+                feed.sample(42, i, row)
+        for feed in feeds:
+            feed.state(42, PROGRAM_OF[feed.station_id], "done", START_NS + 2_000_000_000)
+        unserved.state(42, 1, "done", START_NS + 2_000_000_000)
+        by_key = collect(received, until={"pt1/runs", "pt2/runs"})
+        received.undeclare()
+        for feed in (*feeds, unserved):
+            feed.close()
+    check_run(by_key, "pt1", trace)
+    check_run(by_key, "pt2", trace)
+    predictor_topics = (keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS)
+    assert not [key for key in by_key if key.startswith("pt3/") and key[4:] in predictor_topics]
     assert service.dropped_samples == 1
+    assert service.bad_payloads == 0
+    assert service.station_ids == ["pt1", "pt2"]
+
+
+def test_a_sample_naming_another_station_is_ignored(
+    service: PredictorService, endpoint: str
+) -> None:
+    with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
+        wait_for_token(session, keys.health_key("pt1", "predictor"))
+        feed = StationFeed(session, "pt1")
+        wrong = Sample("pt2", 42, 0, START_NS, 1.0, 0.0, 1.0)
+        feed.samples.put(codec.encode(wrong))
+        deadline = time.monotonic() + 10.0
+        while service.bad_payloads == 0 and time.monotonic() < deadline:
+            time.sleep(0.02)
+        feed.close()
+    assert service.bad_payloads == 1
+    assert service.dropped_samples == 0
+
+
+def test_a_second_predictor_for_a_served_station_is_refused(
+    service: PredictorService, stations: list[LoadedStation], endpoint: str
+) -> None:
+    with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
+        wait_for_token(session, keys.health_key("pt2", "predictor"))
+        with pytest.raises(ConfigError, match="pt2 already have a predictor"):
+            PredictorService(session, stations[1])

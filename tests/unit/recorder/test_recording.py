@@ -5,18 +5,27 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import threading
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import pytest
 import zenoh
 from mcap.reader import make_reader
 
 from services.recorder.json_decoder import JsonDecoderFactory
 from services.recorder.mcap_sink import RAW_ENCODING, RAW_REASON
-from services.recorder.testing import RunningRecorder, has_subscribers, wait_until
+from services.recorder.service import RecorderService
+from services.recorder.testing import (
+    RunningRecorder,
+    has_subscribers,
+    wait_until,
+    write_station_file,
+)
 from shared import keys
 from shared.codec import encode, json_schema
-from shared.config import LoadedStation
+from shared.config import LoadedStation, load_station
 from shared.messages import (
     Intensity,
     RunSummary,
@@ -25,6 +34,7 @@ from shared.messages import (
     StopDecision,
     ToolState,
 )
+from shared.zenoh_session import zenoh_config
 
 T0_NS = 1_700_000_000_000_000_000
 SAMPLES = 300
@@ -203,3 +213,100 @@ def test_a_run_becomes_one_decodable_mcap_file(
         summary = make_reader(handle).get_summary()
     assert summary is not None and summary.statistics is not None
     assert summary.statistics.message_count == len(run2)
+
+
+def test_one_recorder_serves_several_station_files(
+    tmp_path: Path, endpoint: str, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Per-station metadata, wear queryable, health token and RecorderStats; a station
+    with no file is still recorded, with minimal metadata and one warning."""
+    recordings = tmp_path / "recordings"
+    st1 = load_station(write_station_file(tmp_path / "st1.toml", recordings, listen=[endpoint]))
+    st2_file = write_station_file(tmp_path / "st2.toml", recordings, connect=[endpoint])
+    text = st2_file.read_text().replace('id = "st1"', 'id = "st2"')
+    st2_file.write_text(text.replace("tool_id = 7", "tool_id = 8"))
+    st2 = load_station(st2_file)
+    session = zenoh.open(zenoh_config("peer", listen=[endpoint]))
+    service = RecorderService([st1, st2], session, rerun_files=False)
+    stop = threading.Event()
+    worker = threading.Thread(target=service.work, args=(stop,))
+    worker.start()
+    client = zenoh.open(zenoh_config("peer", connect=[endpoint]))
+    stats: list[dict[str, Any]] = []
+    try:
+        watcher = client.declare_subscriber(
+            keys.station_key("*", keys.RECORDER),
+            lambda sample: stats.append(json.loads(sample.payload.to_bytes())),
+        )
+        tokens = client.liveliness().get(keys.health_key("*", "recorder"), timeout=10)
+        assert sorted(str(r.ok.key_expr) for r in tokens if r.ok is not None) == [
+            "boltwatch/st1/health/recorder",
+            "boltwatch/st2/health/recorder",
+        ]
+        sent = 0
+        for name, tool_id in (("st1", 7), ("st2", 8), ("st3", 9)):
+            items = [(topic, at_station(m, name, tool_id)) for topic, m in run_messages(5, 20)]
+            sent += publish_at(client, name, items)
+        wait_until(lambda: service.recorder.messages == sent, "every message recorded")
+        per_station = len(run_messages(5, 20))
+        wait_until(
+            lambda: (
+                {s["station"] for s in stats if s["messages"] == per_station}
+                == {"st1", "st2", "st3"}
+            ),
+            "RecorderStats counting every message of every station",
+        )
+        with_lag = [s for s in stats if s["lag_p50_ms"] is not None]
+        assert {s["station"] for s in with_lag} == {"st1", "st2", "st3"}
+        assert all(0 < s["lag_p50_ms"] <= s["lag_max_ms"] for s in with_lag)
+        assert all(s["recording"] and s["write_errors"] == 0 for s in stats)
+        for name, tool_ids in (("st1", [7]), ("st2", [8])):
+            (reply,) = client.get(keys.station_key(name, keys.WEAR), timeout=10)
+            assert reply.ok is not None
+            answer = json.loads(reply.ok.payload.to_bytes())
+            assert answer["station"] == name
+            assert [tool["tool_id"] for tool in answer["tools"]] == tool_ids
+        assert list(client.get(keys.station_key("st3", keys.WEAR), timeout=1)) == []
+        watcher.undeclare()
+    finally:
+        client.close()
+        stop.set()
+        service.wake()
+        worker.join(10)
+        service.close()
+        session.close()
+
+    metadata = {}
+    for name in ("st1", "st2", "st3"):
+        (path,) = recordings.glob(f"{name}/*/{name}_run5_*.mcap")
+        with path.open("rb") as handle:
+            metadata[name] = {r.name: r.metadata for r in make_reader(handle).iter_metadata()}
+    assert metadata["st1"]["station"]["tool_id"] == "7"
+    assert metadata["st2"]["station"]["tool_id"] == "8"
+    assert metadata["st2"]["station"]["station_file"] == str(st2_file)
+    assert "joint" in metadata["st2"] and "program" in metadata["st2"]
+    assert metadata["st3"]["station"]["station_file"] == ""
+    assert metadata["st3"]["run"] == {"run_id": "5", "tool_id": "9", "program_id": "1"}
+    assert "joint" not in metadata["st3"]
+    warnings = [r for r in caplog.records if "station st3 has no station file" in r.getMessage()]
+    assert len(warnings) == 1
+
+
+def at_station(message: Any, station: str, tool_id: int) -> Any:
+    """``message`` as if sent by ``station`` (with ``tool_id`` where it names the tool)."""
+    if hasattr(message, "tool_id"):
+        return replace(message, station=station, tool_id=tool_id)
+    return replace(message, station=station)
+
+
+def publish_at(session: zenoh.Session, station: str, items: list[tuple[str, Any]]) -> int:
+    publishers = {
+        topic: session.declare_publisher(keys.station_key(station, topic))
+        for topic in {topic for topic, _ in items}
+    }
+    wait_until(lambda: all(has_subscribers(p) for p in publishers.values()), "the recorder")
+    for topic, message in items:
+        publishers[topic].put(encode(message))
+    for publisher in publishers.values():
+        publisher.undeclare()
+    return len(items)

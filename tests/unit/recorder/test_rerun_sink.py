@@ -23,6 +23,7 @@ from services.recorder.file_metadata import FileMetadata
 from services.recorder.incoming import Received, classify
 from services.recorder.recorder import Recorder
 from services.recorder.rerun_sink import RerunOptions, RerunSink
+from services.recorder.rerun_streams import BLUEPRINT_FILE
 from services.recorder.run_files import FileLimits
 from services.recorder.testing import write_station_file
 from shared import keys
@@ -94,8 +95,10 @@ def test_a_run_becomes_a_verified_rrd_with_every_sample(tmp_path: Path) -> None:
     verify(path)
     reader = RrdReader(path)
     (recording,) = reader.recordings()
-    assert (recording.application_id, recording.recording_id) == ("boltwatch", "st1/run1")
-    assert len(reader.blueprints()) == 1  # the layout travels with the file
+    assert recording.application_id == "boltwatch"
+    assert recording.recording_id.startswith("st1")  # pooled streams: rerun_streams.py
+    layout = RrdReader(tmp_path / BLUEPRINT_FILE)  # the layout of the folder's runs
+    assert len(layout.blueprints()) == 1 and not layout.recordings()
     rows = rows_by_entity(path)
     assert rows[f"/{bp.TORQUE}"] == rows[f"/{bp.ANGLE}"] == SAMPLES
     assert rows[f"/{bp.FORCE}"] == SAMPLES - len(range(0, SAMPLES, 50))  # force None every 50
@@ -117,11 +120,11 @@ def test_the_recorder_writes_one_rrd_beside_each_run_mcap(tmp_path: Path) -> Non
 
     mcaps = sorted(path for path in closed if path.suffix == ".mcap")
     assert len(mcaps) == 2
-    for mcap, run_id, samples in zip(mcaps, (1, 2), (300, 10), strict=True):
+    for mcap, samples in zip(mcaps, (300, 10), strict=True):
         rrd = mcap.with_suffix(".rrd")
         verify(rrd)
         (recording,) = RrdReader(rrd).recordings()
-        assert recording.recording_id == f"st1/run{run_id}"
+        assert recording.recording_id.startswith("st1")  # pooled streams: rerun_streams.py
         assert rows_by_entity(rrd)[f"/{bp.TORQUE}"] == samples
 
 
@@ -148,3 +151,69 @@ def test_a_failing_rerun_sink_leaves_the_mcap_file_whole(
         summary = make_reader(handle).get_summary()
     assert summary is not None and summary.statistics is not None
     assert summary.statistics.message_count == len(items)
+
+
+@pytest.mark.filterwarnings("ignore:RRD file has no footer")
+def test_a_cut_rrd_is_reported_and_its_complete_chunks_recovered(tmp_path: Path) -> None:
+    """As a kill -9 leaves it: no footer. verify says so; recover keeps what is whole."""
+    from services.recorder.rrd_recovery import check_rrd, recover_rrd, rows_by_entity
+    from shared.errors import InputError
+
+    whole = tmp_path / "st1_run1_000000.rrd"
+    items = run_messages(1, 3000)
+    with RerunSink(whole, "st1", 1, items[0][1].time_ns, RerunOptions(batch_samples=250)) as sink:
+        for n, item in enumerate(received(1, items)):
+            sink.write(item)
+            if n % 500 == 0:
+                sink.flush()  # the recorder's flush ticks
+    data = whole.read_bytes()
+    assert check_rrd(whole).ok
+    whole_rows = rows_by_entity(whole)
+    assert whole_rows[f"/{bp.TORQUE}"] == 3000
+
+    recovered_samples = []
+    for fraction in (0.3, 0.6, 0.95, 0.999):
+        cut = tmp_path / f"cut{fraction}.rrd"
+        cut.write_bytes(data[: int(len(data) * fraction)])
+        check = check_rrd(cut)
+        assert not check.ok and check.problem is not None
+        assert "Missing RRD footer" in check.problem
+        with pytest.raises(RuntimeError, match="exceeds file size"):  # the SDK alone: nothing
+            list(RrdReader(cut).stream())
+        recovery = recover_rrd(cut)
+        verify(recovery.target)
+        assert recovery.damage == check.problem
+        assert 0 < recovery.samples <= 3000
+        assert sum(recovery.rows_by_entity.values()) <= sum(whole_rows.values())
+        assert str(cut) in recovery.describe() and "damaged: Missing RRD footer" in (
+            recovery.describe()
+        )
+        recovered_samples.append(recovery.samples)
+    assert recovered_samples == sorted(recovered_samples)  # more file, more samples
+    assert recovered_samples[0] < 3000  # a cut early in the run loses its tail
+
+    header_only = tmp_path / "cut_header.rrd"
+    header_only.write_bytes(data[:10])
+    assert not check_rrd(header_only).ok  # rerun rrd verify itself exits 0 on it
+    with pytest.raises(InputError, match=r"cut_header\.rrd: (nothing readable|no complete chunk)"):
+        recover_rrd(header_only)
+    assert not (tmp_path / "cut_header.recovered.rrd").exists()
+
+
+@pytest.mark.filterwarnings("ignore:RRD file has no footer")
+def test_boltwatch_recover_takes_a_cut_rrd(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from services.cli.main import build_parser
+
+    whole = tmp_path / "st1_run1_000000.rrd"
+    items = run_messages(1, 1000)
+    with RerunSink(whole, "st1", 1, items[0][1].time_ns, RerunOptions(batch_samples=250)) as sink:
+        for item in received(1, items):
+            sink.write(item)
+    cut = tmp_path / "cut.rrd"
+    cut.write_bytes(whole.read_bytes()[: whole.stat().st_size * 3 // 4])
+    args = build_parser().parse_args(["recover", str(cut)])
+    assert args.handler(args) == 0
+    verify(tmp_path / "cut.recovered.rrd")
+    assert "Missing RRD footer" in capsys.readouterr().out

@@ -72,9 +72,10 @@ def test_cli_recover_and_export_name_the_bad_file(
     assert main(["export", str(bogus)]) == 2
     assert main(["recover", str(bogus)]) == 2
     err = capsys.readouterr().err.splitlines()
+    magic = "expected the MCAP magic b'\\x89MCAP0\\r\\n')"
     assert err == [
-        f"boltwatch export: {bogus}: not an MCAP file",
-        f"boltwatch recover: {bogus}: not an MCAP file",
+        f"boltwatch export: {bogus}: not an MCAP file (byte 0: b'hello', {magic}",
+        f"boltwatch recover: {bogus}: not an MCAP file (byte 0: b'hello', {magic}",
     ]
     path = recording(tmp_path)
     assert main(["recover", str(path), "--out", str(tmp_path / "copy.mcap")]) == 0

@@ -115,3 +115,28 @@ def test_cli_prints_the_table_and_records_services(
 def test_read_only_needs_an_existing_ledger(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="no wear ledger here"):
         WearLedger(tmp_path / "wear.sqlite", read_only=True)
+
+
+def test_a_tool_is_one_asset_across_stations_and_a_station_lists_its_tools(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with WearLedger(ledger_path(tmp_path)) as ledger:
+        ledger.add_run(summary(1, 1.0, tool_id=7, station="st1"), T0_NS)
+        ledger.add_run(summary(2, 2.0, tool_id=7, station="st2"), T0_NS)  # tool moved
+        ledger.add_run(summary(3, 4.0, tool_id=8, station="st2"), T0_NS)
+        ledger.add_run(summary(1, 8.0, tool_id=9, station="st3"), T0_NS)  # same run id, other st
+        assert ledger.tool_ids() == [7, 8, 9]
+        assert ledger.tool_ids(station="st1") == [7]
+        assert [t.tool_id for t in ledger.tools(station="st2")] == [7, 8]
+        assert ledger.tools(station="nowhere") == []
+        seven = ledger.tool(7)
+    assert (seven.runs, seven.total_intensity, seven.stations) == (2, 3.0, ["st1", "st2"])
+
+    assert main(["wear", "--recordings", str(tmp_path), "--station", "st1"]) == 0
+    table = capsys.readouterr().out.splitlines()
+    assert "stations" in table[0]
+    (line,) = table[1:]
+    assert line.split()[:3] == ["7", "2", "3"]  # whole totals, st1 and st2
+    assert "st1,st2" in line
+    assert main(["wear", "--recordings", str(tmp_path), "--station", "st9"]) == 0
+    assert "no runs at station st9" in capsys.readouterr().out

@@ -85,3 +85,25 @@ def test_summaries_count_once_and_a_due_tool_raises_an_alert(
     assert summary_record is not None
     schemas = {schema.name for schema in summary_record.schemas.values()}
     assert "boltwatch.WearAlert" in schemas  # the alert is recorded, schema'd
+
+
+def test_a_ledger_that_cannot_be_written_keeps_the_runs_until_it_can(tmp_path: Path) -> None:
+    """A file where the ledger's folder should be: logged, nothing raised, counted later."""
+    from services.recorder.wear_ledger import WearLedger
+    from services.recorder.wear_watch import WearWatch
+    from shared.codec import decode
+
+    blocker = tmp_path / "recordings"
+    blocker.write_text("not a folder")
+    ledger_file = blocker / "wear.sqlite"
+    watch = WearWatch(ledger_file, None, lambda _alert: None)
+    for run_id in (1, 2):
+        assert watch.on_summary(decode(RunSummary, summary(run_id, 1.0)), T0_NS) is None
+    assert watch.ledger_errors == 2 and watch.last_ledger_error is not None
+    blocker.unlink()
+    blocker.mkdir()
+    wear = watch.on_summary(decode(RunSummary, summary(3, 1.0)), T0_NS)
+    watch.close()
+    assert wear is not None and wear.runs == 3 and watch.last_ledger_error is None
+    with WearLedger(ledger_file, read_only=True) as ledger:
+        assert ledger.tool(7).total_intensity == pytest.approx(3.0)

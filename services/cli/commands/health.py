@@ -1,0 +1,64 @@
+"""``boltwatch health SERVICE --config FILE [FILE ...]``: a container health check.
+
+Exit 0 when SERVICE is alive for every station named, 1 when it is not, 2
+when the line's router cannot be reached (or a file is bad). "Alive" is the
+service's liveliness token ``boltwatch/<st>/health/<service>``: a token
+vanishes when its process or its zenoh session dies, so a hung container
+whose session is gone fails the check. ``health router`` only opens a client
+session to the router of the station file (that is the router's liveness).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+NAME = "health"
+HELP = "exit 0 if a service is alive for the stations named (for container health checks)"
+
+CHECKED_SERVICES = ("router", "rig", "acquisition", "predictor", "recorder")
+CONNECT_TIMEOUT_MS = 2000
+LIVELINESS_TIMEOUT_S = 2.0
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("service", choices=CHECKED_SERVICES, help="the service to check")
+    parser.add_argument(
+        "--config",
+        type=Path,
+        nargs="+",
+        default=[Path("config/station.toml")],
+        metavar="FILE",
+        help="station file(s): the service must be alive for each station; the first "
+        "file's [zenoh] connect names the router (default: config/station.toml)",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    import sys
+
+    from shared import keys
+    from shared.config import load_line
+    from shared.errors import ConfigError
+    from shared.zenoh_session import open_from, zenoh_config
+
+    stations = load_line(args.config)
+    connect = stations[0].config.zenoh.connect
+    if not connect:
+        raise ConfigError(f"{stations[0].path}: zenoh.connect: health needs a router to ask")
+    with open_from(zenoh_config("client", connect, connect_timeout_ms=CONNECT_TIMEOUT_MS)) as s:
+        if args.service == "router":
+            print(f"router at {', '.join(connect)}: reachable")
+            return 0
+        alive = set()
+        for reply in s.liveliness().get(
+            keys.health_key("*", args.service), timeout=LIVELINESS_TIMEOUT_S
+        ):
+            if reply.ok is not None:
+                alive.add(keys.split_key(str(reply.ok.key_expr))[0])
+    missing = [st.station_id for st in stations if st.station_id not in alive]
+    if missing:
+        print(f"{args.service}: not alive for {', '.join(missing)}", file=sys.stderr)
+        return 1
+    print(f"{args.service}: alive for {', '.join(st.station_id for st in stations)}")
+    return 0

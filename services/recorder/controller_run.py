@@ -1,0 +1,169 @@
+"""One tightening run as a Bosch Rexroth CS351 controller exports it (JSON), read strictly.
+
+The ``graph`` of each entry of ``tightening steps`` is concatenated in order,
+keeping the controller's own timing: repeated timestamps and gaps of tens of
+milliseconds stay as they are (about 833 Hz, torque and angle only, no
+preload). The run's identity comes from the file's header: ``cycle`` (the
+run id, as in the dataset's labels), ``tool serial``, ``prg nr``, ``date``
+(controller local time, no zone in the file: taken as UTC).
+
+Anything unusable (a cut file, a wrong type, a missing field, a number that
+is not finite) is one :class:`~shared.errors.InputError` naming the file and
+the key.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from shared.errors import InputError
+
+STEPS_KEY = "tightening steps"
+TIME_KEY, TORQUE_KEY, ANGLE_KEY = "time values", "torque values", "angle values"
+DATE_FORMAT = "%Y-%m-%d %H:%M:%S"
+
+#: Header fields kept in the ``controller`` metadata record of an imported run.
+HEADER_FIELDS = (
+    "hardware",
+    "sw version",
+    "node id",
+    "prg name",
+    "prg date",
+    "nominal torque",
+    "torque unit",
+    "result",
+    "quality code",
+    "id code",
+    "last cmd",
+    "total time",
+)
+
+
+@dataclass(frozen=True)
+class ControllerRun:
+    """One controller run: identity, header and the concatenated graph."""
+
+    source: Path
+    run_id: int  # ``cycle``
+    tool_id: int  # ``tool serial``
+    program_id: int  # ``prg nr``
+    started_ns: int  # ``date``, taken as UTC
+    header: dict[str, str]
+    time_s: list[float]
+    torque_nm: list[float]
+    angle_deg: list[float]
+    step_names: list[str]
+
+    def __len__(self) -> int:
+        return len(self.time_s)
+
+
+def read_controller_run(path: Path) -> ControllerRun:
+    """The run of one controller JSON file; InputError naming the file if unusable."""
+    document = _load(path)
+    if not isinstance(document, dict):
+        raise InputError(f"{path}: expected a JSON object (a CS351 run), got {_kind(document)}")
+    steps = document.get(STEPS_KEY)
+    if not isinstance(steps, list) or not steps:
+        raise InputError(f"{path}: no '{STEPS_KEY}' list: not a CS351 controller run")
+    columns: tuple[list[float], list[float], list[float]] = ([], [], [])
+    names: list[str] = []
+    for number, step in enumerate(steps):
+        times, torques, angles = _step_columns(path, number, step)
+        columns[0].extend(times)
+        columns[1].extend(torques)
+        columns[2].extend(angles)
+        names.append(str(step.get("name", f"step {number}")))
+    if not columns[0]:
+        raise InputError(f"{path}: the tightening steps hold no samples")
+    return ControllerRun(
+        source=path,
+        run_id=_integer(path, document, "cycle"),
+        tool_id=_integer(path, document, "tool serial"),
+        program_id=_integer(path, document, "prg nr"),
+        started_ns=_date_ns(path, document),
+        header={
+            name: "" if document.get(name) is None else str(document[name]).strip()
+            for name in HEADER_FIELDS
+        },
+        time_s=columns[0],
+        torque_nm=columns[1],
+        angle_deg=columns[2],
+        step_names=names,
+    )
+
+
+def _load(path: Path) -> Any:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError as err:
+        raise InputError(f"{path}: file not found") from err
+    except UnicodeDecodeError as err:
+        raise InputError(f"{path}: not a text file ({err.reason})") from err
+    except json.JSONDecodeError as err:
+        raise InputError(
+            f"{path}: line {err.lineno} column {err.colno}: not valid JSON "
+            f"(truncated or corrupt?): {err.msg}"
+        ) from err
+    except OSError as err:
+        raise InputError(f"{path}: cannot be read: {err.strerror}") from err
+
+
+def _step_columns(
+    path: Path, number: int, step: Any
+) -> tuple[list[float], list[float], list[float]]:
+    where = f"{path}: {STEPS_KEY}[{number}]"
+    graph = step.get("graph") if isinstance(step, dict) else None
+    if not isinstance(graph, dict):
+        raise InputError(f"{where}: no 'graph' object")
+    columns = [_numbers(f"{where}.graph", graph, key) for key in (TIME_KEY, TORQUE_KEY, ANGLE_KEY)]
+    lengths = {len(column) for column in columns}
+    if len(lengths) != 1:
+        counts = ", ".join(
+            f"{len(c)} {k}" for c, k in zip(columns, (TIME_KEY, TORQUE_KEY, ANGLE_KEY), strict=True)
+        )
+        raise InputError(f"{where}.graph: the lists differ in length ({counts})")
+    return columns[0], columns[1], columns[2]
+
+
+def _numbers(where: str, graph: dict[str, Any], key: str) -> list[float]:
+    values = graph.get(key)
+    if not isinstance(values, list):
+        raise InputError(f"{where}: no '{key}' list (found {_kind(values)})")
+    out: list[float] = []
+    for index, value in enumerate(values):
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, int | float)
+            or not math.isfinite(value)
+        ):
+            raise InputError(f"{where}.{key}[{index}]: expected a finite number, got {value!r}")
+        out.append(float(value))
+    return out
+
+
+def _integer(path: Path, document: dict[str, Any], key: str) -> int:
+    value = document.get(key)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise InputError(f"{path}: '{key}': expected an integer, got {_kind(value)} {value!r}")
+    return value
+
+
+def _date_ns(path: Path, document: dict[str, Any]) -> int:
+    value = document.get("date")
+    try:
+        started = datetime.strptime(str(value), DATE_FORMAT).replace(tzinfo=UTC)
+    except ValueError as err:
+        raise InputError(
+            f"{path}: 'date': expected 'YYYY-MM-DD HH:MM:SS', got {_kind(value)} {value!r}"
+        ) from err
+    return int(started.timestamp()) * 1_000_000_000
+
+
+def _kind(value: Any) -> str:
+    return "nothing" if value is None else type(value).__name__

@@ -1,0 +1,199 @@
+"""The recordings folder fails for real: full, read-only, not a folder, a file size limit.
+
+Recording is not on the stop path: the recorder logs the fault (ERROR with the file and
+the errno text, INFO when writing works again), counts what it drops, never crashes, and
+records again at the next run (or within a few seconds) once the disk is back. Every
+message is accounted for: readable in a file, or counted as dropped. The first tests
+drive a Recorder in this process (or a child under RLIMIT_FSIZE); the last runs the
+whole station as real processes on a tmpfs that fills up mid-run.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import resource
+import sqlite3
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from services.recorder.recorder import RETRY_INTERVAL_NS
+from services.recorder.recording_reader import RecordingScan
+from services.recorder.wear_ledger import WearLedger
+from shared.messages import RunSummary
+from tests.paths import REPO
+from tests.system.disk_faults import fill_up, read_only, tmpfs
+from tests.system.live_station import check_next_run_normal, live_station
+from tests.system.recorder_driver import RecorderDriver, recorded_messages
+
+pytestmark = pytest.mark.system
+
+RECORDER_LOG = "services.recorder.recorder"
+
+
+def errors_logged(caplog: pytest.LogCaptureFixture, level: int) -> list[str]:
+    return [r.getMessage() for r in caplog.records if r.name == RECORDER_LOG and r.levelno == level]
+
+
+def test_a_disk_that_fills_up_mid_run(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    caplog.set_level(logging.INFO, logger=RECORDER_LOG)
+    with tmpfs(tmp_path / "recordings", 1 << 20) as recordings:
+        driver = RecorderDriver(tmp_path, recordings)
+        driver.start_run(1)
+        driver.samples(1, 2500)
+        assert driver.recorder.recording_ok
+        filler = fill_up(recordings)
+        driver.samples(1, 3000)  # flushes fail: the file is abandoned, messages dropped
+
+        recorder = driver.recorder
+        assert not recorder.recording_ok and recorder.write_errors >= 1
+        assert recorder.last_write_error is not None
+        assert "No space left on device (ENOSPC)" in recorder.last_write_error
+        (started,) = errors_logged(caplog, logging.ERROR)
+        assert "recording failed" in started and str(recordings) in started
+        assert "ENOSPC" in started
+
+        filler.unlink()  # space comes back; the next retry (a few seconds) records again
+        driver.samples(1, RETRY_INTERVAL_NS // 1_000_000 + 2000)
+        assert recorder.recording_ok
+        assert any("recording works again" in m for m in errors_logged(caplog, logging.INFO))
+        driver.end_run(1)
+        driver.start_run(2)
+        driver.samples(2, 1500)
+        driver.end_run(2)
+        recorder.close()
+
+        assert recorder.dropped_messages > 0
+        # Nothing lost silently: every message received is in a file or counted as dropped.
+        assert recorded_messages(recordings) + recorder.dropped_messages == recorder.messages
+        assert recorder.abandoned_files  # the fault's file, readable up to its last flush
+        abandoned = RecordingScan(recorder.abandoned_files[0])
+        assert sum(1 for _ in abandoned.messages("/samples")) >= 2000  # flushed before the fault
+
+
+def test_a_read_only_folder_then_writable_again(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    caplog.set_level(logging.INFO, logger=RECORDER_LOG)
+    with tmpfs(tmp_path / "recordings", 1 << 20) as recordings:
+        driver = RecorderDriver(tmp_path, recordings)
+        with read_only(recordings):
+            driver.start_run(1)
+            driver.samples(1, 1000)
+            driver.end_run(1)
+            recorder = driver.recorder
+            assert not recorder.recording_ok
+            assert recorder.last_write_error is not None
+            assert "Read-only file system (EROFS)" in recorder.last_write_error
+            assert recorder.dropped_messages == recorder.messages == 1002
+        driver.start_run(2)  # the next run retries at once
+        driver.samples(2, 1500)
+        driver.end_run(2)
+        assert recorder.recording_ok
+        recorder.close()
+        assert recorded_messages(recordings) + recorder.dropped_messages == recorder.messages
+        assert len(errors_logged(caplog, logging.ERROR)) >= 1
+
+
+def test_the_station_folder_replaced_by_a_file(tmp_path: Path) -> None:
+    recordings = tmp_path / "recordings"
+    recordings.mkdir()
+    blocker = recordings / "st1"
+    blocker.write_text("not a folder")
+    driver = RecorderDriver(tmp_path, recordings)
+    driver.start_run(1)
+    driver.samples(1, 200)
+    recorder = driver.recorder
+    assert not recorder.recording_ok and recorder.write_errors >= 1
+    assert recorder.last_write_error is not None
+    assert str(blocker) in recorder.last_write_error
+    assert "Not a directory (ENOTDIR)" in recorder.last_write_error
+    blocker.unlink()
+    driver.start_run(2)
+    driver.samples(2, 1500)
+    assert recorder.recording_ok
+    recorder.close()
+    assert recorded_messages(recordings) + recorder.dropped_messages == recorder.messages
+
+
+def _limit_file_size() -> None:
+    limit = 100_000
+    resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+
+def test_a_file_size_limit_gives_efbig_and_the_next_run_is_recorded(tmp_path: Path) -> None:
+    """RLIMIT_FSIZE in a child process: the first run's file hits it, the next one fits."""
+    result = subprocess.run(
+        [sys.executable, "-m", "tests.system.recorder_driver", str(tmp_path)],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        preexec_fn=_limit_file_size,
+        check=False,
+    )
+    assert result.returncode == 0, result.stderr
+    state = json.loads(result.stdout.splitlines()[-1])
+    assert "File too large (EFBIG)" in state["last_write_error"], state
+    assert "recording failed" in result.stderr
+    assert state["write_errors"] >= 1 and state["dropped_messages"] > 0
+    assert state["recording_ok"], state
+    run2 = [Path(p) for p in state["closed"] if "_run2_" in p]
+    assert run2
+    scan = RecordingScan(run2[0])
+    assert sum(1 for _ in scan.messages("/samples")) == 1000 and scan.complete
+    recordings = tmp_path / "recordings"
+    assert recorded_messages(recordings) + state["dropped_messages"] == state["messages"]
+
+
+def _summary(run_id: int) -> RunSummary:
+    return RunSummary(
+        "st1", run_id, 7, 1, "done", 4e4, None, 4.1e4, 150.0, 2.5, 12, None, 1e6, 1500, 0, 1
+    )
+
+
+def test_a_full_disk_does_not_corrupt_the_wear_ledger(tmp_path: Path) -> None:
+    with tmpfs(tmp_path / "recordings", 1 << 20) as recordings:
+        ledger_file = recordings / "wear.sqlite"
+        with WearLedger(ledger_file) as ledger:
+            assert ledger.add_run(_summary(1), 1)
+            filler = fill_up(recordings)
+            big = [_summary(n) for n in range(2, 2000)]
+            with pytest.raises(sqlite3.OperationalError):
+                for summary in big:  # the WAL grows until the disk refuses it
+                    ledger.add_run(summary, 2)
+            filler.unlink()
+        with WearLedger(ledger_file) as ledger:
+            assert ledger.add_run(_summary(9999), 3)
+            (tool,) = ledger.tools()
+        check = sqlite3.connect(ledger_file).execute("PRAGMA integrity_check").fetchone()
+        assert check == ("ok",)
+        assert tool.runs >= 2
+
+
+def test_the_station_goes_on_while_the_recordings_disk_is_full(tmp_path: Path) -> None:
+    """Real processes; the station's recordings folder is a 4 MB tmpfs filled mid-run
+    (the wear ledger, one level up, stays on the real disk)."""
+    with (
+        tmpfs(tmp_path / "recordings" / "st1", 4 << 20) as station_folder,
+        live_station(tmp_path) as station,
+    ):
+        station.wait_runs_summarised(1)
+        filler = fill_up(station_folder)
+        station.wait_for(
+            lambda: "No space left on device (ENOSPC)" in station.log("recorder"),
+            "the recorder to log the full disk",
+        )
+        during = len(station.summaries())
+        summaries = station.wait_runs_summarised(during + 1)  # tightening goes on
+        assert all(station.decided(s.run_id) for s in summaries[during:])
+        filler.unlink()
+        station.wait_for(
+            lambda: "recording works again" in station.log("recorder"), "the recorder to recover"
+        )
+        check_next_run_normal(station)
+        assert station.process("recorder").exit_code() is None
+        assert "recording failed" in station.log("recorder")

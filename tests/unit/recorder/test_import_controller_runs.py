@@ -1,0 +1,170 @@
+"""``boltwatch import``: the real CS351 runs become recordings like live ones; bad files say so.
+
+Every real run in ``../shared/data/cs351-real-runs`` is imported into MCAP
+with the recorder's own writer, read back with the mcap reader (samples
+decoded with ``json`` alone), and opened by ``boltwatch export`` and
+``boltwatch inspect``. Broken copies (cut, wrong types, missing fields) each
+give one line naming the file and the fault, and do not stop the others.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+
+from services.cli.main import main
+from services.recorder.controller_run import read_controller_run
+from shared.codec import json_schema
+from shared.messages import Sample
+from shared.trace import read_trace
+
+#: ../shared/data beside the checkout (tests/paths.py: HANDBOOK_DATA), never copied here.
+#: This folder has no __init__.py, so it is found from this file.
+HANDBOOK_DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
+RUNS = sorted((HANDBOOK_DATA / "cs351-real-runs").glob("Ch_*.json"))
+
+
+def test_every_real_run_imports_as_a_live_recording(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert len(RUNS) == 10
+    recordings = tmp_path / "recordings"
+    args = ["import", *map(str, RUNS), "--recordings", str(recordings), "--no-rerun"]
+    assert main(args) == 0
+    assert f"imported 10 of 10 runs into {recordings}" in capsys.readouterr().out
+
+    for source in RUNS:
+        run = read_controller_run(source)
+        day = _day(run.started_ns)
+        (path,) = recordings.glob(f"cs351/{day}/cs351_run{run.run_id}_*.mcap")
+        with path.open("rb") as handle:
+            reader = make_reader(handle)
+            summary = reader.get_summary()
+            assert summary is not None
+            schemas = {schema.name: schema for schema in summary.schemas.values()}
+            assert json.loads(schemas["boltwatch.Sample"].data) == json_schema(Sample)
+            assert {(c.topic, c.message_encoding) for c in summary.channels.values()} == {
+                ("boltwatch/cs351/samples", "json"),
+                ("boltwatch/cs351/tool", "json"),
+            }
+            samples = [
+                (message, json.loads(message.data))  # json alone, no code of ours
+                for _, channel, message in reader.iter_messages(topics=["boltwatch/cs351/samples"])
+            ]
+        with path.open("rb") as handle:
+            metadata = {r.name: r.metadata for r in make_reader(handle).iter_metadata()}
+        assert len(samples) == len(run)
+        assert [data["torque_nm"] for _, data in samples] == run.torque_nm
+        assert [data["force_n"] for _, data in samples] == [None] * len(run)
+        times = [data["time_ns"] for _, data in samples]
+        assert times == [run.started_ns + round(t * 1e9) for t in run.time_s]  # own timing
+        assert [m.log_time for m, _ in samples] == times
+        assert [m.sequence for m, _ in samples] == list(range(len(run)))
+        assert metadata["station"]["station"] == "cs351"
+        assert metadata["run"] == {
+            "run_id": str(run.run_id),
+            "tool_id": str(run.tool_id),
+            "program_id": str(run.program_id),
+        }
+        assert metadata["controller"]["source_file"] == source.name
+        assert metadata["controller"]["hardware"] == "CS351"
+
+    first = read_controller_run(RUNS[0])
+    assert len(set(first.time_s)) < len(first)  # the repeated timestamps stayed
+
+
+def _day(time_ns: int) -> str:
+    return f"{datetime.fromtimestamp(time_ns / 1e9, UTC):%Y-%m-%d}"
+
+
+def test_export_inspect_and_rerun_work_on_an_imported_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    recordings = tmp_path / "recordings"
+    assert main(["import", str(RUNS[0]), "--recordings", str(recordings), "--station", "l2"]) == 0
+    (mcap,) = recordings.glob("l2/2022-09-05/l2_run1596334_134339.mcap")
+    assert mcap.with_suffix(".rrd").is_file()
+
+    csv = tmp_path / "run.csv"
+    assert main(["export", str(mcap), "--out", str(csv)]) == 0
+    trace = read_trace(csv)
+    run = read_controller_run(RUNS[0])
+    assert len(trace) == len(run) and not trace.has_force
+    assert list(trace.torque_nm) == pytest.approx(run.torque_nm, abs=1e-4)
+
+    png = tmp_path / "run.png"
+    assert main(["inspect", str(mcap), "--out", str(png)]) == 0
+    assert png.stat().st_size > 10_000
+
+    again = main(["import", str(RUNS[0]), "--recordings", str(recordings), "--station", "l2"])
+    assert again == 0 and "already in" in capsys.readouterr().out
+    assert len(list(recordings.glob("l2/*/*.mcap"))) == 1  # never a second copy
+
+
+def test_csv_output_stays_available(tmp_path: Path) -> None:
+    assert main(["import", str(RUNS[0]), "--csv", str(tmp_path)]) == 0
+    trace = read_trace(tmp_path / f"{RUNS[0].stem}.csv")
+    assert len(trace) == len(read_controller_run(RUNS[0]))
+
+
+def broken_copies(folder: Path) -> dict[str, tuple[Path, str]]:
+    """name -> (a broken copy of a real run, what its error must say)."""
+    text = RUNS[0].read_text()
+    document = json.loads(text)
+    out: dict[str, tuple[Path, str]] = {}
+
+    def put(name: str, content: str, expected: str) -> None:
+        path = folder / f"{name}.json"
+        path.write_text(content)
+        out[name] = (path, expected)
+
+    put("cut", text[: len(text) // 2], "not valid JSON (truncated or corrupt?)")
+    put("empty", "", "not valid JSON")
+    wrong = json.loads(text)
+    wrong["tightening steps"][1]["graph"]["torque values"][5] = "1.2"
+    put("wrong_type", json.dumps(wrong), "tightening steps[1].graph.torque values[5]: expected")
+    nan = json.loads(text)
+    nan["tightening steps"][0]["graph"]["angle values"][2] = float("nan")
+    put("nan", json.dumps(nan), "angle values[2]: expected a finite number, got nan")
+    short = json.loads(text)
+    short["tightening steps"][2]["graph"]["time values"].pop()
+    put("short", json.dumps(short), "tightening steps[2].graph: the lists differ in length")
+    no_graph = json.loads(text)
+    del no_graph["tightening steps"][3]["graph"]
+    put("no_graph", json.dumps(no_graph), "tightening steps[3]: no 'graph' object")
+    no_cycle = dict(document)
+    del no_cycle["cycle"]
+    put("no_cycle", json.dumps(no_cycle), "'cycle': expected an integer, got nothing")
+    bad_date = dict(document, date="yesterday")
+    put("bad_date", json.dumps(bad_date), "'date': expected 'YYYY-MM-DD HH:MM:SS'")
+    put("not_a_run", json.dumps([1, 2]), "expected a JSON object (a CS351 run), got list")
+    return out
+
+
+def test_broken_controller_files_each_give_one_line_and_the_good_ones_are_imported(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    broken = broken_copies(tmp_path)
+    good = [tmp_path / RUNS[1].name, tmp_path / RUNS[6].name]
+    for path in good:
+        shutil.copyfile(RUNS[[r.name for r in RUNS].index(path.name)], path)
+    inputs = [good[0], *(path for path, _ in broken.values()), good[1]]
+    recordings = tmp_path / "recordings"
+
+    status = main(["import", *map(str, inputs), "--recordings", str(recordings), "--no-rerun"])
+
+    assert status == 2  # some failed
+    captured = capsys.readouterr()
+    errors = captured.err.strip().splitlines()
+    assert len(errors) == len(broken)  # one line per bad file
+    for (path, expected), line in zip(broken.values(), errors, strict=True):
+        assert line.startswith(f"boltwatch import: {path}: "), line
+        assert expected in line, line
+    assert f"imported 2 of {len(inputs)} runs" in captured.out
+    assert f"{len(broken)} failed" in captured.out
+    assert len(list(recordings.glob("cs351/*/*.mcap"))) == 2

@@ -1,0 +1,99 @@
+"""Line configuration: several station files for one process, stations derived from one."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from shared.config import derive_stations, derived_ids, load_line, load_station
+from shared.config.toml_writer import dumps
+from shared.errors import ConfigError
+from tests.paths import STATION_FILE
+from tests.system.station_files import write_station
+
+
+def test_derived_ids_count_up_from_the_trailing_number() -> None:
+    assert derived_ids("st1", 3) == ["st1", "st2", "st3"]
+    assert derived_ids("st5", 2) == ["st5", "st6"]
+    assert derived_ids("press", 2) == ["press1", "press2"]
+    assert derived_ids("line-a", 1) == ["line-a1"]
+
+
+def test_derived_stations_are_isolated_and_load(tmp_path: Path) -> None:
+    paths = derive_stations(STATION_FILE, 5, tmp_path / "stations")
+    stations = [load_station(path) for path in paths]
+    base = load_station(STATION_FILE)
+    assert [s.station_id for s in stations] == ["st1", "st2", "st3", "st4", "st5"]
+    assert [path.name for path in paths] == [f"st{i}.toml" for i in range(1, 6)]
+    ports = [s.config.can.port for s in stations]
+    assert base.config.can.port is not None
+    assert ports == [base.config.can.port + i for i in range(5)]
+    assert len({s.config.station.tool_id for s in stations}) == 5
+    assert [s.config.rig.seed for s in stations] == [7, 8, 9, 10, 11]
+    for station in stations:  # the same line, joint, programs and recordings
+        assert station.config.zenoh == base.config.zenoh
+        assert station.config.programs == base.config.programs
+        assert station.config.predictor == base.config.predictor
+        assert station.joint == base.joint
+        assert station.joint_path == base.joint_path.resolve()
+        assert station.dbc_path == base.dbc_path.resolve()
+        assert station.recordings_folder == base.recordings_folder.resolve()
+        assert station.config.can.channel == base.config.can.channel
+    assert [s.station_id for s in load_line(paths)] == [s.station_id for s in stations]
+
+
+def test_one_derived_station_is_the_base_station(tmp_path: Path) -> None:
+    (path,) = derive_stations(STATION_FILE, 1, tmp_path)
+    derived, base = load_station(path), load_station(STATION_FILE)
+    assert derived.config.station.id == base.config.station.id
+    assert derived.config.can == base.config.can.model_copy(update={"dbc": derived.dbc_path})
+
+
+def test_derivation_refuses_ports_beyond_the_range(tmp_path: Path) -> None:
+    station = write_station(tmp_path, replacements={"port = ": "port = 65534 #"})
+    with pytest.raises(ConfigError, match=r"can\.port: 65534 \+ 2 stations exceeds 65535"):
+        derive_stations(station, 3, tmp_path / "out")
+    with pytest.raises(ConfigError, match="at least 1"):
+        derive_stations(station, 0, tmp_path / "out")
+
+
+def test_a_station_twice_is_an_error_naming_both_files(tmp_path: Path) -> None:
+    first = write_station(tmp_path)
+    (tmp_path / "b").mkdir()
+    second = write_station(tmp_path / "b")
+    text = second.read_text().replace(
+        f"tcp/127.0.0.1:{_port(second)}", f"tcp/127.0.0.1:{_port(first)}"
+    )
+    second.write_text(text)
+    with pytest.raises(ConfigError) as err:
+        load_line([first, second])
+    assert str(first) in str(err.value) and str(second) in str(err.value)
+    assert "'st1'" in str(err.value)
+
+
+def test_different_zenoh_sections_are_an_error_naming_both_files(tmp_path: Path) -> None:
+    first = write_station(tmp_path)
+    (tmp_path / "b").mkdir()
+    second = write_station(tmp_path / "b", replacements={'id = "st1"': 'id = "st2"'})
+    with pytest.raises(ConfigError, match="zenoh: the sections differ") as err:
+        load_line([first, second])
+    assert str(first) in str(err.value) and str(second) in str(err.value)
+
+
+def test_no_station_file_is_an_error() -> None:
+    with pytest.raises(ConfigError, match="no station file"):
+        load_line([])
+
+
+def test_toml_writer_round_trips_a_station_file() -> None:
+    document = tomllib.loads(STATION_FILE.read_text())
+    assert tomllib.loads(dumps(document)) == document
+    tricky = {"a": {"quote": 'say "hi"\n', "list": [1.5, -2.0, True], "x y": 1}}
+    assert tomllib.loads(dumps(tricky)) == tricky
+
+
+def _port(path: Path) -> str:
+    text = path.read_text()
+    return text.split("tcp/127.0.0.1:")[1].split('"')[0]
