@@ -22,7 +22,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from shared.config import LoadedStation
-from shared.errors import ConfigError
+from shared.config.line import stations_by_id
 
 LOG = logging.getLogger(__name__)
 
@@ -49,21 +49,6 @@ def flatten(data: Mapping[str, Any], prefix: str = "") -> dict[str, str]:
     return flat
 
 
-def stations_by_id(loaded: LoadedStation | Sequence[LoadedStation]) -> dict[str, LoadedStation]:
-    """Station id -> its loaded file; ConfigError naming both files when an id repeats."""
-    stations = [loaded] if isinstance(loaded, LoadedStation) else list(loaded)
-    by_id: dict[str, LoadedStation] = {}
-    for station in stations:
-        other = by_id.get(station.station_id)
-        if other is not None:
-            raise ConfigError(
-                f"{station.path}: station.id: {station.station_id!r} is already served from "
-                f"{other.path}; each station file of one recorder needs its own id"
-            )
-        by_id[station.station_id] = station
-    return by_id
-
-
 class FileMetadata:
     """Builds the metadata records of each new file from the loaded station files."""
 
@@ -73,7 +58,7 @@ class FileMetadata:
         extra: Mapping[str, Mapping[str, str]] | None = None,
         warn_unknown: bool = True,
     ) -> None:
-        self._stations = stations_by_id(loaded)
+        self._stations = stations_by_id([loaded] if isinstance(loaded, LoadedStation) else loaded)
         self._extra: Metadata = {name: dict(data) for name, data in (extra or {}).items()}
         self._version = software_version()
         self._warned: set[str] = set()

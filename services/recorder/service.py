@@ -43,7 +43,7 @@ from services.recorder.wear_ledger import WearLedger, ledger_path
 from services.recorder.wear_watch import ALERT_TOPIC, WearAlert, WearWatch
 from shared import keys
 from shared.codec import encode
-from shared.config import LoadedStation, load_station
+from shared.config import LoadedStation, load_line
 from shared.errors import ConfigError
 from shared.messages import RecorderStats
 from shared.service_runtime import ServiceRunner
@@ -281,10 +281,8 @@ def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
 
 def main(args: argparse.Namespace) -> int:
     paths = args.config if isinstance(args.config, list) else [args.config]
-    loaded = [load_station(path) for path in paths]
+    loaded = load_line(paths)
     served_stations(loaded)  # bad combinations fail before zenoh is opened
-    if len(loaded) > 1:
-        LOG.info("zenoh settings from %s", loaded[0].path)
     session = open_session(loaded[0].config.zenoh)
     live = start_rerun_live(args)
     try:

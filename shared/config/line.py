@@ -32,6 +32,20 @@ MAX_PORT = 65535
 MAX_TOOL_ID = 65535
 
 
+def stations_by_id(stations: Sequence[LoadedStation]) -> dict[str, LoadedStation]:
+    """Station id -> its file; ConfigError naming both files when an id repeats."""
+    seen: dict[str, LoadedStation] = {}
+    for station in stations:
+        twin = seen.get(station.station_id)
+        if twin is not None:
+            raise ConfigError(
+                f"{twin.path} and {station.path}: station.id: both are station "
+                f"{station.station_id!r}; one process serves a station once"
+            )
+        seen[station.station_id] = station
+    return seen
+
+
 def load_line(paths: Sequence[Path]) -> list[LoadedStation]:
     """Load every station file of a line service; one station id per file, one router.
 
@@ -42,15 +56,8 @@ def load_line(paths: Sequence[Path]) -> list[LoadedStation]:
         raise ConfigError("no station file given")
     stations = [load_station(Path(path)) for path in paths]
     first = stations[0]
-    seen: dict[str, LoadedStation] = {}
+    stations_by_id(stations)
     for station in stations:
-        twin = seen.get(station.station_id)
-        if twin is not None:
-            raise ConfigError(
-                f"{twin.path} and {station.path}: station.id: both are station "
-                f"{station.station_id!r}; one process serves a station once"
-            )
-        seen[station.station_id] = station
         if station.config.zenoh != first.config.zenoh:
             raise ConfigError(
                 f"{first.path} and {station.path}: zenoh: the sections differ "

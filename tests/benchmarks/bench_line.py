@@ -53,7 +53,7 @@ from shared.messages import RecorderStats, RunSummary, ToolState  # noqa: E402
 from shared.zenoh_session import zenoh_config  # noqa: E402
 from tests.benchmarks.bench_stop_path import SHORT_PROGRAM, Heard, figures  # noqa: E402
 from tests.system.can_injector import StopListener  # noqa: E402
-from tests.system.station_files import free_tcp_port, write_station  # noqa: E402
+from tests.system.station_files import free_tcp_port, serve, write_station  # noqa: E402
 from tests.unit.predictor.synthetic import staircase  # noqa: E402
 
 REAL_STATION = "st1"
@@ -147,16 +147,6 @@ class LineHeard:
                 self.recorder_lag_p50_ms.append(stats.lag_p50_ms)
             if stats.lag_max_ms is not None:
                 self.recorder_lag_max_ms.append(stats.lag_max_ms)
-
-
-def serve(args: list[str], log: Path) -> subprocess.Popen[bytes]:
-    with log.open("wb") as out:
-        return subprocess.Popen(
-            [sys.executable, "-m", "services.cli", "serve", *args],
-            cwd=REPO,
-            stdout=out,
-            stderr=subprocess.STDOUT,
-        )
 
 
 def wait_alive(

@@ -53,7 +53,7 @@ from shared.config import load_station  # noqa: E402
 from shared.messages import RunSummary, StickSlipEvent, StopDecision  # noqa: E402
 from shared.zenoh_session import zenoh_config  # noqa: E402
 from tests.system.can_injector import HeardStop, StopListener  # noqa: E402
-from tests.system.station_files import free_tcp_port, write_station  # noqa: E402
+from tests.system.station_files import free_tcp_port, serve, write_station  # noqa: E402
 
 STATION = "st1"
 #: The short program: program 1 of the embedded station, to a lower preload, faster.
@@ -95,16 +95,6 @@ class RunFigures:
     decide_ms: float
     act_ms: float
     lead_ms: float | None
-
-
-def serve(args: list[str], log: Path) -> subprocess.Popen[bytes]:
-    with log.open("wb") as out:
-        return subprocess.Popen(
-            [sys.executable, "-m", "services.cli", "serve", *args],
-            cwd=REPO,
-            stdout=out,
-            stderr=subprocess.STDOUT,
-        )
 
 
 def wait_alive(session: zenoh.Session, services: set[str], processes: list[Path]) -> None:

@@ -8,10 +8,12 @@ import os
 import re
 import signal
 import socket
+import subprocess
+import sys
 from pathlib import Path
 
 from services.recorder.testing import free_port as free_tcp_port
-from tests.paths import CONFIG, STATION_FILE
+from tests.paths import CONFIG, REPO, STATION_FILE
 
 
 def free_udp_port() -> int:
@@ -46,6 +48,17 @@ def write_station(
     path = folder / "station.toml"
     path.write_text(text)
     return path
+
+
+def serve(args: list[str], log: Path) -> subprocess.Popen[bytes]:
+    """``python -m services.cli serve ARGS`` from the repository, output appended to ``log``."""
+    with log.open("ab") as out:
+        return subprocess.Popen(
+            [sys.executable, "-m", "services.cli", "serve", *args],
+            cwd=REPO,
+            stdout=out,
+            stderr=subprocess.STDOUT,
+        )
 
 
 def child_pids(pid: int) -> list[int]:

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import random
 import subprocess
-import sys
 import threading
 import time
 import warnings
@@ -34,9 +33,8 @@ from shared.config import load_station
 from shared.config.station import CanSection
 from shared.messages import BusStats, Sample, StopDecision, ToolRunState, ToolState
 from shared.zenoh_session import zenoh_config
-from tests.paths import REPO
 from tests.system.can_injector import CanInjector, Pacer, StopListener
-from tests.system.station_files import free_tcp_port, write_station
+from tests.system.station_files import free_tcp_port, serve, write_station
 
 pytestmark = pytest.mark.system
 
@@ -107,16 +105,6 @@ class Station:
     endpoint: str
     acquisition: subprocess.Popen[bytes]
     acquisition_log: Path
-
-
-def serve(args: list[str], log: Path) -> subprocess.Popen[bytes]:
-    with log.open("wb") as out:
-        return subprocess.Popen(
-            [sys.executable, "-m", "services.cli", "serve", *args],
-            cwd=REPO,
-            stdout=out,
-            stderr=subprocess.STDOUT,
-        )
 
 
 @pytest.fixture

@@ -19,7 +19,6 @@ from __future__ import annotations
 import re
 import signal
 import subprocess
-import sys
 import threading
 import time
 from collections import Counter
@@ -35,8 +34,7 @@ from shared import keys
 from shared.codec import decode
 from shared.messages import BusStats, RunSummary, Sample
 from shared.zenoh_session import zenoh_config
-from tests.paths import REPO
-from tests.system.station_files import free_tcp_port, write_station
+from tests.system.station_files import free_tcp_port, serve, write_station
 
 pytestmark = pytest.mark.system
 
@@ -80,16 +78,6 @@ class RigRun:
     stop_source: str
     force_n: float
     samples: int
-
-
-def serve(args: list[str], log: Path) -> subprocess.Popen[bytes]:
-    with log.open("ab") as out:
-        return subprocess.Popen(
-            [sys.executable, "-m", "services.cli", "serve", *args],
-            cwd=REPO,
-            stdout=out,
-            stderr=subprocess.STDOUT,
-        )
 
 
 def rig_runs(log: Path) -> dict[int, RigRun]:
