@@ -203,8 +203,11 @@ class PredictorService:
                     express=True,
                     congestion_control=zenoh.CongestionControl.BLOCK,
                 )
-            else:
-                publisher = self._session.declare_publisher(keys.station_key(station, topic))
+            else:  # BLOCK too: zenoh's default DROP lost events under load, silently
+                publisher = self._session.declare_publisher(
+                    keys.station_key(station, topic),
+                    congestion_control=zenoh.CongestionControl.BLOCK,
+                )
             self._publishers[(station, topic)] = publisher
         publisher.put(codec.encode(message))
 

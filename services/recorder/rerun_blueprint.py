@@ -59,10 +59,10 @@ _LINES: dict[str, tuple[str, tuple[int, int, int]]] = {
 _POINTS: dict[str, tuple[str, tuple[int, int, int], rr.components.MarkerShape, float]] = {
     PEAKS: ("peak", (214, 39, 40), rr.components.MarkerShape.Down, 6.0),
     PREDICTED_PEAKS: ("predicted peak", (255, 127, 14), rr.components.MarkerShape.Cross, 5.0),
-    TORQUE_STOP: ("stop", (0, 0, 0), rr.components.MarkerShape.Asterisk, 10.0),
+    TORQUE_STOP: ("stop", (200, 0, 200), rr.components.MarkerShape.Asterisk, 10.0),
     PLATEAUS: ("plateau", (214, 39, 40), rr.components.MarkerShape.Square, 5.0),
     PREDICTED_PLATEAUS: ("predicted plateau", (255, 127, 14), rr.components.MarkerShape.Cross, 5.0),
-    FORCE_STOP: ("stop", (0, 0, 0), rr.components.MarkerShape.Asterisk, 10.0),
+    FORCE_STOP: ("stop", (200, 0, 200), rr.components.MarkerShape.Asterisk, 10.0),
 }
 
 
@@ -79,7 +79,7 @@ def log_series_styles(stream: rr.RecordingStream) -> None:
 
 
 def run_blueprint() -> rrb.Blueprint:
-    """Torque and force with events (top), f_ss/K/intensity (middle), decisions (bottom)."""
+    """Torque and force with events (top), f_ss and K1-K3, intensities, decisions (bottom)."""
     top = rrb.Vertical(
         rrb.TimeSeriesView(
             name="Torque: samples, peaks, predicted peaks, stop",
@@ -92,17 +92,23 @@ def run_blueprint() -> rrb.Blueprint:
             plot_legend=rrb.Corner2D.LeftTop,
         ),
     )
-    middle = rrb.Horizontal(
+    # one view per constant and per intensity: K2 (~1e4) and I_process (~1e6)
+    # would flatten K1, K3 and I_j on a shared axis
+    constants = rrb.Horizontal(
         rrb.TimeSeriesView(name="f_ss (Hz)", origin="/model", contents=F_SS),
-        rrb.TimeSeriesView(
-            name="K1-K3", origin="/model", contents=[f"+ {path}" for path in K_PATHS]
+        *(
+            rrb.TimeSeriesView(name=path.rsplit("/", 1)[-1].upper(), contents=f"+ {path}")
+            for path in K_PATHS
         ),
-        rrb.TimeSeriesView(name="Intensity", origin="/intensity"),
+    )
+    intensities = rrb.Horizontal(
+        rrb.TimeSeriesView(name="I_j (eq. 67)", contents=f"+ {EVENT_INTENSITY}"),
+        rrb.TimeSeriesView(name="I_process (eq. 68)", contents=f"+ {PROCESS_INTENSITY}"),
         rrb.TimeSeriesView(name="Angle (°)", origin="/angle"),
     )
     bottom = rrb.TextLogView(name="Decisions and summary", origin=f"/{LOG}")
     return rrb.Blueprint(
-        rrb.Vertical(top, middle, bottom, row_shares=[3, 1.5, 1]),
+        rrb.Vertical(top, constants, intensities, bottom, row_shares=[3, 1.2, 1.2, 1]),
         rrb.TimePanel(timeline=RUN_TIME, state="collapsed"),
         collapse_panels=True,
     )

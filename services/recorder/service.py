@@ -216,7 +216,11 @@ class RecorderService:
                 LOG.debug("recorder stats of %s not published: %s", stats.station, err)
 
     def _publish_alert(self, alert: WearAlert) -> None:
-        self._session.put(keys.station_key(alert.station, ALERT_TOPIC), encode(alert))
+        self._session.put(
+            keys.station_key(alert.station, ALERT_TOPIC),
+            encode(alert),
+            congestion_control=zenoh.CongestionControl.BLOCK,
+        )
 
     def _wear_replier(self, station: str) -> Callable[[zenoh.Query], None]:
         def reply(query: zenoh.Query) -> None:

@@ -98,6 +98,9 @@ def test_up_tightens_stops_and_records_every_sample(tmp_path: Path) -> None:
     assert bus["stop_commands"] == len(decisions)
     events = messages["boltwatch/st1/events"]
     assert len(events) >= 3 * 5  # the default program sticks and slips clearly
+    for summary in summaries:  # every event the predictor counted is in the recording
+        indexes = sorted(e["index"] for e in events if e["run_id"] == summary["run_id"])
+        assert indexes == list(range(1, summary["events"] + 1)), summary["run_id"]
 
 
 def start_up(station: Path, runs: int) -> subprocess.Popen[str]:

@@ -129,9 +129,9 @@ class StopPolicy:
                 time_s, "angle_limit", f"angle turned ≥ {self._max_angle:g}°", torque_nm, force_n
             )
         if self._target_force is not None:
-            value, target, unit = force_n, self._target_force, "N force"
+            value, target, quantity, unit = force_n, self._target_force, "force", "N"
         elif self._target_torque is not None:
-            value, target, unit = torque_nm, self._target_torque, "Nm torque"
+            value, target, quantity, unit = torque_nm, self._target_torque, "torque", "Nm"
         else:
             return None
         self._ramp.add(value)
@@ -140,14 +140,19 @@ class StopPolicy:
             return None
         if self._over_target >= TARGET_SAMPLES:
             return self._decide(
-                time_s, "target_reached", f"{unit} ≥ target {target:g}", torque_nm, force_n
+                time_s,
+                "target_reached",
+                f"{quantity} {value:.5g} {unit} ≥ target {target:g} {unit}",
+                torque_nm,
+                force_n,
             )
         projected = self._ramp.projected(self._lead_samples)
         if projected >= target:
             return self._decide(
                 time_s,
                 "target_reached",
-                f"ramp projected to {projected:.5g} {unit} at the halt ≥ target {target:g}",
+                f"{quantity} ramp projected to {projected:.5g} {unit} at the halt "
+                f"≥ target {target:g} {unit}",
                 torque_nm,
                 force_n,
                 projected,
