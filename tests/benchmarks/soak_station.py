@@ -3,9 +3,9 @@
 Runs ``boltwatch up`` on an isolated copy of ``config/station.toml`` (own
 zenoh port, own CAN multicast port, recordings in ``--folder``) with more
 runs than fit in the duration, samples the resident memory of every station
-process every ``--every-s`` seconds, and ends it with SIGINT (the same clean
-stop as Ctrl-C). Then it reads every MCAP file back with the standard mcap
-reader and compares:
+process every ``--every-s`` seconds, and ends it with SIGTERM (the same clean
+stop as Ctrl-C; SIGINT is ignored when the soak runs under nohup). Then it
+reads every MCAP file back with the standard mcap reader and compares:
 
 - samples the acquisition counted on CAN (its last ``bus`` message, plus
   those it counted as missed) against samples recorded in MCAP;
@@ -153,7 +153,7 @@ def main() -> int:
                 time.sleep(min(args.every_s, max(args.duration_s - elapsed, 0.1)))
         finally:
             if up.poll() is None:
-                up.send_signal(signal.SIGINT)
+                up.send_signal(signal.SIGTERM)  # SIGINT is ignored under nohup
             up.wait(120)
     elapsed_s = time.monotonic() - started
     text = out_path.read_text()
