@@ -30,6 +30,7 @@ from services.predictor.served_station import ServedStation
 from services.predictor.station_inbox import Delivery, StationInbox
 from shared import codec, keys
 from shared.config import LoadedStation, load_line
+from shared.config.line import stations_by_id
 from shared.errors import ConfigError, InputError
 from shared.messages import Intensity, Sample, StopDecision, ToolState
 from shared.service_runtime import ServiceRunner
@@ -49,9 +50,10 @@ class PredictorService:
     ) -> None:
         served = [stations] if isinstance(stations, LoadedStation) else list(stations)
         self._session = session
-        self._stations = {s.station_id: ServedStation(s) for s in served}
-        if len(self._stations) != len(served):
-            raise ConfigError("a station is named twice (use shared.config.load_line)")
+        self._stations = {
+            station_id: ServedStation(station)
+            for station_id, station in stations_by_id(served).items()
+        }
         self._refuse_stations_served_elsewhere()
         self._runs: dict[tuple[str, int], ActiveRun] = {}
         self._publishers: dict[tuple[str, str], Any] = {}

@@ -35,6 +35,21 @@ def pitch_lever_m(pitch_m: float) -> float:
     return pitch_m / (2.0 * math.pi)
 
 
+def torque_lever_m(
+    pitch_m: float,
+    pitch_diameter_m: float,
+    friction_radius_m: float,
+    mu_thread: float,
+    mu_bearing: float,
+) -> float:
+    """P/2π + d_2/√3 · μ_th + r · μ_b, m: torque per newton of preload (eq. 30)."""
+    return (
+        pitch_lever_m(pitch_m)
+        + pitch_diameter_m / SQRT3 * mu_thread
+        + friction_radius_m * mu_bearing
+    )
+
+
 def torque_for_force_nm(
     force_n: Value,
     pitch_m: float,
@@ -44,11 +59,7 @@ def torque_for_force_nm(
     mu_bearing: float,
 ) -> Value:
     """T = F · (P/2π + d_2/√3 · μ_th + r · μ_b), Nm (eq. 30 with D_b/2 = r)."""
-    lever_m = (
-        pitch_lever_m(pitch_m)
-        + pitch_diameter_m / SQRT3 * mu_thread
-        + friction_radius_m * mu_bearing
-    )
+    lever_m = torque_lever_m(pitch_m, pitch_diameter_m, friction_radius_m, mu_thread, mu_bearing)
     return force_n * lever_m
 
 
@@ -61,11 +72,7 @@ def force_for_torque_n(
     mu_bearing: float,
 ) -> Value:
     """F = T / (P/2π + d_2/√3 · μ_th + r · μ_b), N (eq. 30 solved for F)."""
-    lever_m = (
-        pitch_lever_m(pitch_m)
-        + pitch_diameter_m / SQRT3 * mu_thread
-        + friction_radius_m * mu_bearing
-    )
+    lever_m = torque_lever_m(pitch_m, pitch_diameter_m, friction_radius_m, mu_thread, mu_bearing)
     return torque_nm / lever_m
 
 

@@ -26,6 +26,7 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
+from services.recorder.testing import wait_until
 from shared import keys
 from shared.can_database import StationDatabase
 from shared.codec import decode, encode
@@ -69,14 +70,12 @@ class Heard:
             elif topic == keys.BUS:
                 self.stats.append(decode(BusStats, payload))
 
-    def wait(self, what: str, done: object, timeout_s: float) -> None:
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
+    def wait(self, what: str, done: Callable[[], object], timeout_s: float) -> None:
+        def locked() -> bool:
             with self.lock:
-                if callable(done) and done():
-                    return
-            time.sleep(0.02)
-        raise AssertionError(f"timed out waiting for {what}")
+                return bool(done())
+
+        wait_until(locked, what, timeout_s)
 
     def settled_stats(self, frames: int, dropped: Callable[[], int] = lambda: 0) -> BusStats:
         """The first BusStats that counts ``frames`` frames, less those the kernel ``dropped``."""

@@ -22,6 +22,7 @@ import subprocess
 import threading
 import time
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -30,6 +31,7 @@ import zenoh
 
 from services.cli.station_supervisor import stop_process
 from services.recorder.recording_reader import RecordingScan
+from services.recorder.testing import wait_until
 from shared import keys
 from shared.codec import decode
 from shared.messages import BusStats, RunSummary, Sample
@@ -62,14 +64,12 @@ class Heard:
             elif topic == keys.BUS:
                 self.stats.append(decode(BusStats, sample.payload.to_bytes()))
 
-    def wait(self, what: str, done: object, timeout_s: float) -> None:
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
+    def wait(self, what: str, done: Callable[[], object], timeout_s: float) -> None:
+        def locked() -> bool:
             with self.lock:
-                if callable(done) and done():
-                    return
-            time.sleep(0.05)
-        raise AssertionError(f"timed out waiting for {what}")
+                return bool(done())
+
+        wait_until(locked, what, timeout_s)
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from services.cli.station_supervisor import stop_process
 from shared import keys
 from shared.codec import encode
 from shared.errors import TransportError
@@ -65,12 +66,7 @@ def router(tmp_path: Path) -> Iterator[str]:
                     raise
         yield endpoint
     finally:
-        process.terminate()
-        try:
-            process.wait(10)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(10)
+        stop_process(process, grace_s=10)
         log.close()
 
 
@@ -217,12 +213,7 @@ def recorder_process(router: str, tmp_path: Path) -> Iterator[subprocess.Popen[b
         yield process
     finally:
         watcher.close()
-        process.terminate()
-        try:
-            process.wait(10)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(10)
+        stop_process(process, grace_s=10)
         log.close()
 
 
