@@ -193,6 +193,7 @@ class RecorderStats:
     write_errors: int  # failed writes (disk full, read-only folder, ...) since start
     last_error: str | None  # the newest write error, None when writing is healthy
     recording: bool  # False while the recordings folder cannot be written
+    missing_samples: int = 0  # published by the acquisition (BusStats) but never received
 
 
 #: Registry name of each message type: MCAP schema names and documentation.

@@ -19,8 +19,9 @@ Per station:
 - last decision, last run summary: the latest of each, with its age;
 - recorder: the latest RecorderStats (``boltwatch/<st>/recorder``, once a
   second): lag of samples into the recorder (p50/max over its last second,
-  None when no samples came), messages written, write errors and whether
-  it is recording.
+  None when no samples came), messages written, samples the acquisition
+  published that never reached the recorder, write errors and whether it is
+  recording.
 """
 
 from __future__ import annotations
@@ -118,6 +119,7 @@ class RecorderHealth:
     lag_p50_ms: float | None  # sample receive time in the recorder minus CAN time
     lag_max_ms: float | None
     messages: int  # written for this station since the recorder started
+    missing_samples: int  # published by the acquisition, never received by the recorder
     write_errors: int
     last_error: str | None
     age_s: float  # since the latest RecorderStats was received
@@ -272,6 +274,7 @@ def _recorder_health(
         lag_p50_ms=stats.lag_p50_ms,
         lag_max_ms=stats.lag_max_ms,
         messages=stats.messages,
+        missing_samples=stats.missing_samples,
         write_errors=stats.write_errors,
         last_error=stats.last_error,
         age_s=_age_s(received_ns, now_ns),
@@ -409,8 +412,8 @@ def _recorder_text(recorder: RecorderHealth | None) -> str:
     else:
         lag = f"lag p50 {recorder.lag_p50_ms:.1f} ms, max {recorder.lag_max_ms:.1f} ms"
     counts = (
-        f"{recorder.messages} messages, {recorder.write_errors} write errors, "
-        f"{recorder.age_s:.1f} s ago"
+        f"{recorder.messages} messages, {recorder.missing_samples} samples missing, "
+        f"{recorder.write_errors} write errors, {recorder.age_s:.1f} s ago"
     )
     if not recorder.recording:
         return f"NOT RECORDING: {recorder.last_error or 'write failing'} ({lag}, {counts})"

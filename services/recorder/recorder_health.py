@@ -11,6 +11,20 @@ Write health (``write_errors``, ``last_error``, ``recording``) is read from
 the :class:`~services.recorder.recorder.Recorder`'s ``write_errors``,
 ``last_write_error`` and ``recording_ok`` attributes; until the Recorder
 has them (disk-fault handling lands separately) they read as healthy.
+
+Missing samples are counted end to end, whatever the transport did: each
+BusStats carries the acquisition's running count of samples it published
+(``BusStats.samples``), and the recorder counts the samples it received from
+that station. Both counts start at the first BusStats the recorder sees (what
+was published before the recorder listened is not a loss); the difference,
+recomputed at every BusStats, is ``missing_samples``. It is a level, not a sum
+of guesses: samples still in flight when a BusStats is read are counted
+missing for at most one report and drop out at the next. When the
+acquisition restarts (its count goes down) the loss so far is kept and the
+counting starts again at the new process's first BusStats (samples around a
+restart, before the new process's first report, are not judged). This
+catches what no link-level counter can: a cable pulled for less than zenoh's
+lease loses samples while no session ever sees its router go.
 """
 
 from __future__ import annotations
@@ -26,6 +40,24 @@ _NS_PER_MS = 1_000_000
 class _StationCounts:
     messages: int = 0
     lags_ns: list[int] = field(default_factory=list)
+    samples_received: int = 0
+    published_base: int | None = None  # BusStats.samples when counting (re)started
+    received_base: int = 0  # samples_received then
+    published_last: int = 0
+    missing_before_restart: int = 0  # missing samples of earlier acquisition processes
+    missing_samples: int = 0
+
+    def bus_stats(self, published: int) -> None:
+        """The acquisition says it has published ``published`` samples since it started."""
+        if self.published_base is None or published < self.published_last:
+            self.missing_before_restart = self.missing_samples
+            self.published_base = published
+            self.received_base = self.samples_received
+        self.published_last = published
+        unreceived = (published - self.published_base) - (
+            self.samples_received - self.received_base
+        )
+        self.missing_samples = self.missing_before_restart + max(0, unreceived)
 
 
 class RecorderHealth:
@@ -41,12 +73,21 @@ class RecorderHealth:
 
     def written(self, station: str, received_ns: int, sample_time_ns: int | None) -> None:
         """One message of ``station`` written; ``sample_time_ns`` for Samples only."""
-        counts = self._stations.get(station)
-        if counts is None:
-            counts = self._stations[station] = _StationCounts()
+        counts = self._counts(station)
         counts.messages += 1
         if sample_time_ns is not None:
             counts.lags_ns.append(received_ns - sample_time_ns)
+            counts.samples_received += 1
+
+    def bus_stats(self, station: str, published_samples: int) -> None:
+        """A BusStats of ``station`` arrived: recount its missing samples."""
+        self._counts(station).bus_stats(published_samples)
+
+    def _counts(self, station: str) -> _StationCounts:
+        counts = self._stations.get(station)
+        if counts is None:
+            counts = self._stations[station] = _StationCounts()
+        return counts
 
     def messages(self, station: str) -> int:
         counts = self._stations.get(station)
@@ -70,6 +111,7 @@ class RecorderHealth:
                     write_errors=write_errors,
                     last_error=last_error,
                     recording=recording,
+                    missing_samples=counts.missing_samples,
                 )
             )
         return out

@@ -60,6 +60,7 @@ STATS_KEY = f"{LOCAL_PREFIX}stats"
 STATS_PERIOD_S = 1.0
 CHANNEL_DEPTH = 100_000  # 100 s of samples at 1 kHz
 _DRAIN_LIMIT = CHANNEL_DEPTH
+_BUS_STATS = "boltwatch.BusStats"
 _SAMPLE = "boltwatch.Sample"
 
 
@@ -200,6 +201,8 @@ class RecorderService:
                 else None
             )
             self.health.written(received.station, now_ns, sample_time_ns)
+            if received.schema_name == _BUS_STATS and received.message is not None:
+                self.health.bus_stats(received.station, received.message.samples)
         if received.schema_name == "boltwatch.RunSummary" and received.message is not None:
             self.wear.on_summary(received.message, now_ns)
 

@@ -299,6 +299,7 @@ def test_a_recorder_that_cannot_write_says_so_and_why() -> None:
         write_errors=3,
         last_error="[Errno 28] No space left on device",
         recording=False,
+        missing_samples=42,
     )
     feed(collector, keys.RECORDER, failing)
     collector.message("boltwatch/st1/recorder", b"{broken", T0)
@@ -311,3 +312,4 @@ def test_a_recorder_that_cannot_write_says_so_and_why() -> None:
     text = format_report(report)
     assert "NOT RECORDING: [Errno 28] No space left on device (lag - (no samples)" in text
     assert "3 write errors" in text
+    assert "42 samples missing" in text
