@@ -96,6 +96,7 @@ class BusStats:
     orphans: int  # JointSensors dropped: no ToolSensors partner in time
     stop_commands: int
     unsent_samples: int = 0  # published while the session had no router: lost, counted
+    late_decisions: int = 0  # stop decisions for a run the tool was no longer running
 
 
 @dataclass(frozen=True, slots=True)

@@ -68,6 +68,7 @@ class Acquisition:
         self._frames = 0
         self._receive_errors = 0
         self._stop_commands = 0
+        self._late_decisions = 0
         self._send_lock = threading.Lock()
         self._tool: ToolStatusFrame | None = None
         self._stopped_run: int | None = None
@@ -164,6 +165,7 @@ class Acquisition:
         """Send StopCommand for ``decision`` if it is for the running run; once per run."""
         tool = self._tool
         if tool is None or tool.state != ToolRunState.RUNNING or decision.run_id != tool.run_id:
+            self._late_decisions += 1
             LOG.warning("decision for run %d ignored: the tool is not running it", decision.run_id)
             return False
         with self._send_lock:
@@ -216,4 +218,5 @@ class Acquisition:
             orphans=pairing.orphans,
             stop_commands=self._stop_commands,
             unsent_samples=self._unsent_samples(),
+            late_decisions=self._late_decisions,
         )

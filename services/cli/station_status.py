@@ -1,9 +1,11 @@
-"""What ``boltwatch status`` saw of each station: pure aggregation and formatting.
+"""What ``boltwatch status`` saw of each station: pure aggregation.
 
 The command (``services/cli/commands/status.py``) owns the zenoh session; it
 feeds this module what arrives, and asks it for a report at the end of the
 listening window. Nothing here knows about zenoh or clocks: receive times and
-"now" are passed in (integer nanoseconds since the Unix epoch).
+"now" are passed in (integer nanoseconds since the Unix epoch). The report is
+printed by :mod:`services.cli.station_status_text` (for a person) or
+:func:`to_json` (for a program).
 
 Per station:
 
@@ -79,6 +81,8 @@ class BusHealth:
     unpaired: int
     orphans: int
     stop_commands: int
+    unsent_samples: int  # published with no router reachable
+    late_decisions: int  # decisions for a run the tool was no longer running
 
 
 @dataclass(frozen=True)
@@ -261,6 +265,8 @@ def _bus_health(stats: BusStats | None, received_ns: int, now_ns: int) -> BusHea
         unpaired=stats.unpaired,
         orphans=stats.orphans,
         stop_commands=stats.stop_commands,
+        unsent_samples=stats.unsent_samples,
+        late_decisions=stats.late_decisions,
     )
 
 
@@ -332,9 +338,6 @@ def _age_s(then_ns: int, now_ns: int) -> float:
     return round((now_ns - then_ns) / _NS, 3)
 
 
-# -- output ------------------------------------------------------------------------------
-
-
 def to_json(report: StatusReport) -> dict[str, Any]:
     """The report as one JSON-ready object; stations keyed by id."""
     return {
@@ -349,114 +352,3 @@ def to_json(report: StatusReport) -> dict[str, Any]:
             for status in report.stations
         },
     }
-
-
-def format_report(report: StatusReport) -> str:
-    """The report for a person at a terminal: one block per station."""
-    lines = [f"connected to {report.endpoint}, listened {report.listened_s:.1f} s"]
-    if not report.stations:
-        lines.append(
-            "no station seen: no liveliness tokens and no messages under boltwatch/ "
-            "(is anything running? 'boltwatch up' starts the simulated station)"
-        )
-        return "\n".join(lines)
-    for status in report.stations:
-        lines.append("")
-        lines.extend(_station_lines(status))
-    return "\n".join(lines)
-
-
-_LABEL = 14
-
-
-def _station_lines(status: StationStatus) -> list[str]:
-    def line(label: str, text: str) -> str:
-        return f"  {label:<{_LABEL}}{text}"
-
-    services = ", ".join(
-        f"{name} {'up' if alive else 'DOWN'}" for name, alive in status.services.items()
-    )
-    rate = f"{status.samples_per_s:.0f} received"
-    if status.bus_samples_per_s is not None:
-        rate += f" (bus {status.bus_samples_per_s:.0f})"
-    out = [
-        f"station {status.station}",
-        line("services", services),
-        line("samples/s", rate),
-        line("bus", _bus_text(status.bus)),
-        line("last run", _run_text(status.last_run)),
-        line("last decision", _decision_text(status.last_decision)),
-        line("last summary", _summary_text(status.last_summary)),
-        line("recorder", _recorder_text(status.recorder)),
-    ]
-    if status.unreadable_messages:
-        out.append(line("unreadable", f"{status.unreadable_messages} messages"))
-    return out
-
-
-def _bus_text(bus: BusHealth | None) -> str:
-    if bus is None:
-        return "- (no BusStats in the window: acquisition down?)"
-    return (
-        f"{bus.counter_gaps} gaps, {bus.missed_samples} missed samples, "
-        f"{bus.bad_frames} bad frames, {bus.receive_errors} receive errors "
-        f"({bus.frames} frames since start, {bus.age_s:.1f} s ago)"
-    )
-
-
-def _recorder_text(recorder: RecorderHealth | None) -> str:
-    if recorder is None:
-        return "- (no recorder stats in the window: recorder down or not serving it?)"
-    if recorder.lag_p50_ms is None or recorder.lag_max_ms is None:
-        lag = "lag - (no samples)"
-    else:
-        lag = f"lag p50 {recorder.lag_p50_ms:.1f} ms, max {recorder.lag_max_ms:.1f} ms"
-    counts = (
-        f"{recorder.messages} messages, {recorder.missing_samples} samples missing, "
-        f"{recorder.write_errors} write errors, {recorder.age_s:.1f} s ago"
-    )
-    if not recorder.recording:
-        return f"NOT RECORDING: {recorder.last_error or 'write failing'} ({lag}, {counts})"
-    text = f"recording, {lag}, {counts}"
-    if recorder.last_error:
-        text += f"; last error: {recorder.last_error}"
-    return text
-
-
-def _run_text(run: LastRun | None) -> str:
-    if run is None:
-        return "- (no tool state, sample or summary in the window)"
-    text = f"{run.run_id} {run.state}"
-    if run.tool_id is not None:
-        text += f" (tool {run.tool_id}, program {run.program_id})"
-    if run.source == "samples":
-        text += " (from samples)"
-    elif run.source == "runs":
-        text += " (from its summary)"
-    return text
-
-
-def _decision_text(decision: LastDecision | None) -> str:
-    if decision is None:
-        return "- (none in the window)"
-    return f"{decision.reason} for run {decision.run_id}, {decision.age_s:.1f} s ago"
-
-
-def _summary_text(summary: LastSummary | None) -> str:
-    if summary is None:
-        return "- (none in the window)"
-    error = "-" if summary.error_pct is None else f"{summary.error_pct:+.2f} %"
-    how = summary.stop_reason or f"tool stopped itself ({summary.tool_state})"
-    return (
-        f"run {summary.run_id}: {_amount(summary.reached, summary.unit)} of "
-        f"{_amount(summary.target, summary.unit)} target, error {error}, {how}, "
-        f"{summary.events} events, {summary.age_s:.1f} s ago"
-    )
-
-
-def _amount(value: float | None, unit: str) -> str:
-    if value is None:
-        return "-"
-    if unit == "N":
-        return f"{value / 1000:.2f} kN"
-    return f"{value:.1f} {unit}"

@@ -24,6 +24,8 @@ HORIZON_COLORS = {1: "tab:red", 2: "tab:green", 3: "tab:blue"}  # as Figures 18,
 BOUND_COLOR = "tab:orange"
 GRID_POINTS = 400
 SMALL = 8  # legend font size
+#: The one sign convention of the error panels (Figs. 22, 23), first line of their y labels.
+ERROR_SIGN = "measured − predicted"
 
 
 @dataclass(frozen=True, slots=True)
@@ -267,24 +269,28 @@ def draw_error_panels(
     run: RecordedRun,
     errors: Sequence[PredictionError],
 ) -> None:
-    """Figures 22 and 23: absolute and relative errors of the 1st-3rd predictions."""
+    """Figures 22 and 23: absolute and relative errors of the 1st-3rd predictions.
+
+    Every panel is measured − predicted (see :mod:`post_mortem_errors`), and its
+    y label says so: above zero the prediction fell short, below it overshot.
+    """
     specs = (
         ("peak torque", "T_j − T'_j / Nm", lambda e: e.torque_error_nm,
-         "ε_T (eq. 62) / %", lambda e: e.relative_torque),
+         "(T_j − T'_j)/T_j = ε_T (62) / %", lambda e: e.relative_torque),
         ("plateau force", "F_j − F'_j / kN",
          lambda e: None if e.force_error_n is None else e.force_error_n / 1e3,
-         "ε_F (eq. 63) / %", lambda e: e.relative_force),
-        ("time", "t'_j − t_j / ms", lambda e: e.time_error_s * 1e3,
-         "ε_t (eq. 61) / %", lambda e: e.relative_time),
+         "(F_j − F'_j)/F_j = ε_F (63) / %", lambda e: e.relative_force),
+        ("time", "t_j − t'_j / ms", lambda e: e.time_error_s * 1e3,
+         "(t_j − t'_j)/Δt_j = −ε_t (61) / %", lambda e: e.relative_time),
     )  # fmt: skip
     times = {e.index: run.run_time_s(e.time_ns) for e in run.events}
     for abs_ax, rel_ax, (what, abs_label, abs_of, rel_label, rel_of) in zip(
         absolute, relative, specs, strict=True
     ):
         abs_ax.set(title=f"Fig. 22: prediction error, {what}", xlabel="run time / s")
-        abs_ax.set_ylabel(abs_label)
+        abs_ax.set_ylabel(f"{ERROR_SIGN}\n{abs_label}")
         rel_ax.set(title=f"Fig. 23: relative prediction error, {what}", xlabel="run time / s")
-        rel_ax.set_ylabel(rel_label)
+        rel_ax.set_ylabel(f"{ERROR_SIGN}\n{rel_label}")
         drawn = False
         for horizon in HORIZONS:
             mine = [e for e in errors if e.horizon == horizon]

@@ -2,6 +2,6 @@
 
 Each module defines ``NAME`` (the subcommand), ``HELP`` (one line),
 ``add_arguments(parser)`` and ``run(args) -> int`` (the exit status).
-:mod:`services.cli.main` lists them in ``COMMANDS``; heavy imports happen
+:mod:`services.cli.main` finds them with ``pkgutil``; heavy imports happen
 inside ``run`` so that ``boltwatch --help`` stays fast.
 """

@@ -3,8 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
+
+from services.cli.command_options import (
+    add_recording_argument,
+    add_run_option,
+    warn_damaged_recording,
+)
 
 NAME = "export"
 HELP = "write the samples of a recorded run as a trace CSV (what 'boltwatch predict' reads)"
@@ -16,7 +21,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "time_s,torque_nm,angle_deg,force_n (time_s from the run's first sample). "
         "A damaged recording (recorder killed) exports what is readable, with a warning."
     )
-    parser.add_argument("recording", type=Path, metavar="RUN.mcap", help="the recording")
+    add_recording_argument(parser)
     parser.add_argument(
         "--out",
         type=Path,
@@ -24,13 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="TRACE.csv",
         help="where to write the trace (default: RUN.csv beside the recording)",
     )
-    parser.add_argument(
-        "--run",
-        type=int,
-        default=None,
-        metavar="ID",
-        help="run id to export (default: the run with the most samples in the file)",
-    )
+    add_run_option(parser, "run id to export (default: the run with the most samples in the file)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -38,8 +37,6 @@ def run(args: argparse.Namespace) -> int:
 
     report = export_trace(args.recording, args.out, args.run)
     if not report.complete:
-        print(
-            f"boltwatch export: warning: {report.state}; exported what is readable", file=sys.stderr
-        )
+        warn_damaged_recording(NAME, report.state, "exported what is readable")
     print(f"wrote {report.rows} samples of run {report.run_id} to {report.target}")
     return 0

@@ -13,6 +13,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from services.cli.command_options import DEFAULT_STATION_FILE
+
 NAME = "health"
 HELP = "exit 0 if a service is alive for the stations named (for container health checks)"
 
@@ -27,7 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--config",
         type=Path,
         nargs="+",
-        default=[Path("config/station.toml")],
+        default=[DEFAULT_STATION_FILE],
         metavar="FILE",
         help="station file(s): the service must be alive for each station; the first "
         "file's [zenoh] connect names the router (default: config/station.toml)",

@@ -19,6 +19,8 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from services.cli.command_options import add_recordings_folder_options, recordings_folder
+
 if TYPE_CHECKING:
     from services.recorder.controller_run import ControllerRun
 
@@ -42,19 +44,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="ID",
         help="station id the runs are filed under (default: cs351)",
     )
-    parser.add_argument(
-        "--recordings",
-        type=Path,
-        default=None,
-        metavar="DIR",
-        help="recordings folder (default: the station file's recorder.folder)",
-    )
-    parser.add_argument(
-        "--config",
-        type=Path,
-        default=Path("config/station.toml"),
-        help="station file, for its recorder.folder (default: config/station.toml)",
-    )
+    add_recordings_folder_options(parser)
     parser.add_argument("--no-rerun", action="store_true", help="MCAP only, no .rrd beside it")
     parser.add_argument(
         "--csv",
@@ -85,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
         where = args.csv_dir
     else:
         station = check_station_id(args.station or DEFAULT_STATION)
-        recordings = args.recordings or _recordings_of(args.config)
+        recordings = recordings_folder(args)
         written, write_failed = _write_recordings(good, recordings, station, not args.no_rerun)
         failed += write_failed
         where = recordings
@@ -95,12 +85,6 @@ def run(args: argparse.Namespace) -> int:
         + (f"; {failed} failed" if failed else "")
     )
     return 2 if failed else 0
-
-
-def _recordings_of(config: Path) -> Path:
-    from shared.config import load_station
-
-    return load_station(config).recordings_folder
 
 
 def _write_csv(runs: list[ControllerRun], out_dir: Path) -> int:

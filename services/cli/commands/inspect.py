@@ -3,8 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
+
+from services.cli.command_options import (
+    add_recording_argument,
+    add_run_option,
+    warn_damaged_recording,
+)
 
 NAME = "inspect"
 HELP = "draw a recorded run as a post-mortem PNG of the paper's figures (10, 13-15, 22, 23)"
@@ -19,11 +24,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "program metadata in the file, the analytical bounds are drawn too. For interactive "
         "viewing open the .mcap in Foxglove (it needs no plug-in)."
     )
-    parser.add_argument("recording", type=Path, metavar="RUN.mcap", help="the recording")
+    add_recording_argument(parser)
     parser.add_argument(
         "--out", type=Path, default=None, metavar="RUN.png", help="default: beside the recording"
     )
-    parser.add_argument("--run", type=int, default=None, metavar="ID", help="run id to draw")
+    add_run_option(parser, "run id to draw")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -32,6 +37,6 @@ def run(args: argparse.Namespace) -> int:
     target = args.out or args.recording.with_suffix(".png")
     run = draw_run(args.recording, target, args.run)
     if not run.complete:
-        print(f"boltwatch inspect: warning: {run.state}; drew what is readable", file=sys.stderr)
+        warn_damaged_recording(NAME, run.state, "drew what is readable")
     print(f"wrote {target}: {len(run.samples)} samples, {len(run.events)} stick-slip events")
     return 0

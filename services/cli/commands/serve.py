@@ -14,6 +14,8 @@ import argparse
 import importlib
 from pathlib import Path
 
+from services.cli.command_options import DEFAULT_STATION_FILE
+
 NAME = "serve"
 HELP = "run one long-running service (rig, acquisition, predictor, recorder, router)"
 
@@ -47,7 +49,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                 "--config",
                 type=Path,
                 nargs="+",
-                default=[Path("config/station.toml")],
+                default=[DEFAULT_STATION_FILE],
                 metavar="FILE",
                 help="station file(s): one process serves every station named "
                 "(default: config/station.toml)",
@@ -56,7 +58,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
             sub.add_argument(
                 "--config",
                 type=Path,
-                default=Path("config/station.toml"),
+                default=DEFAULT_STATION_FILE,
                 help="station file (default: config/station.toml)",
             )
         sub.add_argument("--log-level", default=None, help="DEBUG, INFO (default), WARNING")

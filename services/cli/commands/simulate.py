@@ -13,6 +13,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from services.cli.command_options import DEFAULT_STATION_FILE
+
 NAME = "simulate"
 HELP = "simulate one tightening offline and write its trace (CSV) for 'boltwatch predict'"
 
@@ -21,7 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--config",
         type=Path,
-        default=Path("config/station.toml"),
+        default=DEFAULT_STATION_FILE,
         help="station file (default: config/station.toml)",
     )
     parser.add_argument(

@@ -14,6 +14,8 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from services.cli.command_options import DEFAULT_STATION_FILE
+
 if TYPE_CHECKING:
     from services.cli.station_status import StatusReport
 
@@ -23,7 +25,6 @@ HELP = (
     "decision, recorder lag and health"
 )
 
-DEFAULT_CONFIG = Path("config/station.toml")
 CONNECT_TIMEOUT_MS = 2000
 LIVELINESS_TIMEOUT_S = 2.0
 
@@ -43,7 +44,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         default=None,
         metavar="FILE",
-        help=f"station file whose [zenoh] connect names the router (default: {DEFAULT_CONFIG})",
+        help=(
+            f"station file whose [zenoh] connect names the router (default: {DEFAULT_STATION_FILE})"
+        ),
     )
     where.add_argument(
         "--connect",
@@ -62,12 +65,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from services.cli.station_status import format_report, to_json
+    from services.cli.station_status import to_json
+    from services.cli.station_status_text import format_report
     from shared.errors import InputError
 
     if not args.listen_s > 0:
         raise InputError(f"--listen-s must be a positive number of seconds (got {args.listen_s})")
-    endpoint = args.connect or _endpoint_from(args.config or DEFAULT_CONFIG)
+    endpoint = args.connect or _endpoint_from(args.config or DEFAULT_STATION_FILE)
     report = _watch(endpoint, args.listen_s)
     if args.json:
         print(json.dumps(to_json(report), indent=2))

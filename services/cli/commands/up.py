@@ -25,6 +25,8 @@ from datetime import UTC, datetime
 from pathlib import Path
 from types import FrameType
 
+from services.cli.command_options import DEFAULT_STATION_FILE
+
 NAME = "up"
 HELP = "run the simulated station (or --stations N) end to end: rig, acquisition, predictor, ..."
 
@@ -37,7 +39,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--config",
         type=Path,
-        default=Path("config/station.toml"),
+        default=DEFAULT_STATION_FILE,
         help="station file (default: config/station.toml)",
     )
     parser.add_argument(

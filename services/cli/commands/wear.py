@@ -9,7 +9,8 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
+
+from services.cli.command_options import add_recordings_folder_options, recordings_folder
 
 NAME = "wear"
 HELP = "show the wear ledger per tool, or record a tool's service"
@@ -26,19 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("action", nargs="?", choices=["service"], help="record a service")
     parser.add_argument("tool", nargs="?", type=int, help="tool id (with 'service')")
     parser.add_argument("--note", default="", help="what was done (with 'service')")
-    parser.add_argument(
-        "--recordings",
-        type=Path,
-        default=None,
-        metavar="DIR",
-        help="recordings folder holding wear.sqlite (default: the station file's recorder.folder)",
-    )
-    parser.add_argument(
-        "--config",
-        type=Path,
-        default=Path("config/station.toml"),
-        help="station file, for its recorder.folder (default: config/station.toml)",
-    )
+    add_recordings_folder_options(parser, "recordings folder holding wear.sqlite")
     parser.add_argument(
         "--station",
         default=None,
@@ -54,11 +43,9 @@ def run(args: argparse.Namespace) -> int:
 
     from services.recorder.wear_ledger import WearLedger, ledger_path
     from services.recorder.wear_table import format_table
-    from shared.config import load_station
     from shared.errors import InputError
 
-    recordings = args.recordings or load_station(args.config).recordings_folder
-    path = ledger_path(recordings)
+    path = ledger_path(recordings_folder(args))
     if args.action == "service":
         if args.tool is None:
             raise InputError("give the tool id: boltwatch wear service TOOL --note TEXT")

@@ -109,6 +109,7 @@ def test_stop_command_only_for_the_running_run_and_only_once(
     assert not acquisition.send_stop(decision(8))  # another run
     assert acquisition.send_stop(decision(7))
     assert not acquisition.send_stop(decision(7))  # once per run
+    assert acquisition.stats().late_decisions == 2  # the first two: no such run running
     received = tool.recv(1.0)
     assert received is not None and received.arbitration_id == DATABASE.stop_command_id
     signals = DATABASE.decode(received.arbitration_id, received.data)

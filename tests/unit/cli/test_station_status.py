@@ -5,7 +5,8 @@ from __future__ import annotations
 import json
 from typing import Any
 
-from services.cli.station_status import LastRun, StatusCollector, format_report, to_json
+from services.cli.station_status import LastRun, StatusCollector, to_json
+from services.cli.station_status_text import format_report
 from shared import keys
 from shared.codec import encode
 from shared.messages import (
@@ -238,7 +239,11 @@ def test_table_reads_per_station() -> None:
     for sequence in range(2000):
         feed(collector, keys.SAMPLES, sample(4, sequence))
     feed(collector, keys.BUS, bus(T0, samples=0))
-    feed(collector, keys.BUS, bus(T0 + S, samples=1000, counter_gaps=2, missed_samples=3))
+    feed(
+        collector,
+        keys.BUS,
+        bus(T0 + S, samples=1000, counter_gaps=2, missed_samples=3, late_decisions=1),
+    )
     feed(collector, keys.RUNS, summary(3))
 
     text = format_report(collector.report("tcp/127.0.0.1:7447", 2.0, T0 + S))
@@ -248,6 +253,7 @@ def test_table_reads_per_station() -> None:
     assert "acquisition up, predictor DOWN, recorder DOWN, rig DOWN" in text
     assert "1000 received (bus 1000)" in text
     assert "2 gaps, 3 missed samples, 0 bad frames" in text
+    assert "0 unsent samples, 1 late decisions" in text
     assert "run 3: 55.80 kN of 56.00 kN target, error -0.36 %, plateau_closest" in text
     assert "recorder      - (no recorder stats in the window" in text
 

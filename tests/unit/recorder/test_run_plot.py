@@ -117,10 +117,52 @@ def test_report_has_the_papers_panels_with_bounds(tmp_path: Path) -> None:
     assert [(e.horizon, e.index) for e in errors] == [
         (1, 2), (1, 3), (1, 4), (1, 5), (2, 3), (2, 4), (2, 5), (3, 4), (3, 5),
     ]  # fmt: skip
+    # measured − predicted: each prediction is 1 ms late and 300 N high (negative), 0.5 Nm low
     first = errors[0]
-    assert first.time_error_s == pytest.approx(0.001)
+    assert first.time_error_s == pytest.approx(-0.001)
     assert first.torque_error_nm == pytest.approx(0.5)
-    assert first.relative_time == pytest.approx(0.001 / 0.030)
+    assert first.force_error_n == pytest.approx(-300.0)
+    assert first.relative_time == pytest.approx(-0.001 / 0.030)
+    error_axes = figure.axes[8:14]
+    for axis, unit in zip(error_axes, ("Nm", "kN", "ms", "%", "%", "%"), strict=True):
+        label = axis.get_ylabel()
+        assert label.startswith("measured − predicted\n") and label.endswith(f"/ {unit}")
+    time_ms = figure.axes[10].lines[0].get_ydata()  # the 1st predictions of t, in ms
+    assert time_ms == pytest.approx([-1.0] * 4)
+
+
+def _event(index: int, time_s: float, torque_nm: float, force_n: float, period_s: float | None,
+           predictions: list[Prediction]) -> StickSlipEvent:  # fmt: skip
+    return StickSlipEvent(
+        "st1", 1, index, T0_NS + round(time_s * 1e9), time_s, torque_nm, None, None, force_n,
+        None, period_s, None, None, None, None, None, 0.0, predictions,
+    )  # fmt: skip
+
+
+def test_every_error_is_measured_minus_predicted() -> None:
+    # Event 1 predicts event 2 late, too high and too strong, and event 3 early, too low
+    # and too weak: the first errors are all negative, the second all positive.
+    late_high = Prediction(1, time_s=0.105, peak_torque_nm=52.0, plateau_force_n=10_300.0)
+    early_low = Prediction(2, time_s=0.115, peak_torque_nm=57.0, plateau_force_n=10_800.0)
+    events = [
+        _event(1, 0.080, 45.0, 9_500.0, None, [late_high, early_low]),
+        _event(2, 0.100, 50.0, 10_000.0, 0.020, []),
+        _event(3, 0.120, 60.0, 11_000.0, 0.020, []),
+    ]
+    late, early = prediction_errors(events)
+    assert (late.horizon, late.index, early.horizon, early.index) == (1, 2, 2, 3)
+    assert late.time_error_s == pytest.approx(-0.005)
+    assert late.torque_error_nm == pytest.approx(-2.0)
+    assert late.force_error_n == pytest.approx(-300.0)
+    assert late.relative_time == pytest.approx(-0.005 / 0.020)
+    assert late.relative_torque == pytest.approx(-2.0 / 50.0)
+    assert late.relative_force == pytest.approx(-300.0 / 10_000.0)
+    assert early.time_error_s == pytest.approx(0.005)
+    assert early.torque_error_nm == pytest.approx(3.0)
+    assert early.force_error_n == pytest.approx(200.0)
+    assert early.relative_time == pytest.approx(0.005 / 0.020)
+    assert early.relative_torque == pytest.approx(3.0 / 60.0)
+    assert early.relative_force == pytest.approx(200.0 / 11_000.0)
 
 
 def test_plateaus_span_the_stick_phase_before_their_peak(tmp_path: Path) -> None:

@@ -1,0 +1,70 @@
+"""Command-line options that several ``boltwatch`` commands share.
+
+Defined once so that an option reads, defaults and resolves the same in every
+command that takes it:
+
+- ``RUN.mcap`` and ``--run ID`` (export, inspect): one run of one recording;
+  a damaged recording (recorder killed) is read as far as it goes, with a
+  one-line warning on stderr instead of an error;
+- ``--recordings DIR`` and ``--config FILE`` (wear, import): the recordings
+  folder, by default the station file's ``recorder.folder``.
+
+Light imports only: every command module imports this for ``boltwatch --help``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+#: The station file a command reads when none is given.
+DEFAULT_STATION_FILE = Path("config/station.toml")
+
+
+def add_recording_argument(parser: argparse.ArgumentParser) -> None:
+    """The positional ``RUN.mcap``: the recording to read (``args.recording``)."""
+    parser.add_argument("recording", type=Path, metavar="RUN.mcap", help="the recording")
+
+
+def add_run_option(parser: argparse.ArgumentParser, help_text: str) -> None:
+    """``--run ID`` (``args.run``, None when not given): which run of the recording."""
+    parser.add_argument("--run", type=int, default=None, metavar="ID", help=help_text)
+
+
+def warn_damaged_recording(command: str, state: str, what_was_done: str) -> None:
+    """Say on stderr that the recording was damaged and what was still done with it."""
+    print(f"boltwatch {command}: warning: {state}; {what_was_done}", file=sys.stderr)
+
+
+def add_recordings_folder_options(
+    parser: argparse.ArgumentParser, folder_help: str = "recordings folder"
+) -> None:
+    """``--recordings DIR`` and ``--config FILE``; :func:`recordings_folder` resolves them."""
+    parser.add_argument(
+        "--recordings",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help=f"{folder_help} (default: the station file's recorder.folder)",
+    )
+    parser.add_argument(
+        "--config",
+        type=Path,
+        default=DEFAULT_STATION_FILE,
+        help=f"station file, for its recorder.folder (default: {DEFAULT_STATION_FILE})",
+    )
+
+
+def recordings_folder(args: argparse.Namespace) -> Path:
+    """``--recordings`` if given, else the ``recorder.folder`` of the ``--config`` station file.
+
+    The station file is read only when needed: with ``--recordings`` a missing
+    or broken station file is no error.
+    """
+    if args.recordings is not None:
+        folder: Path = args.recordings
+        return folder
+    from shared.config import load_station
+
+    return load_station(args.config).recordings_folder
