@@ -8,7 +8,8 @@ checks, without restarting any service:
 - the acquisition counted the samples it published with no router
   (``BusStats.unsent_samples``) and logged the outage with its length;
 - those samples are missing from the recording (the rig's log says how many
-  samples each run had), and nothing else is;
+  samples each run had), and nothing else is; the recorder's own end-to-end
+  count (``RecorderStats.missing_samples``) is exactly what the recording lacks;
 - the run(s) the predictor could not stop ended at the rig's conventional
   shutoff, at the target: the tool never tightens blind;
 - a run after the outage is recorded whole and stopped by the predictor.
@@ -34,7 +35,7 @@ from services.recorder.recording_reader import RecordingScan
 from services.recorder.testing import wait_until
 from shared import keys
 from shared.codec import decode
-from shared.messages import BusStats, RunSummary, Sample
+from shared.messages import BusStats, RecorderStats, RunSummary, Sample
 from shared.zenoh_session import zenoh_config
 from tests.system.station_files import free_tcp_port, serve, write_station
 
@@ -54,6 +55,7 @@ RIG_RUN = re.compile(r"run (\d+): (\w+) by (\w+), force (\d+) N, .* (\d+) sample
 class Heard:
     summaries: list[RunSummary] = field(default_factory=list)
     stats: list[BusStats] = field(default_factory=list)
+    recorder: list[RecorderStats] = field(default_factory=list)
     lock: threading.Lock = field(default_factory=threading.Lock)
 
     def on_sample(self, sample: zenoh.Sample) -> None:
@@ -63,6 +65,8 @@ class Heard:
                 self.summaries.append(decode(RunSummary, sample.payload.to_bytes()))
             elif topic == keys.BUS:
                 self.stats.append(decode(BusStats, sample.payload.to_bytes()))
+            elif topic == keys.RECORDER:
+                self.recorder.append(decode(RecorderStats, sample.payload.to_bytes()))
 
     def wait(self, what: str, done: Callable[[], object], timeout_s: float) -> None:
         def locked() -> bool:
@@ -159,6 +163,12 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
                     lambda: heard.stats[-1].samples > 0 and heard.stats[-1].unsent_samples > 0,
                     5.0,
                 )
+                final_bus_ns = heard.stats[-1].time_ns
+                heard.wait(
+                    "the recorder's count after the final BusStats",
+                    lambda: heard.recorder and heard.recorder[-1].time_ns > final_bus_ns + 10**9,
+                    5.0,
+                )
             finally:
                 subscriber.undeclare()
     finally:
@@ -175,6 +185,7 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
     print(
         f"unsent {stats.unsent_samples}, missing from the recording {sum(missing.values())} "
         f"in runs {outage_runs}; bus missed {stats.missed_samples}; "
+        f"recorder missing {heard.recorder[-1].missing_samples}; "
         f"stop sources {Counter(r.stop_source for r in runs.values())}"
     )
     print("acquisition:", *re.findall(r".*router back after.*", logs["acq"].read_text()))
@@ -192,8 +203,9 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
     assert lost_in_recording <= stats.unsent_samples + 1000 * RECONNECT_PERIOD_MAX_S * 2
     assert 1 <= len(outage_runs) <= 3, missing
     assert all(lost >= 0 for lost in missing.values()), missing
-    # The gap is in the recording: a run with samples before or after the outage, not all.
-    assert any(0 < len(set(sequences.get(r, []))) < runs[r].samples for r in outage_runs)
+    # The recorder counted the loss itself, to the sample, whatever the runs it fell in.
+    recorded_samples = sum(len(set(run_sequences)) for run_sequences in sequences.values())
+    assert heard.recorder[-1].missing_samples == stats.samples - recorded_samples
     # No run tightened blind: the ones the predictor could not stop hit the shutoff at target.
     unstopped = [r for r in outage_runs if runs[r].stop_source != "stop_command"]
     assert unstopped, f"no run ended during the outage: {runs}"

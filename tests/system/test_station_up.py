@@ -95,7 +95,10 @@ def test_up_tightens_stops_and_records_every_sample(tmp_path: Path) -> None:
     decisions = messages["boltwatch/st1/decision"]
     assert decisions, "the predictor never decided to stop"
     assert len({d["run_id"] for d in decisions}) == len(decisions)  # one per run
-    assert bus["stop_commands"] == len(decisions)
+    # each decision became a StopCommand, or came after the tool's own shutoff
+    # (a loaded machine) and was counted late: never dropped unseen
+    assert bus["stop_commands"] >= 1
+    assert bus["stop_commands"] + bus["late_decisions"] == len(decisions)
     events = messages["boltwatch/st1/events"]
     assert len(events) >= 3 * 5  # the default program sticks and slips clearly
     for summary in summaries:  # every event the predictor counted is in the recording
