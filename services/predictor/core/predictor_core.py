@@ -24,6 +24,7 @@ import math
 from services.predictor.core.event_figures import compute_figures
 from services.predictor.core.extremum_tracker import ExtremumTracker, Slip
 from services.predictor.core.force_history import ForceHistory
+from services.predictor.core.halt_planner import HaltPlanner
 from services.predictor.core.inclination_window import NO_FLIP, InclinationWindow
 from services.predictor.core.input_guard import InputGuard, InputReport
 from services.predictor.core.model_bands import BandVerdict, ModelBandCheck
@@ -41,6 +42,7 @@ HISTORY = 10  # events kept for the fits (the fits use at most 8)
 FIRST_PLATEAU_SAMPLES = 20  # stick samples looked at for the first event's plateau
 
 STAIRCASE_EVENTS = 3  # rising peaks in a row before torque peaks may decide (eq. 64)
+PLAN_PERIODS = 1.5  # a torque halt plan holds this many predicted periods after its peak
 MAX_STEP_FRACTION = 0.25  # a predicted step larger than this share of the value: no decision
 
 CoreOutput = CoreEvent | CoreDecision
@@ -63,6 +65,12 @@ class PredictorCore:
             else None
         )
         self.scores = PredictionScores()
+        target_torque = settings.target_torque_nm
+        self._halt_planner = (
+            HaltPlanner(target_torque)
+            if not settings.force_mode and target_torque is not None and target_torque > 0.0
+            else None
+        )
         self._count = 0
         self._start_time_s = math.nan
         self._start_angle_deg = math.nan
@@ -79,6 +87,11 @@ class PredictorCore:
     def input_report(self) -> InputReport:
         """What the input guard did with bad input so far."""
         return self._guard.report
+
+    @property
+    def halt_planner(self) -> HaltPlanner | None:
+        """The torque halt planner (torque target without force), else None."""
+        return self._halt_planner
 
     @property
     def decision(self) -> CoreDecision | None:
@@ -188,9 +201,20 @@ class PredictorCore:
             predictions=predictions,
         )
         out: list[CoreOutput] = [event]
-        if not settings.force_mode:
-            regular = predictions and self._is_staircase()
-            self.policy.expect_peak(predictions[0].peak_torque_nm if regular else None)
+        if self._halt_planner is not None and self.policy.decision is None:
+            halt = self._halt_planner.on_event(
+                peak.index,
+                peak.torque_nm,
+                trough.index,
+                trough.torque_nm,
+                [p.peak_torque_nm for p in predictions],
+            )
+            planner = self._halt_planner
+            valid = 0
+            if predictions and self._guard.nominal_dt_s > 0.0:
+                period_s = predictions[0].time_s - peak.time_s
+                valid = int(PLAN_PERIODS * period_s / self._guard.nominal_dt_s) + 1
+            self.policy.plan_halt(halt, planner.rate_nm_per_sample, planner.drop_nm, valid)
         verdict = None
         if self.model_bands is not None:
             verdict = self.model_bands.on_event(

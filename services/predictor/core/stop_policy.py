@@ -12,6 +12,10 @@ Checked on every sample (O(1)):
   the motor will stop at is projected over the station's reaction
   (:mod:`.ramp_estimator`), and the rule fires when that reaches the target:
   waiting for the measurement would overshoot by the reaction's worth of ramp.
+  Torque target on a joint that sticks and slips: the halt level of the stick
+  phase under way comes from :mod:`.halt_planner` (a slip during the halt
+  costs the whole torque drop), and the rule fires when the torque plus the
+  reaction's worth of stick ramp reaches it.
 
 Checked once per stick-slip event j (after its slip, on the new plateau):
 
@@ -44,9 +48,6 @@ from services.predictor.core.settings import PredictorSettings
 from shared.messages import StopReasonName
 
 TARGET_SAMPLES = 3
-#: torque target: a stick phase whose predicted peak is within this share of the
-#: target may slip while the stop is on its way (see :meth:`StopPolicy.expect_peak`)
-SLIP_GUARD = 0.015
 
 
 class StopPolicy:
@@ -72,20 +73,57 @@ class StopPolicy:
         self._max_torque = s.max_torque_nm if s.max_torque_nm is not None else math.inf
         self._max_force = s.max_force_n if s.has_force and s.max_force_n is not None else math.inf
         self._max_angle = s.max_angle_deg if s.max_angle_deg is not None else math.inf
-        self._expected_peak_nm = math.nan
+        self._halt_nm = math.nan
+        self._halt_rate_nm = math.nan
+        self._halt_drop_nm = math.nan
+        self._halt_samples_left = 0
+        self._halt_max_nm = -math.inf
+        self._previous_value = math.nan
 
-    def expect_peak(self, peak_nm: float | None) -> None:
-        """The predicted peak torque of the stick phase now under way (torque target only).
+    def plan_halt(
+        self,
+        halt_nm: float | None,
+        rate_nm_per_sample: float = math.nan,
+        drop_nm: float = math.nan,
+        valid_samples: int = 0,
+    ) -> None:
+        """Torque target: the torque to halt at in the stick phase now under way.
 
-        The settled torque of a halted tool is the torque at the halt if the
-        joint sticks, but the trough after the slip if the slip starts before
-        the motor has stopped. When this phase's peak is predicted within
-        SLIP_GUARD of the target, the target is crossed right before the slip:
-        the stop is held back, and the next stick phase, which starts below
-        and ends above the target, crosses it far from its slip. If the joint
-        goes on sticking after all, the stop comes at SLIP_GUARD past the target.
+        From :class:`~.halt_planner.HaltPlanner`: below the target when the
+        phase is likely to slip right at it, above when the next phase is the
+        safer one to stop in. ``rate_nm_per_sample`` is the stick ramp, used to
+        decide one reaction ahead of the halt. The plan holds for this phase
+        only: when the torque falls by half the typical drop ``drop_nm`` (a
+        slip, seen or not) the halt level becomes the target itself, and after
+        ``valid_samples`` the plan is dropped (the joint no longer sticks and
+        slips as predicted). None, or no plan: halt on the
+        target by the usual rules (three samples over it, or the steady-ramp
+        projection).
         """
-        self._expected_peak_nm = peak_nm if peak_nm is not None else math.nan
+        usable = (
+            halt_nm is not None and rate_nm_per_sample > 0.0 and drop_nm > 0.0 and valid_samples > 0
+        )
+        self._halt_nm = halt_nm if usable and halt_nm is not None else math.nan
+        self._halt_rate_nm = rate_nm_per_sample
+        self._halt_drop_nm = drop_nm
+        self._halt_samples_left = valid_samples
+        self._halt_max_nm = -math.inf
+
+    def _halt_plan_holds(self, value: float) -> bool:
+        """Count down the plan and watch for a slip; False once it no longer applies."""
+        if math.isnan(self._halt_nm):
+            return False
+        self._halt_samples_left -= 1
+        self._halt_max_nm = max(self._halt_max_nm, value)
+        if self._halt_samples_left < 0:
+            self._halt_nm = math.nan
+            return False
+        if value < self._halt_max_nm - 0.5 * self._halt_drop_nm and self._target_torque:
+            # slipped: the plan was for the phase that just ended; until the
+            # event is confirmed and a new plan made, this phase halts on target
+            self._halt_nm = self._target_torque
+            self._halt_max_nm = value
+        return True
 
     def _decide(
         self,
@@ -136,8 +174,23 @@ class StopPolicy:
             return None
         self._ramp.add(value)
         self._over_target = self._over_target + 1 if value >= target else 0
-        if self._target_torque is not None and self._holds_back(value, target):
-            return None
+        previous, self._previous_value = self._previous_value, value
+        if self._target_torque is not None and self._halt_plan_holds(value):
+            # one spike is not a reason: the torque now is taken as at most two
+            # ramp steps above the sample before
+            now = value if math.isnan(previous) else min(value, previous + 2.0 * self._halt_rate_nm)
+            at_halt = now + self._halt_rate_nm * self._lead_samples
+            if at_halt < self._halt_nm:
+                return None
+            return self._decide(
+                time_s,
+                "target_reached",
+                f"{quantity} {value:.5g} {unit} + ramp: {at_halt:.5g} {unit} at the halt ≥ "
+                f"planned {self._halt_nm:.5g} {unit} (target {target:g} {unit}, slip risk)",
+                torque_nm,
+                force_n,
+                at_halt,
+            )
         if self._over_target >= TARGET_SAMPLES:
             return self._decide(
                 time_s,
@@ -158,13 +211,6 @@ class StopPolicy:
                 projected,
             )
         return None
-
-    def _holds_back(self, value: float, target: float) -> bool:
-        """Torque target: this stick phase's predicted slip is too close to the target."""
-        peak = self._expected_peak_nm
-        if not abs(peak - target) <= SLIP_GUARD * target:
-            return False
-        return value < target * (1.0 + SLIP_GUARD)
 
     def on_input_fault(self, time_s: float, bad_samples: int) -> CoreDecision | None:
         if self.decision is not None:

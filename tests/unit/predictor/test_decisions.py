@@ -189,15 +189,39 @@ def test_torque_target_stops_on_a_stick_ramp_at_the_target() -> None:
     assert decision.torque_nm == pytest.approx(120.0, abs=1.5)
 
 
-def test_a_slip_expected_at_the_torque_target_holds_the_stop_back() -> None:
-    from services.predictor.core.stop_policy import SLIP_GUARD, StopPolicy
+def first_stop(policy: object, ramp: list[tuple[float, float]]) -> float | None:
+    from services.predictor.core.stop_policy import StopPolicy
 
-    policy = StopPolicy(PredictorSettings(target_torque_nm=100.0, has_force=False))
-    policy.expect_peak(100.5)  # this stick phase is predicted to slip at the target
+    assert isinstance(policy, StopPolicy)
+    return next((tq for t, tq in ramp if policy.on_sample(t, tq, math.nan, 0.0) is not None), None)
+
+
+def test_a_halt_plan_moves_the_torque_stop_and_holds_one_phase_only() -> None:
+    from services.predictor.core.stop_policy import StopPolicy
+
+    settings = PredictorSettings(target_torque_nm=100.0, has_force=False)
     ramp = [(i * 1e-3, 95.0 + 0.5 * i) for i in range(30)]
-    stop = next((t, tq) for t, tq in ramp if policy.on_sample(t, tq, math.nan, 0.0) is not None)
-    assert stop[1] >= 100.0 * (1.0 + SLIP_GUARD)
-    other = StopPolicy(PredictorSettings(target_torque_nm=100.0, has_force=False))
-    other.expect_peak(110.0)  # the slip is far above: stop at the target
-    stop = next((t, tq) for t, tq in ramp if other.on_sample(t, tq, math.nan, 0.0) is not None)
-    assert stop[1] < 100.0 * (1.0 + SLIP_GUARD)
+    above = StopPolicy(settings)
+    above.plan_halt(103.0, 0.5, 8.0, 100)  # the next phase is the safer one: ride past
+    assert first_stop(above, ramp) == pytest.approx(102.5)  # 102.5 + 0.5 · 1.5 ≥ 103
+    below = StopPolicy(settings)
+    below.plan_halt(98.0, 0.5, 8.0, 100)  # this phase slips at the target: stop below
+    assert first_stop(below, ramp) == pytest.approx(97.5)
+    expired = StopPolicy(settings)
+    expired.plan_halt(103.0, 0.5, 8.0, 3)  # outlived: back to the target rules
+    stop = first_stop(expired, ramp)
+    assert stop is not None and stop <= 101.0
+    slipped = StopPolicy(settings)
+    slipped.plan_halt(103.0, 0.5, 8.0, 100)
+    # the phase slips (undetected yet) at 99 Nm: the new phase halts on the target
+    ramp = [(i * 1e-3, 95.0 + 0.5 * i) for i in range(9)]
+    ramp += [(0.01 + i * 1e-3, 92.0 + 0.5 * i) for i in range(30)]
+    assert first_stop(slipped, ramp) == pytest.approx(99.5)
+    unplanned = StopPolicy(settings)
+    unplanned.plan_halt(None)
+    stop = first_stop(unplanned, [(i * 1e-3, 95.0 + 0.5 * i) for i in range(30)])
+    assert stop is not None and 99.0 <= stop <= 101.5
+    spiked = StopPolicy(settings)
+    spiked.plan_halt(100.0, 0.5, 8.0, 100)
+    ramp = [(i * 1e-3, 95.0 + 0.5 * i + (3.0 if i == 4 else 0.0)) for i in range(30)]
+    assert first_stop(spiked, ramp) == pytest.approx(99.5)  # the spike at 97 + 3 is not it
