@@ -42,3 +42,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=DEFAULT_RERUN_WEB_PORT,
         help=f"HTTP port of --rerun-web (default {DEFAULT_RERUN_WEB_PORT})",
     )
+    parser.add_argument(
+        "--view-only",
+        action="store_true",
+        help="a live view beside the line's recorder (with --rerun-web): no wear ledger, "
+        "no wear queries, no RecorderStats; its health token is 'viewer', not 'recorder'",
+    )

@@ -41,10 +41,11 @@ DEFAULT_WEB_PORT = 9090
 
 @dataclass(frozen=True, slots=True)
 class RerunOptions:
-    """How run recordings are written; ``live_url``: a gRPC server to stream to as well."""
+    """How runs go to Rerun: a ``.rrd`` beside each MCAP file, and/or a live gRPC server."""
 
     batch_samples: int = 250  # samples sent every this many (0.25 s at 1 kHz) and at flushes
     live_url: str | None = None
+    write_files: bool = True  # False: live only (``--no-rerun --rerun-serve``)
 
 
 class _Series:
@@ -105,11 +106,13 @@ class RerunSink:
         self._torque = self._series[bp.TORQUE]
         self._angle = self._series[bp.ANGLE]
         self._force = self._series[bp.FORCE]
-        path.parent.mkdir(parents=True, exist_ok=True)
-        ensure_layout_file(path.parent)
+        sinks: list[Any] = []
+        if options.write_files:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            ensure_layout_file(path.parent)
+            sinks.append(rr.FileSink(path))
         self._station = station
         self._stream = borrow_stream(station)
-        sinks: list[Any] = [rr.FileSink(path)]
         if options.live_url is not None:
             sinks.append(rr.GrpcSink(options.live_url))
         try:

@@ -17,7 +17,10 @@ a station with no file are recorded too, with minimal metadata.
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
-(:class:`services.recorder.rerun_sink.RerunLive`). Rerun failing never stops
+(:class:`services.recorder.rerun_sink.RerunLive`). ``--view-only`` makes a
+second recorder a live view beside the line's one: it keeps no wear ledger,
+answers no wear query, publishes no RecorderStats and holds the health token
+``viewer``, so nothing on the line mistakes it for the recorder. Rerun failing never stops
 the MCAP recording: it is logged and the recorder goes on without it.
 """
 
@@ -58,6 +61,8 @@ WAKE_KEY = f"{LOCAL_PREFIX}wake"
 TICK_KEY = f"{LOCAL_PREFIX}tick"
 STATS_KEY = f"{LOCAL_PREFIX}stats"
 STATS_PERIOD_S = 1.0
+#: health role of a ``--view-only`` recorder (a live view, not the line's recorder)
+VIEWER = "viewer"
 CHANNEL_DEPTH = 100_000  # 100 s of samples at 1 kHz
 _DRAIN_LIMIT = CHANNEL_DEPTH
 _BUS_STATS = "boltwatch.BusStats"
@@ -104,20 +109,25 @@ class RecorderService:
         session: zenoh.Session,
         rerun_files: bool = True,
         rerun_live_url: str | None = None,
+        view_only: bool = False,
     ) -> None:
+        """``view_only``: a live view beside the line's recorder (``--view-only``)."""
         stations = served_stations(loaded)
         first = stations[0]
         self._session = session
         self._tick_s = first.config.recorder.flush_interval_s / 2
-        rerun = rerun_options(rerun_live_url) if rerun_files else None
+        rerun = rerun_options(rerun_files, rerun_live_url)
         metadata = FileMetadata(stations)
         self.station_ids = metadata.station_ids
         self.recorder = Recorder(first.recordings_folder, limits_of(first), metadata, rerun)
         self.health = RecorderHealth(self.station_ids)
         self._ledger_file = ledger_path(first.recordings_folder)
-        self.wear = WearWatch(
-            self._ledger_file, first.config.recorder.wear_service_threshold, self._publish_alert
-        )
+        self.view_only = view_only
+        self.wear: WearWatch | None = None
+        if not view_only:
+            self.wear = WearWatch(
+                self._ledger_file, first.config.recorder.wear_service_threshold, self._publish_alert
+            )
         self._subscriber = session.declare_subscriber(
             keys.EVERYTHING, zenoh.handlers.FifoChannel(CHANNEL_DEPTH)
         )
@@ -125,12 +135,12 @@ class RecorderService:
             session.declare_queryable(
                 keys.station_key(station, keys.WEAR), self._wear_replier(station)
             )
-            for station in self.station_ids
+            for station in ([] if view_only else self.station_ids)
         ]
         liveliness = session.liveliness()
+        role = VIEWER if view_only else "recorder"
         self._tokens = [
-            liveliness.declare_token(keys.health_key(station, "recorder"))
-            for station in self.station_ids
+            liveliness.declare_token(keys.health_key(station, role)) for station in self.station_ids
         ]
         LOG.info(
             "recording %s into %s (station files: %s)",
@@ -158,7 +168,8 @@ class RecorderService:
                     break
                 self._handle(sample)
         finally:
-            self.wear.close()
+            if self.wear is not None:
+                self.wear.close()
             closed = self.recorder.close()
             LOG.info("recorder stopped: %d messages, %d files", self.recorder.messages, len(closed))
             ticker.join(self._tick_s + STATS_PERIOD_S + 1.0)
@@ -177,9 +188,9 @@ class RecorderService:
     def stats(self, now_ns: int) -> list[RecorderStats]:
         """RecorderStats of every station now (starts the next lag window)."""
         recorder, wear = self.recorder, self.wear
-        write_errors = recorder.write_errors + wear.ledger_errors
+        write_errors = recorder.write_errors + (wear.ledger_errors if wear else 0)
         last_error = recorder.last_write_error or (
-            f"wear ledger: {wear.last_ledger_error}" if wear.last_ledger_error else None
+            f"wear ledger: {wear.last_ledger_error}" if wear and wear.last_ledger_error else None
         )
         return self.health.report(now_ns, write_errors, last_error, recorder.recording_ok)
 
@@ -189,7 +200,7 @@ class RecorderService:
         if key.startswith(LOCAL_PREFIX):
             if key == TICK_KEY:
                 self.recorder.tick(now_ns)
-            elif key == STATS_KEY:
+            elif key == STATS_KEY and not self.view_only:
                 self._publish_stats(now_ns)
             return
         received = classify(key, sample.payload.to_bytes(), now_ns)
@@ -203,7 +214,11 @@ class RecorderService:
             self.health.written(received.station, now_ns, sample_time_ns)
             if received.schema_name == _BUS_STATS and received.message is not None:
                 self.health.bus_stats(received.station, received.message.samples)
-        if received.schema_name == "boltwatch.RunSummary" and received.message is not None:
+        if (
+            self.wear is not None
+            and received.schema_name == "boltwatch.RunSummary"
+            and received.message is not None
+        ):
             self.wear.on_summary(received.message, now_ns)
 
     def _publish_stats(self, now_ns: int) -> None:
@@ -262,14 +277,16 @@ class RecorderService:
             LOG.debug("local put on %s failed: %s", key, err)
 
 
-def rerun_options(live_url: str | None) -> RerunOptions | None:
-    """Options of the per-run .rrd files; None (logged) when Rerun cannot be imported."""
+def rerun_options(write_files: bool, live_url: str | None) -> RerunOptions | None:
+    """What goes to Rerun; None when nothing does or (logged) when Rerun cannot be imported."""
+    if not write_files and live_url is None:
+        return None
     try:
         from services.recorder.rerun_sink import RerunOptions
     except ImportError:
         LOG.exception("Rerun is unusable; recording MCAP only")
         return None
-    return RerunOptions(live_url=live_url)
+    return RerunOptions(live_url=live_url, write_files=write_files)
 
 
 def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
@@ -298,9 +315,11 @@ def main(args: argparse.Namespace) -> int:
             session,
             rerun_files=not getattr(args, "no_rerun", False),
             rerun_live_url=live.url if live is not None else None,
+            view_only=getattr(args, "view_only", False),
         )
         try:
-            return ServiceRunner("recorder", service.work, service.wake).run()
+            name = VIEWER if service.view_only else "recorder"
+            return ServiceRunner(name, service.work, service.wake).run()
         finally:
             service.close()
     finally:

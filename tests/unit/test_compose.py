@@ -49,6 +49,11 @@ def served_role(name: str) -> str:
     return "recorder" if name == "viewer" else name.split("-", maxsplit=1)[0]
 
 
+def health_role(name: str) -> str:
+    """The health token a service holds: the viewer is a recorder that says ``viewer``."""
+    return "viewer" if name == "viewer" else served_role(name)
+
+
 def station_files(name: str) -> list[Path]:
     service = SERVICES[name]
     args = build_parser().parse_args(service["command"])
@@ -76,6 +81,7 @@ def test_command_is_a_valid_boltwatch_command(name: str) -> None:
         source, _ = split_volume(volume)
         if source.startswith("./"):
             assert (REPO / source).exists(), f"{name}: mounted {source} does not exist"
+    assert getattr(args, "view_only", False) == (name == "viewer"), "only the viewer is a view"
     if name == "router":
         return
     stations = load_line(station_files(name))  # each loads; one id per file, one router
@@ -98,14 +104,13 @@ def test_station_files_are_isolated_from_each_other() -> None:
 @pytest.mark.parametrize("name", sorted(SERVICES))
 def test_health_checks_parse_and_dependencies_wait_for_health(name: str) -> None:
     service = SERVICES[name]
-    if name != "viewer":
-        test = service["healthcheck"]["test"]
-        assert test[:2] == ["CMD", "boltwatch"]
-        args = build_parser().parse_args(test[2:])
-        assert args.command == "health" and args.service == served_role(name)
-        if name != "router":
-            checked = [host_path(str(f), service["volumes"]) for f in args.config]
-            assert checked == station_files(name)
+    test = service["healthcheck"]["test"]
+    assert test[:2] == ["CMD", "boltwatch"]
+    args = build_parser().parse_args(test[2:])
+    assert args.command == "health" and args.service == health_role(name)
+    if name != "router":
+        checked = [host_path(str(f), service["volumes"]) for f in args.config]
+        assert checked == station_files(name)
     depends_on = service.get("depends_on", {})
     assert isinstance(depends_on, dict), f"{name}: depends_on needs conditions"
     for dependency, condition in depends_on.items():

@@ -18,7 +18,7 @@ from services.cli.command_options import DEFAULT_STATION_FILE
 NAME = "health"
 HELP = "exit 0 if a service is alive for the stations named (for container health checks)"
 
-CHECKED_SERVICES = ("router", "rig", "acquisition", "predictor", "recorder")
+CHECKED_SERVICES = ("router", "rig", "acquisition", "predictor", "recorder", "viewer")
 CONNECT_TIMEOUT_MS = 2000
 LIVELINESS_TIMEOUT_S = 2.0
 

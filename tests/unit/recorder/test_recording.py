@@ -6,6 +6,7 @@ import json
 import subprocess
 import sys
 import threading
+import time
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -310,3 +311,43 @@ def publish_at(session: zenoh.Session, station: str, items: list[tuple[str, Any]
     for publisher in publishers.values():
         publisher.undeclare()
     return len(items)
+
+
+def test_a_view_only_recorder_takes_none_of_the_line_recorders_duties(
+    tmp_path: Path, endpoint: str
+) -> None:
+    """docker-compose's viewer: its health token is ``viewer``, it answers no wear query,
+    publishes no RecorderStats and keeps no wear ledger, so nothing mistakes it for the
+    line's recorder; it still records what it hears (into its own folder)."""
+    recordings = tmp_path / "viewer"
+    st1 = load_station(write_station_file(tmp_path / "st1.toml", recordings, listen=[endpoint]))
+    session = zenoh.open(zenoh_config("peer", listen=[endpoint]))
+    service = RecorderService(st1, session, rerun_files=False, view_only=True)
+    stop = threading.Event()
+    worker = threading.Thread(target=service.work, args=(stop,))
+    worker.start()
+    client = zenoh.open(zenoh_config("peer", connect=[endpoint]))
+    stats: list[bytes] = []
+    try:
+        watcher = client.declare_subscriber(
+            keys.station_key("*", keys.RECORDER), lambda sample: stats.append(b"")
+        )
+        tokens = client.liveliness().get(keys.health_key("st1", "*"), timeout=10)
+        assert [str(r.ok.key_expr) for r in tokens if r.ok is not None] == [
+            "boltwatch/st1/health/viewer"
+        ]
+        sent = publish_at(client, "st1", run_messages(5, 20))
+        wait_until(lambda: service.recorder.messages == sent, "every message recorded")
+        time.sleep(2.5)  # two RecorderStats periods: a line recorder would have published
+        assert stats == []
+        assert list(client.get(keys.station_key("st1", keys.WEAR), timeout=1)) == []
+        watcher.undeclare()
+    finally:
+        client.close()
+        stop.set()
+        service.wake()
+        worker.join(10)
+        service.close()
+        session.close()
+    assert list(recordings.glob("st1/*/st1_run5_*.mcap"))
+    assert not (recordings / "wear.sqlite").exists()

@@ -7,6 +7,8 @@ read back with :class:`rerun.chunk.RrdReader`.
 
 from __future__ import annotations
 
+import signal
+import socket
 import subprocess
 import sys
 from collections import Counter
@@ -18,14 +20,15 @@ import pytest
 from rerun.chunk import RrdReader
 from test_recording import run_messages  # type: ignore[import-not-found]  # sibling test module
 
+from services.cli.station_supervisor import stop_process
 from services.recorder import rerun_blueprint as bp
 from services.recorder.file_metadata import FileMetadata
 from services.recorder.incoming import Received, classify
 from services.recorder.recorder import Recorder
-from services.recorder.rerun_sink import RerunOptions, RerunSink
+from services.recorder.rerun_sink import RerunLive, RerunOptions, RerunSink
 from services.recorder.rerun_streams import BLUEPRINT_FILE
 from services.recorder.run_files import FileLimits
-from services.recorder.testing import write_station_file
+from services.recorder.testing import wait_until, write_station_file
 from shared import keys
 from shared.codec import encode
 from shared.config import LoadedStation, load_station
@@ -217,3 +220,58 @@ def test_boltwatch_recover_takes_a_cut_rrd(
     assert args.handler(args) == 0
     verify(tmp_path / "cut.recovered.rrd")
     assert "Missing RRD footer" in capsys.readouterr().out
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+        return port
+
+
+def test_live_only_streams_every_sample_to_the_viewer_and_writes_no_file(
+    tmp_path: Path,
+) -> None:
+    """``--no-rerun --rerun-web`` (docker-compose's viewer): the run reaches the live
+    server whole, and no ``.rrd`` or layout file is written."""
+    live = RerunLive(free_port())
+    saved = tmp_path / "saved.rrd"
+    try:
+        items = run_messages(1, SAMPLES)
+        options = RerunOptions(live_url=live.url, write_files=False)
+        path = tmp_path / "runs" / "st1_run1_000000.rrd"
+        with RerunSink(path, "st1", 1, items[0][1].time_ns, options) as sink:
+            for item in received(1, items):
+                sink.write(item)
+        assert not sink.failed and not (tmp_path / "runs").exists()
+        # a late viewer: the server keeps what it was sent for viewers that connect later
+        viewer = subprocess.Popen(
+            [str(RERUN_CLI), live.url, "--save", str(saved), "--port", str(free_port())],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        try:
+            wait_until(lambda: samples_saved(saved) == SAMPLES, "the run saved from the server")
+        finally:
+            viewer.send_signal(signal.SIGINT)
+            stop_process(viewer)
+    finally:
+        live.close()
+
+
+def samples_saved(path: Path) -> int:
+    """Torque rows of the ``st1`` recording saved so far (0 while there is none)."""
+    if not path.exists() or path.stat().st_size == 0:
+        return 0
+    try:
+        reader = RrdReader(path)
+        runs = [r for r in reader.recordings() if r.recording_id.startswith("st1")]
+        if not runs:
+            return 0
+        return sum(
+            chunk.num_rows
+            for chunk in reader.stream(store=runs[0])
+            if chunk.entity_path == f"/{bp.TORQUE}" and not chunk.is_static
+        )
+    except Exception:  # a file still being written may end mid-message
+        return 0
