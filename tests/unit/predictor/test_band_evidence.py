@@ -35,7 +35,7 @@ def benchmark_program(speed_rad_s: float, target_n: float, max_time_s: float) ->
 
 # (k_e, k_s, r, mu_stick, mu_slip, speed, target, max_time_s, rig seed): benchmark draws
 FALSE_STOP_JOINTS = {
-    "seed 1, joint 80: K1 too high (wiggles, floor unsettled)": (
+    "seed 1, joint 80: K1 too high (wiggles, floor unsettled before the seed)": (
         333.9894015103854, 40363.53160988732, 0.00853951259982423, 0.35020878670001643,
         0.33232414944068134, 0.14699130994133972, 45749.83946648429, 26.71044856401293, 1080,
     ),
