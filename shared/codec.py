@@ -12,6 +12,7 @@ import dataclasses
 import json
 import types
 import typing
+from collections.abc import Callable
 from functools import cache
 from typing import Any, TypeVar
 
@@ -22,22 +23,46 @@ MessageT = TypeVar("MessageT")
 _JSON_TYPES: dict[type, str] = {int: "integer", float: "number", str: "string", bool: "boolean"}
 
 
+#: ``json.dumps(..., separators=(",", ":"))`` without building an encoder per call
+_COMPACT = json.JSONEncoder(separators=(",", ":"))
+
+
 def encode(message: Any) -> bytes:
     """The JSON bytes of one message (compact, UTF-8)."""
-    return json.dumps(to_dict(message), separators=(",", ":")).encode()
+    return _COMPACT.encode(to_dict(message)).encode()
 
 
 def to_dict(message: Any) -> dict[str, Any]:
-    """Shallow field dict; nested dataclasses (lists of them too) become dicts."""
-    out: dict[str, Any] = {}
-    for name in _field_names(type(message)):
-        value = getattr(message, name)
+    """Shallow field dict; nested dataclasses (lists of them too) become dicts.
+
+    Only fields whose annotation can hold a list or a dataclass are looked at
+    twice (the predictor publishes an event and an intensity per stick-slip).
+    """
+    names, nested = _encoding_plan(typing.cast(Any, type(message)))
+    out = {name: getattr(message, name) for name in names}
+    for name in nested:
+        value = out[name]
         if isinstance(value, list):
-            value = [to_dict(item) if dataclasses.is_dataclass(item) else item for item in value]
+            out[name] = [
+                to_dict(item) if dataclasses.is_dataclass(item) else item for item in value
+            ]
         elif dataclasses.is_dataclass(value):
-            value = to_dict(value)
-        out[name] = value
+            out[name] = to_dict(value)
     return out
+
+
+@cache
+def _encoding_plan(message_type: Any) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(every field name, the names of fields that may hold a list or a dataclass)."""
+    hints = typing.get_type_hints(message_type)
+    names = _field_names(message_type)
+    return names, tuple(name for name in names if _may_nest(hints.get(name, Any)))
+
+
+def _may_nest(hint: Any) -> bool:
+    if hint is Any or typing.get_origin(hint) is list or dataclasses.is_dataclass(hint):
+        return True
+    return any(_may_nest(arg) for arg in typing.get_args(hint))
 
 
 def decode(message_type: type[MessageT], payload: bytes | bytearray | memoryview) -> MessageT:
@@ -47,6 +72,152 @@ def decode(message_type: type[MessageT], payload: bytes | bytearray | memoryview
         return from_dict(message_type, data)
     except (ValueError, TypeError, KeyError) as err:
         raise InputError(f"not a valid {message_type.__name__} message: {err}") from err
+
+
+def decoder(message_type: type[MessageT]) -> Callable[[bytes | bytearray], MessageT]:
+    """A checking decoder of one flat message type, for the hot paths (samples at 1 kHz).
+
+    Unlike :func:`decode`, it checks every field's JSON type against the
+    schema (integer, number, string, enum, null), and it is about as fast:
+    fields are looked up and checked with C-level ``map`` calls, the
+    dataclass is built positionally. Missing fields take their defaults;
+    unknown fields, wrong types and bad JSON raise InputError naming the field.
+    Types with nested dataclasses or lists are refused (use :func:`decode`).
+    """
+    flat = _FlatMessage(message_type)
+    names, allowed, enums, build = flat.names, flat.allowed, flat.enums, flat.message_type
+    loads, contains, field_count = _loads_utf8, frozenset.__contains__, len(flat.names)
+
+    def decode_flat(payload: bytes | bytearray) -> MessageT:
+        try:
+            data = loads(payload)
+            if len(data) != field_count:
+                raise KeyError
+            values = list(map(data.__getitem__, names))
+        except (ValueError, TypeError) as err:
+            raise InputError(f"not a valid {flat.type_name} message: {err}") from err
+        except KeyError:  # a field missing (perhaps with a default) or unknown
+            values = flat.with_defaults(data)
+        if not all(map(contains, allowed, map(type, values))):
+            raise InputError(flat.type_error(values))
+        for index, enum in enums:
+            if values[index] not in enum:
+                raise InputError(flat.enum_error(index, values[index]))
+        return build(*values)
+
+    return decode_flat
+
+
+_DECODER = json.JSONDecoder()
+
+
+def _loads_utf8(payload: bytes | bytearray) -> Any:
+    """``json.loads(payload)``, in half the time for the usual compact UTF-8 object.
+
+    ``json.loads`` on bytes first sniffs the encoding and wraps the C scanner
+    in two Python calls; ``raw_decode`` of a decoded str skips both. Anything
+    unusual (another encoding, surrounding whitespace, trailing data, an
+    error) goes to ``json.loads`` itself, so results and errors are its own.
+    """
+    try:
+        text = payload.decode()
+        value, end = _DECODER.raw_decode(text)
+        if end == len(text):
+            return value
+    except ValueError:  # UnicodeDecodeError and JSONDecodeError included
+        pass
+    return json.loads(payload)
+
+
+class _FlatMessage(typing.Generic[MessageT]):
+    """What :func:`decoder` derives once from a flat message type, and its error texts."""
+
+    def __init__(self, message_type: type[MessageT]) -> None:
+        hints = typing.get_type_hints(message_type)
+        fields = dataclasses.fields(typing.cast(Any, message_type))
+        self.message_type = message_type
+        self.type_name = message_type.__name__
+        self.names = tuple(f.name for f in fields)
+        self.defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
+        self.allowed = tuple(_json_python_types(hints[name]) for name in self.names)
+        self.enums = tuple(
+            (index, values)
+            for index, name in enumerate(self.names)
+            if (values := _enum_values(hints[name])) is not None
+        )
+
+    def with_defaults(self, data: Any) -> list[Any]:
+        """The field values of ``data`` with defaults filled in; InputError if it cannot be."""
+        name = self.type_name
+        if not isinstance(data, dict):
+            raise InputError(f"not a valid {name} message: not a JSON object")
+        unknown = sorted(set(data) - set(self.names))
+        if unknown:
+            raise InputError(f"not a valid {name} message: unknown field(s) {', '.join(unknown)}")
+        missing = [n for n in self.names if n not in data and n not in self.defaults]
+        if missing:
+            raise InputError(f"not a valid {name} message: missing field(s) {', '.join(missing)}")
+        return [data[n] if n in data else self.defaults[n] for n in self.names]
+
+    def type_error(self, values: list[Any]) -> str:
+        for field_name, value, allowed in zip(self.names, values, self.allowed, strict=True):
+            if type(value) not in allowed:
+                expected = " or ".join(sorted(_JSON_NAMES[t] for t in allowed))
+                return (
+                    f"not a valid {self.type_name} message: {field_name} is "
+                    f"{_JSON_NAMES.get(type(value), type(value).__name__)} {value!r}, "
+                    f"expected {expected}"
+                )
+        return f"not a valid {self.type_name} message"  # pragma: no cover
+
+    def enum_error(self, index: int, value: Any) -> str:
+        enum = next(values for i, values in self.enums if i == index)
+        return (
+            f"not a valid {self.type_name} message: {self.names[index]} is {value!r}, "
+            f"expected one of {', '.join(sorted(map(repr, enum)))}"
+        )
+
+
+_JSON_NAMES: dict[type, str] = {
+    int: "integer",
+    float: "number",
+    str: "string",
+    bool: "boolean",
+    type(None): "null",
+    list: "array",
+    dict: "object",
+}
+
+
+def _json_python_types(hint: Any) -> frozenset[type]:
+    """The Python types ``json.loads`` gives for a value the field's schema allows."""
+    origin = typing.get_origin(hint)
+    if origin is typing.Literal:
+        return frozenset(type(value) for value in typing.get_args(hint))
+    if origin in (typing.Union, types.UnionType):
+        return frozenset().union(*(_json_python_types(arg) for arg in typing.get_args(hint)))
+    if hint is type(None):
+        return frozenset({type(None)})
+    if hint is float:  # a JSON number may be written without a fraction
+        return frozenset({float, int})
+    if hint in (int, str, bool):
+        return frozenset({hint})
+    raise TypeError(f"codec.decoder handles flat messages only, not a field of type {hint!r}")
+
+
+def _enum_values(hint: Any) -> frozenset[Any] | None:
+    """The allowed values of a ``Literal`` field (``None`` too when optional), else None."""
+    origin = typing.get_origin(hint)
+    if origin is typing.Literal:
+        return frozenset(typing.get_args(hint))
+    if origin in (typing.Union, types.UnionType):
+        parts = [_enum_values(arg) for arg in typing.get_args(hint)]
+        if any(part is not None for part in parts):
+            allowed: set[Any] = set()
+            for arg, part in zip(typing.get_args(hint), parts, strict=True):
+                allowed |= part if part is not None else {None} if arg is type(None) else set()
+            return frozenset(allowed)
+    return None
 
 
 def from_dict(message_type: type[MessageT], data: dict[str, Any]) -> MessageT:

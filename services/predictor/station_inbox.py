@@ -1,53 +1,92 @@
-"""The predictor's one FIFO: every served station's samples and tool states, in order.
+"""The predictor's inbox: every served station's samples and tool states, handled one at a time.
 
 Zenoh has no key expression for "these N stations and no other", and a
 subscriber on ``boltwatch/*/*`` would carry every station of the line into
 this process. So each served station gets its own two subscribers
-(``samples`` and ``tool``) whose callbacks run on zenoh's network thread
-(``indirect=False``: no thread per subscriber) and only append to one
-bounded queue; ONE worker thread drains it, so all decisions still come
-from a single thread in arrival order. A full queue blocks the callback (as
-a zenoh FIFO channel would): nothing is dropped while the process runs.
+(``samples`` and ``tool``). Their callbacks run on zenoh's receive thread
+(``indirect=False``: no thread per subscriber) and handle the message right
+there, under one lock, so decisions still come from one message at a time,
+in arrival order. No queue and no hand-over to a worker thread (a wake-up and
+a GIL switch per sample). While a message is handled zenoh reads no further:
+back-pressure goes to the router as with a full FIFO, and the acquisition's
+samples are published with BLOCK, so none is dropped. A thread per
+subscriber (``FifoChannel`` + ``recv()``, or ``indirect=True``) was measured
+too and is wrong: a run's ``tool`` and ``samples`` then race each other.
+
+Zenoh's receive threads are not Python threads: for each callback pyo3 asks
+CPython for the GIL with ``PyGILState_Ensure``, which, on a thread with no
+Python thread state, makes one and frees it again when the callback returns
+(with a ``mmap``/``munmap`` of its frame stack). So the first callback on
+each receive thread calls ``PyGILState_Ensure`` once more and never releases
+it: that thread keeps its thread state, later callbacks only take the GIL
+(CPython only). On 20 stations, CPU per sample of the predictor process:
+queue + worker 32.6 µs, callback 26.4 µs, callback keeping its thread state
+18.2 µs (``tests/benchmarks/bench_line_inbox.py``, medians of 3).
+
+An exception in the handler is not swallowed by zenoh: the first one is
+kept, later messages are counted in :attr:`StationInbox.lost_after_failure`,
+and :meth:`StationInbox.serve` raises it in the service's worker thread, so
+the service ends with status 1 as it would on any worker error.
 """
 
 from __future__ import annotations
 
-import queue
+import ctypes
+import platform
 import threading
-from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Sequence
+from typing import Protocol
 
 import zenoh
 
 from shared import keys
 
-QUEUE_MESSAGES = 10_000
-PUT_RETRY_S = 0.5
+#: (served station id, topic, payload) -> None; called one message at a time
+Handler = Callable[[str, str, bytes], None]
+
+_CPYTHON = platform.python_implementation() == "CPython"
 
 
-@dataclass(frozen=True)
-class Delivery:
-    """One received message with the served station and topic of its subscription."""
+def _keep_thread_state() -> None:
+    """Make the calling (foreign) thread's Python thread state live as long as the thread."""
+    if _CPYTHON:
+        ctypes.pythonapi.PyGILState_Ensure()  # holds the GIL already: only counts up
 
-    station_id: str
-    topic: str
-    payload: bytes
+
+class Inbox(Protocol):
+    """What the predictor service needs of its inbox (the benchmark compares others)."""
+
+    def serve(self, stop: threading.Event) -> None: ...
+
+    def wake(self) -> None: ...
+
+    def close(self) -> None: ...
+
+
+#: builds an inbox on a session for the served station ids, feeding a handler
+InboxFactory = Callable[[zenoh.Session, Sequence[str], Handler], Inbox]
 
 
 class StationInbox:
-    """Subscribers of the served stations feeding one queue; ``receive`` blocks on it."""
+    """Subscribers of the served stations whose callbacks call ``handle`` under one lock."""
+
+    #: keep each receive thread's Python thread state (see the module docstring)
+    keep_thread_states = True
 
     def __init__(
         self,
         session: zenoh.Session,
         station_ids: Iterable[str],
+        handle: Handler,
         topics: tuple[str, ...] = (keys.SAMPLES, keys.TOOL),
-        max_messages: int = QUEUE_MESSAGES,
     ) -> None:
-        self._queue: queue.Queue[Delivery | None] = queue.Queue(max_messages)
-        self._closing = threading.Event()
-        #: messages that arrived while closing (the worker had already stopped)
-        self.lost_at_close = 0
+        self._handle = handle
+        self._lock = threading.Lock()
+        self._ended = threading.Event()
+        self._failure: BaseException | None = None
+        self._pinned_threads: set[int] = set()
+        #: messages that arrived after the handler had failed (not handled)
+        self.lost_after_failure = 0
         self._subscribers = [
             session.declare_subscriber(
                 keys.station_key(station_id, topic),
@@ -58,35 +97,43 @@ class StationInbox:
         ]
 
     def _deliver_to(self, station_id: str, topic: str) -> Callable[[zenoh.Sample], None]:
-        put = self._queue.put
-        closing = self._closing
+        handle = self._handle
+        lock = self._lock
+        pinned = self._pinned_threads
+        keep = self.keep_thread_states
 
         def deliver(sample: zenoh.Sample) -> None:
-            delivery = Delivery(station_id, topic, sample.payload.to_bytes())
-            while not closing.is_set():
-                try:
-                    put(delivery, timeout=PUT_RETRY_S)
+            if keep and threading.get_ident() not in pinned:
+                _keep_thread_state()
+                pinned.add(threading.get_ident())
+            payload = sample.payload.to_bytes()
+            with lock:
+                if self._failure is not None:
+                    self.lost_after_failure += 1
                     return
-                except queue.Full:
-                    continue
-            self.lost_at_close += 1
+                try:
+                    handle(station_id, topic, payload)
+                except BaseException as err:  # raised again by serve(), never swallowed
+                    self._failure = err
+                    self._ended.set()
 
         return deliver
 
-    def receive(self) -> Delivery | None:
-        """The next message, blocking; None once :meth:`wake` was called."""
-        return self._queue.get()
+    def serve(self, stop: threading.Event) -> None:
+        """Block until ``stop`` is set (and :meth:`wake` called) or the handler failed."""
+        while not stop.is_set():
+            self._ended.wait()
+            if self._failure is not None:
+                raise self._failure
+            if not stop.is_set():
+                self._ended.clear()
 
     def wake(self) -> None:
-        """Unblock :meth:`receive` (it returns None)."""
-        try:
-            self._queue.put_nowait(None)
-        except queue.Full:
-            self._closing.set()  # the worker is busy, not blocked: it sees the stop flag
+        """Unblock :meth:`serve` (it returns once the stop flag is set)."""
+        self._ended.set()
 
     def close(self) -> None:
-        """Undeclare every subscriber; a callback blocked on a full queue gives up."""
-        self._closing.set()
+        """Undeclare every subscriber (a callback in progress finishes first)."""
         for subscriber in self._subscribers:
             subscriber.undeclare()
         self._subscribers.clear()

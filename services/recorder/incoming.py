@@ -1,19 +1,23 @@
 """What the recorder receives: one zenoh sample, classified and (when it is ours) decoded.
 
 A key ``boltwatch/<station>/<topic>`` whose topic names a message type (see
-:data:`TOPIC_TYPES`) is decoded with :mod:`shared.codec`; anything else is
-kept as raw bytes. Nothing is dropped here: a payload that does not decode is
-marked ``decodable=False`` and still recorded (on a raw channel).
+:data:`TOPIC_TYPES`) is decoded with :mod:`shared.codec` (the checking
+:func:`~shared.codec.decoder` for flat types: samples at 1 kHz per station
+are most of what a line's recorder does); anything else is kept as raw
+bytes. Nothing is dropped here: a payload that does not decode (bad JSON, or
+a field of the wrong type) is marked ``decodable=False`` and still recorded
+(on a raw channel).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 from services.recorder.wear_watch import ALERT_TOPIC, WearAlert
 from shared import keys
-from shared.codec import decode
+from shared.codec import decode, decoder
 from shared.errors import InputError
 from shared.messages import MESSAGE_TYPES
 
@@ -32,6 +36,19 @@ TOPIC_TYPES: dict[str, str] = {
     keys.RUNS: "boltwatch.RunSummary",
     keys.RECORDER: "boltwatch.RecorderStats",
     ALERT_TOPIC: "boltwatch.WearAlert",
+}
+
+
+def _decoder_of(message_type: type) -> Callable[[bytes], Any]:
+    try:
+        return decoder(message_type)
+    except TypeError:  # nested dataclasses or lists: the general decoder
+        return lambda payload: decode(message_type, payload)
+
+
+#: zenoh topic -> (registry name, decoder) of its message type
+_TOPIC_DECODERS: dict[str, tuple[str, Callable[[bytes], Any]]] = {
+    topic: (name, _decoder_of(RECORDED_TYPES[name])) for topic, name in TOPIC_TYPES.items()
 }
 
 #: Keys the recorder puts to itself (wake-up, flush tick); never recorded.
@@ -83,11 +100,12 @@ def classify(key: str, payload: bytes, log_time_ns: int) -> Received:
         station, topic = keys.split_key(key)
     except ValueError:
         return Received(key, OTHER_STATION, None, None, payload, log_time_ns, log_time_ns)
-    schema_name = TOPIC_TYPES.get(topic)
-    if schema_name is None:
+    known = _TOPIC_DECODERS.get(topic)
+    if known is None:
         return Received(key, station, None, None, payload, log_time_ns, log_time_ns)
+    schema_name, decode_payload = known
     try:
-        message: Any = decode(RECORDED_TYPES[schema_name], payload)
+        message: Any = decode_payload(payload)
     except InputError:
         return Received(key, station, schema_name, None, payload, log_time_ns, log_time_ns)
     # RunSummary has no time_ns: it is published when the run ended.
