@@ -60,6 +60,7 @@ def test_summaries_count_once_and_a_due_tool_raises_an_alert(
     runs.put(summary(1, 1.5))  # redelivered
     runs.put(summary(2, 1.0))  # 2.5 >= threshold
     wear = recorder.service.wear
+    assert wear is not None  # the line's recorder keeps the ledger (a view does not)
     wait_until(lambda: wear.counted + wear.repeated == 3, "the summaries")
     assert (wear.counted, wear.repeated) == (2, 1)
     wait_until(lambda: len(alerts) == 1, "the wear alert")

@@ -1,0 +1,181 @@
+"""StationInbox on real zenoh sessions: served stations only, in order, failures not swallowed,
+and zenoh's receive threads keep their Python thread state between callbacks."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+import zenoh
+
+from services.predictor.station_inbox import StationInbox
+from services.recorder.testing import free_port
+from shared import keys
+from shared.zenoh_session import zenoh_config
+
+Handled = list[tuple[str, str, bytes]]
+REPO = Path(__file__).resolve().parents[3]
+
+
+@pytest.fixture
+def sessions() -> Iterator[tuple[zenoh.Session, zenoh.Session]]:
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    with (
+        zenoh.open(zenoh_config("peer", listen=[endpoint])) as served,
+        zenoh.open(zenoh_config("peer", connect=[endpoint])) as feeding,
+    ):
+        yield served, feeding
+
+
+def wait_until(condition: Callable[[], bool], timeout_s: float = 10.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError("condition not met in time")
+        time.sleep(0.01)
+
+
+def publishers(session: zenoh.Session, station_id: str) -> dict[str, zenoh.Publisher]:
+    found = {
+        topic: session.declare_publisher(keys.station_key(station_id, topic))
+        for topic in (keys.SAMPLES, keys.TOOL)
+    }
+    for publisher in found.values():
+        wait_until(lambda p=publisher: bool(p.matching_status.matching))  # type: ignore[misc]
+    return found
+
+
+def test_only_served_stations_arrive_in_publication_order(
+    sessions: tuple[zenoh.Session, zenoh.Session],
+) -> None:
+    served, feeding = sessions
+    handled: Handled = []
+    inbox = StationInbox(served, ["a1", "a2"], lambda *message: handled.append(message))
+    try:
+        feeds = {s: publishers(feeding, s) for s in ("a1", "a2")}
+        unserved = feeding.declare_publisher(keys.station_key("a3", keys.SAMPLES))
+        expected: Handled = []
+        for i in range(200):
+            for station_id, topics in feeds.items():
+                topic = keys.TOOL if i % 50 == 0 else keys.SAMPLES
+                topics[topic].put(f"{station_id}-{i}".encode())
+                expected.append((station_id, topic, f"{station_id}-{i}".encode()))
+            unserved.put(b"never")
+        wait_until(lambda: len(handled) >= len(expected))
+        time.sleep(0.2)  # anything more (a3) would arrive now
+    finally:
+        inbox.close()
+    for station_id in ("a1", "a2"):
+        assert [m for m in handled if m[0] == station_id] == [
+            m for m in expected if m[0] == station_id
+        ]
+    assert len(handled) == len(expected)
+
+
+def test_a_handler_error_ends_serve_with_it_and_later_messages_are_counted(
+    sessions: tuple[zenoh.Session, zenoh.Session],
+) -> None:
+    served, feeding = sessions
+
+    def handle(_station: str, _topic: str, payload: bytes) -> None:
+        if payload == b"bad":
+            raise ValueError("handler broke on 'bad'")
+
+    inbox = StationInbox(served, ["a1"], handle)
+    stop = threading.Event()
+    failure: list[BaseException] = []
+
+    def serve() -> None:
+        try:
+            inbox.serve(stop)
+        except BaseException as err:
+            failure.append(err)
+
+    worker = threading.Thread(target=serve, daemon=True)
+    worker.start()
+    try:
+        samples = publishers(feeding, "a1")[keys.SAMPLES]
+        samples.put(b"good")
+        samples.put(b"bad")
+        samples.put(b"after")
+        worker.join(10.0)
+        wait_until(lambda: inbox.lost_after_failure == 1)
+    finally:
+        inbox.close()
+    assert not worker.is_alive()
+    assert [str(err) for err in failure] == ["handler broke on 'bad'"]
+
+
+def test_serve_returns_once_stopped_and_woken(
+    sessions: tuple[zenoh.Session, zenoh.Session],
+) -> None:
+    inbox = StationInbox(sessions[0], ["a1"], lambda *_: None)
+    stop = threading.Event()
+    worker = threading.Thread(target=inbox.serve, args=(stop,), daemon=True)
+    worker.start()
+    inbox.wake()  # a wake without stop: serve goes on waiting
+    time.sleep(0.1)
+    assert worker.is_alive()
+    stop.set()
+    inbox.wake()
+    worker.join(5.0)
+    inbox.close()
+    assert not worker.is_alive()
+
+
+class UnpinnedInbox(StationInbox):
+    keep_thread_states = False
+
+
+def calls_seen_before(keep_thread_states: bool) -> list[int]:
+    """For 50 callbacks, how many earlier calls a threading.local remembered. A
+    threading.local lives in the thread state: it survives from one callback to
+    the next only if the thread state does (CPython makes a new one otherwise)."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    local = threading.local()
+    seen_before: list[int] = []
+
+    def handle(_station: str, _topic: str, _payload: bytes) -> None:
+        seen_before.append(getattr(local, "calls", 0))
+        local.calls = getattr(local, "calls", 0) + 1
+
+    inbox_type = StationInbox if keep_thread_states else UnpinnedInbox
+    with (
+        zenoh.open(zenoh_config("peer", listen=[endpoint])) as served,
+        zenoh.open(zenoh_config("peer", connect=[endpoint])) as feeding,
+    ):
+        inbox = inbox_type(served, ["a1"], handle)
+        try:
+            samples = publishers(feeding, "a1")[keys.SAMPLES]
+            for _ in range(50):
+                samples.put(b"x")
+                time.sleep(0.002)  # one callback at a time
+            wait_until(lambda: len(seen_before) == 50)
+        finally:
+            inbox.close()
+    return seen_before
+
+
+@pytest.mark.parametrize("keep", [True, False])
+def test_receive_threads_keep_their_python_thread_state(keep: bool) -> None:
+    """In a fresh process each: zenoh's receive threads live as long as the process,
+    so a thread state kept by an earlier test would still be there."""
+    script = (
+        "from tests.unit.predictor.test_station_inbox import calls_seen_before; "
+        f"print(max(calls_seen_before({keep})))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script],
+        check=False,
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    assert (int(done.stdout.strip()) > 0) is keep

@@ -1,0 +1,63 @@
+"""classify(): what the recorder files each received payload as.
+
+Flat messages go through the checking codec.decoder: a payload that breaks
+its schema (a wrong type, an unknown field) is still recorded, on a raw
+channel (``decodable`` False), never silently on the schema'd one.
+"""
+
+from __future__ import annotations
+
+import json
+
+from services.recorder.incoming import OTHER_STATION, classify
+from shared import keys
+from shared.codec import encode, to_dict
+from shared.messages import RunSummary, Sample, StickSlipEvent, ToolState
+
+T_NS = 1_700_000_000_000_000_000
+SAMPLE = Sample("st4", 9, 33, T_NS + 5, 80.0, 12.5, None)
+
+
+def test_a_sample_is_filed_by_station_run_sequence_and_its_own_time() -> None:
+    received = classify(keys.station_key("st4", keys.SAMPLES), encode(SAMPLE), T_NS + 99)
+    assert received.station == "st4" and received.schema_name == "boltwatch.Sample"
+    assert received.message == SAMPLE and received.decodable
+    assert (received.run_id, received.sequence) == (9, 33)
+    assert (received.log_time_ns, received.publish_time_ns) == (T_NS + 99, T_NS + 5)
+    assert not received.run_started
+
+
+def test_a_sample_breaking_its_schema_is_kept_raw() -> None:
+    for change in ({"sequence": "33"}, {"torque_nm": None}, {"extra": 1}):
+        payload = json.dumps({**to_dict(SAMPLE), **change}).encode()
+        received = classify(keys.station_key("st4", keys.SAMPLES), payload, T_NS)
+        assert received.schema_name == "boltwatch.Sample"
+        assert received.message is None and not received.decodable
+        assert received.payload == payload and received.publish_time_ns == T_NS
+        assert received.sequence is None
+
+
+def test_run_start_summary_and_nested_events() -> None:
+    running = classify(
+        keys.station_key("st4", keys.TOOL),
+        encode(ToolState("st4", 9, 1, 2, "running", T_NS + 1)),
+        T_NS,
+    )
+    assert running.run_started and running.publish_time_ns == T_NS + 1
+    summary = RunSummary("st4", 9, 1, 2, "done", None, 9.0, None, 8.0, -1.0, 0, None, 0.0, 5, 6, 7)
+    filed = classify(keys.station_key("st4", keys.RUNS), encode(summary), T_NS)
+    assert filed.message == summary and filed.publish_time_ns == 7  # ended_ns
+    event = StickSlipEvent(
+        "st4", 9, 1, T_NS + 3, 0.1, 50.0, None, None, None, None, None, None, None, None,
+        None, None, 0.0, [],
+    )  # fmt: skip
+    nested = classify(keys.station_key("st4", keys.EVENTS), encode(event), T_NS)
+    assert nested.message == event and nested.run_id == 9
+
+
+def test_other_keys_are_raw() -> None:
+    unknown_topic = classify("boltwatch/st4/something", b"\x00", T_NS)
+    assert unknown_topic.schema_name is None and unknown_topic.decodable
+    assert unknown_topic.station == "st4"
+    outside = classify("elsewhere", b"{}", T_NS)
+    assert outside.station == OTHER_STATION and outside.schema_name is None
