@@ -65,6 +65,7 @@ class PredictorService:
         self._runs: dict[tuple[str, int], ActiveRun] = {}
         self._publishers: dict[tuple[str, str], Any] = {}
         self.dropped_samples = 0
+        self.unfinished_runs = 0  # runs whose end never arrived (a network outage)
         self.bad_payloads = 0
         self._inbox: Inbox = inbox(session, list(self._stations), self.handle)
         self._tokens = [
@@ -153,6 +154,7 @@ class PredictorService:
         if state.state == "running":
             if run_key in self._runs:
                 return
+            self._forget_unfinished_runs(state.station)
             try:
                 program = served.program(state.program_id)
             except KeyError as err:
@@ -174,6 +176,18 @@ class PredictorService:
                 summary.events,
                 summary.stop_reason,
                 f"{summary.error_pct:.2f}" if summary.error_pct is not None else "-",
+                run.core.input_report.as_dict(),
+            )
+
+    def _forget_unfinished_runs(self, station: str) -> None:
+        """A new run of ``station`` starts: its older runs have ended, unheard (an outage)."""
+        for run_key in [key for key in self._runs if key[0] == station]:
+            run = self._runs.pop(run_key)
+            self.unfinished_runs += 1
+            LOG.warning(
+                "%s run %s: its end never arrived (network outage?); no summary, %s",
+                station,
+                run_key[1],
                 run.core.input_report.as_dict(),
             )
 

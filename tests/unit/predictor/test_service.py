@@ -248,3 +248,25 @@ def test_a_second_predictor_for_a_served_station_is_refused(
         wait_for_token(session, keys.health_key("pt2", "predictor"))
         with pytest.raises(ConfigError, match="pt2 already have a predictor"):
             PredictorService(session, stations[1])
+
+
+def test_a_run_whose_end_never_arrived_is_forgotten_when_the_next_starts(
+    service: PredictorService, endpoint: str
+) -> None:
+    """A router outage swallowed run 41's ``done``: the next run of the station ends
+    it (one tool, one run at a time), counted, instead of keeping it for ever."""
+    rows = staircase().rows()
+    with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
+        wait_for_token(session, keys.health_key("pt1", "predictor"))
+        feed = StationFeed(session, "pt1")
+        feed.state(41, PROGRAM_OF["pt1"], "running", START_NS)
+        for i, row in enumerate(rows[:50]):
+            feed.sample(41, i, row)
+        feed.state(42, PROGRAM_OF["pt1"], "running", START_NS + 3_000_000_000)
+        feed.sample(41, 50, rows[50])  # late: run 41 is gone
+        deadline = time.monotonic() + 10.0
+        while service.dropped_samples == 0 and time.monotonic() < deadline:
+            time.sleep(0.02)
+        feed.close()
+    assert service.unfinished_runs == 1
+    assert service.dropped_samples == 1
