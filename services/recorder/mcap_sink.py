@@ -72,6 +72,7 @@ class McapSink:
         self._channels: dict[tuple[str, str], int] = {}
         self._counters: dict[int, int] = {}
         self._unflushed_bytes = 0
+        self._flushed_bytes = 0  # the file's length at the last flush
         self._closed = False
         self._abandoned = False
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -85,6 +86,7 @@ class McapSink:
                 self._writer.add_metadata(name, dict(data))
             self._writer.flush()
             self._sync()
+            self._flushed_bytes = self._file.tell()
             if fsync:
                 _sync_folder(path.parent)  # the new file's name survives a power cut too
         except BaseException:
@@ -98,8 +100,12 @@ class McapSink:
 
     @property
     def size_bytes(self) -> int:
-        """Bytes on disk plus (uncompressed) bytes waiting in the open chunk."""
-        return self._file.tell() + self._unflushed_bytes
+        """Bytes on disk at the last flush plus (uncompressed) bytes written since.
+
+        Read per message by the rotation check, so no system call here: the
+        file's length is taken at each flush (``tell()`` is an ``lseek``).
+        """
+        return self._flushed_bytes + self._unflushed_bytes
 
     def write(self, received: Received) -> None:
         """Append one payload on its channel."""
@@ -133,6 +139,7 @@ class McapSink:
             return
         self._writer.flush()
         self._sync()
+        self._flushed_bytes = self._file.tell()
         self._unflushed_bytes = 0
         self.flushed_messages = self.messages
 

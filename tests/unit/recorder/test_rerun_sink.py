@@ -11,6 +11,7 @@ import signal
 import socket
 import subprocess
 import sys
+import warnings
 from collections import Counter
 from dataclasses import replace
 from pathlib import Path
@@ -264,7 +265,9 @@ def samples_saved(path: Path) -> int:
     if not path.exists() or path.stat().st_size == 0:
         return 0
     try:
-        reader = RrdReader(path)
+        with warnings.catch_warnings():  # no footer yet: the viewer is still writing it
+            warnings.simplefilter("ignore")
+            reader = RrdReader(path)
         runs = [r for r in reader.recordings() if r.recording_id.startswith("st1")]
         if not runs:
             return 0
