@@ -99,7 +99,9 @@ def decoder(message_type: type[MessageT]) -> Callable[[bytes | bytearray], Messa
         except KeyError:  # a field missing (perhaps with a default) or unknown
             values = flat.with_defaults(data)
         if not all(map(contains, allowed, map(type, values))):
-            raise InputError(flat.type_error(values))
+            values = flat.integral_floats_as_ints(values)
+            if not all(map(contains, allowed, map(type, values))):
+                raise InputError(flat.type_error(values))
         for index, enum in enums:
             if values[index] not in enum:
                 raise InputError(flat.enum_error(index, values[index]))
@@ -158,6 +160,18 @@ class _FlatMessage(typing.Generic[MessageT]):
         if missing:
             raise InputError(f"not a valid {name} message: missing field(s) {', '.join(missing)}")
         return [data[n] if n in data else self.defaults[n] for n in self.names]
+
+    def integral_floats_as_ints(self, values: list[Any]) -> list[Any]:
+        """``1.0`` where an integer is expected is a JSON Schema integer: make it ``1``."""
+        return [
+            int(value)
+            if type(value) is float
+            and float not in allowed
+            and int in allowed
+            and value.is_integer()
+            else value
+            for value, allowed in zip(values, self.allowed, strict=True)
+        ]
 
     def type_error(self, values: list[Any]) -> str:
         for field_name, value, allowed in zip(self.names, values, self.allowed, strict=True):

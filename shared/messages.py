@@ -97,6 +97,7 @@ class BusStats:
     stop_commands: int
     unsent_samples: int = 0  # published while the session had no router: lost, counted
     late_decisions: int = 0  # stop decisions for a run the tool was no longer running
+    started_ns: int = 0  # when this acquisition process started: a new value, a new process
 
 
 @dataclass(frozen=True, slots=True)

@@ -63,6 +63,7 @@ class Acquisition:
         self._decoder = FrameDecoder(database)
         self._outlet = outlet
         self._clock_ns = clock_ns
+        self._started_ns = clock_ns()
         self._assembler = SampleAssembler(has_force_sensor)
         self._rejected: Counter[str] = Counter()
         self._frames = 0
@@ -219,4 +220,5 @@ class Acquisition:
             stop_commands=self._stop_commands,
             unsent_samples=self._unsent_samples(),
             late_decisions=self._late_decisions,
+            started_ns=self._started_ns,
         )

@@ -23,6 +23,13 @@ it: that thread keeps its thread state, later callbacks only take the GIL
 queue + worker 32.6 µs, callback 26.4 µs, callback keeping its thread state
 18.2 µs (``tests/benchmarks/bench_line_inbox.py``, medians of 3).
 
+The handler publishes (events, decisions, with BLOCK) from inside the
+callback. That is safe because the predictor never subscribes, on the same
+session, to a key it publishes: zenoh delivers a session-local put on the
+publishing thread, and the lock here is not re-entrant. A publish blocked by
+a congested link holds this receive thread (and so the samples behind it)
+until zenoh's block timeout closes the link, as a full FIFO did before.
+
 An exception in the handler is not swallowed by zenoh: the first one is
 kept, later messages are counted in :attr:`StationInbox.lost_after_failure`,
 and :meth:`StationInbox.serve` raises it in the service's worker thread, so
@@ -84,6 +91,7 @@ class StationInbox:
         self._lock = threading.Lock()
         self._ended = threading.Event()
         self._failure: BaseException | None = None
+        self._closed = False
         self._pinned_threads: set[int] = set()
         #: messages that arrived after the handler had failed (not handled)
         self.lost_after_failure = 0
@@ -108,6 +116,8 @@ class StationInbox:
                 pinned.add(threading.get_ident())
             payload = sample.payload.to_bytes()
             with lock:
+                if self._closed:  # shutting down: the service no longer publishes
+                    return
                 if self._failure is not None:
                     self.lost_after_failure += 1
                     return
@@ -133,7 +143,14 @@ class StationInbox:
         self._ended.set()
 
     def close(self) -> None:
-        """Undeclare every subscriber (a callback in progress finishes first)."""
+        """Undeclare every subscriber, then wait for a callback in progress to finish.
+
+        zenoh's ``undeclare`` does not wait for a running callback, so the lock
+        is the barrier: once ``close`` returns no handler runs, and the service
+        may undeclare its publishers and close the session.
+        """
         for subscriber in self._subscribers:
             subscriber.undeclare()
         self._subscribers.clear()
+        with self._lock:
+            self._closed = True

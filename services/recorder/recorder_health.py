@@ -20,9 +20,10 @@ was published before the recorder listened is not a loss); the difference,
 recomputed at every BusStats, is ``missing_samples``. It is a level, not a sum
 of guesses: samples still in flight when a BusStats is read are counted
 missing for at most one report and drop out at the next. When the
-acquisition restarts (its count goes down) the loss so far is kept and the
-counting starts again at the new process's first BusStats (samples around a
-restart, before the new process's first report, are not judged). This
+acquisition restarts (``BusStats.started_ns`` changes, or its count goes
+down) the loss so far is kept and the counting starts again at the new
+process's first BusStats (samples around a restart, before the new
+process's first report, are not judged). This
 catches what no link-level counter can: a cable pulled for less than zenoh's
 lease loses samples while no session ever sees its router go.
 """
@@ -44,15 +45,18 @@ class _StationCounts:
     published_base: int | None = None  # BusStats.samples when counting (re)started
     received_base: int = 0  # samples_received then
     published_last: int = 0
+    acquisition_started_ns: int | None = None  # BusStats.started_ns of the counted process
     missing_before_restart: int = 0  # missing samples of earlier acquisition processes
     missing_samples: int = 0
 
-    def bus_stats(self, published: int) -> None:
-        """The acquisition says it has published ``published`` samples since it started."""
-        if self.published_base is None or published < self.published_last:
+    def bus_stats(self, published: int, started_ns: int) -> None:
+        """The acquisition started at ``started_ns`` has published ``published`` samples."""
+        restarted = started_ns != self.acquisition_started_ns or published < self.published_last
+        if self.published_base is None or restarted:
             self.missing_before_restart = self.missing_samples
             self.published_base = published
             self.received_base = self.samples_received
+            self.acquisition_started_ns = started_ns
         self.published_last = published
         unreceived = (published - self.published_base) - (
             self.samples_received - self.received_base
@@ -71,17 +75,24 @@ class RecorderHealth:
         """Served stations first, then every other station seen, in arrival order."""
         return list(self._stations)
 
-    def written(self, station: str, received_ns: int, sample_time_ns: int | None) -> None:
-        """One message of ``station`` written; ``sample_time_ns`` for Samples only."""
+    def written(
+        self, station: str, received_ns: int, sample_time_ns: int | None, is_sample: bool = False
+    ) -> None:
+        """One message of ``station`` written; a Sample's time when it decoded.
+
+        ``is_sample``: it came on the samples key, decodable or not (an
+        undecodable one is recorded raw: received, so not missing).
+        """
         counts = self._counts(station)
         counts.messages += 1
+        if is_sample:
+            counts.samples_received += 1
         if sample_time_ns is not None:
             counts.lags_ns.append(received_ns - sample_time_ns)
-            counts.samples_received += 1
 
-    def bus_stats(self, station: str, published_samples: int) -> None:
+    def bus_stats(self, station: str, published_samples: int, started_ns: int) -> None:
         """A BusStats of ``station`` arrived: recount its missing samples."""
-        self._counts(station).bus_stats(published_samples)
+        self._counts(station).bus_stats(published_samples, started_ns)
 
     def _counts(self, station: str) -> _StationCounts:
         counts = self._stations.get(station)

@@ -206,14 +206,14 @@ class RecorderService:
         received = classify(key, sample.payload.to_bytes(), now_ns)
         self.recorder.write(received)
         if received.station != OTHER_STATION:
+            is_sample = received.schema_name == _SAMPLE
             sample_time_ns = (
-                received.publish_time_ns
-                if received.schema_name == _SAMPLE and received.message is not None
-                else None
+                received.publish_time_ns if is_sample and received.message is not None else None
             )
-            self.health.written(received.station, now_ns, sample_time_ns)
+            self.health.written(received.station, now_ns, sample_time_ns, is_sample)
             if received.schema_name == _BUS_STATS and received.message is not None:
-                self.health.bus_stats(received.station, received.message.samples)
+                bus = received.message
+                self.health.bus_stats(received.station, bus.samples, bus.started_ns)
         if (
             self.wear is not None
             and received.schema_name == "boltwatch.RunSummary"

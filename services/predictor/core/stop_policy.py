@@ -98,12 +98,17 @@ class StopPolicy:
         ``valid_samples`` the plan is dropped (the joint no longer sticks and
         slips as predicted). None, or no plan: halt on the
         target by the usual rules (three samples over it, or the steady-ramp
-        projection).
+        projection). A plan never aims at or past the torque limit: it is
+        capped one ramp step below ``max_torque_nm``.
         """
         usable = (
             halt_nm is not None and rate_nm_per_sample > 0.0 and drop_nm > 0.0 and valid_samples > 0
         )
-        self._halt_nm = halt_nm if usable and halt_nm is not None else math.nan
+        self._halt_nm = (
+            min(halt_nm, self._max_torque - rate_nm_per_sample)
+            if usable and halt_nm is not None
+            else math.nan
+        )
         self._halt_rate_nm = rate_nm_per_sample
         self._halt_drop_nm = drop_nm
         self._halt_samples_left = valid_samples

@@ -225,3 +225,17 @@ def test_a_halt_plan_moves_the_torque_stop_and_holds_one_phase_only() -> None:
     spiked.plan_halt(100.0, 0.5, 8.0, 100)
     ramp = [(i * 1e-3, 95.0 + 0.5 * i + (3.0 if i == 4 else 0.0)) for i in range(30)]
     assert first_stop(spiked, ramp) == pytest.approx(99.5)  # the spike at 97 + 3 is not it
+
+
+def test_a_halt_plan_never_aims_past_the_torque_limit() -> None:
+    """A program whose limit sits within the plan's reach (target 100, limit 102): the plan
+    is capped below the limit, so the stop is the planned one, never a limit fault."""
+    from services.predictor.core.stop_policy import StopPolicy
+
+    settings = PredictorSettings(target_torque_nm=100.0, has_force=False, max_torque_nm=102.0)
+    policy = StopPolicy(settings)
+    policy.plan_halt(103.0, 0.5, 8.0, 100)
+    ramp = [(i * 1e-3, 95.0 + 0.5 * i) for i in range(30)]
+    decision = next(d for t, tq in ramp if (d := policy.on_sample(t, tq, math.nan, 0.0)))
+    assert decision.reason == "target_reached"
+    assert decision.torque_nm < 102.0

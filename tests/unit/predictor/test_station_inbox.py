@@ -7,14 +7,14 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 import zenoh
 
 from services.predictor.station_inbox import StationInbox
-from services.recorder.testing import free_port
+from services.recorder.testing import free_port, wait_until
 from shared import keys
 from shared.zenoh_session import zenoh_config
 
@@ -32,21 +32,13 @@ def sessions() -> Iterator[tuple[zenoh.Session, zenoh.Session]]:
         yield served, feeding
 
 
-def wait_until(condition: Callable[[], bool], timeout_s: float = 10.0) -> None:
-    deadline = time.monotonic() + timeout_s
-    while not condition():
-        if time.monotonic() > deadline:
-            raise AssertionError("condition not met in time")
-        time.sleep(0.01)
-
-
 def publishers(session: zenoh.Session, station_id: str) -> dict[str, zenoh.Publisher]:
     found = {
         topic: session.declare_publisher(keys.station_key(station_id, topic))
         for topic in (keys.SAMPLES, keys.TOOL)
     }
     for publisher in found.values():
-        wait_until(lambda p=publisher: bool(p.matching_status.matching))  # type: ignore[misc]
+        wait_until(lambda p=publisher: bool(p.matching_status.matching), "the inbox")  # type: ignore[misc]
     return found
 
 
@@ -66,7 +58,7 @@ def test_only_served_stations_arrive_in_publication_order(
                 topics[topic].put(f"{station_id}-{i}".encode())
                 expected.append((station_id, topic, f"{station_id}-{i}".encode()))
             unserved.put(b"never")
-        wait_until(lambda: len(handled) >= len(expected))
+        wait_until(lambda: len(handled) >= len(expected), "every message")
         time.sleep(0.2)  # anything more (a3) would arrive now
     finally:
         inbox.close()
@@ -104,7 +96,7 @@ def test_a_handler_error_ends_serve_with_it_and_later_messages_are_counted(
         samples.put(b"bad")
         samples.put(b"after")
         worker.join(10.0)
-        wait_until(lambda: inbox.lost_after_failure == 1)
+        wait_until(lambda: inbox.lost_after_failure == 1, "the message after the failure")
     finally:
         inbox.close()
     assert not worker.is_alive()
@@ -155,7 +147,7 @@ def calls_seen_before(keep_thread_states: bool) -> list[int]:
             for _ in range(50):
                 samples.put(b"x")
                 time.sleep(0.002)  # one callback at a time
-            wait_until(lambda: len(seen_before) == 50)
+            wait_until(lambda: len(seen_before) == 50, "fifty callbacks")
         finally:
             inbox.close()
     return seen_before
@@ -179,3 +171,25 @@ def test_receive_threads_keep_their_python_thread_state(keep: bool) -> None:
     )
     assert done.returncode == 0, done.stderr
     assert (int(done.stdout.strip()) > 0) is keep
+
+
+def test_close_waits_for_the_callback_in_progress(
+    sessions: tuple[zenoh.Session, zenoh.Session],
+) -> None:
+    """zenoh's undeclare does not wait for a running callback; close() must, or the
+    service would undeclare publishers (and close the session) under a handler."""
+    served, feeding = sessions
+    started = threading.Event()
+    finished: list[float] = []
+
+    def slow(*_message: object) -> None:
+        started.set()
+        time.sleep(0.5)
+        finished.append(time.monotonic())
+
+    inbox = StationInbox(served, ["a1"], slow)
+    publishers(feeding, "a1")[keys.SAMPLES].put(b"x")
+    assert started.wait(10.0)
+    inbox.close()
+    closed_at = time.monotonic()
+    assert finished and finished[0] <= closed_at

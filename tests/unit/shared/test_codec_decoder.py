@@ -47,6 +47,12 @@ def test_a_number_without_fraction_is_a_number_and_nan_is_kept() -> None:
     assert math.isnan(decode_sample(sample_json(force_n=math.nan)).force_n or 0.0)
 
 
+def test_an_integer_written_with_a_zero_fraction_is_an_integer() -> None:
+    """JSON Schema counts 1.0 as an integer (producers such as serde's f64 write it)."""
+    decoded = decode_sample(sample_json(run_id=7.0, sequence=12.0))
+    assert decoded == SAMPLE and type(decoded.run_id) is int and type(decoded.sequence) is int
+
+
 def test_whitespace_and_field_order_do_not_matter() -> None:
     fields = codec.to_dict(SAMPLE)
     reordered = dict(reversed(list(fields.items())))
