@@ -135,6 +135,13 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
             subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard.on_sample)
             try:
                 heard.wait("the acquisition's BusStats", lambda: heard.stats, START_TIMEOUT_S)
+                # the recorder hears the station before the first run: what it counts
+                # from then on is the whole of what the recording lacks
+                heard.wait(
+                    "the recorder hearing the station",
+                    lambda: any(stats.messages > 0 for stats in heard.recorder),
+                    START_TIMEOUT_S,
+                )
                 rig_args = ["rig", "--config", str(path), "--program", "1"]
                 rig = serve([*rig_args, "--first-run-id", str(FIRST_RUN)], logs["rig"])
                 heard.wait(
