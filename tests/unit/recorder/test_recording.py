@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import subprocess
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -229,12 +231,8 @@ def test_one_recorder_serves_several_station_files(
     st2 = load_station(st2_file)
     session = zenoh.open(zenoh_config("peer", listen=[endpoint]))
     service = RecorderService([st1, st2], session, rerun_files=False)
-    stop = threading.Event()
-    worker = threading.Thread(target=service.work, args=(stop,))
-    worker.start()
-    client = zenoh.open(zenoh_config("peer", connect=[endpoint]))
     stats: list[dict[str, Any]] = []
-    try:
+    with serving(service, session), zenoh.open(zenoh_config("peer", connect=[endpoint])) as client:
         watcher = client.declare_subscriber(
             keys.station_key("*", keys.RECORDER),
             lambda sample: stats.append(json.loads(sample.payload.to_bytes())),
@@ -269,13 +267,6 @@ def test_one_recorder_serves_several_station_files(
             assert [tool["tool_id"] for tool in answer["tools"]] == tool_ids
         assert list(client.get(keys.station_key("st3", keys.WEAR), timeout=1)) == []
         watcher.undeclare()
-    finally:
-        client.close()
-        stop.set()
-        service.wake()
-        worker.join(10)
-        service.close()
-        session.close()
 
     metadata = {}
     for name in ("st1", "st2", "st3"):
@@ -298,6 +289,22 @@ def at_station(message: Any, station: str, tool_id: int) -> Any:
     if hasattr(message, "tool_id"):
         return replace(message, station=station, tool_id=tool_id)
     return replace(message, station=station)
+
+
+@contextlib.contextmanager
+def serving(service: RecorderService, session: zenoh.Session) -> Iterator[RecorderService]:
+    """The service's worker running; on exit it is stopped, closed, and its session too."""
+    stop = threading.Event()
+    worker = threading.Thread(target=service.work, args=(stop,))
+    worker.start()
+    try:
+        yield service
+    finally:
+        stop.set()
+        service.wake()
+        worker.join(10)
+        service.close()
+        session.close()
 
 
 def publish_at(session: zenoh.Session, station: str, items: list[tuple[str, Any]]) -> int:
@@ -323,12 +330,8 @@ def test_a_view_only_recorder_takes_none_of_the_line_recorders_duties(
     st1 = load_station(write_station_file(tmp_path / "st1.toml", recordings, listen=[endpoint]))
     session = zenoh.open(zenoh_config("peer", listen=[endpoint]))
     service = RecorderService(st1, session, rerun_files=False, view_only=True)
-    stop = threading.Event()
-    worker = threading.Thread(target=service.work, args=(stop,))
-    worker.start()
-    client = zenoh.open(zenoh_config("peer", connect=[endpoint]))
     stats: list[bytes] = []
-    try:
+    with serving(service, session), zenoh.open(zenoh_config("peer", connect=[endpoint])) as client:
         watcher = client.declare_subscriber(
             keys.station_key("*", keys.RECORDER), lambda sample: stats.append(b"")
         )
@@ -342,12 +345,5 @@ def test_a_view_only_recorder_takes_none_of_the_line_recorders_duties(
         assert stats == []
         assert list(client.get(keys.station_key("st1", keys.WEAR), timeout=1)) == []
         watcher.undeclare()
-    finally:
-        client.close()
-        stop.set()
-        service.wake()
-        worker.join(10)
-        service.close()
-        session.close()
     assert list(recordings.glob("st1/*/st1_run5_*.mcap"))
     assert not (recordings / "wear.sqlite").exists()
