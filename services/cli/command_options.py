@@ -6,6 +6,8 @@ command that takes it:
 - ``RUN.mcap`` and ``--run ID`` (export, inspect): one run of one recording;
   a damaged recording (recorder killed) is read as far as it goes, with a
   one-line warning on stderr instead of an error;
+- ``--config FILE`` (one or several): the station file(s), by default
+  ``config/station.toml``;
 - ``--recordings DIR`` and ``--config FILE`` (wear, import): the recordings
   folder, by default the station file's ``recorder.folder``.
 
@@ -37,6 +39,26 @@ def warn_damaged_recording(command: str, state: str, what_was_done: str) -> None
     print(f"boltwatch {command}: warning: {state}; {what_was_done}", file=sys.stderr)
 
 
+def add_station_file_option(
+    parser: argparse.ArgumentParser,
+    help_text: str = "station file",
+    several: bool = False,
+) -> None:
+    """``--config FILE`` (``several``: one or more, a list) defaulting to the station file."""
+    default_help = f"{help_text} (default: {DEFAULT_STATION_FILE})"
+    if several:
+        parser.add_argument(
+            "--config",
+            type=Path,
+            nargs="+",
+            default=[DEFAULT_STATION_FILE],
+            metavar="FILE",
+            help=default_help,
+        )
+    else:
+        parser.add_argument("--config", type=Path, default=DEFAULT_STATION_FILE, help=default_help)
+
+
 def add_recordings_folder_options(
     parser: argparse.ArgumentParser, folder_help: str = "recordings folder"
 ) -> None:
@@ -48,12 +70,7 @@ def add_recordings_folder_options(
         metavar="DIR",
         help=f"{folder_help} (default: the station file's recorder.folder)",
     )
-    parser.add_argument(
-        "--config",
-        type=Path,
-        default=DEFAULT_STATION_FILE,
-        help=f"station file, for its recorder.folder (default: {DEFAULT_STATION_FILE})",
-    )
+    add_station_file_option(parser, "station file, for its recorder.folder")
 
 
 def recordings_folder(args: argparse.Namespace) -> Path:

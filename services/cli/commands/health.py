@@ -11,9 +11,8 @@ session to the router of the station file (that is the router's liveness).
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from services.cli.command_options import DEFAULT_STATION_FILE
+from services.cli.command_options import add_station_file_option
 
 NAME = "health"
 HELP = "exit 0 if a service is alive for the stations named (for container health checks)"
@@ -25,14 +24,11 @@ LIVELINESS_TIMEOUT_S = 2.0
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("service", choices=CHECKED_SERVICES, help="the service to check")
-    parser.add_argument(
-        "--config",
-        type=Path,
-        nargs="+",
-        default=[DEFAULT_STATION_FILE],
-        metavar="FILE",
-        help="station file(s): the service must be alive for each station; the first "
-        "file's [zenoh] connect names the router (default: config/station.toml)",
+    add_station_file_option(
+        parser,
+        "station file(s): the service must be alive for each station; the first "
+        "file's [zenoh] connect names the router",
+        several=True,
     )
 
 

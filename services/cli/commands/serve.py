@@ -12,9 +12,8 @@ from __future__ import annotations
 
 import argparse
 import importlib
-from pathlib import Path
 
-from services.cli.command_options import DEFAULT_STATION_FILE
+from services.cli.command_options import add_station_file_option
 
 NAME = "serve"
 HELP = "run one long-running service (rig, acquisition, predictor, recorder, router)"
@@ -45,22 +44,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     for name, package in SERVICES.items():
         sub = services.add_parser(name, help=SERVICE_HELP[name], description=SERVICE_HELP[name])
         if name in MULTI_STATION:
-            sub.add_argument(
-                "--config",
-                type=Path,
-                nargs="+",
-                default=[DEFAULT_STATION_FILE],
-                metavar="FILE",
-                help="station file(s): one process serves every station named "
-                "(default: config/station.toml)",
+            add_station_file_option(
+                sub, "station file(s): one process serves every station named", several=True
             )
         elif name != "router":
-            sub.add_argument(
-                "--config",
-                type=Path,
-                default=DEFAULT_STATION_FILE,
-                help="station file (default: config/station.toml)",
-            )
+            add_station_file_option(sub)
         sub.add_argument("--log-level", default=None, help="DEBUG, INFO (default), WARNING")
         sub.set_defaults(service_package=package)
         importlib.import_module(f"{package}.arguments").add_arguments(sub)

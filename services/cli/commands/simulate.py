@@ -13,19 +13,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from services.cli.command_options import DEFAULT_STATION_FILE
+from services.cli.command_options import add_station_file_option
 
 NAME = "simulate"
 HELP = "simulate one tightening offline and write its trace (CSV) for 'boltwatch predict'"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--config",
-        type=Path,
-        default=DEFAULT_STATION_FILE,
-        help="station file (default: config/station.toml)",
-    )
+    add_station_file_option(parser)
     parser.add_argument(
         "--program", type=int, default=None, help="program id (default: the first program)"
     )

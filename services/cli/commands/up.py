@@ -22,10 +22,9 @@ import argparse
 import signal
 import sys
 from datetime import UTC, datetime
-from pathlib import Path
 from types import FrameType
 
-from services.cli.command_options import DEFAULT_STATION_FILE
+from services.cli.command_options import add_station_file_option
 
 NAME = "up"
 HELP = "run the simulated station (or --stations N) end to end: rig, acquisition, predictor, ..."
@@ -36,12 +35,7 @@ class StoppedBySignalError(Exception):
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--config",
-        type=Path,
-        default=DEFAULT_STATION_FILE,
-        help="station file (default: config/station.toml)",
-    )
+    add_station_file_option(parser)
     parser.add_argument(
         "--runs", type=int, default=5, help="tightenings to run per station (default 5)"
     )
