@@ -51,7 +51,12 @@ from shared.codec import decode, encode  # noqa: E402
 from shared.config import derive_stations, load_station  # noqa: E402
 from shared.messages import RecorderStats, RunSummary, ToolState  # noqa: E402
 from shared.zenoh_session import zenoh_config  # noqa: E402
-from tests.benchmarks.bench_stop_path import SHORT_PROGRAM, Heard, figures  # noqa: E402
+from tests.benchmarks.bench_stop_path import (  # noqa: E402
+    SHORT_PROGRAM,
+    Heard,
+    figures,
+    tighten,
+)
 from tests.system.can_injector import StopListener  # noqa: E402
 from tests.system.station_files import free_tcp_port, serve, write_station  # noqa: E402
 from tests.unit.predictor.synthetic import staircase  # noqa: E402
@@ -244,14 +249,8 @@ def bench(stations: int, runs: int, rerun: bool, folder: Path) -> dict[str, obje
                 processes.append(generator)
                 time.sleep(2.0)  # the load is on before the measured runs
             rig_args = ["rig", "--config", str(paths[0]), "--runs", str(runs), "--program", "1"]
-            rig = serve(rig_args, folder / "rig.log")
-            processes.append(rig)
-            started = time.monotonic()
-            rig.wait(timeout=RUN_TIMEOUT_S * runs)
-            deadline = time.monotonic() + 5.0
-            while len(heard.summaries) < runs and time.monotonic() < deadline:
-                time.sleep(0.1)
-            elapsed_s = time.monotonic() - started
+            log = folder / "rig.log"
+            _, elapsed_s = tighten(rig_args, log, runs, heard, processes, RUN_TIMEOUT_S)
             if generator is not None:
                 stop_process(generator, grace_s=10.0)
                 time.sleep(1.5)  # the last summaries and recorder stats

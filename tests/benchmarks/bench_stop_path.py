@@ -87,6 +87,26 @@ class Heard:
                 self.summaries[summary.run_id] = summary
 
 
+def tighten(
+    rig_args: list[str],
+    log: Path,
+    runs: int,
+    heard: Heard,
+    processes: list[subprocess.Popen[bytes]],
+    run_timeout_s: float = RUN_TIMEOUT_S,
+) -> tuple[subprocess.Popen[bytes], float]:
+    """Serve the rig (added to ``processes``) until its ``runs`` end, then wait up to
+    5 s for their summaries; the rig's process and the seconds it all took."""
+    rig = serve(rig_args, log)
+    processes.append(rig)
+    started = time.monotonic()
+    rig.wait(timeout=run_timeout_s * runs)
+    deadline = time.monotonic() + 5.0
+    while len(heard.summaries) < runs and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return rig, time.monotonic() - started
+
+
 @dataclass(frozen=True)
 class RunFigures:
     run_id: int
@@ -197,14 +217,7 @@ def run(runs: int, folder: Path) -> int:
                 first_run_id = int(time.time())
                 rig_args = ["rig", "--config", str(path), "--runs", str(runs)]
                 rig_args += ["--program", "1", "--first-run-id", str(first_run_id)]
-                rig = serve(rig_args, logs["rig"])
-                processes.append(rig)
-                started = time.monotonic()
-                rig.wait(timeout=RUN_TIMEOUT_S * runs)
-                deadline = time.monotonic() + 5.0
-                while len(heard.summaries) < runs and time.monotonic() < deadline:
-                    time.sleep(0.1)
-                elapsed_s = time.monotonic() - started
+                rig, elapsed_s = tighten(rig_args, logs["rig"], runs, heard, processes)
             finally:
                 subscriber.undeclare()
             stops = listener.heard
