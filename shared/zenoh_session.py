@@ -93,16 +93,31 @@ def _insert_tls(config: zenoh.Config, tls: TlsFiles) -> None:
 def section_config(section: ZenohSection) -> zenoh.Config:
     """The zenoh.Config of a station's ``[zenoh]`` section."""
     timeout_ms = -1 if section.connect_timeout_s is None else round(section.connect_timeout_s * 1e3)
-    tls = None
-    if section.tls_root_ca is not None:
-        tls = TlsFiles(section.tls_root_ca, section.tls_cert, section.tls_key)
     return zenoh_config(
         section.mode,
         section.connect,
         section.listen,
         connect_timeout_ms=timeout_ms,
         reconnect_period_max_ms=round(section.reconnect_period_max_s * 1e3),
-        tls=tls,
+        tls=_tls_files(section),
+    )
+
+
+def _tls_files(section: ZenohSection) -> TlsFiles | None:
+    if section.tls_root_ca is None:
+        return None
+    return TlsFiles(section.tls_root_ca, section.tls_cert, section.tls_key)
+
+
+def client_config(
+    section: ZenohSection, connect_timeout_ms: int, connect: Sequence[str] | None = None
+) -> zenoh.Config:
+    """A short-lived client (``health``, ``status``) that reaches the router the way the
+    section's services do: its endpoints (or ``connect``) and its TLS files, so with
+    mutual TLS it shows the section's certificate."""
+    endpoints = section.connect if connect is None else connect
+    return zenoh_config(
+        "client", endpoints, connect_timeout_ms=connect_timeout_ms, tls=_tls_files(section)
     )
 
 

@@ -1,7 +1,9 @@
 """The line's zenoh access control: who may put what, matched by certificate common name.
 
-Default deny. Every known service (subjects below, one certificate each,
-common name ``<station>-<role>`` or ``line-recorder`` / ``line-monitor``)
+Default deny. Every known service (subjects below, one certificate each:
+common name ``<station>-<role>``, or one of the line's observers
+``line-recorder``, ``line-viewer`` (the live view, ``serve recorder
+--view-only``) and ``line-monitor`` (``boltwatch status``, the operator))
 may declare subscribers, queryables and liveliness tokens under
 ``boltwatch/**`` and receive what is published there; only
 
@@ -30,7 +32,7 @@ from shared import keys
 ACQUISITION_TOPICS = (keys.SAMPLES, keys.TOOL, keys.BUS)
 PREDICTOR_TOPICS = (keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS)
 RECORDER_TOPICS = (keys.RECORDER, keys.WEAR, f"{keys.WEAR}/**")
-LINE_OBSERVERS = ("line-recorder", "line-monitor")
+LINE_OBSERVERS = ("line-recorder", "line-viewer", "line-monitor")
 
 _DECLARATIONS = [
     "declare_subscriber",

@@ -38,13 +38,15 @@ def run(args: argparse.Namespace) -> int:
     from shared import keys
     from shared.config import load_line
     from shared.errors import ConfigError
-    from shared.zenoh_session import open_from, zenoh_config
+    from shared.zenoh_session import client_config, open_from
 
     stations = load_line(args.config)
-    connect = stations[0].config.zenoh.connect
+    section = stations[0].config.zenoh
+    connect = section.connect
     if not connect:
         raise ConfigError(f"{stations[0].path}: zenoh.connect: health needs a router to ask")
-    with open_from(zenoh_config("client", connect, connect_timeout_ms=CONNECT_TIMEOUT_MS)) as s:
+    # As the file's services connect (with mutual TLS: this container's certificate).
+    with open_from(client_config(section, CONNECT_TIMEOUT_MS)) as s:
         if args.service == "router":
             print(f"router at {', '.join(connect)}: reachable")
             return 0

@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING
 from services.cli.command_options import DEFAULT_STATION_FILE
 
 if TYPE_CHECKING:
+    import zenoh
+
     from services.cli.station_status import StatusReport
 
 NAME = "status"
@@ -45,14 +47,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="FILE",
         help=(
-            f"station file whose [zenoh] connect names the router (default: {DEFAULT_STATION_FILE})"
+            f"station file whose [zenoh] connect names the router, with its tls_* files for "
+            f"a router with mutual TLS (default: {DEFAULT_STATION_FILE})"
         ),
     )
     where.add_argument(
         "--connect",
         default=None,
         metavar="ENDPOINT",
-        help="router endpoint, e.g. tcp/127.0.0.1:7447 (instead of a station file)",
+        help="router endpoint, e.g. tcp/127.0.0.1:7447 (instead of a station file; no TLS)",
     )
     parser.add_argument(
         "--listen-s",
@@ -68,11 +71,18 @@ def run(args: argparse.Namespace) -> int:
     from services.cli.station_status import to_json
     from services.cli.station_status_text import format_report
     from shared.errors import InputError
+    from shared.zenoh_session import zenoh_config
 
     if not args.listen_s > 0:
         raise InputError(f"--listen-s must be a positive number of seconds (got {args.listen_s})")
-    endpoint = args.connect or _endpoint_from(args.config or DEFAULT_STATION_FILE)
-    report = _watch(endpoint, args.listen_s)
+    if args.connect:
+        endpoint, config = (
+            args.connect,
+            zenoh_config("client", [args.connect], connect_timeout_ms=CONNECT_TIMEOUT_MS),
+        )
+    else:
+        endpoint, config = _router_of(args.config or DEFAULT_STATION_FILE)
+    report = _watch(endpoint, config, args.listen_s)
     if args.json:
         print(json.dumps(to_json(report), indent=2))
     else:
@@ -80,9 +90,12 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _endpoint_from(config: Path) -> str:
+def _router_of(config: Path) -> tuple[str, zenoh.Config]:
+    """The router endpoint of a station file and a client config that reaches it as the
+    file's services do (its TLS files included)."""
     from shared.config import load_station
     from shared.errors import ConfigError
+    from shared.zenoh_session import client_config
 
     section = load_station(config).config.zenoh
     if not section.connect:
@@ -90,10 +103,11 @@ def _endpoint_from(config: Path) -> str:
             f"{config}: zenoh.connect is empty (a peer that only listens); "
             "give the router with --connect ENDPOINT"
         )
-    return section.connect[0]
+    endpoint = section.connect[0]
+    return endpoint, client_config(section, CONNECT_TIMEOUT_MS, [endpoint])
 
 
-def _watch(endpoint: str, listen_s: float) -> StatusReport:
+def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport:
     """Listen on ``endpoint`` for ``listen_s`` seconds; the StatusReport of what came."""
     import threading
     import time
@@ -103,12 +117,9 @@ def _watch(endpoint: str, listen_s: float) -> StatusReport:
     from services.cli.station_status import StatusCollector
     from shared import keys
     from shared.errors import TransportError
-    from shared.zenoh_session import zenoh_config
 
     try:
-        session = zenoh.open(
-            zenoh_config("client", [endpoint], connect_timeout_ms=CONNECT_TIMEOUT_MS)
-        )
+        session = zenoh.open(config)
     except zenoh.ZError as err:
         reason = str(err).split(" at ", 1)[0]  # drop the Rust source location
         raise TransportError(

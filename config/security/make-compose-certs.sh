@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# Certificates and access control for docker-compose.tls.yml (README, "Compose with TLS").
+#
+#   config/security/make-compose-certs.sh OUT_DIR [STATION...]      (default stations: st1 st2)
+#   BOLTWATCH_CERTS=OUT_DIR BOLTWATCH_RECORDINGS=$PWD/recordings \
+#       docker compose -f docker-compose.yml -f docker-compose.tls.yml up --build
+#
+# Every container gets its own identity: OUT_DIR/<name>/ holds ca.pem (the line's
+# CA), identity.pem (a certificate whose common name is <name>) and identity.key,
+# and is mounted read-only at /etc/boltwatch-identity. The names are the access
+# control's subjects (services/router/access_control.py):
+#   router                                   the router (server certificate, names "router")
+#                                            + acl.json5, the access control for STATION...
+#   line-recorder, line-viewer, line-monitor the line's recorder, the live viewer, the operator
+#   <st>-acquisition, <st>-predictor, <st>-rig   for each station
+# OUT_DIR/line-ca/ is config/security/make-certs.sh's folder: the CA's key (ca.key) is
+# there and is never mounted; keep it offline. Running again reuses the CA and
+# re-issues every identity. Keys are 0600; the containers run as uid 10001
+# (Dockerfile), so as root the identities are given to that uid (BOLTWATCH_UID);
+# otherwise the script prints the chown to run. Nothing here is ever committed.
+set -euo pipefail
+
+if [[ $# -lt 1 ]]; then
+    echo "usage: $0 OUT_DIR [STATION...]   (default stations: st1 st2)" >&2
+    exit 2
+fi
+out=$1
+shift
+stations=("$@")
+if [[ ${#stations[@]} -eq 0 ]]; then
+    stations=(st1 st2)
+fi
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+repo=$(cd "$here/../.." && pwd)
+owner_uid=${BOLTWATCH_UID:-10001}
+
+names=(line-recorder line-viewer line-monitor)
+for station in "${stations[@]}"; do
+    names+=("$station-acquisition" "$station-predictor" "$station-rig")
+done
+
+# The services reach the router as "router" (the compose service name).
+ROUTER_SAN="DNS:router${ROUTER_SAN:+,$ROUTER_SAN}" "$here/make-certs.sh" "$out/line-ca" "${names[@]}" >/dev/null
+umask 077
+
+# identity NAME SOURCE_STEM: OUT_DIR/NAME/{ca.pem,identity.pem,identity.key}
+identity() {
+    local name=$1 stem=$2 folder="$out/$1"
+    mkdir -p "$folder"
+    chmod 755 "$folder"
+    install -m 644 "$out/line-ca/ca.pem" "$folder/ca.pem"
+    install -m 644 "$out/line-ca/$stem.pem" "$folder/identity.pem"
+    install -m 600 "$out/line-ca/$stem.key" "$folder/identity.key"
+}
+
+identity router router
+PYTHONPATH="$repo${PYTHONPATH:+:$PYTHONPATH}" "${PYTHON:-python3}" -m services.router.access_control \
+    "${stations[@]}" >"$out/router/acl.json5.new"
+mv "$out/router/acl.json5.new" "$out/router/acl.json5"
+chmod 644 "$out/router/acl.json5"
+for name in "${names[@]}"; do
+    identity "$name" "$name"
+done
+
+folders=(router "${names[@]}")
+if [[ $(id -u) -eq 0 ]]; then
+    for name in "${folders[@]}"; do
+        chown -R "$owner_uid" "$out/$name"
+    done
+    owned="owned by uid $owner_uid (the containers' user)"
+else
+    owned="keys 0600: the containers run as uid $owner_uid, so run
+  sudo chown -R $owner_uid ${folders[*]/#/$out/}"
+fi
+echo "identities in $out: ${folders[*]} ($owned); the CA key stays in $out/line-ca"

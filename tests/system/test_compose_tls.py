@@ -1,0 +1,210 @@
+"""docker-compose.tls.yml run on loopback: the commands compose would run, with the identities.
+
+Certificates come from config/security/make-compose-certs.sh; the compose files
+are merged as ``docker compose -f docker-compose.yml -f docker-compose.tls.yml``
+merges them (tests/compose_layout.py). Each service runs as
+``python -m services.cli`` with the exact arguments of its merged command, in a
+copy of what its container sees (config, its own identity, the recordings),
+with two things changed for loopback: the router is ``127.0.0.1`` on a free port
+instead of ``router:7447`` (the router's certificate names 127.0.0.1 too), and
+the station's CAN multicast port is a free one. Health checks run as the
+containers run them: ``boltwatch health ...`` with that container's identity.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+import zenoh
+
+from services.cli.station_supervisor import stop_process
+from services.recorder.testing import has_subscribers
+from shared import keys
+from shared.config import load_station
+from shared.zenoh_session import open_session
+from tests.compose_layout import (
+    BASE_FILE,
+    IDENTITY,
+    TLS_FILE,
+    ContainerFiles,
+    load_merged,
+    make_compose_certs,
+    split_volume,
+)
+from tests.paths import REPO
+from tests.system.station_files import free_tcp_port, free_udp_port, serve
+
+pytestmark = [
+    pytest.mark.system,
+    pytest.mark.skipif(shutil.which("openssl") is None, reason="needs the openssl CLI"),
+]
+
+RUNNING = ("router", "acquisition-st1", "predictor-st1", "rig-st1", "recorder")
+TLS_STATIONS = "/etc/boltwatch/compose/tls"
+HEALTHY_WITHIN_S = 60.0
+NOT_ALIVE = 1  # `boltwatch health`: 1 not alive (yet), 2 router unreachable or bad file
+HEARD_WITHIN_S = 60.0
+DECISION = keys.station_key("st1", keys.DECISION)
+
+
+class ComposeLine:
+    """The merged compose services, each with its container's files under ``folder``."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self.certs = folder / "certs"
+        make_compose_certs(self.certs)
+        recordings = folder / "recordings"
+        recordings.mkdir()
+        env = {"BOLTWATCH_CERTS": str(self.certs), "BOLTWATCH_RECORDINGS": str(recordings)}
+        self.services: dict[str, Any] = load_merged([BASE_FILE, TLS_FILE], env)["services"]
+        self.port = free_tcp_port()
+        self.can_ports = {"43113": str(free_udp_port()), "43114": str(free_udp_port())}
+        self.processes: dict[str, subprocess.Popen[bytes]] = {}
+        self._containers: dict[tuple[str, str | None], ContainerFiles] = {}
+
+    def files(self, name: str, identity: str | None = None) -> ContainerFiles:
+        """Service ``name``'s container (with another identity mounted, if given)."""
+        if (name, identity) not in self._containers:
+            self._containers[name, identity] = self._lay_out(name, identity)
+        return self._containers[name, identity]
+
+    def _lay_out(self, name: str, identity: str | None) -> ContainerFiles:
+        volumes = list(self.services[name]["volumes"])
+        if identity is not None:
+            volumes = [v for v in volumes if split_volume(v)[1] != IDENTITY]
+            volumes.append(f"{self.certs / identity}:{IDENTITY}:ro")
+        root = self.folder / "containers" / (name if identity is None else f"{name}-as-{identity}")
+        files = ContainerFiles(root, volumes)
+        for station_file in files.host(TLS_STATIONS).glob("*.toml"):
+            text = station_file.read_text().replace("tls/router:7447", f"tls/127.0.0.1:{self.port}")
+            for compose_port, free_port in self.can_ports.items():
+                text = re.sub(rf"^port = {compose_port}$", f"port = {free_port}", text, flags=re.M)
+            station_file.write_text(text)
+        return files
+
+    def start(self, name: str) -> None:
+        command = self.files(name).arguments(self.services[name]["command"])
+        command = [a.replace("tls/0.0.0.0:7447", f"tls/127.0.0.1:{self.port}") for a in command]
+        assert command[0] == "serve"
+        self.processes[name] = serve(command[1:], self.folder / f"{name}.log")
+
+    def health(self, name: str) -> subprocess.CompletedProcess[str]:
+        """The container's health check (``CMD boltwatch health ...``), once."""
+        test = self.services[name]["healthcheck"]["test"]
+        assert test[:2] == ["CMD", "boltwatch"]
+        arguments = self.files(name).arguments(test[2:])
+        return subprocess.run(
+            [sys.executable, "-m", "services.cli", *arguments],
+            check=False,
+            cwd=REPO,
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
+
+    def session(self, name: str, identity: str | None = None) -> zenoh.Session:
+        """A session as service ``name``'s container opens it (its station file's [zenoh])."""
+        files = self.files(name, identity)
+        station_file = files.host(f"{TLS_STATIONS}/station1.toml")
+        return open_session(load_station(station_file).config.zenoh)
+
+    def log(self, name: str) -> str:
+        return (self.folder / f"{name}.log").read_text(errors="replace")[-3000:]
+
+
+@pytest.fixture
+def line(tmp_path: Path) -> Iterator[ComposeLine]:
+    started = ComposeLine(tmp_path)
+    try:
+        for name in RUNNING:
+            started.start(name)
+        yield started
+    finally:
+        for name in reversed(list(started.processes)):
+            stop_process(started.processes[name], grace_s=10.0)
+
+
+def test_every_service_is_healthy_with_its_own_identity_and_status_sees_them(
+    line: ComposeLine,
+) -> None:
+    """As compose waits on health: retry each container's check until it passes; then the
+    operator's ``boltwatch status`` with the line-monitor identity sees st1's services."""
+    line.session("router").close()  # the router takes TLS sessions now: 2 is a real failure
+    deadline = time.monotonic() + HEALTHY_WITHIN_S
+    for name in RUNNING:
+        while (checked := line.health(name)).returncode != 0:
+            said = f"{checked.stdout}{checked.stderr}"
+            assert checked.returncode == NOT_ALIVE, f"{name}'s health check failed: {said}"
+            exited = line.processes[name].poll()
+            assert exited is None, f"{name} exited ({exited}):\n{line.log(name)}"
+            assert time.monotonic() < deadline, f"{name} never healthy: {said}\n{line.log(name)}"
+            time.sleep(0.5)
+    monitor_file = line.files("recorder", identity="line-monitor").host(
+        f"{TLS_STATIONS}/station1.toml"
+    )
+    status = subprocess.run(
+        [sys.executable, "-m", "services.cli", "status", "--config", str(monitor_file), "--json"],
+        check=True,
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    services = json.loads(status.stdout)["stations"]["st1"]["services"]
+    alive = {service for service, up in services.items() if up}
+    assert {"acquisition", "predictor", "rig", "recorder"} <= alive
+
+
+def test_data_flows_and_only_st1s_predictor_may_decide_for_st1(line: ComposeLine) -> None:
+    heard: dict[str, list[bytes]] = {}
+    arrived = threading.Condition()
+
+    def on_sample(sample: zenoh.Sample) -> None:
+        with arrived:
+            heard.setdefault(str(sample.key_expr), []).append(sample.payload.to_bytes())
+            arrived.notify_all()
+
+    def wait_for(what: str, condition: Any) -> None:
+        with arrived:
+            if not arrived.wait_for(lambda: condition(heard), timeout=HEARD_WITHIN_S):
+                logs = "\n".join(f"-- {n}:\n{line.log(n)}" for n in RUNNING)
+                raise AssertionError(f"never heard {what} (heard {sorted(heard)})\n{logs}")
+
+    sessions: list[zenoh.Session] = []
+    try:
+        # The operator's identity, as `boltwatch status` would use it (line-monitor).
+        monitor = line.session("recorder", identity="line-monitor")
+        sessions.append(monitor)
+        subscriber = monitor.declare_subscriber(keys.station_key("st1", "*"), on_sample)
+        samples, recorder = (keys.station_key("st1", t) for t in (keys.SAMPLES, keys.RECORDER))
+        # The acquisition's and the recorder's own certificates may put their keys.
+        wait_for("st1's samples and recorder stats", lambda h: samples in h and recorder in h)
+
+        impostor = line.session("predictor-st1", identity="st2-predictor")
+        legit = line.session("predictor-st1")
+        sessions += [impostor, legit]
+        publisher = legit.declare_publisher(DECISION)
+        deadline = time.monotonic() + HEARD_WITHIN_S
+        while not has_subscribers(publisher) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        impostor.put(DECISION, b"impostor")  # first: if it got through it would land first
+        publisher.put(b"st1-predictor")
+        wait_for("st1-predictor's decision", lambda h: b"st1-predictor" in h.get(DECISION, []))
+        time.sleep(0.3)  # anything else in flight lands now
+        assert b"impostor" not in heard[DECISION], "st2's predictor decided for st1"
+        publisher.undeclare()
+        subscriber.undeclare()
+    finally:
+        for session in sessions:
+            session.close()
