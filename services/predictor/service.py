@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import os
 import threading
 import time
 from collections.abc import Sequence
@@ -34,6 +33,7 @@ from shared.config import LoadedStation, load_line
 from shared.config.line import stations_by_id
 from shared.errors import ConfigError, InputError
 from shared.messages import Intensity, Sample, StopDecision, ToolState
+from shared.receive_threads import use_one_receive_thread
 from shared.service_runtime import ServiceRunner
 from shared.zenoh_session import open_session
 
@@ -229,15 +229,11 @@ class PredictorService:
         publisher.put(codec.encode(message))
 
 
-#: zenoh's receive pool at one thread (unless ZENOH_RUNTIME says otherwise): the
-#: callbacks then never pass the GIL between two receive threads (16.4 instead
-#: of 18.2 µs CPU per sample on 20 stations, ``tests/benchmarks/bench_line_inbox.py``)
-ZENOH_RUNTIME = "(rx: (worker_threads: 1))"
-
-
 def main(args: argparse.Namespace) -> int:
     """Load every station file once, open one session, serve until a signal."""
-    os.environ.setdefault("ZENOH_RUNTIME", ZENOH_RUNTIME)  # read when the first session opens
+    # One receive thread: callbacks never pass the GIL between two receive threads
+    # (16.4 instead of 18.2 µs CPU per sample on 20 stations, bench_line_inbox.py).
+    use_one_receive_thread()
     stations = load_line(args.config)
     with (
         open_session(stations[0].config.zenoh) as session,

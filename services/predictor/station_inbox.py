@@ -13,15 +13,11 @@ samples are published with BLOCK, so none is dropped. A thread per
 subscriber (``FifoChannel`` + ``recv()``, or ``indirect=True``) was measured
 too and is wrong: a run's ``tool`` and ``samples`` then race each other.
 
-Zenoh's receive threads are not Python threads: for each callback pyo3 asks
-CPython for the GIL with ``PyGILState_Ensure``, which, on a thread with no
-Python thread state, makes one and frees it again when the callback returns
-(with a ``mmap``/``munmap`` of its frame stack). So the first callback on
-each receive thread calls ``PyGILState_Ensure`` once more and never releases
-it: that thread keeps its thread state, later callbacks only take the GIL
-(CPython only). On 20 stations, CPU per sample of the predictor process:
-queue + worker 32.6 µs, callback 26.4 µs, callback keeping its thread state
-18.2 µs (``tests/benchmarks/bench_line_inbox.py``, medians of 3).
+Each callback first keeps its receive thread's Python thread state
+(:func:`shared.receive_threads.keep_thread_state`): on 20 stations, CPU per
+sample of the predictor process, queue + worker 32.6 µs, callback 26.4 µs,
+callback keeping its thread state 18.2 µs (``tests/benchmarks/bench_line_inbox.py``,
+medians of 3).
 
 The handler publishes (events, decisions, with BLOCK) from inside the
 callback. That is safe because the predictor never subscribes, on the same
@@ -38,8 +34,6 @@ the service ends with status 1 as it would on any worker error.
 
 from __future__ import annotations
 
-import ctypes
-import platform
 import threading
 from collections.abc import Callable, Iterable, Sequence
 from typing import Protocol
@@ -47,17 +41,10 @@ from typing import Protocol
 import zenoh
 
 from shared import keys
+from shared.receive_threads import keep_thread_state
 
 #: (served station id, topic, payload) -> None; called one message at a time
 Handler = Callable[[str, str, bytes], None]
-
-_CPYTHON = platform.python_implementation() == "CPython"
-
-
-def _keep_thread_state() -> None:
-    """Make the calling (foreign) thread's Python thread state live as long as the thread."""
-    if _CPYTHON:
-        ctypes.pythonapi.PyGILState_Ensure()  # holds the GIL already: only counts up
 
 
 class Inbox(Protocol):
@@ -92,7 +79,6 @@ class StationInbox:
         self._ended = threading.Event()
         self._failure: BaseException | None = None
         self._closed = False
-        self._pinned_threads: set[int] = set()
         #: messages that arrived after the handler had failed (not handled)
         self.lost_after_failure = 0
         self._subscribers = [
@@ -107,13 +93,11 @@ class StationInbox:
     def _deliver_to(self, station_id: str, topic: str) -> Callable[[zenoh.Sample], None]:
         handle = self._handle
         lock = self._lock
-        pinned = self._pinned_threads
         keep = self.keep_thread_states
 
         def deliver(sample: zenoh.Sample) -> None:
-            if keep and threading.get_ident() not in pinned:
-                _keep_thread_state()
-                pinned.add(threading.get_ident())
+            if keep:
+                keep_thread_state()
             payload = sample.payload.to_bytes()
             with lock:
                 if self._closed:  # shutting down: the service no longer publishes

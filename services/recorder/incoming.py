@@ -51,9 +51,6 @@ _TOPIC_DECODERS: dict[str, tuple[str, Callable[[bytes], Any]]] = {
     topic: (name, _decoder_of(RECORDED_TYPES[name])) for topic, name in TOPIC_TYPES.items()
 }
 
-#: Keys the recorder puts to itself (wake-up, flush tick); never recorded.
-LOCAL_PREFIX = f"{keys.ROOT}/_local/"
-
 #: Station folder of keys outside ``boltwatch/<station>/...``.
 OTHER_STATION = "_other"
 

@@ -1,13 +1,13 @@
 """``boltwatch serve recorder``: everything on ``boltwatch/**`` into MCAP files.
 
-One zenoh session, one subscriber on :data:`shared.keys.EVERYTHING` with a
-deep FIFO channel, read with a blocking ``recv()`` in the service's worker
-thread (:class:`shared.service_runtime.ServiceRunner`). Session-local keys
-drive it without leaving the process: ``boltwatch/_local/wake`` (stop now),
-``boltwatch/_local/tick`` (put every half flush interval so files are flushed
-even when the line is quiet) and ``boltwatch/_local/stats`` (once a second:
-publish :class:`~shared.messages.RecorderStats` per station). On SIGTERM the
-channel is drained and every file finished, so it is readable without recovery.
+One zenoh session, one subscriber on :data:`shared.keys.EVERYTHING`
+(:class:`~services.recorder.line_inbox.LineInbox`: its callback keeps each
+message, the service's worker thread files them in batches every
+:data:`TAKE_INTERVAL_S`). The worker also flushes files every half flush
+interval, even when the line is quiet, and once a second publishes
+:class:`~shared.messages.RecorderStats` per station. On SIGTERM the
+subscriber is undeclared, what it received is filed and every file
+finished, so it is readable without recovery.
 
 One process serves several stations (``--config A.toml B.toml``): each
 served station gets its metadata from its own file, its own ``wear``
@@ -33,12 +33,13 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import zenoh
 
 from services.recorder.file_metadata import FileMetadata
-from services.recorder.incoming import LOCAL_PREFIX, OTHER_STATION, classify
+from services.recorder.incoming import OTHER_STATION, classify
+from services.recorder.line_inbox import LineInbox
 from services.recorder.recorder import Recorder
 from services.recorder.recorder_health import RecorderHealth
 from services.recorder.run_files import FileLimits
@@ -57,14 +58,13 @@ if TYPE_CHECKING:
 
 LOG = logging.getLogger(__name__)
 
-WAKE_KEY = f"{LOCAL_PREFIX}wake"
-TICK_KEY = f"{LOCAL_PREFIX}tick"
-STATS_KEY = f"{LOCAL_PREFIX}stats"
 STATS_PERIOD_S = 1.0
+#: how often the worker takes what the inbox received (a batch of 250 messages
+#: on 50 stations): receive times are taken on arrival, so this delays only the
+#: files and the live view
+TAKE_INTERVAL_S = 0.005
 #: health role of a ``--view-only`` recorder (a live view, not the line's recorder)
 VIEWER = "viewer"
-CHANNEL_DEPTH = 100_000  # 100 s of samples at 1 kHz
-_DRAIN_LIMIT = CHANNEL_DEPTH
 _BUS_STATS = "boltwatch.BusStats"
 _SAMPLE = "boltwatch.Sample"
 
@@ -128,9 +128,7 @@ class RecorderService:
             self.wear = WearWatch(
                 self._ledger_file, first.config.recorder.wear_service_threshold, self._publish_alert
             )
-        self._subscriber = session.declare_subscriber(
-            keys.EVERYTHING, zenoh.handlers.FifoChannel(CHANNEL_DEPTH)
-        )
+        self._inbox = LineInbox(session, keys.EVERYTHING)
         self._queryables = [
             session.declare_queryable(
                 keys.station_key(station, keys.WEAR), self._wear_replier(station)
@@ -150,36 +148,38 @@ class RecorderService:
         )
 
     def wake(self) -> None:
-        """Unblock ``recv()`` in :meth:`work` (a put that never leaves the process)."""
-        self._local_put(WAKE_KEY)
+        """Make :meth:`work` look at its stop flag now."""
+        self._inbox.wake()
 
     def work(self, stop: threading.Event) -> None:
-        """Record until ``stop`` is set, then drain the channel and finish every file."""
-        ticker = threading.Thread(
-            target=self._tick_until, args=(stop,), name="recorder-tick", daemon=True
-        )
-        ticker.start()
+        """Record until ``stop`` is set, then file what was received and finish every file."""
+        next_tick = next_stats = time.monotonic()
         try:
             while not stop.is_set():
-                self._handle(self._subscriber.recv())
-            for _ in range(_DRAIN_LIMIT):
-                sample = self._subscriber.try_recv()
-                if sample is None:
-                    break
-                self._handle(sample)
+                self._file(self._inbox.take(TAKE_INTERVAL_S))
+                now = time.monotonic()
+                if now >= next_tick:
+                    self.recorder.tick(time.time_ns())
+                    next_tick = now + self._tick_s
+                if now >= next_stats and not self.view_only:
+                    self._publish_stats(time.time_ns())
+                    next_stats = now + STATS_PERIOD_S
         finally:
+            self._inbox.close()
+            self._file(self._inbox.take(0))
+            if self._inbox.after_close:
+                LOG.info("not recorded, arrived while stopping: %d", self._inbox.after_close)
             if self.wear is not None:
                 self.wear.close()
             closed = self.recorder.close()
             LOG.info("recorder stopped: %d messages, %d files", self.recorder.messages, len(closed))
-            ticker.join(self._tick_s + STATS_PERIOD_S + 1.0)
 
     def close(self) -> None:
         """Undeclare the subscriber, queryables and health tokens; safe to call twice."""
-        entities: list[zenoh.LivelinessToken | zenoh.Queryable[None] | zenoh.Subscriber[Any]] = [
+        self._inbox.close()
+        entities: list[zenoh.LivelinessToken | zenoh.Queryable[None]] = [
             *self._tokens,
             *self._queryables,
-            self._subscriber,
         ]
         for entity in entities:
             with contextlib.suppress(zenoh.ZError):
@@ -194,16 +194,12 @@ class RecorderService:
         )
         return self.health.report(now_ns, write_errors, last_error, recorder.recording_ok)
 
-    def _handle(self, sample: zenoh.Sample) -> None:
-        now_ns = time.time_ns()
-        key = str(sample.key_expr)
-        if key.startswith(LOCAL_PREFIX):
-            if key == TICK_KEY:
-                self.recorder.tick(now_ns)
-            elif key == STATS_KEY and not self.view_only:
-                self._publish_stats(now_ns)
-            return
-        received = classify(key, sample.payload.to_bytes(), now_ns)
+    def _file(self, messages: list[tuple[str, bytes, int]]) -> None:
+        for key, payload, received_ns in messages:
+            self._handle(key, payload, received_ns)
+
+    def _handle(self, key: str, payload: bytes, now_ns: int) -> None:
+        received = classify(key, payload, now_ns)
         self.recorder.write(received)
         if received.station != OTHER_STATION:
             is_sample = received.schema_name == _SAMPLE
@@ -257,24 +253,6 @@ class RecorderService:
             return
         reply = {"station": station, "ledger": str(self._ledger_file), "tools": tools}
         query.reply(query.key_expr, json.dumps(reply).encode())
-
-    def _tick_until(self, stop: threading.Event) -> None:
-        """Flush ticks every half flush interval, stats ticks every second."""
-        next_tick = next_stats = time.monotonic()
-        while not stop.wait(max(0.0, min(next_tick, next_stats) - time.monotonic())):
-            now = time.monotonic()
-            if now >= next_tick:
-                self._local_put(TICK_KEY)
-                next_tick = now + self._tick_s
-            if now >= next_stats:
-                self._local_put(STATS_KEY)
-                next_stats = now + STATS_PERIOD_S
-
-    def _local_put(self, key: str) -> None:
-        try:
-            self._session.put(key, b"", allowed_destination=zenoh.Locality.SESSION_LOCAL)
-        except zenoh.ZError as err:  # session already closing
-            LOG.debug("local put on %s failed: %s", key, err)
 
 
 def rerun_options(write_files: bool, live_url: str | None) -> RerunOptions | None:

@@ -25,7 +25,11 @@ variants run in turns within one round, so a busy machine hurts them alike.
   (``ZENOH_RUNTIME``), so callbacks never pass the GIL between two threads.
 - ``recorder`` / ``recorder-classify-before``: the real recorder process
   (``--no-rerun``) instead of the predictor, with ``classify`` as it is or as
-  it was (``codec.decode`` for every message); "runs" are not its output.
+  it was (``codec.decode`` for every message); "runs" are not its output, the
+  samples in its MCAP files are (``recorded``: it must equal ``published``).
+- ``recorder-at-before``: ``serve recorder --no-rerun`` of another checkout
+  (``--before-repo``, e.g. ``git worktree add /tmp/before c7ff33d``), run
+  side by side with the current one.
 - ``indirect``: like ``callback`` with ``indirect=True`` (zenoh runs each
   subscriber's callbacks on a thread of its own).
 """
@@ -54,6 +58,7 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
 from services.cli.station_supervisor import stop_process  # noqa: E402
 from services.predictor.service import PredictorService  # noqa: E402
 from services.predictor.station_inbox import Handler, Inbox, StationInbox  # noqa: E402
+from services.recorder.recording_reader import RecordingScan  # noqa: E402
 from shared import keys  # noqa: E402
 from shared.codec import decode  # noqa: E402
 from shared.config import derive_stations, load_line  # noqa: E402
@@ -183,8 +188,28 @@ VARIANTS: dict[str, Callable[[zenoh.Session, Sequence[str], Handler], Inbox]] = 
 RUNTIMES = {"callback-rx1": "(rx: (worker_threads: 1))"}
 
 
-#: recorder variants: the real ``serve recorder --no-rerun``, classify() as it is or as before
-RECORDER_VARIANTS = ("recorder", "recorder-classify-before")
+#: recorder variants: the real ``serve recorder --no-rerun``, classify() as it is or as
+#: before, or another checkout's recorder
+RECORDER_VARIANTS = ("recorder", "recorder-classify-before", "recorder-at-before")
+
+
+def consumer_command(variant: str, paths: list[Path], before_repo: Path | None) -> list[str]:
+    """The process of one variant: this file as a child, or the other checkout's recorder."""
+    if variant != "recorder-at-before":
+        return [sys.executable, __file__, "--consume", variant, *map(str, paths)]
+    if before_repo is None:
+        raise SystemExit("recorder-at-before needs --before-repo PATH")
+    serve_recorder = ["-m", "services.cli", "serve", "recorder", "--no-rerun", "--config"]
+    return [sys.executable, *serve_recorder, *map(str, paths)]
+
+
+def recorded_samples(recordings: Path) -> int:
+    """Sample messages in every MCAP file under ``recordings``."""
+    suffix = f"/{keys.SAMPLES}"
+    return sum(
+        sum(1 for _ in RecordingScan(path).messages(suffix))
+        for path in sorted(recordings.rglob("*.mcap"))
+    )
 
 
 def consume(variant: str, files: list[str]) -> int:
@@ -208,7 +233,9 @@ def consume(variant: str, files: list[str]) -> int:
         return ServiceRunner("predictor", service.work, service.wake).run()
 
 
-def one_run(variant: str, stations: int, seconds: float, folder: Path) -> dict[str, float]:
+def one_run(
+    variant: str, stations: int, seconds: float, folder: Path, before_repo: Path | None
+) -> dict[str, float]:
     port = free_tcp_port()
     endpoint = f"tcp/127.0.0.1:{port}"
     base = write_station(folder, zenoh_port=port, replacements=SHORT_PROGRAM)
@@ -227,8 +254,8 @@ def one_run(variant: str, stations: int, seconds: float, folder: Path) -> dict[s
     try:
         processes.append(serve(["router", "--listen", endpoint], folder / "router.log"))
         predictor = subprocess.Popen(
-            [sys.executable, __file__, "--consume", variant, *map(str, paths)],
-            cwd=REPO,
+            consumer_command(variant, paths, before_repo),
+            cwd=before_repo if variant == "recorder-at-before" else REPO,
             stdout=(folder / "predictor.log").open("wb"),
             stderr=subprocess.STDOUT,
         )
@@ -264,7 +291,9 @@ def one_run(variant: str, stations: int, seconds: float, folder: Path) -> dict[s
             stop_process(process, grace_s=10.0)
     note = (folder / "generator.log").read_text()
     published = int(note.split("generator: ", 1)[1].split()[0])
+    recorded = recorded_samples(folder / "recordings") if variant in RECORDER_VARIANTS else -1
     return {
+        "recorded": recorded,
         "cpu_us_per_sample": used_s / published * 1e6,
         "runs": len(summaries),
         "incomplete_runs": sum(1 for s in summaries if s.samples != expected_samples),
@@ -285,6 +314,9 @@ def main(argv: list[str] | None = None) -> int:
         choices=[*VARIANTS, *RECORDER_VARIANTS],
         help="predictor inboxes (default: all) or the recorder's classify, before/after",
     )
+    parser.add_argument(
+        "--before-repo", type=Path, default=None, help="the checkout of recorder-at-before"
+    )
     parser.add_argument("--consume", default=None, help=argparse.SUPPRESS)
     parser.add_argument("files", nargs="*", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -295,12 +327,12 @@ def main(argv: list[str] | None = None) -> int:
         order = args.variants if round_index % 2 == 0 else list(reversed(args.variants))
         for variant in order:
             with tempfile.TemporaryDirectory(prefix=f"bench-inbox-{variant}-") as tmp:
-                result = one_run(variant, args.stations, args.seconds, Path(tmp))
+                result = one_run(variant, args.stations, args.seconds, Path(tmp), args.before_repo)
             cpu[variant].append(result["cpu_us_per_sample"])
             print(
                 f"round {round_index + 1} {variant}: {result['cpu_us_per_sample']:.1f} µs/sample, "
                 f"{result['runs']:.0f} runs, {result['incomplete_runs']:.0f} incomplete, "
-                f"{result['published']:.0f} samples, "
+                f"{result['published']:.0f} samples ({result['recorded']:.0f} recorded), "
                 f"summary lag p50 {result['summary_lag_p50_ms']:.1f} ms",
                 flush=True,
             )
