@@ -5,12 +5,15 @@ CPython for the GIL with ``PyGILState_Ensure``, which, on a thread with no
 Python thread state, makes one and frees it again when the callback returns
 (with a ``mmap``/``munmap`` of its frame stack). :func:`keep_thread_state`,
 called first in a callback, calls ``PyGILState_Ensure`` once more on a
-thread it has not seen and never releases it: that thread keeps its thread
-state, later callbacks only take the GIL. On CPython only; elsewhere it does
+thread whose state it has not kept yet (a mark in a ``threading.local``,
+which lives in that very thread state) and never releases it: that thread
+keeps its thread state, later callbacks only take the GIL. A kept state is
+freed only when the process ends (zenoh's receive threads live as long as
+their runtime). On CPython only; elsewhere it does
 nothing (a fresh thread state per callback: slower, still correct).
 
-Measured on the predictor with 20 stations (``bench_line_inbox.py``), CPU per
-sample: callback 26.4 µs, callback keeping its thread state 18.2 µs.
+Measured in the README's benchmark table (``bench_line_inbox.py``, the
+predictor's inbox variants).
 
 :data:`ONE_RECEIVE_THREAD` is the ``ZENOH_RUNTIME`` a service sets (before
 its first session opens) so that callbacks never pass the GIL between two of
@@ -25,7 +28,7 @@ import platform
 import threading
 
 _CPYTHON = platform.python_implementation() == "CPython"
-_KEPT: set[int] = set()  # idents of the threads whose state is kept
+_KEPT = threading.local()  # lives in the thread state: set once it is kept
 
 #: zenoh's receive pool at one thread (read when the first session opens)
 ONE_RECEIVE_THREAD = "(rx: (worker_threads: 1))"
@@ -33,12 +36,11 @@ ONE_RECEIVE_THREAD = "(rx: (worker_threads: 1))"
 
 def keep_thread_state() -> None:
     """Keep the calling (foreign) thread's Python thread state for the thread's life."""
-    ident = threading.get_ident()
-    if ident in _KEPT:
+    if getattr(_KEPT, "kept", False):
         return
     if _CPYTHON:
         ctypes.pythonapi.PyGILState_Ensure()  # holds the GIL already: only counts up
-    _KEPT.add(ident)
+    _KEPT.kept = True
 
 
 def use_one_receive_thread() -> None:

@@ -92,7 +92,7 @@ def common_name(pem: Path) -> str:
 
 
 def split_volume(volume: str) -> tuple[str, str]:
-    """``SOURCE:TARGET[:ro]`` -> (SOURCE, TARGET)."""
+    """``SOURCE:TARGET[:ro]`` -> (SOURCE, TARGET); SOURCE may be ``${VAR:?message}``."""
     match = MOUNT.fullmatch(volume)
     assert match, f"not a SOURCE:TARGET mount: {volume}"
     return match.group(1), match.group(2)

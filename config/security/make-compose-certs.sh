@@ -51,6 +51,7 @@ identity() {
     install -m 644 "$out/line-ca/ca.pem" "$folder/ca.pem"
     install -m 644 "$out/line-ca/$stem.pem" "$folder/identity.pem"
     install -m 600 "$out/line-ca/$stem.key" "$folder/identity.key"
+    rm -f "$out/line-ca/$stem.key"  # one copy of each key: in its own identity folder
 }
 
 identity router router

@@ -232,7 +232,7 @@ class PredictorService:
 def main(args: argparse.Namespace) -> int:
     """Load every station file once, open one session, serve until a signal."""
     # One receive thread: callbacks never pass the GIL between two receive threads
-    # (16.4 instead of 18.2 µs CPU per sample on 20 stations, bench_line_inbox.py).
+    # (measured with bench_line_inbox.py, variant callback-rx1; figures in the README).
     use_one_receive_thread()
     stations = load_line(args.config)
     with (

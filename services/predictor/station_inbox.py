@@ -14,10 +14,9 @@ subscriber (``FifoChannel`` + ``recv()``, or ``indirect=True``) was measured
 too and is wrong: a run's ``tool`` and ``samples`` then race each other.
 
 Each callback first keeps its receive thread's Python thread state
-(:func:`shared.receive_threads.keep_thread_state`): on 20 stations, CPU per
-sample of the predictor process, queue + worker 32.6 µs, callback 26.4 µs,
-callback keeping its thread state 18.2 µs (``tests/benchmarks/bench_line_inbox.py``,
-medians of 3).
+(:func:`shared.receive_threads.keep_thread_state`; the inbox variants are
+measured side by side in ``tests/benchmarks/bench_line_inbox.py``, figures in
+the README).
 
 The handler publishes (events, decisions, with BLOCK) from inside the
 callback. That is safe because the predictor never subscribes, on the same

@@ -5,9 +5,8 @@ thread (``indirect=False``) and only appends ``(key, payload, receive time)``
 to a pending list. The recorder's worker takes the whole list at once
 (:meth:`LineInbox.take`, every few milliseconds) and files it: one
 hand-over per batch instead of one per message (a ``FifoChannel`` read with
-a blocking ``recv()``, as before). CPU per sample of the recorder process on
-20 stations, side by side: 22.2 µs against 23.8 µs before, medians of 3
-(``tests/benchmarks/bench_line_inbox.py --variants recorder recorder-at-before``).
+a blocking ``recv()``, as before; measured side by side in the README's
+benchmark table: ``bench_line_inbox.py --variants recorder recorder-at-before``).
 The disk stays off the receive thread: a flush that waits for ``fsync``
 holds the worker, not zenoh.
 
@@ -81,17 +80,18 @@ class LineInbox:
         self._woken.set()
 
     def close(self) -> None:
-        """Undeclare the subscriber; what was received stays for a last :meth:`take`.
+        """Stop keeping messages and undeclare the subscriber; what was received stays for
+        a last :meth:`take`. Safe to call twice.
 
-        zenoh's ``undeclare`` does not wait for a callback in progress: the lock
-        is the barrier, so once ``close`` returns nothing more is appended.
-        Safe to call twice.
+        Closed first, then undeclared: a callback waiting for room wakes and returns
+        (counted in :attr:`after_close`), so it never holds up the undeclare, and
+        once ``close`` returns nothing more is appended (the lock is the barrier:
+        zenoh's ``undeclare`` does not wait for a callback in progress).
         """
         with self._lock:
             if self._closed:
                 return
-        with contextlib.suppress(zenoh.ZError):  # the session is already closed
-            self._subscriber.undeclare()
-        with self._lock:
             self._closed = True
             self._room.notify_all()
+        with contextlib.suppress(zenoh.ZError):  # the session is already closed
+            self._subscriber.undeclare()

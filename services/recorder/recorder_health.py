@@ -2,7 +2,7 @@
 
 Lag is the receive time in the recorder minus ``Sample.time_ns`` (the CAN
 receive time stamped by the acquisition), measured when the recorder's worker
-takes the sample off its queue: it includes the network and the queue, so a
+files the sample: it includes the network and the wait in the inbox, so a
 recorder falling behind shows here before it loses anything. Each report
 covers the samples since the previous report (about one second); a station
 that sent no samples has no lag (None), not zero.

@@ -39,7 +39,7 @@ import zenoh
 
 from services.recorder.file_metadata import FileMetadata
 from services.recorder.incoming import OTHER_STATION, classify
-from services.recorder.line_inbox import LineInbox
+from services.recorder.line_inbox import LineInbox, Message
 from services.recorder.recorder import Recorder
 from services.recorder.recorder_health import RecorderHealth
 from services.recorder.run_files import FileLimits
@@ -60,8 +60,8 @@ LOG = logging.getLogger(__name__)
 
 STATS_PERIOD_S = 1.0
 #: how often the worker takes what the inbox received (a batch of 250 messages
-#: on 50 stations): receive times are taken on arrival, so this delays only the
-#: files and the live view
+#: on 50 stations): MCAP log times are taken on arrival; lag (RecorderStats) is
+#: measured when a batch is filed, so it includes the wait in the inbox
 TAKE_INTERVAL_S = 0.005
 #: health role of a ``--view-only`` recorder (a live view, not the line's recorder)
 VIEWER = "viewer"
@@ -164,11 +164,13 @@ class RecorderService:
                 if now >= next_stats and not self.view_only:
                     self._publish_stats(time.time_ns())
                     next_stats = now + STATS_PERIOD_S
-        finally:
+            self._file(self._inbox.take(0))  # a receive thread waiting for room gets it
             self._inbox.close()
             self._file(self._inbox.take(0))
+        finally:
+            self._inbox.close()
             if self._inbox.after_close:
-                LOG.info("not recorded, arrived while stopping: %d", self._inbox.after_close)
+                LOG.warning("not recorded, arrived while stopping: %d", self._inbox.after_close)
             if self.wear is not None:
                 self.wear.close()
             closed = self.recorder.close()
@@ -194,11 +196,13 @@ class RecorderService:
         )
         return self.health.report(now_ns, write_errors, last_error, recorder.recording_ok)
 
-    def _file(self, messages: list[tuple[str, bytes, int]]) -> None:
+    def _file(self, messages: list[Message]) -> None:
+        filed_ns = time.time_ns()  # the lag counts the wait in the inbox too
         for key, payload, received_ns in messages:
-            self._handle(key, payload, received_ns)
+            self._handle(key, payload, received_ns, filed_ns)
 
-    def _handle(self, key: str, payload: bytes, now_ns: int) -> None:
+    def _handle(self, key: str, payload: bytes, now_ns: int, filed_ns: int) -> None:
+        """File one message received at ``now_ns`` (its MCAP log time) at ``filed_ns``."""
         received = classify(key, payload, now_ns)
         self.recorder.write(received)
         if received.station != OTHER_STATION:
@@ -206,7 +210,7 @@ class RecorderService:
             sample_time_ns = (
                 received.publish_time_ns if is_sample and received.message is not None else None
             )
-            self.health.written(received.station, now_ns, sample_time_ns, is_sample)
+            self.health.written(received.station, filed_ns, sample_time_ns, is_sample)
             if received.schema_name == _BUS_STATS and received.message is not None:
                 bus = received.message
                 self.health.bus_stats(received.station, bus.samples, bus.started_ns)
@@ -230,11 +234,19 @@ class RecorderService:
                 LOG.debug("recorder stats of %s not published: %s", stats.station, err)
 
     def _publish_alert(self, alert: WearAlert) -> None:
+        """Put the alert for the line and record it here: a put this session also heard
+        would come back through the inbox on this very thread, which waits when the
+        inbox is full, for room only this thread makes."""
+        key = keys.station_key(alert.station, ALERT_TOPIC)
+        payload = encode(alert)
         self._session.put(
-            keys.station_key(alert.station, ALERT_TOPIC),
-            encode(alert),
+            key,
+            payload,
             congestion_control=zenoh.CongestionControl.BLOCK,
+            allowed_destination=zenoh.Locality.REMOTE,
         )
+        now_ns = time.time_ns()
+        self._handle(key, payload, now_ns, now_ns)
 
     def _wear_replier(self, station: str) -> Callable[[zenoh.Query], None]:
         def reply(query: zenoh.Query) -> None:

@@ -26,7 +26,8 @@ variants run in turns within one round, so a busy machine hurts them alike.
 - ``recorder`` / ``recorder-classify-before``: the real recorder process
   (``--no-rerun``) instead of the predictor, with ``classify`` as it is or as
   it was (``codec.decode`` for every message); "runs" are not its output, the
-  samples in its MCAP files are (``recorded``: it must equal ``published``).
+  samples in its MCAP files are (``recorded``, printed beside ``published``:
+compare them).
 - ``recorder-at-before``: ``serve recorder --no-rerun`` of another checkout
   (``--before-repo``, e.g. ``git worktree add /tmp/before c7ff33d``), run
   side by side with the current one.

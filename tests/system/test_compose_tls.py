@@ -194,15 +194,22 @@ def test_data_flows_and_only_st1s_predictor_may_decide_for_st1(line: ComposeLine
         impostor = line.session("predictor-st1", identity="st2-predictor")
         legit = line.session("predictor-st1")
         sessions += [impostor, legit]
+        decisions = monitor.declare_subscriber(keys.station_key("*", keys.DECISION), on_sample)
         publisher = legit.declare_publisher(DECISION)
+        own_key = keys.station_key("st2", keys.DECISION)  # what st2's predictor may decide
+        own = impostor.declare_publisher(own_key)
         deadline = time.monotonic() + HEARD_WITHIN_S
-        while not has_subscribers(publisher) and time.monotonic() < deadline:
+        while not (has_subscribers(publisher) and has_subscribers(own)):
+            assert time.monotonic() < deadline, "no subscriber matched the decisions"
             time.sleep(0.05)
         impostor.put(DECISION, b"impostor")  # first: if it got through it would land first
+        own.put(b"st2-own")  # after it on the same link: heard, so the one before was handled
         publisher.put(b"st1-predictor")
+        wait_for("st2's own decision", lambda h: b"st2-own" in h.get(own_key, []))
         wait_for("st1-predictor's decision", lambda h: b"st1-predictor" in h.get(DECISION, []))
-        time.sleep(0.3)  # anything else in flight lands now
         assert b"impostor" not in heard[DECISION], "st2's predictor decided for st1"
+        own.undeclare()
+        decisions.undeclare()
         publisher.undeclare()
         subscriber.undeclare()
     finally:

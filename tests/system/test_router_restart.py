@@ -49,6 +49,7 @@ RECONNECT_PERIOD_MAX_S = 0.5
 START_TIMEOUT_S = 30.0
 RUN_TIMEOUT_S = 30.0
 RIG_RUN = re.compile(r"run (\d+): (\w+) by (\w+), force (\d+) N, .* (\d+) samples, ")
+LINK_EVENT_SAMPLES = 20  # 20 ms at 1 kHz: how far the link flag may lag the link
 
 
 @dataclass
@@ -204,9 +205,12 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
     assert len(outage_lines) == 1, logs["acq"].read_text()[-2000:]
     assert float(outage_lines[0][0]) >= OUTAGE_S * 0.9
     assert stats.unsent_samples >= 0.3 * OUTAGE_S * 1000  # runs take most of the outage
-    # What was counted unsent is missing from the recording, and little else is.
+    # What was counted unsent is missing from the recording, and little else is. The
+    # acquisition's link flag follows zenoh's link events, a few ms after the transport:
+    # a sample put in between is counted unsent yet may arrive (seen: 2675 unsent, 2674
+    # missing), so the unsent count is an estimate within LINK_EVENT_SAMPLES.
     lost_in_recording = sum(missing.values())
-    assert stats.unsent_samples <= lost_in_recording + stats.missed_samples
+    assert stats.unsent_samples <= lost_in_recording + stats.missed_samples + LINK_EVENT_SAMPLES
     assert lost_in_recording <= stats.unsent_samples + 1000 * RECONNECT_PERIOD_MAX_S * 2
     assert 1 <= len(outage_runs) <= 3, missing
     assert all(lost >= 0 for lost in missing.values()), missing

@@ -34,6 +34,7 @@ from tests.compose_layout import (
     common_name,
     load_merged,
     make_compose_certs,
+    split_volume,
 )
 from tests.paths import REPO
 
@@ -43,14 +44,6 @@ SERVICES: dict[str, Any] = COMPOSE["services"]
 STATIONS = ("st1", "st2")
 PER_STATION = ("acquisition", "rig", "predictor")
 VARIABLE = re.compile(r"\$\{([^}]*)\}")
-MOUNT = re.compile(r"(.+):(/[^:]*)(?::ro|:rw)?")
-
-
-def split_volume(volume: str) -> tuple[str, str]:
-    """``SOURCE:TARGET[:ro]`` -> (SOURCE, TARGET); SOURCE may be ``${VAR:?message}``."""
-    match = MOUNT.fullmatch(volume)
-    assert match, f"not a SOURCE:TARGET mount: {volume}"
-    return match.group(1), match.group(2)
 
 
 def host_path(container_path: str, volumes: list[str]) -> Path:
@@ -329,6 +322,7 @@ def test_identity_folders_hold_no_ca_key_and_keys_are_private(tls_line: TlsLine)
         )
         assert stat.S_IMODE((folder / "identity.key").stat().st_mode) == 0o600
     assert (tls_line.certs / "line-ca" / "ca.key").exists()
+    assert [p.name for p in (tls_line.certs / "line-ca").glob("*.key")] == ["ca.key"]
     script = CERTS_SCRIPT.read_text()
     uid = re.search(r"--uid (\d+)", (REPO / "Dockerfile").read_text())
     assert uid and f"BOLTWATCH_UID:-{uid.group(1)}" in script, "keys go to the containers' user"

@@ -7,7 +7,6 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -20,16 +19,6 @@ from shared.zenoh_session import zenoh_config
 
 Handled = list[tuple[str, str, bytes]]
 REPO = Path(__file__).resolve().parents[3]
-
-
-@pytest.fixture
-def sessions() -> Iterator[tuple[zenoh.Session, zenoh.Session]]:
-    endpoint = f"tcp/127.0.0.1:{free_port()}"
-    with (
-        zenoh.open(zenoh_config("peer", listen=[endpoint])) as served,
-        zenoh.open(zenoh_config("peer", connect=[endpoint])) as feeding,
-    ):
-        yield served, feeding
 
 
 def publishers(session: zenoh.Session, station_id: str) -> dict[str, zenoh.Publisher]:

@@ -4,25 +4,12 @@ publisher back instead of dropping, and what arrives after close is counted."""
 from __future__ import annotations
 
 import threading
-from collections.abc import Iterator
 
-import pytest
 import zenoh
 
 from services.recorder.line_inbox import LineInbox, Message
-from services.recorder.testing import free_port, has_subscribers, wait_until
+from services.recorder.testing import has_subscribers, wait_until
 from shared import keys
-from shared.zenoh_session import zenoh_config
-
-
-@pytest.fixture
-def sessions() -> Iterator[tuple[zenoh.Session, zenoh.Session]]:
-    endpoint = f"tcp/127.0.0.1:{free_port()}"
-    with (
-        zenoh.open(zenoh_config("peer", listen=[endpoint])) as served,
-        zenoh.open(zenoh_config("peer", connect=[endpoint])) as feeding,
-    ):
-        yield served, feeding
 
 
 def blocking_publisher(session: zenoh.Session, key: str) -> zenoh.Publisher:
@@ -118,3 +105,25 @@ def test_wake_ends_a_waiting_take_at_once(
         assert not waiting.is_alive()
     finally:
         inbox.close()
+
+
+def test_close_wakes_a_receive_thread_waiting_for_room_and_counts_its_message(
+    sessions: tuple[zenoh.Session, zenoh.Session],
+) -> None:
+    served, feeding = sessions
+    inbox = LineInbox(served, keys.EVERYTHING, max_pending=10)
+    samples = blocking_publisher(feeding, keys.station_key("a1", keys.SAMPLES))
+    publisher_thread = threading.Thread(
+        target=lambda: [samples.put(str(i).encode()) for i in range(300)], daemon=True
+    )
+    publisher_thread.start()
+    wait_until(lambda: inbox.full_waits > 0, "the receive thread to wait for room")
+    closing = threading.Thread(target=inbox.close, daemon=True)
+    closing.start()
+    closing.join(10.0)
+    assert not closing.is_alive(), "close() hung on the waiting receive thread"
+    publisher_thread.join(10.0)
+    assert not publisher_thread.is_alive()
+    kept = inbox.take(0)
+    assert [payload for _, payload, _ in kept] == [str(i).encode() for i in range(10)]
+    assert inbox.after_close >= 1

@@ -1,0 +1,22 @@
+"""Fixtures of every unit test folder."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import pytest
+import zenoh
+
+from services.recorder.testing import free_port
+from shared.zenoh_session import zenoh_config
+
+
+@pytest.fixture
+def sessions() -> Iterator[tuple[zenoh.Session, zenoh.Session]]:
+    """Two peer sessions on loopback: (served, feeding); the feeding one connects."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    with (
+        zenoh.open(zenoh_config("peer", listen=[endpoint])) as served,
+        zenoh.open(zenoh_config("peer", connect=[endpoint])) as feeding,
+    ):
+        yield served, feeding
