@@ -122,8 +122,9 @@ def test_close_wakes_a_receive_thread_waiting_for_room_and_counts_its_message(
     closing.start()
     closing.join(10.0)
     assert not closing.is_alive(), "close() hung on the waiting receive thread"
+    # The woken receive thread counts its message once it has the lock again.
+    wait_until(lambda: inbox.after_close >= 1, "the waiting message counted")
     publisher_thread.join(10.0)
     assert not publisher_thread.is_alive()
     kept = inbox.take(0)
     assert [payload for _, payload, _ in kept] == [str(i).encode() for i in range(10)]
-    assert inbox.after_close >= 1
