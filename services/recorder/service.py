@@ -294,8 +294,7 @@ def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
 
 
 def main(args: argparse.Namespace) -> int:
-    paths = args.config if isinstance(args.config, list) else [args.config]
-    loaded = load_line(paths)
+    loaded = load_line(args.config)  # serve recorder: one or more files, always a list
     served_stations(loaded)  # bad combinations fail before zenoh is opened
     session = open_session(loaded[0].config.zenoh)
     live = start_rerun_live(args)

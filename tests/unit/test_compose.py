@@ -66,11 +66,15 @@ def health_role(name: str) -> str:
     return "viewer" if name == "viewer" else served_role(name)
 
 
+def config_files(command: list[str]) -> list[str]:
+    """The ``--config`` files of a boltwatch command, one or several, as the CLI parses them."""
+    config = build_parser().parse_args(command).config
+    return [str(file) for file in (config if isinstance(config, list) else [config])]
+
+
 def station_files(name: str) -> list[Path]:
     service = SERVICES[name]
-    args = build_parser().parse_args(service["command"])
-    files = args.config if isinstance(args.config, list) else [args.config]
-    return [host_path(str(file), service["volumes"]) for file in files]
+    return [host_path(file, service["volumes"]) for file in config_files(service["command"])]
 
 
 def test_the_line_layout_is_there() -> None:
@@ -183,9 +187,7 @@ class TlsLine:
         }
 
     def station_files(self, name: str, command: list[str]) -> list[Path]:
-        args = build_parser().parse_args(command)
-        files = args.config if isinstance(args.config, list) else [args.config]
-        return [self.containers[name].host(str(file)) for file in files]
+        return [self.containers[name].host(file) for file in config_files(command)]
 
 
 @pytest.fixture(scope="module")
