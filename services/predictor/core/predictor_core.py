@@ -122,7 +122,9 @@ class PredictorCore:
         )
         if flip != NO_FLIP:
             slip = self._tracker.on_flip(flip, self._window)
-            if slip is not None:
+            if slip is not None and (self.settings.advisory or self.policy.decision is None):
+                # after a binding decision the tool is being stopped: what follows is the
+                # motor halting and the joint unloading, not stick-slip
                 out.extend(self._on_slip(slip, time_s, torque_nm))
         decision = self.policy.on_sample(
             time_s, torque_nm, force, angle_deg - self._start_angle_deg

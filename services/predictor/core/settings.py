@@ -86,6 +86,9 @@ class PredictorSettings:
     constants: JointConstants | None = None  # the expected joint, when one is configured
     # torque target: also stop on the peak-torque plateau rule of eq. 64 (see stop_policy)
     torque_plateau_rule: bool = False
+    # the decision does not stop the tool (a run replayed after a controller stopped it):
+    # events go on being reported after it; otherwise none is reported after the decision
+    advisory: bool = False
 
     @property
     def force_mode(self) -> bool:
