@@ -73,3 +73,20 @@ class StationDatabase:
 
     def is_extended(self, name: str) -> bool:
         return bool(self._messages[name].is_extended_frame)
+
+    def signal_bounds(self, message: str, signal: str) -> tuple[float, float]:
+        """(minimum, maximum) physical value of a contract signal.
+
+        The DBC's stated range where it gives one, never wider than what the
+        signal's bits can carry at its scale and offset.
+        """
+        found = self._messages[message].get_signal_by_name(signal)
+        raw_low, raw_high = (
+            (-(1 << (found.length - 1)), (1 << (found.length - 1)) - 1)
+            if found.is_signed
+            else (0, (1 << found.length) - 1)
+        )
+        ends = sorted((raw_low * found.scale + found.offset, raw_high * found.scale + found.offset))
+        low = ends[0] if found.minimum is None else max(ends[0], float(found.minimum))
+        high = ends[1] if found.maximum is None else min(ends[1], float(found.maximum))
+        return float(low), float(high)

@@ -157,8 +157,9 @@ class StopDecision:
     detail: str
     torque_nm: float
     force_n: float | None
-    predicted_force_n: float | None
+    predicted_force_n: float | None  # the force the stop is predicted to land on (force target)
     decided_ns: int  # wall clock when the decision was published
+    predicted_torque_nm: float | None = None  # the torque it lands on (torque target)
 
 
 @dataclass(frozen=True, slots=True)

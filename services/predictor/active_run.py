@@ -103,6 +103,7 @@ class ActiveRun:
             torque_nm=torque,
             force_n=decision.force_n,
             predicted_force_n=decision.predicted_force_n,
+            predicted_torque_nm=decision.predicted_torque_nm,
             decided_ns=wall_ns,
         )
         return self.decision

@@ -27,5 +27,9 @@ class ServedStation:
         """The core's settings for one run of ``program`` at this station."""
         config = self.station.config
         return PredictorSettings.of(
-            program, config.predictor, config.station.has_force_sensor, self.constants
+            program,
+            config.predictor,
+            config.station.has_force_sensor,
+            self.constants,
+            self.station.sensor_range,
         )

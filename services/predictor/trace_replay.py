@@ -40,15 +40,15 @@ def output_record(output: CoreEvent | CoreDecision) -> dict[str, Any]:
     else:
         record = {"type": "stop"}
     record.update(fields)
-    return _finite(record)
+    return json_safe(record)
 
 
-def _finite(value: Any) -> Any:
-    """NaN and infinities become null: JSON has no such numbers."""
+def json_safe(value: Any) -> Any:
+    """NaN and infinities become null, in nested dicts and lists too: JSON has no such numbers."""
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, dict):
-        return {key: _finite(item) for key, item in value.items()}
+        return {key: json_safe(item) for key, item in value.items()}
     if isinstance(value, list):
-        return [_finite(item) for item in value]
+        return [json_safe(item) for item in value]
     return value

@@ -202,7 +202,12 @@ class RerunSink:
         self._series[bp.FORCE_STOP].add(t_ns, decision.force_n)
         text = (
             f"STOP {decision.reason} at {decision.time_s:.3f} s: torque {decision.torque_nm:.1f} "
-            f"N·m, force {_n(decision.force_n)}, predicted force {_n(decision.predicted_force_n)}"
+            f"N·m, force {_n(decision.force_n)}, predicted "
+            + (
+                f"torque {decision.predicted_torque_nm:.4g} N·m"
+                if decision.predicted_torque_nm is not None
+                else f"force {_n(decision.predicted_force_n)}"
+            )
         )
         self._text(t_ns, text + (f" ({decision.detail})" if decision.detail else ""), "WARN")
 

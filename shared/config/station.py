@@ -12,9 +12,11 @@ from typing import Literal
 
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
+from shared.can_database import StationDatabase
 from shared.config.joint import JointConfig, load_joint
 from shared.config.loading import StrictModel, read_toml, resolve_relative, validate
-from shared.errors import ConfigError
+from shared.errors import CanDatabaseError, ConfigError
+from shared.sensor_range import SensorRange
 
 StationId = str
 
@@ -193,10 +195,14 @@ class StationConfig(StrictModel):
 class LoadedStation:
     """A validated station file with its paths resolved and its joint loaded."""
 
-    def __init__(self, path: Path, config: StationConfig, joint: JointConfig) -> None:
+    def __init__(
+        self, path: Path, config: StationConfig, joint: JointConfig, sensor_range: SensorRange
+    ) -> None:
         self.path = path
         self.config = config
         self.joint = joint
+        #: what the station's sensors can measure: the ranges of its DBC's signals
+        self.sensor_range = sensor_range
 
     @property
     def station_id(self) -> str:
@@ -225,4 +231,8 @@ def load_station(path: Path) -> LoadedStation:
     dbc_path = resolve_relative(config.can.dbc, path)
     if not dbc_path.is_file():
         raise ConfigError(f"{path}: can.dbc: file not found: {dbc_path}")
-    return LoadedStation(path, config, load_joint(joint_path))
+    try:
+        sensor_range = SensorRange.of_database(StationDatabase(dbc_path))
+    except CanDatabaseError as err:
+        raise ConfigError(f"{path}: can.dbc: {err}") from err
+    return LoadedStation(path, config, load_joint(joint_path), sensor_range)

@@ -31,12 +31,10 @@ from services.predictor.core import PredictorCore, PredictorSettings, model_band
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # run as a script: the repo root
 from tests.benchmarks.bench_predictor_accuracy import (
-    OLD_NOISE_HELP,
     Joint,
     draw_joint,
     max_samples,
     physics,
-    use_old_noise_start,
 )
 
 WRONG_MU_SLIP_SHARE = 0.4  # the wrong joint's μ_slip as a share of its μ_stick
@@ -101,10 +99,7 @@ def main() -> None:
         action="store_true",
         help="judge every event (the rule before its evidence requirements), to compare",
     )
-    parser.add_argument("--old-noise-start", action="store_true", help=OLD_NOISE_HELP)
     args = parser.parse_args()
-    if args.old_noise_start:
-        use_old_noise_start()
     evidence = not args.without_evidence
     if not evidence:
         model_bands.MIN_STICK_SHARE = -math.inf

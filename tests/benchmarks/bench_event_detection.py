@@ -51,12 +51,10 @@ from shared.config import RigSection
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # run as a script: the repo root
 from tests.benchmarks.bench_predictor_accuracy import (
-    OLD_NOISE_HELP,
     Joint,
     draw_joint,
     max_samples,
     physics,
-    use_old_noise_start,
 )
 
 MATCH_SAMPLES = 5
@@ -135,10 +133,7 @@ def main() -> None:
     parser.add_argument("--joints", type=int, default=100)
     parser.add_argument("--seed", type=int, default=2018)
     parser.add_argument("--windows", default="5,3")
-    parser.add_argument("--old-noise-start", action="store_true", help=OLD_NOISE_HELP)
     args = parser.parse_args()
-    if args.old_noise_start:
-        use_old_noise_start()
     rng = np.random.default_rng(args.seed)
     joints = [draw_joint(rng, args.seed * 1000 + i) for i in range(args.joints)]
     for window in (int(w) for w in args.windows.split(",")):

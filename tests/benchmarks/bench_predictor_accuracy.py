@@ -2,11 +2,6 @@
 
 Run: ``.venv/bin/python tests/benchmarks/bench_predictor_accuracy.py [--joints N] [--per-joint]``
 
-``--old-noise-start`` (here, in bench_event_detection.py and bench_band_margin.py)
-runs the core with the slip detector's former noise start-up, to compare: the
-running |d2| median started from a single value (see
-services/predictor/core/extremum_tracker.py). The product code has only the new one.
-
 For each of N joints drawn across the paper's ranges (k_e 200-2000 Nm/rad,
 k_s 30-180 kN/rad, μ_stick 0.1-0.4 with μ_slip 2-8 % below, motor speeds
 0.1-2 rad/s log-uniform, targets 30-60 kN, sensor noise), every policy
@@ -58,7 +53,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from services.predictor.core import PredictorCore, PredictorSettings
-from services.predictor.core.extremum_tracker import NOISE_STEP, ExtremumTracker
 from services.predictor.core.settings import PlateauMethod
 from services.rig.physics import Measurement, TighteningPhysics
 from shared.config import Program, RigSection
@@ -68,9 +62,6 @@ SETTLE_SAMPLES = 300
 LATENCY_SAMPLES = 1  # samples the motor still turns after the sample that triggered the stop
 ORACLE_BAND = 0.03  # oracle halts tried at every sample with |F - F_target| ≤ this · F_target
 CLASS_BAND = 0.05  # the class of a joint is what the rig does within this band of the target
-
-
-OLD_NOISE_HELP = "the detector's former noise start-up (one |d2| sample), to compare"
 
 
 @dataclass(frozen=True)
@@ -97,28 +88,6 @@ class Stop:
     reason: str
     slipping_at_trigger: bool  # the slip was under way when the stop was triggered
     reached_torque_nm: float = math.nan  # settled true torque
-
-
-def _observe_torque_from_one_sample(self: ExtremumTracker, torque_nm: float) -> None:
-    """The former start-up of the noise estimate: from the first |d2| alone."""
-    t1 = self._t1
-    if not (math.isnan(t1) or math.isnan(self._t2)):
-        d2 = abs(torque_nm - 2.0 * t1 + self._t2)
-        est = self.noise_d2_nm
-        if est <= 0.0:
-            self.noise_d2_nm = d2 if d2 > 0.0 else 1e-12
-        elif d2 > est:
-            self.noise_d2_nm = est * (1.0 + NOISE_STEP)
-        else:
-            self.noise_d2_nm = est * (1.0 - NOISE_STEP)
-    self._t2 = t1
-    self._t1 = torque_nm
-
-
-def use_old_noise_start() -> None:
-    """For this benchmark process only: the detector's noise estimate starts from one |d2|."""
-    ExtremumTracker.observe_torque = _observe_torque_from_one_sample  # type: ignore[method-assign]
-    print("OLD noise start-up (one |d2| sample)")
 
 
 def draw_joint(rng: np.random.Generator, seed: int) -> Joint:
@@ -319,10 +288,7 @@ def main() -> None:
     parser.add_argument(
         "--no-joint", action="store_true", help="the predictor without the joint's model band"
     )
-    parser.add_argument("--old-noise-start", action="store_true", help=OLD_NOISE_HELP)
     args = parser.parse_args()
-    if args.old_noise_start:
-        use_old_noise_start()
     rng = np.random.default_rng(args.seed)
     joints = [draw_joint(rng, args.seed * 1000 + i) for i in range(args.joints)]
     methods: list[PlateauMethod] = args.methods.split(",")

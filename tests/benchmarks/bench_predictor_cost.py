@@ -26,6 +26,10 @@ from services.rig.physics import TighteningPhysics
 from shared.config import Program, RigSection
 from shared.model import JointConstants
 
+#: a target no run reaches (an infinite one is refused, and would decide at once: every
+#: plateau is as far from it as the next)
+OUT_OF_REACH = 1e12
+
 
 def record(seed: int, samples: int) -> list[tuple[float, float, float, float]]:
     program = Program(
@@ -60,9 +64,9 @@ def main() -> None:
         for recording in recordings:
             rows = recording
             if mode == "force":
-                settings = PredictorSettings(target_force_n=math.inf)
+                settings = PredictorSettings(target_force_n=OUT_OF_REACH)
             else:
-                top = max(row[1] for row in recording) if mode.endswith("end") else math.inf
+                top = max(row[1] for row in recording) if mode.endswith("end") else OUT_OF_REACH
                 settings = PredictorSettings(target_torque_nm=top, has_force=False)
                 rows = [(t, torque, math.nan, angle) for t, torque, _, angle in recording]
             core = PredictorCore(settings)

@@ -47,25 +47,41 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="samples in the peak-detection window (default 5, see the predictor docs)",
     )
     parser.add_argument(
-        "--summary", action="store_true", help="print input counts and prediction errors to stderr"
+        "--dbc",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="the station's CAN database: values outside what its Torque, Angle and Force "
+        "signals can carry are bad input, counted and never used (default: the range of the "
+        "contract DBC, config/can/station.dbc)",
+    )
+    parser.add_argument(
+        "--summary",
+        action="store_true",
+        help="print input counts (bad, implausible, held values) and prediction errors to "
+        "stderr, as one JSON object",
     )
 
 
 def run(args: argparse.Namespace) -> int:
     import json
+    import math
     import sys
 
     from services.predictor.core import DEFAULT_WINDOW_SAMPLES, PredictorCore, PredictorSettings
-    from services.predictor.trace_replay import output_record, replay
+    from services.predictor.trace_replay import json_safe, output_record, replay
     from shared.errors import InputError
+    from shared.sensor_range import CONTRACT_RANGE, SensorRange
     from shared.trace import read_trace
 
     if args.target_force is None and args.target_torque is None:
         raise InputError("give --target-force N, --target-torque NM, or both")
     for name in ("target_force", "target_torque"):
         value = getattr(args, name)
-        if value is not None and not value > 0:
-            raise InputError(f"--{name.replace('_', '-')} must be > 0 (got {value})")
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise InputError(
+                f"--{name.replace('_', '-')} must be a finite number > 0 (got {value})"
+            )
     window = args.window if args.window is not None else DEFAULT_WINDOW_SAMPLES
     if not 3 <= window <= 200:
         raise InputError(f"--window must be between 3 and 200 samples (got {window})")
@@ -79,6 +95,15 @@ def run(args: argparse.Namespace) -> int:
             constants = JointConstants.of(load_joint(args.joint))
         except ConfigError as err:
             raise InputError(str(err)) from err
+    sensor_range = CONTRACT_RANGE
+    if args.dbc is not None:
+        from shared.can_database import StationDatabase
+        from shared.errors import CanDatabaseError
+
+        try:
+            sensor_range = SensorRange.of_database(StationDatabase(args.dbc))
+        except CanDatabaseError as err:
+            raise InputError(str(err)) from err
     trace = read_trace(args.trace)
     has_force = args.target_force is not None and trace.has_force
     settings = PredictorSettings(
@@ -87,6 +112,7 @@ def run(args: argparse.Namespace) -> int:
         has_force=has_force,
         window_samples=window,
         constants=constants,
+        sensor_range=sensor_range,
     )
     if args.target_force is not None and not trace.has_force:
         if args.target_torque is None:
@@ -101,7 +127,7 @@ def run(args: argparse.Namespace) -> int:
     core = PredictorCore(settings)
     out = sys.stdout
     for output in replay(core, trace):
-        out.write(json.dumps(output_record(output)) + "\n")
+        out.write(json.dumps(output_record(output), allow_nan=False) + "\n")
     out.flush()
     if args.summary:
         summary = {
@@ -111,5 +137,5 @@ def run(args: argparse.Namespace) -> int:
             "input": core.input_report.as_dict(),
             "prediction_errors": core.scores.summary(),
         }
-        print(json.dumps(summary), file=sys.stderr)
+        print(json.dumps(json_safe(summary), allow_nan=False), file=sys.stderr)
     return 0

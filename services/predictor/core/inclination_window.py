@@ -1,6 +1,8 @@
 """The window of the n newest samples and its mean inclination (paper eqs. 43-51).
 
-D_T, D_F, D_t (eqs. 43-45) are ring buffers of n samples. The inclination
+D_T and D_t (eqs. 43, 45) are ring buffers of n samples, with the angle and
+the sample's index beside them (the force of eq. 44 is kept per index by
+:mod:`.force_history`: the plateaus need more than n samples of it). The inclination
 sum S = Σ ΔT_i/Δt_i over the n-1 neighbouring pairs of the window (eq. 46)
 is kept as a running sum: each new sample adds its slope and the pair that
 leaves the window subtracts its own, so the work per sample is O(1). The sum
@@ -29,7 +31,7 @@ MIN_PASSED = -1
 
 
 class InclinationWindow:
-    """Ring buffer of (sample index, t, T, F, angle) with the running inclination sum."""
+    """Ring buffer of (sample index, t, T, angle) with the running inclination sum."""
 
     def __init__(self, n: int) -> None:
         if n < 3:
@@ -37,7 +39,6 @@ class InclinationWindow:
         self.n = n
         self.time_s = [0.0] * n
         self.torque_nm = [0.0] * n
-        self.force_n = [0.0] * n
         self.angle_deg = [0.0] * n
         self.index = [0] * n  # the sample's index within the run
         self._slopes = [0.0] * n  # slope of the pair ending at each slot
@@ -52,7 +53,6 @@ class InclinationWindow:
         index: int,
         time_s: float,
         torque_nm: float,
-        force_n: float,
         angle_deg: float,
         nominal_dt_s: float,
     ) -> int:
@@ -85,7 +85,6 @@ class InclinationWindow:
         self.index[new] = index
         self.time_s[new] = time_s
         self.torque_nm[new] = torque_nm
-        self.force_n[new] = force_n
         self.angle_deg[new] = angle_deg
         self.head = new
         self._since_resum += 1

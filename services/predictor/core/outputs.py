@@ -43,4 +43,5 @@ class CoreDecision:
     detail: str
     torque_nm: float
     force_n: float | None
-    predicted_force_n: float | None  # or the predicted peak torque in torque-only mode
+    predicted_force_n: float | None  # the force the stop is predicted to land on (force target)
+    predicted_torque_nm: float | None = None  # the torque it lands on (torque target)

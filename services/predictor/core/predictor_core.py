@@ -26,8 +26,17 @@ from services.predictor.core.extremum_tracker import ExtremumTracker, Slip
 from services.predictor.core.force_history import ForceHistory
 from services.predictor.core.halt_planner import HaltPlanner
 from services.predictor.core.inclination_window import NO_FLIP, InclinationWindow
-from services.predictor.core.input_guard import InputGuard, InputReport
+from services.predictor.core.input_guard import (
+    DROP,
+    HOLD,
+    USE,
+    USE_HELD,
+    GuardedSample,
+    InputGuard,
+    InputReport,
+)
 from services.predictor.core.model_bands import BandVerdict, ModelBandCheck
+from services.predictor.core.motor_motion import MotorMotion
 from services.predictor.core.outputs import CoreDecision, CoreEvent
 from services.predictor.core.regression import predict_events
 from services.predictor.core.scoring import PredictionScores
@@ -53,9 +62,11 @@ class PredictorCore:
 
     def __init__(self, settings: PredictorSettings) -> None:
         self.settings = settings
-        self._guard = InputGuard(settings.has_force)
+        self._guard = InputGuard(settings.has_force, settings.sensor_range)
         self._window = InclinationWindow(settings.window_samples)
-        self._tracker = ExtremumTracker()
+        self._motion = MotorMotion()
+        self._tracker = ExtremumTracker(self._motion)
+        self._add_torque_noise = self._tracker.torque_noise.add
         self._forces = ForceHistory()
         self._screw = ScrewPlateaus()
         self.policy = StopPolicy(settings)
@@ -101,25 +112,40 @@ class PredictorCore:
     def update(
         self, time_s: float, torque_nm: float, force_n: float, angle_deg: float
     ) -> list[CoreOutput]:
-        """Feed one sample (force NaN when none); the events and decision it produced."""
-        force = self._guard.check(time_s, torque_nm, force_n)
-        if force is None:
-            if self._guard.bad_run >= self.settings.fault_samples:
-                fault = self.policy.on_input_fault(time_s, self._guard.bad_run)
+        """Feed one sample (force NaN when none); the events and decision it produced.
+
+        Whatever the values, only what :mod:`.input_guard` lets through, made
+        finite, reaches the rest of the core.
+        """
+        guard = self._guard
+        code = guard.check(time_s, torque_nm, force_n, angle_deg)
+        if code == USE:
+            return self._use(guard.sample)
+        if code == DROP:
+            if guard.bad_run >= self.settings.fault_samples:
+                fault = self.policy.on_input_fault(time_s, guard.bad_run)
                 if fault is not None:
                     return [fault]
             return []
+        if code == HOLD:
+            return []
+        out = self._use(guard.confirmed)  # a gap (or the run's first sample) confirmed
+        if code == USE_HELD:
+            out += self._use(guard.sample)
+        return out  # USE_HELD_HOLD: this sample is held in turn
+
+    def _use(self, sample: GuardedSample) -> list[CoreOutput]:
+        time_s, torque_nm, force, angle_deg, angle_measured = sample
         index = self._count
         self._count = index + 1
         if index == 0:
             self._start_time_s = time_s
             self._start_angle_deg = angle_deg
         self._forces.add(force)
-        self._tracker.observe_torque(torque_nm)
+        self._motion.add(time_s, angle_deg, angle_measured)
+        self._add_torque_noise(torque_nm)
         out: list[CoreOutput] = []
-        flip = self._window.push(
-            index, time_s, torque_nm, force, angle_deg, self._guard.nominal_dt_s
-        )
+        flip = self._window.push(index, time_s, torque_nm, angle_deg, self._guard.nominal_dt_s)
         if flip != NO_FLIP:
             slip = self._tracker.on_flip(flip, self._window)
             if slip is not None and (self.settings.advisory or self.policy.decision is None):
@@ -146,10 +172,8 @@ class PredictorCore:
             trough_before = self._previous_trough_index
             if trough_before < 0:
                 trough_before = max(-1, peak.index - FIRST_PLATEAU_SAMPLES)
-            value = self._forces.plateau_before(trough_before, peak.index)
-            plateau = value if math.isfinite(value) else None
-            value = self._forces.plateau_after(trough.index)
-            force_now = value if math.isfinite(value) else None
+            plateau = self._forces.plateau_before(trough_before, peak.index)
+            force_now = self._forces.plateau_after(trough.index)
         speed = settings.motor_speed_rad_s
         if speed is None and previous_time is not None and peak.time_s > previous_time:
             speed = math.radians(peak.angle_deg - self._previous_angle_deg) / (

@@ -58,6 +58,7 @@ from typing import Literal
 
 from shared.config import PredictorSection, Program
 from shared.model import JointConstants
+from shared.sensor_range import CONTRACT_RANGE, SensorRange
 
 DEFAULT_WINDOW_SAMPLES = 5
 
@@ -89,6 +90,8 @@ class PredictorSettings:
     # the decision does not stop the tool (a run replayed after a controller stopped it):
     # events go on being reported after it; otherwise none is reported after the decision
     advisory: bool = False
+    # what the sensors can measure: a value outside is bad input (see input_guard)
+    sensor_range: SensorRange = CONTRACT_RANGE
 
     @property
     def force_mode(self) -> bool:
@@ -102,6 +105,7 @@ class PredictorSettings:
         section: PredictorSection,
         has_force: bool,
         constants: JointConstants | None = None,
+        sensor_range: SensorRange = CONTRACT_RANGE,
     ) -> PredictorSettings:
         """Settings for a run of ``program`` on a station with (or without) a force sensor."""
         return cls(
@@ -117,4 +121,5 @@ class PredictorSettings:
             max_angle_deg=program.max_angle_deg,
             motor_speed_rad_s=program.motor_speed_rad_s,
             constants=constants,
+            sensor_range=sensor_range,
         )

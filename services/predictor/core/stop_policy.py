@@ -136,7 +136,7 @@ class StopPolicy:
         reason: StopReasonName,
         detail: str,
         torque_nm: float,
-        force_n: float,
+        force_n: float | None,
         predicted: float | None = None,
     ) -> CoreDecision:
         self.decision = CoreDecision(
@@ -144,15 +144,21 @@ class StopPolicy:
             reason=reason,
             detail=detail,
             torque_nm=torque_nm,
-            force_n=None if math.isnan(force_n) else force_n,
-            predicted_force_n=predicted,
+            force_n=force_n,
+            # what the rule predicted the stop lands on: force when the target is a force
+            predicted_force_n=predicted if self._target_force is not None else None,
+            predicted_torque_nm=predicted if self._target_force is None else None,
         )
         return self.decision
 
     def on_sample(
-        self, time_s: float, torque_nm: float, force_n: float, turned_deg: float
+        self, time_s: float, torque_nm: float, force_n: float | None, turned_deg: float
     ) -> CoreDecision | None:
-        """Hard limits and the conventional target; None to go on."""
+        """Hard limits and the conventional target; None to go on.
+
+        ``force_n`` None: the sample has no force (none measured yet in this run),
+        so the force rules wait for one.
+        """
         if self.decision is not None:
             return None
         need = self.settings.limit_samples
@@ -161,7 +167,8 @@ class StopPolicy:
             return self._decide(
                 time_s, "torque_limit", f"torque ≥ {self._max_torque:g} Nm", torque_nm, force_n
             )
-        self._over_force = self._over_force + 1 if force_n >= self._max_force else 0
+        over_force = force_n is not None and force_n >= self._max_force
+        self._over_force = self._over_force + 1 if over_force else 0
         if self._over_force >= need:
             return self._decide(
                 time_s, "force_limit", f"force ≥ {self._max_force:g} N", torque_nm, force_n
@@ -172,6 +179,8 @@ class StopPolicy:
                 time_s, "angle_limit", f"angle turned ≥ {self._max_angle:g}°", torque_nm, force_n
             )
         if self._target_force is not None:
+            if force_n is None:
+                return None
             value, target, quantity, unit = force_n, self._target_force, "force", "N"
         elif self._target_torque is not None:
             value, target, quantity, unit = torque_nm, self._target_torque, "torque", "Nm"
@@ -225,7 +234,7 @@ class StopPolicy:
             "input_fault",
             f"{bad_samples} unusable samples in a row",
             math.nan,
-            math.nan,
+            None,
         )
 
     def on_event(
@@ -243,7 +252,7 @@ class StopPolicy:
         """Rules evaluated after each event's slip (eqs. 64, 65, 70, 71)."""
         if self.decision is not None:
             return None
-        force = force_now_n if force_now_n is not None else math.nan
+        force = force_now_n
         limit = self.settings.max_process_intensity
         if limit is not None and process_intensity > limit:
             return self._decide(

@@ -71,3 +71,69 @@ def test_real_runs_import_and_predict_torque_only(
         for stop in stops:  # only in the final tightening step, not while thread forming
             assert stop["reason"] in ("plateau_closest", "target_reached")
             assert float(stop["time_s"]) > 0.5 * float(trace.time_s[-1])  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("value", ["inf", "-inf", "nan", "0", "-3", "1e400"])
+@pytest.mark.parametrize("option", ["--target-torque", "--target-force"])
+def test_a_target_that_is_not_a_finite_positive_number_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], option: str, value: str
+) -> None:
+    path = tmp_path / "run.csv"
+    write_trace(path, staircase(torque_noise_nm=0.2, force_noise_n=30.0).csv_rows())
+    assert main(["predict", str(path), f"{option}={value}"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"{option} must be a finite number > 0" in err[0]
+
+
+def strict_json(text: str) -> object:
+    """json.loads that refuses NaN and Infinity (they are not JSON)."""
+
+    def refuse(constant: str) -> object:
+        raise ValueError(f"not JSON: {constant}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+@pytest.mark.parametrize("absurd", [1e300, 1e308, -1e308])
+def test_an_absurd_sample_is_counted_and_the_output_stays_json(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], absurd: float
+) -> None:
+    """Issue 14 item 3: one 1e300 sample silenced the run and --summary printed Infinity."""
+    rows = staircase(torque_noise_nm=0.2, force_noise_n=30.0).csv_rows()
+    clean, damaged = tmp_path / "clean.csv", tmp_path / "damaged.csv"
+    write_trace(clean, rows)
+    t, _, a, f = rows[500]
+    write_trace(damaged, [*rows[:500], (t, absurd, a, f), *rows[501:]])
+    outputs = []
+    for path in (clean, damaged):
+        assert main(["predict", str(path), "--target-force", "30400", "--summary"]) == 0
+        captured = capsys.readouterr()
+        records = [strict_json(line) for line in captured.out.splitlines()]
+        summary = strict_json(captured.err.strip().splitlines()[-1])
+        outputs.append((records, summary))
+    (clean_records, clean_summary), (records, summary) = outputs
+    assert summary["input"]["implausible"] == 1  # type: ignore[index]
+    assert [r for r in records if r["type"] == "stop"] == [  # type: ignore[index]
+        r
+        for r in clean_records
+        if r["type"] == "stop"  # type: ignore[index]
+    ]
+    assert summary["events"] == pytest.approx(clean_summary["events"], abs=1)  # type: ignore[index]
+
+
+def test_predict_takes_the_sensor_range_of_a_dbc(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """With the station's DBC, a torque its 24-bit signal cannot carry is implausible."""
+    rows = staircase(torque_noise_nm=0.2, force_noise_n=30.0).csv_rows()
+    path = tmp_path / "run.csv"
+    t, _, a, f = rows[300]
+    write_trace(path, [*rows[:300], (t, 9000.0, a, f), *rows[301:]])
+    dbc = Path(__file__).resolve().parents[3] / "config" / "can" / "station.dbc"
+    assert (
+        main(["predict", str(path), "--target-force", "30400", "--summary", "--dbc", str(dbc)]) == 0
+    )
+    summary = strict_json(capsys.readouterr().err.strip().splitlines()[-1])
+    assert summary["input"]["implausible"] == 1  # type: ignore[index]
+    assert main(["predict", str(path), "--target-force", "1", "--dbc", str(tmp_path)]) == 2
+    assert capsys.readouterr().err.count("\n") == 1

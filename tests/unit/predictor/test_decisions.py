@@ -69,8 +69,10 @@ def test_torque_only_stops_near_the_torque_target() -> None:
     (decision,) = decisions(run(core, rows))
     assert decision.reason == "plateau_closest"
     assert decision.force_n is None
-    assert decision.predicted_force_n is not None
-    assert abs(decision.predicted_force_n - 120.0) < 5.0
+    # a torque prediction is named as one (it was predicted_force_n, holding Nm)
+    assert decision.predicted_force_n is None
+    assert decision.predicted_torque_nm is not None
+    assert abs(decision.predicted_torque_nm - 120.0) < 5.0
 
 
 def test_smooth_ramp_without_stick_slip_stops_on_target() -> None:
@@ -193,7 +195,7 @@ def first_stop(policy: object, ramp: list[tuple[float, float]]) -> float | None:
     from services.predictor.core.stop_policy import StopPolicy
 
     assert isinstance(policy, StopPolicy)
-    return next((tq for t, tq in ramp if policy.on_sample(t, tq, math.nan, 0.0) is not None), None)
+    return next((tq for t, tq in ramp if policy.on_sample(t, tq, None, 0.0) is not None), None)
 
 
 def test_a_halt_plan_moves_the_torque_stop_and_holds_one_phase_only() -> None:
@@ -236,6 +238,6 @@ def test_a_halt_plan_never_aims_past_the_torque_limit() -> None:
     policy = StopPolicy(settings)
     policy.plan_halt(103.0, 0.5, 8.0, 100)
     ramp = [(i * 1e-3, 95.0 + 0.5 * i) for i in range(30)]
-    decision = next(d for t, tq in ramp if (d := policy.on_sample(t, tq, math.nan, 0.0)))
+    decision = next(d for t, tq in ramp if (d := policy.on_sample(t, tq, None, 0.0)))
     assert decision.reason == "target_reached"
     assert decision.torque_nm < 102.0

@@ -27,18 +27,18 @@ from shared.messages import Prediction
 def test_slope_sum_is_eq_46_over_the_window_pairs() -> None:
     window = InclinationWindow(3)
     # pairs: (0,0)->(1ms,2): 2000; (1ms,2)->(3ms,1): -500; then the first pair leaves.
-    window.push(0, 0.000, 0.0, 0.0, 0.0, 1e-3)
-    window.push(1, 0.001, 2.0, 0.0, 0.0, 1e-3)
-    window.push(2, 0.003, 1.0, 0.0, 0.0, 1e-3)
+    window.push(0, 0.000, 0.0, 0.0, 1e-3)
+    window.push(1, 0.001, 2.0, 0.0, 1e-3)
+    window.push(2, 0.003, 1.0, 0.0, 1e-3)
     assert window.slope_sum == pytest.approx(2000.0 - 500.0)
-    window.push(3, 0.004, 4.0, 0.0, 0.0, 1e-3)  # +3000; the 2000 pair leaves
+    window.push(3, 0.004, 4.0, 0.0, 1e-3)  # +3000; the 2000 pair leaves
     assert window.slope_sum == pytest.approx(-500.0 + 3000.0)
 
 
 def test_repeated_timestamp_uses_half_the_nominal_period() -> None:
     window = InclinationWindow(3)
-    window.push(0, 0.001, 1.0, 0.0, 0.0, 1e-3)
-    window.push(1, 0.001, 2.0, 0.0, 0.0, 1e-3)  # Δt = 0 -> 0.5 ms
+    window.push(0, 0.001, 1.0, 0.0, 1e-3)
+    window.push(1, 0.001, 2.0, 0.0, 1e-3)  # Δt = 0 -> 0.5 ms
     assert window.slope_sum == pytest.approx(1.0 / 0.0005)
 
 
@@ -47,7 +47,7 @@ def test_sign_flips_mark_maximum_then_minimum_eqs_47_to_51() -> None:
     torques = [0.0, 1.0, 2.0, 3.0, 1.0, 0.5, 0.6, 2.0]
     flips = []
     for i, torque in enumerate(torques):
-        flips.append(window.push(i, i * 1e-3, torque, 0.0, 0.0, 1e-3))
+        flips.append(window.push(i, i * 1e-3, torque, 0.0, 1e-3))
         if flips[-1] == MAX_PASSED:  # window [2, 3, 1]: S = 1000 - 2000 < 0
             slot = window.argmax()
             assert (window.time_s[slot], window.torque_nm[slot]) == (0.003, 3.0)  # eqs. 48, 49
@@ -61,7 +61,7 @@ def test_sign_flips_mark_maximum_then_minimum_eqs_47_to_51() -> None:
 def test_running_sum_matches_a_fresh_sum_after_many_samples() -> None:
     window = InclinationWindow(5)
     for i in range(10_000):
-        window.push(i, i * 1e-3, math.sin(i / 7.0) * 100.0, 0.0, 0.0, 1e-3)
+        window.push(i, i * 1e-3, math.sin(i / 7.0) * 100.0, 0.0, 1e-3)
     fresh = sum(
         (window.torque_nm[b] - window.torque_nm[a]) / 1e-3
         for a, b in zip(

@@ -14,7 +14,9 @@ import math
 import numpy as np
 
 from services.predictor.core import CoreEvent, PredictorCore, PredictorSettings
-from services.predictor.core.extremum_tracker import SEED_SAMPLES, ExtremumTracker
+from services.predictor.core.extremum_tracker import ExtremumTracker
+from services.predictor.core.motor_motion import MotorMotion
+from services.predictor.core.second_difference import SEED_SAMPLES
 
 NOISE_NM = 0.2  # the rig's torque noise
 RAMP_NM_PER_SAMPLE = 0.05  # a slow stick ramp: k_e 334 Nm/rad at 0.15 rad/s, 1 kHz
@@ -45,9 +47,9 @@ def test_the_estimate_starts_near_the_noise_median() -> None:
     after = SEED_SAMPLES + 8
     ratios = []
     for seed in range(RUNS):
-        tracker = ExtremumTracker()
+        tracker = ExtremumTracker(MotorMotion())
         for torque_nm in noisy_ramp(seed)[:after]:
-            tracker.observe_torque(torque_nm)
+            tracker.torque_noise.add(torque_nm)
         ratios.append(tracker.noise_d2_nm / D2_MEDIAN_NM)
     # one |d2| as the start gave 0.07 .. 2.5 here
     assert min(ratios) >= 0.5 and max(ratios) <= 2.0, (min(ratios), max(ratios))
@@ -80,11 +82,11 @@ def torques_with_d2(d2_nm: list[float]) -> list[float]:
 
 def test_the_estimate_is_the_median_of_the_first_values_then_steps() -> None:
     d2_nm = [float(v) for v in np.random.default_rng(0).permutation(SEED_SAMPLES) + 1]
-    tracker = ExtremumTracker()
+    tracker = ExtremumTracker(MotorMotion())
     torques = torques_with_d2([*d2_nm, 1e3])
     for torque_nm in torques[:-1]:
-        tracker.observe_torque(torque_nm)
+        tracker.torque_noise.add(torque_nm)
     # the upper median of 1 .. SEED_SAMPLES, not the first value alone
     assert tracker.noise_d2_nm == SEED_SAMPLES // 2 + 1
-    tracker.observe_torque(torques[-1])  # after the start-up: one step of 2 %, O(1)
+    tracker.torque_noise.add(torques[-1])  # after the start-up: one step of 2 %, O(1)
     assert tracker.noise_d2_nm == (SEED_SAMPLES // 2 + 1) * 1.02
