@@ -4,15 +4,21 @@ No zenoh, no clock: the same :class:`PredictorCore` serves the live service,
 ``boltwatch predict`` and the tests. Files, one concept each:
 
 - :mod:`.settings`           what one run is predicted against (program, targets, limits)
-- :mod:`.input_guard`        bad input (NaN, repeated / out-of-order times, gaps) made safe
+- :mod:`.input_guard`        bad input (NaN, absurd values, bad times, gaps, lost frames) made safe
 - :mod:`.inclination_window` the window of n samples and its mean inclination, eqs. 43-51
+- :mod:`.second_difference`  a signal's noise: the running median of its |second difference|
 - :mod:`.extremum_tracker`   maxima and minima paired into slips, with a noise floor
+- :mod:`.motor_motion`       did the motor drive through a drop (a slip) or not (a release, pause)
+- :mod:`.force_history`      force sums per sample: the plateau of any stick phase in O(1)
 - :mod:`.event_figures`      ΔT, ΔF, Δt, f_ss, K1-K3, I_j, I_process (eqs. 31-33, 66-68)
 - :mod:`.regression`         least-squares fits and next-event predictions (eqs. 52-56, 6.4)
 - :mod:`.scoring`            errors of past predictions (eqs. 57-63)
 - :mod:`.ramp_estimator`     where a steady ramp will be when the motor has stopped
 - :mod:`.screw_plateaus`     torque-only plateaus from the screw angle (eqs. 8, 9)
+- :mod:`.halt_planner`       torque-only: the halt torque of least expected error per stick phase
+- :mod:`.model_bands`        eq. 71 against the band of the station's joint model (eqs. 34-39)
 - :mod:`.stop_policy`        when to stop and why (eqs. 64, 65, 70, 71, hard limits)
+- :mod:`.outputs`            what the core reports: CoreEvent, CoreDecision
 - :mod:`.predictor_core`     the facade that joins them
 """
 
