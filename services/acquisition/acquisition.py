@@ -214,7 +214,7 @@ class Acquisition:
             receive_errors=self._receive_errors,
             counter_gaps=pairing.counter_gaps,
             missed_samples=pairing.missed_samples,
-            counter_faults=pairing.repeated + pairing.backwards,
+            counter_faults=pairing.repeated + pairing.backwards + pairing.implausible,
             unpaired=pairing.unpaired,
             orphans=pairing.orphans,
             stop_commands=self._stop_commands,

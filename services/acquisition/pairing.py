@@ -7,8 +7,21 @@ Counter order, as soon as they are complete: the stop path is latency-critical.
 
 Faults are counted, never raised:
 
-- a Counter that skips ahead is a gap; the skipped samples are counted as missed;
+- a Counter that skips ahead is a gap; the skipped samples are counted as
+  missed, but only as many as the time since the last frame can explain: at
+  the contract's :data:`SAMPLE_RATE_HZ` the tool cannot have sent more than
+  one sample per period, plus :data:`JITTER_SAMPLES` for frames that arrive
+  bunched. A longer jump (a corrupt or forged frame, random traffic on the
+  sensor id) is not a gap but a counter fault: the frame is dropped, and
+  "missed samples" never exceeds what the bus could have carried;
 - a repeated or backwards Counter (a replayed or confused node) is dropped;
+- the dropped frames are kept as candidates (the newest :data:`CANDIDATES`):
+  :data:`RESYNC_FRAMES` dropped frames that go on from each other, as the
+  tool's own samples do, show that its Counter itself moved (a restarted
+  node, or a forged frame taken first): the count resumes from there
+  (``resyncs``), so one bad frame never silences the rest of a run, while a
+  flood of random frames (one in about 9000 plausibly follows another) almost
+  never moves it;
 - a ``ToolSensors`` whose partner has not come by the time the tool is two
   samples further leaves without force (``unpaired``); a partner arriving
   after that, or a ``JointSensors`` with no tool frame, is dropped (``orphans``).
@@ -17,6 +30,7 @@ Faults are counted, never raised:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 from shared.can_database import COUNTER_MODULO
 
@@ -25,6 +39,15 @@ PAIRING_TOLERANCE = 2
 
 #: Counter steps above this count as going backwards rather than a gap ahead.
 BACKWARDS_THRESHOLD = COUNTER_MODULO // 2
+
+#: The contract's sample rate (DESIGN, CAN): ToolSensors at 1 kHz while running.
+SAMPLE_RATE_HZ = 1000.0
+#: Samples a gap may exceed what the elapsed time explains (frames that arrive bunched).
+JITTER_SAMPLES = 5
+#: Dropped frames kept to recognise a Counter that really moved ...
+CANDIDATES = 32
+#: ... when this many in a row go on from each other (random frames almost never do).
+RESYNC_FRAMES = 3
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,6 +66,8 @@ class PairingCounters:
     missed_samples: int = 0
     repeated: int = 0
     backwards: int = 0
+    implausible: int = 0  # jumps ahead longer than the time since the last frame explains
+    resyncs: int = 0  # the Counter moved (a run of frames went on from a dropped one)
     unpaired: int = 0
     orphans: int = 0
 
@@ -63,7 +88,10 @@ class SampleAssembler:
         self.has_force_sensor = has_force_sensor
         self.counters = PairingCounters()
         self._last_counter: int | None = None
+        self._last_time_ns = 0
         self._last_sequence = -1
+        #: dropped frames (counter, time_ns, frames in a row ending with it), oldest first
+        self._candidates: list[tuple[int, int, int]] = []
         self._pending_tools: list[_PendingTool] = []  # in sequence order
         self._pending_forces: dict[int, float] = {}  # counter -> force of JointSensors
 
@@ -78,6 +106,7 @@ class SampleAssembler:
         """A new run: the next ToolSensors frame is sequence 0. Counters keep counting."""
         self._last_counter = None
         self._last_sequence = -1
+        self._candidates.clear()
         self._pending_tools.clear()
         self._pending_forces.clear()
 
@@ -85,7 +114,7 @@ class SampleAssembler:
         self, counter: int, torque_nm: float, angle_deg: float, time_ns: int
     ) -> list[AssembledSample]:
         """A ToolSensors frame arrived; returns the samples it completes, in order."""
-        sequence = self._unroll(counter)
+        sequence = self._unroll(counter, time_ns)
         if sequence is None:
             return []
         pending = _PendingTool(sequence, counter, time_ns, torque_nm, angle_deg)
@@ -117,21 +146,52 @@ class SampleAssembler:
         self._pending_forces[counter] = force_n
         return []
 
-    def _unroll(self, counter: int) -> int | None:
+    def _unroll(self, counter: int, time_ns: int) -> int | None:
         """Sequence number of a ToolSensors Counter, counting gaps; None to drop the frame."""
-        step = 1 if self._last_counter is None else (counter - self._last_counter) % COUNTER_MODULO
-        if step == 0:
-            self.counters.repeated += 1
-            return None
-        if step > BACKWARDS_THRESHOLD:
-            self.counters.backwards += 1
-            return None
-        if step > 1:
-            self.counters.counter_gaps += 1
-            self.counters.missed_samples += step - 1
+        if self._last_counter is None:
+            step = 1
+        else:
+            step = (counter - self._last_counter) % COUNTER_MODULO
+            if step == 0:
+                self.counters.repeated += 1
+                return None
+            if step > BACKWARDS_THRESHOLD:
+                return self._candidate(counter, time_ns, "backwards")
+            if step > _plausible_steps(time_ns - self._last_time_ns):
+                return self._candidate(counter, time_ns, "implausible")
+            if step > 1:
+                self.counters.counter_gaps += 1
+                self.counters.missed_samples += step - 1
+        return self._accept(counter, time_ns, step)
+
+    def _accept(self, counter: int, time_ns: int, step: int) -> int:
         self._last_counter = counter
+        self._last_time_ns = time_ns
         self._last_sequence += step
+        self._candidates.clear()
         return self._last_sequence
+
+    def _candidate(
+        self, counter: int, time_ns: int, fault: Literal["backwards", "implausible"]
+    ) -> int | None:
+        """A frame off the count: dropped, unless it ends a run of dropped frames that go on
+        from each other as the tool's own would (:data:`RESYNC_FRAMES`): then it moved."""
+        chain = 1
+        for old_counter, old_time_ns, old_chain in self._candidates:
+            step = (counter - old_counter) % COUNTER_MODULO
+            if 0 < step <= _plausible_steps(time_ns - old_time_ns):
+                chain = max(chain, old_chain + 1)
+        if chain >= RESYNC_FRAMES:
+            self.counters.resyncs += 1
+            return self._accept(counter, time_ns, 1)
+        if fault == "backwards":
+            self.counters.backwards += 1
+        else:
+            self.counters.implausible += 1
+        self._candidates.append((counter, time_ns, chain))
+        if len(self._candidates) > CANDIDATES:
+            del self._candidates[0]
+        return None
 
     def _complete(
         self, pending: _PendingTool, force_n: float | None, time_ns: int
@@ -149,3 +209,8 @@ class SampleAssembler:
             self.counters.unpaired += 1
             out.append(self._complete(pending, None, pending.time_ns))
         return out
+
+
+def _plausible_steps(elapsed_ns: int) -> float:
+    """The largest Counter step that ``elapsed_ns`` between two frames can explain."""
+    return 1 + JITTER_SAMPLES + max(0, elapsed_ns) * SAMPLE_RATE_HZ / 1e9
