@@ -1,45 +1,59 @@
-"""Controller runs into the recordings folder, as the live recorder would have written them.
+"""Controller runs into the recordings folder, as the live station would have recorded them.
 
 Each :class:`ControllerRun` becomes the messages a live station publishes
-(``ToolState`` running, one ``Sample`` per controller sample with
-``force_n`` None, ``ToolState`` done) and goes through the recorder's own
-:class:`~services.recorder.recorder.Recorder`: same channels, schemas,
+(``ToolState`` running, one ``Sample`` per controller sample with ``force_n``
+None, ``ToolState`` done). They are written with the recorder's own
+:class:`~services.recorder.mcap_sink.McapSink` (and
+:class:`~services.recorder.rerun_sink.RerunSink`): same channels, schemas,
 metadata records, folders and file names as a live recording, plus a
-``controller`` metadata record with the controller's header. Times are the
-controller's own: ``time_ns`` = ``date`` + ``time values``, used as both
-log and publish time, repeated timestamps and gaps unchanged; ``sequence``
-is the sample's index in the run.
+``controller`` metadata record with the controller's header.
+
+Times are the controller's own: a sample's ``time_ns`` = ``date`` + its
+``time values`` entry, used as both log and publish time, repeated
+timestamps and gaps unchanged; ``sequence`` is the sample's index in the
+run. A run is one file, whatever its times say (the live recorder's
+rotation bounds runs that never end; an imported run has its end).
+
+A run is written whole or not at all (:mod:`services.recorder.import_files`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import re
-from dataclasses import dataclass
+from collections.abc import Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from services.recorder.controller_run import ControllerRun
 from services.recorder.file_metadata import FileMetadata
+from services.recorder.import_files import (
+    put_in_place,
+    read_copy,
+    remove_leftovers,
+    remove_temporary,
+    run_files,
+    temporary_path,
+)
 from services.recorder.incoming import Received, classify
-from services.recorder.recorder import Recorder
-from services.recorder.run_files import FileLimits, file_path
+from services.recorder.mcap_sink import McapSink
+from services.recorder.recorder import describe_os_error
+from services.recorder.run_files import file_path
 from shared import keys
 from shared.codec import encode
-from shared.errors import InputError
+from shared.errors import BoltwatchError, InputError
 from shared.messages import Sample, ToolState
 
 if TYPE_CHECKING:
-    from services.recorder.rerun_sink import RerunOptions
+    from services.recorder.rerun_sink import RerunOptions, RerunSink
 
 STATION_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 DEFAULT_STATION = "cs351"
-#: One chunk per second of controller time; a run is one file (runs last seconds).
-IMPORT_LIMITS = FileLimits(
-    flush_interval_ns=1_000_000_000,
-    max_file_bytes=256 * 1024 * 1024,
-    max_file_duration_ns=3600 * 1_000_000_000,
-    late_grace_ns=0,
-)
+
+
+class RunNotWrittenError(BoltwatchError):
+    """The run's files could not be written (disk, folder, Rerun); nothing of it was kept."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,7 +62,8 @@ class ImportedRun:
     mcap: Path | None  # None: skipped, already in the recordings folder
     rrd: Path | None
     samples: int
-    existing: Path | None = None
+    existing: Path | None = None  # the finished import that was there already
+    replaced: list[Path] = field(default_factory=list)  # unfinished imports replaced
 
 
 def check_station_id(station: str) -> str:
@@ -59,26 +74,25 @@ def check_station_id(station: str) -> str:
     return station
 
 
-def already_imported(recordings: Path, station: str, run: ControllerRun) -> Path | None:
-    """The file of this run in its day folder, if one is there already."""
-    day = file_path(recordings, station, run.run_id, run.started_ns).parent
-    return next(iter(sorted(day.glob(f"{station}_run{run.run_id}_*.mcap"))), None)
-
-
-def controller_messages(station: str, run: ControllerRun) -> list[tuple[str, Any, int]]:
-    """(topic, message, time_ns) of the run, in order, as a live station publishes them."""
-    times_ns = [run.started_ns + round(t * 1e9) for t in run.time_s]
-    out: list[tuple[str, Any, int]] = [
-        (keys.TOOL, _state(station, run, "running", run.started_ns), run.started_ns)
-    ]
+def controller_messages(station: str, run: ControllerRun) -> Iterator[tuple[str, Any, int]]:
+    """(topic, message, log time ns) of the run, in order, as a live station publishes them."""
+    started_ns = run.started_ns
+    yield keys.TOOL, _state(station, run, "running", started_ns), started_ns
     for sequence, (time_ns, torque, angle) in enumerate(
-        zip(times_ns, run.torque_nm, run.angle_deg, strict=True)
+        zip(run.times_ns, run.torque_nm, run.angle_deg, strict=True)
     ):
-        sample = Sample(station, run.run_id, sequence, time_ns, torque, angle, None)
-        out.append((keys.SAMPLES, sample, time_ns))
-    end_ns = max(times_ns[-1], run.started_ns) + 1
-    out.append((keys.TOOL, _state(station, run, "done", end_ns), end_ns))
-    return out
+        yield (
+            keys.SAMPLES,
+            Sample(station, run.run_id, sequence, time_ns, torque, angle, None),
+            time_ns,
+        )
+    end_ns = run_end_ns(run)
+    yield keys.TOOL, _state(station, run, "done", end_ns), end_ns
+
+
+def run_end_ns(run: ControllerRun) -> int:
+    """When the run ended: one nanosecond after its last sample (``ToolState`` done)."""
+    return run.times_ns[-1] + 1
 
 
 def import_run(
@@ -87,20 +101,40 @@ def import_run(
     station: str = DEFAULT_STATION,
     rerun: RerunOptions | None = None,
 ) -> ImportedRun:
-    """Write ``run`` under ``recordings`` with the recorder's writing code (skip if there)."""
-    existing = already_imported(recordings, station, run)
-    if existing is not None:
-        return ImportedRun(run.source, None, None, len(run), existing)
-    metadata = FileMetadata([], extra={"controller": controller_record(run)}, warn_unknown=False)
-    recorder = Recorder(recordings, IMPORT_LIMITS, metadata, rerun)
+    """Write ``run`` under ``recordings`` (skipped if a finished import is there).
+
+    RunNotWrittenError when its files cannot be written; nothing of it is left then.
+    """
+    canonical = file_path(recordings, station, run.run_id, run.started_ns, unique=False)
+    day = canonical.parent
+    prefix = f"{day.parent.name}_run{run.run_id}_"  # the station as file_path made it safe
+    copies = [read_copy(path) for path in run_files(day, prefix)] if day.is_dir() else []
+    finished = next((copy for copy in copies if copy.holds(len(run))), None)
+    if finished is not None:
+        return ImportedRun(run.source, None, None, len(run), finished.path)
+    unfinished = [copy.path for copy in copies if copy.imported]
+    if day.is_dir():
+        remove_leftovers(day, prefix)
+    target = _target(canonical, unfinished)
+    rrd = _write(run, station, target, rerun)
+    moves = [(temporary_path(target), target)]
+    if rrd:  # the .rrd first: a .mcap under its real name means the run is complete
+        moves.insert(0, (temporary_path(target).with_suffix(".rrd"), target.with_suffix(".rrd")))
     try:
-        for topic, message, time_ns in controller_messages(station, run):
-            recorder.write(_received(station, topic, message, time_ns))
-    finally:
-        closed = recorder.close()
-    (mcap,) = closed
-    rrd = mcap.with_suffix(".rrd")
-    return ImportedRun(run.source, mcap, rrd if rrd.is_file() else None, len(run))
+        put_in_place(moves)
+    except OSError as err:
+        remove_temporary([temporary for temporary, _ in moves])
+        raise RunNotWrittenError(
+            f"cannot rename into {target}: {describe_os_error(err, target)}"
+        ) from err
+    replaced = _remove_replaced(unfinished, target, has_rrd=rrd)
+    return ImportedRun(
+        run.source,
+        target,
+        target.with_suffix(".rrd") if rrd else None,
+        len(run),
+        replaced=replaced,
+    )
 
 
 def controller_record(run: ControllerRun) -> dict[str, str]:
@@ -113,6 +147,99 @@ def controller_record(run: ControllerRun) -> dict[str, str]:
     }
     record.update(run.header)
     return record
+
+
+def _target(canonical: Path, unfinished: list[Path]) -> Path:
+    """The run's real name: its canonical one, unless a file that is not an import has it."""
+    candidate, copy = canonical, 2
+    while candidate.exists() and candidate not in unfinished:
+        candidate = canonical.with_name(f"{canonical.stem}_{copy}.mcap")
+        copy += 1
+    return candidate
+
+
+def _write(
+    run: ControllerRun,
+    station: str,
+    target: Path,
+    rerun: RerunOptions | None,
+) -> bool:
+    """Write the run under temporary names beside ``target``; True when a ``.rrd`` was too."""
+    temporary = temporary_path(target)
+    metadata = FileMetadata([], extra={"controller": controller_record(run)}, warn_unknown=False)
+    records = metadata.for_file(station, run.run_id, run.tool_id, run.program_id)
+    companion: RerunSink | None = None
+    try:
+        sink = McapSink(
+            temporary, records, run.run_id, run.started_ns, f"boltwatch {metadata.version}"
+        )
+        try:
+            if rerun is not None:
+                companion = _open_rerun(run, station, target, rerun)
+            for topic, message, time_ns in controller_messages(station, run):
+                received = _received(station, topic, message, time_ns)
+                sink.write(received)
+                if companion is not None:
+                    companion.write(received)
+            sink.close()
+        except BaseException:
+            sink.abandon()
+            raise
+        finally:
+            if companion is not None:
+                companion.close()
+        if companion is not None and companion.failed:
+            rrd = target.with_suffix(".rrd")
+            raise RunNotWrittenError(f"{rrd}: the Rerun recording failed (see the log above)")
+    except OSError as err:
+        remove_temporary([temporary, temporary.with_suffix(".rrd")])
+        _remove_if_empty(target.parent)
+        raise RunNotWrittenError(_real_names(describe_os_error(err, target), target)) from err
+    except BaseException:
+        remove_temporary([temporary, temporary.with_suffix(".rrd")])
+        _remove_if_empty(target.parent)
+        raise
+    return companion is not None
+
+
+def _remove_if_empty(folder: Path) -> None:
+    """A day folder made for a run that failed goes with it (if nothing else is in it)."""
+    with contextlib.suppress(OSError):
+        folder.rmdir()
+
+
+def _real_names(text: str, target: Path) -> str:
+    """``text`` (an error) with the temporary names put back to the real ones: a person
+    looks for the file the run was going to, not for a hidden one that is gone."""
+    return text.replace(str(temporary_path(target).with_suffix("")), str(target.with_suffix("")))
+
+
+def _open_rerun(run: ControllerRun, station: str, target: Path, options: RerunOptions) -> RerunSink:
+    """The run's Rerun sink, writing the temporary ``.rrd`` beside ``target``."""
+    from services.recorder.rerun_sink import RerunSink
+
+    temporary = temporary_path(target).with_suffix(".rrd")
+    try:
+        return RerunSink(temporary, station, run.run_id, run.started_ns, options, target.stem)
+    except OSError:
+        raise
+    except Exception as err:  # the rerun SDK raises its own errors
+        why = _real_names(str(err), target)
+        raise RunNotWrittenError(
+            f"{target.with_suffix('.rrd')}: the Rerun recording cannot be opened: {why}"
+        ) from err
+
+
+def _remove_replaced(unfinished: list[Path], target: Path, has_rrd: bool) -> list[Path]:
+    """Remove the unfinished imports the new file replaces (and their ``.rrd``)."""
+    replaced: list[Path] = []
+    for path in unfinished:
+        if path != target:
+            path.unlink(missing_ok=True)
+        if path != target or not has_rrd:
+            path.with_suffix(".rrd").unlink(missing_ok=True)
+        replaced.append(path)
+    return replaced
 
 
 def _state(station: str, run: ControllerRun, state: Any, time_ns: int) -> ToolState:

@@ -7,9 +7,12 @@ preload). The run's identity comes from the file's header: ``cycle`` (the
 run id, as in the dataset's labels), ``tool serial``, ``prg nr``, ``date``
 (controller local time, no zone in the file: taken as UTC).
 
+The clock is checked (:mod:`services.recorder.controller_timing`:
+representable, never going back).
+
 Anything unusable (a cut file, a wrong type, a missing field, a number that
-is not finite) is one :class:`~shared.errors.InputError` naming the file and
-the key.
+is not finite, a run id below 0, a clock that goes back) is one
+:class:`~shared.errors.InputError` naming the file and the key.
 """
 
 from __future__ import annotations
@@ -21,11 +24,14 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from services.recorder.controller_timing import check_date, check_times
 from shared.errors import InputError
 
 STEPS_KEY = "tightening steps"
 TIME_KEY, TORQUE_KEY, ANGLE_KEY = "time values", "torque values", "angle values"
 DATE_FORMAT = "%Y-%m-%d %H:%M:%S"
+#: Identity fields are integers from 0 up to what the wear ledger (SQLite) holds.
+LARGEST_ID = 2**63 - 1
 
 #: Header fields kept in the ``controller`` metadata record of an imported run.
 HEADER_FIELDS = (
@@ -52,7 +58,7 @@ class ControllerRun:
     run_id: int  # ``cycle``
     tool_id: int  # ``tool serial``
     program_id: int  # ``prg nr``
-    started_ns: int  # ``date``, taken as UTC
+    started_ns: int  # ``date``, taken as UTC; ``time values`` count from it
     header: dict[str, str]
     time_s: list[float]
     torque_nm: list[float]
@@ -61,6 +67,11 @@ class ControllerRun:
 
     def __len__(self) -> int:
         return len(self.time_s)
+
+    @property
+    def times_ns(self) -> list[int]:
+        """Each sample's time: ``date`` + its time value, in integer nanoseconds."""
+        return [self.started_ns + round(t * 1e9) for t in self.time_s]
 
 
 def read_controller_run(path: Path) -> ControllerRun:
@@ -71,22 +82,29 @@ def read_controller_run(path: Path) -> ControllerRun:
     steps = document.get(STEPS_KEY)
     if not isinstance(steps, list) or not steps:
         raise InputError(f"{path}: no '{STEPS_KEY}' list: not a CS351 controller run")
+    run_id = _integer(path, document, "cycle")
+    tool_id = _integer(path, document, "tool serial")
+    program_id = _integer(path, document, "prg nr")
+    date_ns = _date_ns(path, document)
     columns: tuple[list[float], list[float], list[float]] = ([], [], [])
+    step_times: list[list[float]] = []
     names: list[str] = []
     for number, step in enumerate(steps):
         times, torques, angles = _step_columns(path, number, step)
         columns[0].extend(times)
         columns[1].extend(torques)
         columns[2].extend(angles)
+        step_times.append(times)
         names.append(str(step.get("name", f"step {number}")))
     if not columns[0]:
         raise InputError(f"{path}: the tightening steps hold no samples")
+    check_times(path, date_ns, step_times, STEPS_KEY)
     return ControllerRun(
         source=path,
-        run_id=_integer(path, document, "cycle"),
-        tool_id=_integer(path, document, "tool serial"),
-        program_id=_integer(path, document, "prg nr"),
-        started_ns=_date_ns(path, document),
+        run_id=run_id,
+        tool_id=tool_id,
+        program_id=program_id,
+        started_ns=date_ns,
         header={
             name: "" if document.get(name) is None else str(document[name]).strip()
             for name in HEADER_FIELDS
@@ -151,6 +169,10 @@ def _integer(path: Path, document: dict[str, Any], key: str) -> int:
     value = document.get(key)
     if isinstance(value, bool) or not isinstance(value, int):
         raise InputError(f"{path}: '{key}': expected an integer, got {_kind(value)} {value!r}")
+    if value < 0:
+        raise InputError(f"{path}: '{key}': expected a number from 0 up, got {value}")
+    if value > LARGEST_ID:
+        raise InputError(f"{path}: '{key}': {value} is too large (at most 2**63 - 1)")
     return value
 
 
@@ -162,7 +184,7 @@ def _date_ns(path: Path, document: dict[str, Any]) -> int:
         raise InputError(
             f"{path}: 'date': expected 'YYYY-MM-DD HH:MM:SS', got {_kind(value)} {value!r}"
         ) from err
-    return int(started.timestamp()) * 1_000_000_000
+    return check_date(path, started)
 
 
 def _kind(value: Any) -> str:

@@ -87,6 +87,7 @@ class RerunSink:
         run_id: int,
         run_started_ns: int,
         options: RerunOptions = RerunOptions(),  # frozen: shared safely
+        recording_name: str | None = None,  # default: the file's stem
     ) -> None:
         self.path = path
         self.run_id = run_id
@@ -120,7 +121,7 @@ class RerunSink:
         except Exception:
             self._stream.disconnect()  # drop the buffered sink, not "dropping data" at exit
             raise
-        self._stream.send_recording_name(path.stem)
+        self._stream.send_recording_name(recording_name or path.stem)
         self._stream.send_recording_start_time_nanos(run_started_ns)
         bp.log_series_styles(self._stream)
 

@@ -24,7 +24,7 @@ from mcap.reader import make_reader
 from services.cli.main import main
 from services.recorder.controller_run import read_controller_run
 from shared.codec import json_schema
-from shared.messages import Sample
+from shared.messages import MESSAGE_TYPES
 from shared.trace import read_trace
 from tests.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 
@@ -68,22 +68,25 @@ def test_every_real_run_imports_as_a_live_recording(
     recordings = tmp_path / "recordings"
     args = ["import", *map(str, runs), "--recordings", str(recordings), "--no-rerun"]
     assert main(args) == 0
-    assert f"imported {len(runs)} of {len(runs)} runs into {recordings}" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert out.splitlines()[-1] == (
+        f"imported {len(runs)} of {len(runs)} runs into {recordings}, 0 already there, 0 refused"
+    )
 
     for source in runs:
         run = read_controller_run(source)
-        day = _day(run.started_ns)
-        (path,) = recordings.glob(f"cs351/{day}/cs351_run{run.run_id}_*.mcap")
+        (path,) = recordings.glob(f"cs351/{_day(run.started_ns)}/cs351_run{run.run_id}_*.mcap")
         with path.open("rb") as handle:
             reader = make_reader(handle)
             summary = reader.get_summary()
             assert summary is not None
-            schemas = {schema.name: schema for schema in summary.schemas.values()}
-            assert json.loads(schemas["boltwatch.Sample"].data) == json_schema(Sample)
-            assert {(c.topic, c.message_encoding) for c in summary.channels.values()} == {
-                ("boltwatch/cs351/samples", "json"),
-                ("boltwatch/cs351/tool", "json"),
-            }
+            schemas = {schema.id: schema for schema in summary.schemas.values()}
+            channels = {c.topic: c for c in summary.channels.values()}
+            for topic, channel in channels.items():  # every channel schema'd, as live
+                schema = schemas[channel.schema_id]
+                assert channel.message_encoding == "json"
+                assert json.loads(schema.data) == json_schema(MESSAGE_TYPES[schema.name]), topic
+            assert {"boltwatch/cs351/samples", "boltwatch/cs351/tool"} <= set(channels)
             samples = [
                 (message, json.loads(message.data))  # json alone, no code of ours
                 for _, channel, message in reader.iter_messages(topics=["boltwatch/cs351/samples"])
@@ -124,9 +127,9 @@ def test_export_inspect_and_rerun_work_on_an_imported_run(
     (mcap,) = recordings.glob("l2/2022-09-05/l2_run1596334_134339.mcap")
     assert mcap.with_suffix(".rrd").is_file()
 
-    csv = tmp_path / "run.csv"
-    assert main(["export", str(mcap), "--out", str(csv)]) == 0
-    trace = read_trace(csv)
+    out_csv = tmp_path / "run.csv"
+    assert main(["export", str(mcap), "--out", str(out_csv)]) == 0
+    trace = read_trace(out_csv)
     run = read_controller_run(SHIPPED[0])
     assert len(trace) == len(run) and not trace.has_force
     assert list(trace.torque_nm) == pytest.approx(run.torque_nm, abs=1e-4)
@@ -135,8 +138,12 @@ def test_export_inspect_and_rerun_work_on_an_imported_run(
     assert main(["inspect", str(mcap), "--out", str(png)]) == 0
     assert png.stat().st_size > 10_000
 
+    capsys.readouterr()
     again = main(["import", str(SHIPPED[0]), "--recordings", str(recordings), "--station", "l2"])
-    assert again == 0 and "already in" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert again == 0 and "already in" in out
+    assert out.splitlines()[-1].startswith("imported 0 of 1 runs")  # skipped is not imported
+    assert out.splitlines()[-1].endswith(", 1 already there, 0 refused")
     assert len(list(recordings.glob("l2/*/*.mcap"))) == 1  # never a second copy
 
 
@@ -192,13 +199,15 @@ def test_broken_controller_files_each_give_one_line_and_the_good_ones_are_import
 
     status = main(["import", *map(str, inputs), "--recordings", str(recordings), "--no-rerun"])
 
-    assert status == 2  # some failed
+    assert status == 2  # some refused
     captured = capsys.readouterr()
     errors = captured.err.strip().splitlines()
     assert len(errors) == len(broken)  # one line per bad file
     for (path, expected), line in zip(broken.values(), errors, strict=True):
         assert line.startswith(f"boltwatch import: {path}: "), line
         assert expected in line, line
-    assert f"imported 2 of {len(inputs)} runs" in captured.out
-    assert f"{len(broken)} failed" in captured.out
+    assert captured.out.splitlines()[-1] == (
+        f"imported 2 of {len(inputs)} runs into {recordings}, 0 already there, "
+        f"{len(broken)} refused"
+    )
     assert len(list(recordings.glob("cs351/*/*.mcap"))) == 2
