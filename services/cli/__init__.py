@@ -4,5 +4,7 @@
   :mod:`.command_options` (options several commands share)
 - ``boltwatch up``: :mod:`.station_run`, :mod:`.station_supervisor`, :mod:`.run_table`
 - ``boltwatch status``: :mod:`.station_status`, :mod:`.station_status_text`
-- ``boltwatch import``: :mod:`.import_destination` (recordings or trace CSVs)
+- ``boltwatch import``: :mod:`.import_destination` (recordings or trace CSVs),
+  :mod:`.controller_replay` (the predictor over an imported run: here, because
+  the recorder may not import the predictor)
 """

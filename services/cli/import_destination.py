@@ -51,7 +51,7 @@ def write_csv_whole(target: Path, rows: Iterable[tuple[float, float, float, floa
 
 
 class CsvWriter:
-    """Each run as ``<folder>/<source stem>.csv``, the controller's times."""
+    """Each run as ``<folder>/<source stem>.csv``, time from its first sample."""
 
     def __init__(self, folder: Path) -> None:
         self.folder = folder
@@ -62,7 +62,7 @@ class CsvWriter:
         from services.recorder.recorder import describe_os_error
 
         target = self.folder / f"{run.source.stem}.csv"
-        rows = zip(run.time_s, run.torque_nm, run.angle_deg, [None] * len(run), strict=True)
+        rows = zip(run.run_time_s, run.torque_nm, run.angle_deg, [None] * len(run), strict=True)
         try:
             count = write_csv_whole(target, rows)
         except OSError as err:
@@ -78,9 +78,11 @@ class CsvWriter:
 
 
 class RecordingsWriter:
-    """Each run into the recordings folder."""
+    """Each run into the recordings folder, with its predictor replay and wear-ledger count."""
 
     def __init__(self, folder: Path, station: str, rerun: bool) -> None:
+        from services.recorder.wear_ledger import WearLedger, ledger_path
+
         self.folder = folder
         self._station = station
         self._options: RerunOptions | None = None
@@ -88,22 +90,29 @@ class RecordingsWriter:
             from services.recorder.rerun_sink import RerunOptions
 
             self._options = RerunOptions()
+        self._ledger = WearLedger(ledger_path(folder))
 
     def write(self, run: ControllerRun) -> bool:
         """Import the run; True when written now, False when it was already there."""
+        from services.cli.controller_replay import replay_run
         from services.recorder.controller_import import import_run
 
-        imported = import_run(run, self.folder, self._station, self._options)
+        replay = replay_run(self._station, run)
+        imported = import_run(run, self.folder, self._station, self._options, replay, self._ledger)
         if imported.mcap is None:
             print(f"{run.source}: run {run.run_id} already in {imported.existing}, skipped")
             return False
+        summary = replay.summary
         extra = f" + {imported.rrd.name}" if imported.rrd is not None else ""
         replaced = "".join(f"; replaced the unfinished {path.name}" for path in imported.replaced)
-        print(f"{run.source} -> {imported.mcap}{extra} ({imported.samples} samples{replaced})")
+        print(
+            f"{run.source} -> {imported.mcap}{extra} ({imported.samples} samples, "
+            f"{summary.events} events, I_process {summary.process_intensity:.3g}{replaced})"
+        )
         return True
 
     def __enter__(self) -> RecordingsWriter:
         return self
 
     def __exit__(self, *_exc: object) -> None:
-        pass
+        self._ledger.close()

@@ -14,7 +14,8 @@ Files, one concept each:
   post-mortem :mod:`.run_plot`, :mod:`.post_mortem_run`,
   :mod:`.post_mortem_panels`, :mod:`.post_mortem_errors`
 - controller runs (``boltwatch import``): :mod:`.controller_run` (the JSON),
-  :mod:`.controller_timing` (its clock), :mod:`.controller_import` (into
-  recordings), :mod:`.import_files` (whole or not at all)
+  :mod:`.controller_steps` (the controller's result), :mod:`.controller_timing`
+  (its clock), :mod:`.controller_import` (into recordings),
+  :mod:`.import_files` (whole or not at all)
 - :mod:`.testing`: helpers for tests (station files on loopback, free ports)
 """

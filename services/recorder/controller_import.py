@@ -2,11 +2,14 @@
 
 Each :class:`ControllerRun` becomes the messages a live station publishes
 (``ToolState`` running, one ``Sample`` per controller sample with ``force_n``
-None, ``ToolState`` done). They are written with the recorder's own
-:class:`~services.recorder.mcap_sink.McapSink` (and
-:class:`~services.recorder.rerun_sink.RerunSink`): same channels, schemas,
-metadata records, folders and file names as a live recording, plus a
-``controller`` metadata record with the controller's header.
+None, ``ToolState`` done), the controller's own result (``ControllerResult``
+on ``boltwatch/<st>/controller``) and, when given, what the predictor made of
+it (:class:`PredictorReplay`: events, intensities, the advisory decision
+after the sample that caused each, and the ``RunSummary`` at the end). They
+are written with the recorder's own :class:`~services.recorder.mcap_sink.McapSink`
+(and :class:`~services.recorder.rerun_sink.RerunSink`): same channels,
+schemas, metadata records, folders and file names as a live recording, plus
+a ``controller`` metadata record with the controller's header.
 
 Times are the controller's own: a sample's ``time_ns`` = ``date`` + its
 ``time values`` entry, used as both log and publish time, repeated
@@ -14,13 +17,19 @@ timestamps and gaps unchanged; ``sequence`` is the sample's index in the
 run. A run is one file, whatever its times say (the live recorder's
 rotation bounds runs that never end; an imported run has its end).
 
-A run is written whole or not at all (:mod:`services.recorder.import_files`).
+A run is written whole or not at all (:mod:`services.recorder.import_files`),
+and counted in the wear ledger (by (station, run): never twice) before its
+files get their real names, so a run in the folder is a run in the ledger.
+The recording is not written here: this package may not import the
+predictor; the command line replays it and hands the messages in.
 """
 
 from __future__ import annotations
 
 import contextlib
 import re
+import sqlite3
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,10 +52,11 @@ from services.recorder.run_files import file_path
 from shared import keys
 from shared.codec import encode
 from shared.errors import BoltwatchError, InputError
-from shared.messages import Sample, ToolState
+from shared.messages import RunSummary, Sample, ToolState
 
 if TYPE_CHECKING:
     from services.recorder.rerun_sink import RerunOptions, RerunSink
+    from services.recorder.wear_ledger import WearLedger
 
 STATION_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 DEFAULT_STATION = "cs351"
@@ -57,6 +67,15 @@ class RunNotWrittenError(BoltwatchError):
 
 
 @dataclass(frozen=True, slots=True)
+class PredictorReplay:
+    """What the predictor core made of a run, to record beside its samples."""
+
+    #: (index of the sample after which it was published, topic, message), in order
+    outputs: list[tuple[int, str, Any]]
+    summary: RunSummary
+
+
+@dataclass(frozen=True, slots=True)
 class ImportedRun:
     source: Path
     mcap: Path | None  # None: skipped, already in the recordings folder
@@ -64,6 +83,7 @@ class ImportedRun:
     samples: int
     existing: Path | None = None  # the finished import that was there already
     replaced: list[Path] = field(default_factory=list)  # unfinished imports replaced
+    newly_counted: bool = False  # the run entered the wear ledger now
 
 
 def check_station_id(station: str) -> str:
@@ -74,20 +94,30 @@ def check_station_id(station: str) -> str:
     return station
 
 
-def controller_messages(station: str, run: ControllerRun) -> Iterator[tuple[str, Any, int]]:
+def controller_messages(
+    station: str, run: ControllerRun, replay: PredictorReplay | None = None
+) -> Iterator[tuple[str, Any, int]]:
     """(topic, message, log time ns) of the run, in order, as a live station publishes them."""
     started_ns = run.started_ns
+    outputs = replay.outputs if replay is not None else []
+    next_output = 0
     yield keys.TOOL, _state(station, run, "running", started_ns), started_ns
     for sequence, (time_ns, torque, angle) in enumerate(
         zip(run.times_ns, run.torque_nm, run.angle_deg, strict=True)
     ):
-        yield (
-            keys.SAMPLES,
-            Sample(station, run.run_id, sequence, time_ns, torque, angle, None),
-            time_ns,
-        )
+        sample = Sample(station, run.run_id, sequence, time_ns, torque, angle, None)
+        yield keys.SAMPLES, sample, time_ns
+        while next_output < len(outputs) and outputs[next_output][0] <= sequence:
+            _, topic, message = outputs[next_output]
+            yield topic, message, time_ns
+            next_output += 1
     end_ns = run_end_ns(run)
+    for _, topic, message in outputs[next_output:]:
+        yield topic, message, end_ns
     yield keys.TOOL, _state(station, run, "done", end_ns), end_ns
+    yield keys.CONTROLLER, run.result(station, end_ns), end_ns
+    if replay is not None:
+        yield keys.RUNS, replay.summary, end_ns
 
 
 def run_end_ns(run: ControllerRun) -> int:
@@ -100,6 +130,8 @@ def import_run(
     recordings: Path,
     station: str = DEFAULT_STATION,
     rerun: RerunOptions | None = None,
+    replay: PredictorReplay | None = None,
+    ledger: WearLedger | None = None,
 ) -> ImportedRun:
     """Write ``run`` under ``recordings`` (skipped if a finished import is there).
 
@@ -111,15 +143,21 @@ def import_run(
     copies = [read_copy(path) for path in run_files(day, prefix)] if day.is_dir() else []
     finished = next((copy for copy in copies if copy.holds(len(run))), None)
     if finished is not None:
-        return ImportedRun(run.source, None, None, len(run), finished.path)
+        counted = _count(ledger, finished.summary)
+        return ImportedRun(run.source, None, None, len(run), finished.path, newly_counted=counted)
     unfinished = [copy.path for copy in copies if copy.imported]
     if day.is_dir():
         remove_leftovers(day, prefix)
     target = _target(canonical, unfinished)
-    rrd = _write(run, station, target, rerun)
+    rrd = _write(run, station, target, rerun, replay)
     moves = [(temporary_path(target), target)]
     if rrd:  # the .rrd first: a .mcap under its real name means the run is complete
         moves.insert(0, (temporary_path(target).with_suffix(".rrd"), target.with_suffix(".rrd")))
+    try:
+        counted = _count(ledger, replay.summary if replay is not None else None)
+    except BoltwatchError:
+        remove_temporary([temporary for temporary, _ in moves])
+        raise
     try:
         put_in_place(moves)
     except OSError as err:
@@ -134,6 +172,7 @@ def import_run(
         target.with_suffix(".rrd") if rrd else None,
         len(run),
         replaced=replaced,
+        newly_counted=counted,
     )
 
 
@@ -163,6 +202,7 @@ def _write(
     station: str,
     target: Path,
     rerun: RerunOptions | None,
+    replay: PredictorReplay | None,
 ) -> bool:
     """Write the run under temporary names beside ``target``; True when a ``.rrd`` was too."""
     temporary = temporary_path(target)
@@ -176,7 +216,7 @@ def _write(
         try:
             if rerun is not None:
                 companion = _open_rerun(run, station, target, rerun)
-            for topic, message, time_ns in controller_messages(station, run):
+            for topic, message, time_ns in controller_messages(station, run, replay):
                 received = _received(station, topic, message, time_ns)
                 sink.write(received)
                 if companion is not None:
@@ -227,6 +267,18 @@ def _open_rerun(run: ControllerRun, station: str, target: Path, options: RerunOp
         why = _real_names(str(err), target)
         raise RunNotWrittenError(
             f"{target.with_suffix('.rrd')}: the Rerun recording cannot be opened: {why}"
+        ) from err
+
+
+def _count(ledger: WearLedger | None, summary: RunSummary | None) -> bool:
+    """Add the run to the wear ledger; True when it was not in it yet."""
+    if ledger is None or summary is None:
+        return False
+    try:
+        return ledger.add_run(summary, time.time_ns())
+    except sqlite3.Error as err:
+        raise RunNotWrittenError(
+            f"{ledger.path}: the wear ledger cannot be written: {err}"
         ) from err
 
 

@@ -9,10 +9,11 @@ import that was killed (its process is gone) are removed by the next import
 of the same run.
 
 What an earlier import left of a run is told apart by reading it back
-(:class:`RecordedCopy`): a complete file holding every sample of the run is
-"already there"; any other file carrying a ``controller`` record (an
-import's, e.g. cut short) is replaced; a file without one (a live recording
-of the same station and run id) is never touched.
+(:class:`RecordedCopy`): a complete file holding every sample of the run and
+its predictor summary is "already there"; any other file carrying a
+``controller`` record (an import's, e.g. cut short or written before imports
+replayed the predictor) is replaced; a file without one (a live recording of
+the same station and run id) is never touched.
 """
 
 from __future__ import annotations
@@ -26,11 +27,14 @@ from pathlib import Path
 from mcap.records import Message, Metadata
 
 from services.recorder.recording_reader import RecordingScan
+from shared.codec import decode
 from shared.errors import InputError
+from shared.messages import RunSummary
 
 TEMPORARY_MARK = ".importing"
 CONTROLLER_RECORD = "controller"
 _SAMPLE_SCHEMA = "boltwatch.Sample"
+_SUMMARY_SCHEMA = "boltwatch.RunSummary"
 _TEMPORARY = re.compile(r"^\.(?P<stem>.+)\.(?P<pid>\d+)" + re.escape(TEMPORARY_MARK) + r"\.\w+$")
 
 
@@ -42,10 +46,13 @@ class RecordedCopy:
     complete: bool  # the footer was reached
     imported: bool  # carries a ``controller`` record: written by an import
     samples: int
+    summary: RunSummary | None  # the last RunSummary in it
 
     def holds(self, samples: int) -> bool:
         """True when this is a finished import of a run of ``samples`` samples."""
-        return self.imported and self.complete and self.samples == samples
+        return (
+            self.imported and self.complete and self.samples == samples and self.summary is not None
+        )
 
 
 def read_copy(path: Path) -> RecordedCopy:
@@ -53,6 +60,7 @@ def read_copy(path: Path) -> RecordedCopy:
     scan = RecordingScan(path)
     imported = False
     samples = 0
+    summary: RunSummary | None = None
     try:
         for record in scan.records():
             if isinstance(record, Metadata):
@@ -63,9 +71,11 @@ def read_copy(path: Path) -> RecordedCopy:
                 name = schema.name if schema is not None else None
                 if name == _SAMPLE_SCHEMA:
                     samples += 1
+                elif name == _SUMMARY_SCHEMA:
+                    summary = decode(RunSummary, record.data)
     except InputError:
-        return RecordedCopy(path, False, imported, samples)
-    return RecordedCopy(path, scan.complete, imported, samples)
+        return RecordedCopy(path, False, imported, samples, summary)
+    return RecordedCopy(path, scan.complete, imported, samples, summary)
 
 
 def run_files(day: Path, stem_prefix: str) -> list[Path]:

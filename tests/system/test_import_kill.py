@@ -5,7 +5,7 @@ killed part way, five times in a row (at start-up, then each time right
 after another run got its name), each restart going on from what the last
 left. Whatever moment a kill lands on, every ``.mcap`` under its real
 name is complete with all its samples, its predictor summary and its
-``.rrd``. A last, unkilled import
+``.rrd``; the wear ledger never holds a run twice. A last, unkilled import
 finishes every run, skips none it has not finished, and leaves no temporary
 file behind.
 """
@@ -21,6 +21,7 @@ from pathlib import Path
 import pytest
 
 from services.recorder.import_files import read_copy
+from services.recorder.wear_ledger import WearLedger
 from tests.paths import PROJECT_REAL_RUNS, REPO
 
 pytestmark = pytest.mark.system
@@ -75,7 +76,7 @@ def wait_for(recordings: Path, finished: int, writing: bool, child: subprocess.P
 
 
 def check_what_is_there(recordings: Path, runs: dict[int, tuple[Path, int]]) -> int:
-    """Every visible .mcap is a finished import, with its .rrd."""
+    """Every visible .mcap is a finished import; the ledger counts each run at most once."""
     finished = 0
     for path in recordings.glob("cs351/*/[!.]*.mcap"):  # not the hidden temporaries
         run_id = int(path.name.split("_run")[1].split("_")[0])
@@ -83,6 +84,11 @@ def check_what_is_there(recordings: Path, runs: dict[int, tuple[Path, int]]) -> 
         assert copy.holds(runs[run_id][1]), copy
         assert path.with_suffix(".rrd").stat().st_size > 0
         finished += 1
+    ledger_file = recordings / "wear.sqlite"
+    if ledger_file.exists():
+        with WearLedger(ledger_file, read_only=True) as ledger:
+            counted = sum(tool.runs for tool in ledger.tools())
+        assert finished <= counted <= len(runs)  # counted before its files get their names
     return finished
 
 
@@ -113,3 +119,5 @@ def test_an_import_killed_anywhere_leaves_whole_runs_and_the_next_one_finishes(
     ), (last, finished_after_kills)
     assert check_what_is_there(recordings, runs) == len(runs)
     assert [p for p in recordings.rglob(".*") if p.is_file()] == []  # no temporary left
+    with WearLedger(recordings / "wear.sqlite", read_only=True) as ledger:
+        assert sum(tool.runs for tool in ledger.tools()) == len(runs)

@@ -4,8 +4,13 @@ Reads the JSON runs a Bosch Rexroth CS351 controller exports (one file per
 run, see :mod:`services.recorder.controller_run`) and writes each as a live
 recording would be: ``<recordings>/<station>/<YYYY-MM-DD>/<station>_run<id>_<HHMMSS>.mcap``
 (+ ``.rrd``), same channels, schemas and metadata, the controller's own
-timing kept. ``--csv DIR`` writes offline trace CSVs instead (header
-``time_s,torque_nm,angle_deg,force_n``, force empty) for ``boltwatch predict``.
+timing kept, the controller's result on ``boltwatch/<st>/controller``, and
+the predictor's replay of the run (:mod:`services.cli.controller_replay`):
+its events, intensity, advisory decision and run summary. Each run is
+counted in the wear ledger under the controller's tool serial, once.
+``--csv DIR`` writes offline trace CSVs instead (header
+``time_s,torque_nm,angle_deg,force_n``, force empty, time from the run's
+first sample, like ``boltwatch export``) for ``boltwatch predict``.
 
 Every input is tried, one at a time: a bad file is one line on stderr naming
 the file and what is wrong, the others are still imported, and the last line
@@ -32,9 +37,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "Write each controller run into the recordings folder exactly as the recorder "
         "writes a live run (MCAP with JSON schemas, metadata, a Rerun .rrd beside it), "
         "under the station --station and the date of the run, keeping the controller's "
-        "timing (about 833 Hz, repeated timestamps and gaps as recorded), one file per "
-        "run whatever its duration, written whole or not at all. A run already in the "
-        "folder is skipped. With --csv DIR, write trace CSVs for 'boltwatch predict' "
+        "timing (about 833 Hz, repeated timestamps and gaps as recorded) and its result "
+        "(OK/NOK, each step's nominal and actual values). The predictor is replayed over "
+        "each run (torque only, to the last step's torque target): its events, intensity "
+        "and the stop it would have decided are recorded, marked as a replay, and the run "
+        "counts in the wear ledger under the controller's tool serial, once. A run already "
+        "in the folder is skipped. With --csv DIR, write trace CSVs for 'boltwatch predict' "
         "instead. Bad files are reported one line each; the rest are still imported."
     )
     parser.add_argument("runs", type=Path, nargs="+", metavar="CONTROLLER.json", help="run files")

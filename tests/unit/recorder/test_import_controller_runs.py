@@ -58,7 +58,7 @@ def test_the_project_ships_real_runs_of_both_classes_with_source_and_licence() -
     for row in labels:
         run = read_controller_run(PROJECT_REAL_RUNS / row["file_name"])
         assert str(run.run_id) == row["run_id"]
-        assert run.header["id code"] == row["workpiece_id"]
+        assert run.verdict.part_id == row["workpiece_id"]
 
 
 @pytest.mark.parametrize("runs", REAL_RUN_SETS)
@@ -97,7 +97,7 @@ def test_every_real_run_imports_as_a_live_recording(
         assert [data["torque_nm"] for _, data in samples] == run.torque_nm
         assert [data["force_n"] for _, data in samples] == [None] * len(run)
         times = [data["time_ns"] for _, data in samples]
-        assert times == [run.started_ns + round(t * 1e9) for t in run.time_s]  # own timing
+        assert times == [run.date_ns + round(t * 1e9) for t in run.time_s]  # own timing
         assert [m.log_time for m, _ in samples] == times
         assert [m.sequence for m, _ in samples] == list(range(len(run)))
         assert metadata["station"]["station"] == "cs351"
@@ -184,6 +184,13 @@ def broken_copies(folder: Path) -> dict[str, tuple[Path, str]]:
     bad_date = dict(document, date="yesterday")
     put("bad_date", json.dumps(bad_date), "'date': expected 'YYYY-MM-DD HH:MM:SS'")
     put("not_a_run", json.dumps([1, 2]), "expected a JSON object (a CS351 run), got list")
+    bad_nominal = json.loads(text)
+    bad_nominal["tightening steps"][3]["tightening functions"][0]["nom"] = "1.4"
+    put(
+        "bad_nominal",
+        json.dumps(bad_nominal),
+        "tightening steps[3].tightening functions[0].nom: expected a finite number, got '1.4'",
+    )
     return out
 
 
