@@ -108,7 +108,18 @@ def test_an_imported_run_holds_the_predictor_output_of_a_live_run(
     path = recording_of(recordings, RUNS[0])  # the post-mortem shows the predictor's view
     assert main(["inspect", str(path), "--out", str(tmp_path / "run.png")]) == 0
     events = messages_by_topic(path)["events"]
-    assert f"624 samples, {len(events)} stick-slip events" in capsys.readouterr().out
+    assert f"run 1596334, 624 samples, {len(events)} stick-slip events" in capsys.readouterr().out
+
+
+def test_inspect_asked_for_a_run_the_file_lacks_names_the_runs_it_has(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert import_runs(RUNS[:1], tmp_path) == 0
+    path = recording_of(tmp_path, RUNS[0])
+    capsys.readouterr()
+    assert main(["inspect", str(path), "--run", "5", "--out", str(tmp_path / "x.png")]) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line == f"boltwatch inspect: {path}: no samples of run 5 (runs in the file: 1596334)"
 
 
 def test_imported_runs_count_in_the_wear_ledger_once_by_station_and_run(
