@@ -4,6 +4,8 @@ The wire format is plain JSON (one object per message, UTF-8). The schema is
 derived from the dataclass annotations, so code and schema cannot drift:
 ``int`` -> integer, ``float`` -> number, ``str`` -> string, ``X | None`` ->
 ``[X, null]``, ``Literal[...]`` -> enum, nested dataclasses and lists nest.
+A field with a default is not required (payloads from before it was added
+stay valid and decode to the default).
 """
 
 from __future__ import annotations
@@ -286,14 +288,21 @@ _SCHEMAS: dict[type, dict[str, Any]] = {}
 
 
 def _object_schema(message_type: type) -> dict[str, Any]:
+    """Every field a property; required unless it has a default (a field added later with a
+    default keeps older payloads, which lack it, valid: they decode to the default)."""
     hints = typing.get_type_hints(message_type)
-    properties = {f.name: _type_schema(hints[f.name]) for f in dataclasses.fields(message_type)}
+    fields = dataclasses.fields(message_type)
+    properties = {f.name: _type_schema(hints[f.name]) for f in fields}
     return {
         "type": "object",
         "properties": properties,
-        "required": list(properties),
+        "required": [f.name for f in fields if _required(f)],
         "additionalProperties": False,
     }
+
+
+def _required(field: dataclasses.Field[Any]) -> bool:
+    return field.default is dataclasses.MISSING and field.default_factory is dataclasses.MISSING
 
 
 def _type_schema(hint: Any) -> dict[str, Any]:

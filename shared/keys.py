@@ -13,12 +13,15 @@ key                        publisher                    payload (see :mod:`share
 ``decision``               predictor                    :class:`StopDecision`
 ``runs``                   predictor                    :class:`RunSummary`, one per run
 ``recorder``               recorder                     :class:`RecorderStats`, once a second
+``controller``             import (a controller bridge) :class:`ControllerResult`, one per run
 ``wear``                   recorder (queryable)         wear ledger rows
 ``health/<service>``       every service (liveliness)   -
 =========================  ===========================  =================================
 
-``tool``, ``bus`` and ``recorder`` are additions to DESIGN.md's list: services need run
-boundaries, bus fault counters and recorder health, and those are neither samples nor runs.
+``tool``, ``bus``, ``recorder`` and ``controller`` are additions to DESIGN.md's list:
+services need run boundaries, bus fault counters and recorder health, and a plant needs
+its tool controllers' own results (OK/NOK, each step's values); none of those is a sample
+or a run summary.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ INTENSITY = "intensity"
 DECISION = "decision"
 RUNS = "runs"
 RECORDER = "recorder"
+CONTROLLER = "controller"
 WEAR = "wear"
 HEALTH = "health"
 

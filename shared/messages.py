@@ -158,8 +158,11 @@ class StopDecision:
     torque_nm: float
     force_n: float | None
     predicted_force_n: float | None  # the force the stop is predicted to land on (force target)
-    decided_ns: int  # wall clock when the decision was published
+    decided_ns: int  # wall clock when the decision was published (a replay: the sample's time)
     predicted_torque_nm: float | None = None  # the torque it lands on (torque target)
+    # True: decided on a replay of a run a tool controller stopped (``boltwatch import``),
+    # never acted on; False (the default, also when absent on the wire): a live decision
+    advisory: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -199,6 +202,63 @@ class RecorderStats:
     missing_samples: int = 0  # published by the acquisition (BusStats) but never received
 
 
+@dataclass(frozen=True, slots=True)
+class ControllerFunction:
+    """One function of a controller step, with its nominal and actual value.
+
+    Tightening functions (``TF ...``) end the step when reached; monitoring
+    functions (``MF ...``, ``MFs ...``) are windows the step must stay in.
+    Values are in the function's own unit: torque in the run's
+    ``torque_unit``, angle in degrees, time in seconds.
+    """
+
+    name: str  # as the controller names it, e.g. "TF Torque", "MFs TorqueMax"
+    nominal: float | None  # ``nom``; None when the controller gave none
+    actual: float | None  # ``act``
+
+
+@dataclass(frozen=True, slots=True)
+class ControllerStep:
+    """One step of a controller's tightening program and how it went."""
+
+    name: str  # e.g. "Finding", "Thread forming", "Tightening 1.4"
+    result: str  # "OK" or "NOK" as the controller wrote it ("" when it wrote none)
+    quality_code: str
+    samples: int  # samples of the step's graph
+    functions: list[ControllerFunction] = field(default_factory=list)
+
+
+@dataclass(frozen=True, slots=True)
+class ControllerResult:
+    """A tool controller's own result of one run: its verdict, codes and every step's values.
+
+    Published once per run, when it ended (imported controller runs; a
+    controller bridge would publish the same). Batch counters are the
+    controller's, ``-1`` where it keeps no batch, None where the file had none.
+    """
+
+    station: str
+    run_id: int
+    tool_id: int
+    program_id: int
+    time_ns: int  # the run's last sample
+    result: str  # "OK" or "NOK": the controller's verdict on the whole run
+    quality_code: str
+    part_id: str  # ``id code``: the part (work piece) the run tightened
+    torque_unit: str
+    # trailing samples of the last step's graph that are the tool unloading (``torsion release``)
+    torsion_release_samples: int | None
+    batch_number: int | None
+    batch_ok: int | None
+    batch_nok: int | None
+    batch_max_ok: int | None
+    batch_max_nok: int | None
+    batch_canceled: int | None
+    batch_direction_ok: int | None
+    batch_direction_nok: int | None
+    steps: list[ControllerStep] = field(default_factory=list)
+
+
 #: Registry name of each message type: MCAP schema names and documentation.
 MESSAGE_TYPES: dict[str, type] = {
     f"boltwatch.{cls.__name__}": cls
@@ -211,5 +271,6 @@ MESSAGE_TYPES: dict[str, type] = {
         StopDecision,
         RunSummary,
         RecorderStats,
+        ControllerResult,
     )
 }

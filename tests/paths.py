@@ -7,9 +7,11 @@ CONFIG = REPO / "config"
 STATION_FILE = CONFIG / "station.toml"
 DBC_FILE = CONFIG / "can" / "station.dbc"
 JOINT_5_2 = CONFIG / "joints" / "paper-section-5-2.toml"
-#: ../shared beside the checkout (CI puts it there); never copied into the project.
+#: ../shared beside the checkout (CI puts it there); a bare clone has none.
 HANDBOOK_DATA = REPO.parent / "shared" / "data"
-#: real controller runs shipped with the project (tests/data/cs351-real-runs/README.md)
+#: Four real CS351 runs shipped with the project (both classes; source and licence in
+#: its README.md): every test can use them, in a bare clone too.
 PROJECT_REAL_RUNS = REPO / "tests" / "data" / "cs351-real-runs"
-#: the ten real runs of the handbook, a wider check when ../shared is there
+#: The ten real CS351 runs of the team handbook, a wider check where ../shared is there
+#: (tests skip it, with the reason, where it is not).
 HANDBOOK_REAL_RUNS = HANDBOOK_DATA / "cs351-real-runs"

@@ -1,1 +1,10 @@
-"""The ``boltwatch`` command line: the one place that knows every service."""
+"""The ``boltwatch`` command line: the one place that knows every service.
+
+- :mod:`.main` (entry point), :mod:`.commands` (one module per subcommand),
+  :mod:`.command_options` (options several commands share)
+- ``boltwatch up``: :mod:`.station_run`, :mod:`.station_supervisor`, :mod:`.run_table`
+- ``boltwatch status``: :mod:`.station_status`, :mod:`.station_status_text`
+- ``boltwatch import``: :mod:`.import_destination` (recordings or trace CSVs),
+  :mod:`.controller_replay` (the predictor over an imported run: here, because
+  the recorder may not import the predictor)
+"""

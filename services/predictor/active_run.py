@@ -1,7 +1,8 @@
 """One tightening run as the live service sees it: a core plus the run's bookkeeping.
 
 Turns the core's plain outputs into :mod:`shared.messages` (events,
-intensity, decision) and, at the end, the run's :class:`RunSummary`.
+intensity, decision: :mod:`services.predictor.run_messages`) and, at the
+end, the run's :class:`RunSummary`.
 Pure: the wall-clock time of a decision is passed in by the caller.
 """
 
@@ -10,6 +11,7 @@ from __future__ import annotations
 import math
 
 from services.predictor.core import CoreDecision, CoreEvent, PredictorCore, PredictorSettings
+from services.predictor.run_messages import decision_message, event_messages
 from shared.config import Program
 from shared.messages import (
     Intensity,
@@ -58,53 +60,21 @@ class ActiveRun:
         return messages
 
     def _event_messages(self, event: CoreEvent, sample: Sample) -> list[Outgoing]:
-        station, run_id = self.state.station, self.state.run_id
-        return [
-            StickSlipEvent(
-                station=station,
-                run_id=run_id,
-                index=event.index,
-                time_ns=self.started_ns + round(event.time_s * 1e9),
-                time_s=event.time_s,
-                peak_torque_nm=event.peak_torque_nm,
-                min_torque_nm=event.min_torque_nm,
-                torque_drop_nm=event.torque_drop_nm,
-                plateau_force_n=event.plateau_force_n,
-                force_step_n=event.force_step_n,
-                period_s=event.period_s,
-                f_ss_hz=event.f_ss_hz,
-                k1=event.k1,
-                k2=event.k2,
-                k3=event.k3,
-                intensity=event.intensity,
-                process_intensity=event.process_intensity,
-                predictions=list(event.predictions),
-            ),
-            Intensity(
-                station=station,
-                run_id=run_id,
-                time_ns=sample.time_ns,
-                event_intensity=event.intensity if event.intensity is not None else 0.0,
-                process_intensity=event.process_intensity,
-            ),
-        ]
+        state = self.state
+        return list(
+            event_messages(state.station, state.run_id, self.started_ns, event, sample.time_ns)
+        )
 
     def _decision_message(
         self, decision: CoreDecision, sample: Sample, wall_ns: int
     ) -> StopDecision:
-        torque = decision.torque_nm if math.isfinite(decision.torque_nm) else sample.torque_nm
-        self.decision = StopDecision(
-            station=self.state.station,
-            run_id=self.state.run_id,
-            time_ns=sample.time_ns,
-            time_s=decision.time_s,
-            reason=decision.reason,
-            detail=decision.detail,
-            torque_nm=torque,
-            force_n=decision.force_n,
-            predicted_force_n=decision.predicted_force_n,
-            predicted_torque_nm=decision.predicted_torque_nm,
-            decided_ns=wall_ns,
+        self.decision = decision_message(
+            self.state.station,
+            self.state.run_id,
+            decision,
+            sample.time_ns,
+            sample.torque_nm,
+            wall_ns,
         )
         return self.decision
 

@@ -1,1 +1,21 @@
-"""Recorder: MCAP files per run, Rerun, and the machine-wear ledger."""
+"""Recorder: MCAP files per run, Rerun, and the machine-wear ledger.
+
+Files, one concept each:
+
+- live recording: :mod:`.service` (zenoh wiring), :mod:`.arguments`,
+  :mod:`.line_inbox`, :mod:`.incoming` (classify and decode), :mod:`.recorder`
+  (payloads into files, disk faults), :mod:`.run_files` (one file per run),
+  :mod:`.mcap_sink`, :mod:`.file_metadata`, :mod:`.recorder_health`
+- Rerun: :mod:`.rerun_sink`, :mod:`.rerun_streams`, :mod:`.rerun_blueprint`
+- wear: :mod:`.wear_ledger` (SQLite), :mod:`.wear_watch` (summaries in, alerts
+  out), :mod:`.wear_table`
+- reading back: :mod:`.recording_reader`, :mod:`.json_decoder`,
+  :mod:`.trace_export`, :mod:`.recovery`, :mod:`.rrd_recovery`, and the
+  post-mortem :mod:`.run_plot`, :mod:`.post_mortem_run`,
+  :mod:`.post_mortem_panels`, :mod:`.post_mortem_errors`
+- controller runs (``boltwatch import``): :mod:`.controller_run` (the JSON),
+  :mod:`.controller_steps` (the controller's result), :mod:`.controller_timing`
+  (its clock), :mod:`.controller_import` (into recordings),
+  :mod:`.import_files` (whole or not at all)
+- :mod:`.testing`: helpers for tests (station files on loopback, free ports)
+"""

@@ -1,45 +1,78 @@
-"""Controller runs into the recordings folder, as the live recorder would have written them.
+"""Controller runs into the recordings folder, as the live station would have recorded them.
 
 Each :class:`ControllerRun` becomes the messages a live station publishes
-(``ToolState`` running, one ``Sample`` per controller sample with
-``force_n`` None, ``ToolState`` done) and goes through the recorder's own
-:class:`~services.recorder.recorder.Recorder`: same channels, schemas,
-metadata records, folders and file names as a live recording, plus a
-``controller`` metadata record with the controller's header. Times are the
-controller's own: ``time_ns`` = ``date`` + ``time values``, used as both
-log and publish time, repeated timestamps and gaps unchanged; ``sequence``
-is the sample's index in the run.
+(``ToolState`` running, one ``Sample`` per controller sample with ``force_n``
+None, ``ToolState`` done), the controller's own result (``ControllerResult``
+on ``boltwatch/<st>/controller``) and, when given, what the predictor made of
+it (:class:`PredictorReplay`: events, intensities, the advisory decision
+after the sample that caused each, and the ``RunSummary`` at the end). They
+are written with the recorder's own :class:`~services.recorder.mcap_sink.McapSink`
+(and :class:`~services.recorder.rerun_sink.RerunSink`): same channels,
+schemas, metadata records, folders and file names as a live recording, plus
+a ``controller`` metadata record with the controller's header.
+
+Times are the controller's own: a sample's ``time_ns`` = ``date`` + its
+``time values`` entry, used as both log and publish time, repeated
+timestamps and gaps unchanged; ``sequence`` is the sample's index in the
+run. A run is one file, whatever its times say (the live recorder's
+rotation bounds runs that never end; an imported run has its end).
+
+A run is written whole or not at all (:mod:`services.recorder.import_files`),
+and counted in the wear ledger (by (station, run): never twice) before its
+files get their real names, so a run in the folder is a run in the ledger.
+The recording is not written here: this package may not import the
+predictor; the command line replays it and hands the messages in.
 """
 
 from __future__ import annotations
 
+import contextlib
 import re
-from dataclasses import dataclass
+import sqlite3
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from services.recorder.controller_run import ControllerRun
 from services.recorder.file_metadata import FileMetadata
+from services.recorder.import_files import (
+    put_in_place,
+    read_copy,
+    remove_leftovers,
+    remove_temporary,
+    run_files,
+    temporary_path,
+)
 from services.recorder.incoming import Received, classify
-from services.recorder.recorder import Recorder
-from services.recorder.run_files import FileLimits, file_path
+from services.recorder.mcap_sink import McapSink
+from services.recorder.recorder import describe_os_error
+from services.recorder.run_files import file_path
 from shared import keys
 from shared.codec import encode
-from shared.errors import InputError
-from shared.messages import Sample, ToolState
+from shared.errors import BoltwatchError, InputError
+from shared.messages import RunSummary, Sample, ToolState
 
 if TYPE_CHECKING:
-    from services.recorder.rerun_sink import RerunOptions
+    from services.recorder.rerun_sink import RerunOptions, RerunSink
+    from services.recorder.wear_ledger import WearLedger
 
 STATION_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 DEFAULT_STATION = "cs351"
-#: One chunk per second of controller time; a run is one file (runs last seconds).
-IMPORT_LIMITS = FileLimits(
-    flush_interval_ns=1_000_000_000,
-    max_file_bytes=256 * 1024 * 1024,
-    max_file_duration_ns=3600 * 1_000_000_000,
-    late_grace_ns=0,
-)
+
+
+class RunNotWrittenError(BoltwatchError):
+    """The run's files could not be written (disk, folder, Rerun); nothing of it was kept."""
+
+
+@dataclass(frozen=True, slots=True)
+class PredictorReplay:
+    """What the predictor core made of a run, to record beside its samples."""
+
+    #: (index of the sample after which it was published, topic, message), in order
+    outputs: list[tuple[int, str, Any]]
+    summary: RunSummary
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,7 +81,9 @@ class ImportedRun:
     mcap: Path | None  # None: skipped, already in the recordings folder
     rrd: Path | None
     samples: int
-    existing: Path | None = None
+    existing: Path | None = None  # the finished import that was there already
+    replaced: list[Path] = field(default_factory=list)  # unfinished imports replaced
+    newly_counted: bool = False  # the run entered the wear ledger now
 
 
 def check_station_id(station: str) -> str:
@@ -59,26 +94,35 @@ def check_station_id(station: str) -> str:
     return station
 
 
-def already_imported(recordings: Path, station: str, run: ControllerRun) -> Path | None:
-    """The file of this run in its day folder, if one is there already."""
-    day = file_path(recordings, station, run.run_id, run.started_ns).parent
-    return next(iter(sorted(day.glob(f"{station}_run{run.run_id}_*.mcap"))), None)
-
-
-def controller_messages(station: str, run: ControllerRun) -> list[tuple[str, Any, int]]:
-    """(topic, message, time_ns) of the run, in order, as a live station publishes them."""
-    times_ns = [run.started_ns + round(t * 1e9) for t in run.time_s]
-    out: list[tuple[str, Any, int]] = [
-        (keys.TOOL, _state(station, run, "running", run.started_ns), run.started_ns)
-    ]
+def controller_messages(
+    station: str, run: ControllerRun, replay: PredictorReplay | None = None
+) -> Iterator[tuple[str, Any, int]]:
+    """(topic, message, log time ns) of the run, in order, as a live station publishes them."""
+    started_ns = run.started_ns
+    outputs = replay.outputs if replay is not None else []
+    next_output = 0
+    yield keys.TOOL, _state(station, run, "running", started_ns), started_ns
     for sequence, (time_ns, torque, angle) in enumerate(
-        zip(times_ns, run.torque_nm, run.angle_deg, strict=True)
+        zip(run.times_ns, run.torque_nm, run.angle_deg, strict=True)
     ):
         sample = Sample(station, run.run_id, sequence, time_ns, torque, angle, None)
-        out.append((keys.SAMPLES, sample, time_ns))
-    end_ns = max(times_ns[-1], run.started_ns) + 1
-    out.append((keys.TOOL, _state(station, run, "done", end_ns), end_ns))
-    return out
+        yield keys.SAMPLES, sample, time_ns
+        while next_output < len(outputs) and outputs[next_output][0] <= sequence:
+            _, topic, message = outputs[next_output]
+            yield topic, message, time_ns
+            next_output += 1
+    end_ns = run_end_ns(run)
+    for _, topic, message in outputs[next_output:]:
+        yield topic, message, end_ns
+    yield keys.TOOL, _state(station, run, "done", end_ns), end_ns
+    yield keys.CONTROLLER, run.result(station, end_ns), end_ns
+    if replay is not None:
+        yield keys.RUNS, replay.summary, end_ns
+
+
+def run_end_ns(run: ControllerRun) -> int:
+    """When the run ended: one nanosecond after its last sample (``ToolState`` done)."""
+    return run.times_ns[-1] + 1
 
 
 def import_run(
@@ -86,21 +130,50 @@ def import_run(
     recordings: Path,
     station: str = DEFAULT_STATION,
     rerun: RerunOptions | None = None,
+    replay: PredictorReplay | None = None,
+    ledger: WearLedger | None = None,
 ) -> ImportedRun:
-    """Write ``run`` under ``recordings`` with the recorder's writing code (skip if there)."""
-    existing = already_imported(recordings, station, run)
-    if existing is not None:
-        return ImportedRun(run.source, None, None, len(run), existing)
-    metadata = FileMetadata([], extra={"controller": controller_record(run)}, warn_unknown=False)
-    recorder = Recorder(recordings, IMPORT_LIMITS, metadata, rerun)
+    """Write ``run`` under ``recordings`` (skipped if a finished import is there).
+
+    RunNotWrittenError when its files cannot be written; nothing of it is left then.
+    """
+    canonical = file_path(recordings, station, run.run_id, run.started_ns, unique=False)
+    day = canonical.parent
+    prefix = f"{day.parent.name}_run{run.run_id}_"  # the station as file_path made it safe
+    copies = [read_copy(path) for path in run_files(day, prefix)] if day.is_dir() else []
+    finished = next((copy for copy in copies if copy.holds(len(run))), None)
+    if finished is not None:
+        counted = _count(ledger, finished.summary)
+        return ImportedRun(run.source, None, None, len(run), finished.path, newly_counted=counted)
+    unfinished = [copy.path for copy in copies if copy.imported]
+    if day.is_dir():
+        remove_leftovers(day, prefix)
+    target = _target(canonical, unfinished)
+    rrd = _write(run, station, target, rerun, replay)
+    moves = [(temporary_path(target), target)]
+    if rrd:  # the .rrd first: a .mcap under its real name means the run is complete
+        moves.insert(0, (temporary_path(target).with_suffix(".rrd"), target.with_suffix(".rrd")))
     try:
-        for topic, message, time_ns in controller_messages(station, run):
-            recorder.write(_received(station, topic, message, time_ns))
-    finally:
-        closed = recorder.close()
-    (mcap,) = closed
-    rrd = mcap.with_suffix(".rrd")
-    return ImportedRun(run.source, mcap, rrd if rrd.is_file() else None, len(run))
+        counted = _count(ledger, replay.summary if replay is not None else None)
+    except BoltwatchError:
+        remove_temporary([temporary for temporary, _ in moves])
+        raise
+    try:
+        put_in_place(moves)
+    except OSError as err:
+        remove_temporary([temporary for temporary, _ in moves])
+        raise RunNotWrittenError(
+            f"cannot rename into {target}: {describe_os_error(err, target)}"
+        ) from err
+    replaced = _remove_replaced(unfinished, target, has_rrd=rrd)
+    return ImportedRun(
+        run.source,
+        target,
+        target.with_suffix(".rrd") if rrd else None,
+        len(run),
+        replaced=replaced,
+        newly_counted=counted,
+    )
 
 
 def controller_record(run: ControllerRun) -> dict[str, str]:
@@ -113,6 +186,112 @@ def controller_record(run: ControllerRun) -> dict[str, str]:
     }
     record.update(run.header)
     return record
+
+
+def _target(canonical: Path, unfinished: list[Path]) -> Path:
+    """The run's real name: its canonical one, unless a file that is not an import has it."""
+    candidate, copy = canonical, 2
+    while candidate.exists() and candidate not in unfinished:
+        candidate = canonical.with_name(f"{canonical.stem}_{copy}.mcap")
+        copy += 1
+    return candidate
+
+
+def _write(
+    run: ControllerRun,
+    station: str,
+    target: Path,
+    rerun: RerunOptions | None,
+    replay: PredictorReplay | None,
+) -> bool:
+    """Write the run under temporary names beside ``target``; True when a ``.rrd`` was too."""
+    temporary = temporary_path(target)
+    metadata = FileMetadata([], extra={"controller": controller_record(run)}, warn_unknown=False)
+    records = metadata.for_file(station, run.run_id, run.tool_id, run.program_id)
+    companion: RerunSink | None = None
+    try:
+        sink = McapSink(
+            temporary, records, run.run_id, run.started_ns, f"boltwatch {metadata.version}"
+        )
+        try:
+            if rerun is not None:
+                companion = _open_rerun(run, station, target, rerun)
+            for topic, message, time_ns in controller_messages(station, run, replay):
+                received = _received(station, topic, message, time_ns)
+                sink.write(received)
+                if companion is not None:
+                    companion.write(received)
+            sink.close()
+        except BaseException:
+            sink.abandon()
+            raise
+        finally:
+            if companion is not None:
+                companion.close()
+        if companion is not None and companion.failed:
+            rrd = target.with_suffix(".rrd")
+            raise RunNotWrittenError(f"{rrd}: the Rerun recording failed (see the log above)")
+    except OSError as err:
+        remove_temporary([temporary, temporary.with_suffix(".rrd")])
+        _remove_if_empty(target.parent)
+        raise RunNotWrittenError(_real_names(describe_os_error(err, target), target)) from err
+    except BaseException:
+        remove_temporary([temporary, temporary.with_suffix(".rrd")])
+        _remove_if_empty(target.parent)
+        raise
+    return companion is not None
+
+
+def _remove_if_empty(folder: Path) -> None:
+    """A day folder made for a run that failed goes with it (if nothing else is in it)."""
+    with contextlib.suppress(OSError):
+        folder.rmdir()
+
+
+def _real_names(text: str, target: Path) -> str:
+    """``text`` (an error) with the temporary names put back to the real ones: a person
+    looks for the file the run was going to, not for a hidden one that is gone."""
+    return text.replace(str(temporary_path(target).with_suffix("")), str(target.with_suffix("")))
+
+
+def _open_rerun(run: ControllerRun, station: str, target: Path, options: RerunOptions) -> RerunSink:
+    """The run's Rerun sink, writing the temporary ``.rrd`` beside ``target``."""
+    from services.recorder.rerun_sink import RerunSink
+
+    temporary = temporary_path(target).with_suffix(".rrd")
+    try:
+        return RerunSink(temporary, station, run.run_id, run.started_ns, options, target.stem)
+    except OSError:
+        raise
+    except Exception as err:  # the rerun SDK raises its own errors
+        why = _real_names(str(err), target)
+        raise RunNotWrittenError(
+            f"{target.with_suffix('.rrd')}: the Rerun recording cannot be opened: {why}"
+        ) from err
+
+
+def _count(ledger: WearLedger | None, summary: RunSummary | None) -> bool:
+    """Add the run to the wear ledger; True when it was not in it yet."""
+    if ledger is None or summary is None:
+        return False
+    try:
+        return ledger.add_run(summary, time.time_ns())
+    except sqlite3.Error as err:
+        raise RunNotWrittenError(
+            f"{ledger.path}: the wear ledger cannot be written: {err}"
+        ) from err
+
+
+def _remove_replaced(unfinished: list[Path], target: Path, has_rrd: bool) -> list[Path]:
+    """Remove the unfinished imports the new file replaces (and their ``.rrd``)."""
+    replaced: list[Path] = []
+    for path in unfinished:
+        if path != target:
+            path.unlink(missing_ok=True)
+        if path != target or not has_rrd:
+            path.with_suffix(".rrd").unlink(missing_ok=True)
+        replaced.append(path)
+    return replaced
 
 
 def _state(station: str, run: ControllerRun, state: Any, time_ns: int) -> ToolState:

@@ -35,6 +35,7 @@ TOPIC_TYPES: dict[str, str] = {
     keys.DECISION: "boltwatch.StopDecision",
     keys.RUNS: "boltwatch.RunSummary",
     keys.RECORDER: "boltwatch.RecorderStats",
+    keys.CONTROLLER: "boltwatch.ControllerResult",
     ALERT_TOPIC: "boltwatch.WearAlert",
 }
 

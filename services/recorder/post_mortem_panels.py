@@ -16,7 +16,7 @@ import numpy as np
 
 from services.recorder.post_mortem_errors import HORIZONS, PredictionError
 from services.recorder.post_mortem_run import ModelClock, RecordedRun
-from shared.messages import StickSlipEvent
+from shared.messages import StickSlipEvent, StopDecision
 from shared.model import JointModel
 from shared.model.slip_bounds import PAPER_PARTIAL_RELIEF
 
@@ -67,6 +67,12 @@ def _legend(ax: Any, loc: str = "upper right") -> None:
         ax.legend(loc=loc, fontsize=SMALL)
 
 
+def _decision_label(decision: StopDecision) -> str:
+    if decision.advisory:
+        return f"replayed stop decision ({decision.reason}, not acted on)"
+    return f"stop decision ({decision.reason})"
+
+
 def _decisions(ax: Any, run: RecordedRun) -> None:
     for n, decision in enumerate(run.decisions):
         ax.axvline(
@@ -74,7 +80,7 @@ def _decisions(ax: Any, run: RecordedRun) -> None:
             color="black",
             ls="--",
             lw=1.2,
-            label=f"stop decision ({decision.reason})" if n == 0 else None,
+            label=_decision_label(decision) if n == 0 else None,
         )
 
 

@@ -65,6 +65,7 @@ class RecordedRun:
     motor_speed_rad_s: float | None = None
     model_missing: str = ""  # why there is no model ("" when there is one)
     state: str = ""  # RecordingScan.describe() of the source: complete, or what was lost
+    runs_in_file: list[int] = field(default_factory=list)  # every run with samples in the file
 
     @property
     def t0_ns(self) -> int:
@@ -131,15 +132,11 @@ def read_run(source: Path, run_id: int | None = None) -> RecordedRun:
             undecodable += 1
     if undecodable:
         LOG.warning("%s: %d messages could not be decoded, left out", source, undecodable)
-    if run_id is None and samples:
-        counts: dict[int, int] = {}
-        for sample in samples:
-            counts[sample.run_id] = counts.get(sample.run_id, 0) + 1
-        run_id = max(counts, key=counts.__getitem__)
+    counts: dict[int, int] = {}
+    for sample in samples:
+        counts[sample.run_id] = counts.get(sample.run_id, 0) + 1
+    run_id = _chosen_run(source, counts, run_id, scan.damage)
     samples = [s for s in samples if s.run_id == run_id]
-    if run_id is None or not samples:
-        damage = "" if scan.damage is None else f" ({scan.damage})"
-        raise InputError(f"{source}: no samples to plot{damage}")
     run = RecordedRun(
         source,
         run_id,
@@ -149,9 +146,24 @@ def read_run(source: Path, run_id: int | None = None) -> RecordedRun:
         metadata,
         scan.complete,
         state=scan.describe(),
+        runs_in_file=sorted(counts),
     )
     run.joint, run.motor_speed_rad_s, run.model_missing = _model_inputs(metadata)
     return run
+
+
+def _chosen_run(
+    source: Path, counts: dict[int, int], run_id: int | None, damage: str | None
+) -> int:
+    """``run_id`` if the file has samples of it, else the run with the most samples."""
+    if not counts:
+        raise InputError(f"{source}: no samples to plot{'' if damage is None else f' ({damage})'}")
+    if run_id is None:
+        return max(counts, key=counts.__getitem__)
+    if run_id not in counts:
+        known = ", ".join(str(run) for run in sorted(counts))
+        raise InputError(f"{source}: no samples of run {run_id} (runs in the file: {known})")
+    return run_id
 
 
 def _model_inputs(

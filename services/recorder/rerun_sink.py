@@ -7,9 +7,10 @@ pooled: :mod:`services.recorder.rerun_streams`) and points it at its own
 also streams to the process's gRPC server (:class:`RerunLive`). Samples are
 buffered in plain lists and sent with ``send_columns`` every
 ``batch_samples`` samples, at each flush tick and at close: nothing per
-sample but a few list appends. Events, predictions, the stop decision and
-the run summary are rare and go out at flush ticks (one chunk per entity
-and tick: each Rerun chunk costs about a kilobyte of schema on disk).
+sample but a few list appends. Events, predictions, the stop decision (a
+replayed one is marked so), the run summary and a controller's result are
+rare and go out at flush ticks (one chunk per entity and tick: each Rerun
+chunk costs about a kilobyte of schema on disk).
 
 MCAP is the record that matters: every Rerun call here is guarded. The first
 failure is logged with its traceback, the sink disables itself and the
@@ -87,6 +88,7 @@ class RerunSink:
         run_id: int,
         run_started_ns: int,
         options: RerunOptions = RerunOptions(),  # frozen: shared safely
+        recording_name: str | None = None,  # default: the file's stem
     ) -> None:
         self.path = path
         self.run_id = run_id
@@ -120,7 +122,7 @@ class RerunSink:
         except Exception:
             self._stream.disconnect()  # drop the buffered sink, not "dropping data" at exit
             raise
-        self._stream.send_recording_name(path.stem)
+        self._stream.send_recording_name(recording_name or path.stem)
         self._stream.send_recording_start_time_nanos(run_started_ns)
         bp.log_series_styles(self._stream)
 
@@ -146,6 +148,8 @@ class RerunSink:
                 self._decision(message)
             elif received.schema_name == "boltwatch.RunSummary":
                 self._summary(message)
+            elif received.schema_name == "boltwatch.ControllerResult":
+                self._controller(message)
             elif received.schema_name == "boltwatch.ToolState":
                 self._text(
                     message.time_ns,
@@ -200,8 +204,9 @@ class RerunSink:
         t_ns = self._run_started_ns + round(decision.time_s * 1e9)
         self._series[bp.TORQUE_STOP].add(t_ns, decision.torque_nm)
         self._series[bp.FORCE_STOP].add(t_ns, decision.force_n)
+        stop = "STOP (replayed, not acted on)" if decision.advisory else "STOP"
         text = (
-            f"STOP {decision.reason} at {decision.time_s:.3f} s: torque {decision.torque_nm:.1f} "
+            f"{stop} {decision.reason} at {decision.time_s:.3f} s: torque {decision.torque_nm:.1f} "
             f"N·m, force {_n(decision.force_n)}, predicted "
             + (
                 f"torque {decision.predicted_torque_nm:.4g} N·m"
@@ -220,6 +225,14 @@ class RerunSink:
             f"I_process {summary.process_intensity:.3g}, {summary.samples} samples"
         )
         self._text(summary.ended_ns, text, "INFO")
+
+    def _controller(self, result: Any) -> None:
+        steps = ", ".join(f"{step.name} {step.result or '?'}" for step in result.steps)
+        text = (
+            f"controller: {result.result or '?'} (quality code {result.quality_code or '-'}, "
+            f"part {result.part_id or '-'}); steps: {steps}"
+        )
+        self._text(result.time_ns, text, "INFO" if result.result == "OK" else "WARN")
 
     def _text(self, time_ns: int, text: str, level: str) -> None:
         self._text_times_ns.append(time_ns)

@@ -56,9 +56,15 @@ class FileLimits:
 
 
 def file_path(
-    folder: Path, station: str, run_id: int | None, opened_ns: int, part: int = 1
+    folder: Path,
+    station: str,
+    run_id: int | None,
+    opened_ns: int,
+    part: int = 1,
+    unique: bool = True,
 ) -> Path:
-    """Where a file opened at ``opened_ns`` goes; never an existing file."""
+    """Where a file opened at ``opened_ns`` goes; never an existing file (``unique=False``:
+    the name it would have in an empty folder, existing or not)."""
     opened = datetime.fromtimestamp(opened_ns / 1e9, UTC)
     safe_station = _UNSAFE.sub("_", station) or "_"
     label = "idle" if run_id is None else f"run{run_id}"
@@ -68,7 +74,7 @@ def file_path(
     day = folder / safe_station / f"{opened:%Y-%m-%d}"
     path = day / f"{stem}.mcap"
     copy = 2
-    while path.exists():
+    while unique and path.exists():
         path = day / f"{stem}_{copy}.mcap"
         copy += 1
     return path

@@ -4,25 +4,29 @@ Reads the JSON runs a Bosch Rexroth CS351 controller exports (one file per
 run, see :mod:`services.recorder.controller_run`) and writes each as a live
 recording would be: ``<recordings>/<station>/<YYYY-MM-DD>/<station>_run<id>_<HHMMSS>.mcap``
 (+ ``.rrd``), same channels, schemas and metadata, the controller's own
-timing kept. ``--csv DIR`` writes offline trace CSVs instead (header
-``time_s,torque_nm,angle_deg,force_n``, force empty) for ``boltwatch predict``.
+timing kept, the controller's result on ``boltwatch/<st>/controller``, and
+the predictor's replay of the run (:mod:`services.cli.controller_replay`):
+its events, intensity, advisory decision and run summary. Each run is
+counted in the wear ledger under the controller's tool serial, once.
+``--csv DIR`` writes offline trace CSVs instead (header
+``time_s,torque_nm,angle_deg,force_n``, force empty, time from the run's
+first sample, like ``boltwatch export``) for ``boltwatch predict``.
 
-Every input is tried: a bad file is one line on stderr naming the file and
-what is wrong, the good ones are still imported, and the exit status is 2
-when any failed.
+Every input is tried, one at a time: a bad file is one line on stderr naming
+the file and what is wrong, the others are still imported, and the last line
+counts what was imported, already there, refused (bad input) and not written
+(the disk). The exit status is 2 when any was refused or not written. Each
+run is written whole or not at all.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from services.cli.command_options import add_recordings_folder_options, recordings_folder
-
-if TYPE_CHECKING:
-    from services.recorder.controller_run import ControllerRun
 
 NAME = "import"
 HELP = "import tightening-controller JSON runs (CS351) as recordings (MCAP), or trace CSVs"
@@ -33,7 +37,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "Write each controller run into the recordings folder exactly as the recorder "
         "writes a live run (MCAP with JSON schemas, metadata, a Rerun .rrd beside it), "
         "under the station --station and the date of the run, keeping the controller's "
-        "timing (about 833 Hz, repeated timestamps and gaps as recorded). A run already "
+        "timing (about 833 Hz, repeated timestamps and gaps as recorded) and its result "
+        "(OK/NOK, each step's nominal and actual values). The predictor is replayed over "
+        "each run (torque only, to the last step's torque target): its events, intensity "
+        "and the stop it would have decided are recorded, marked as a replay, and the run "
+        "counts in the wear ledger under the controller's tool serial, once. A run already "
         "in the folder is skipped. With --csv DIR, write trace CSVs for 'boltwatch predict' "
         "instead. Bad files are reported one line each; the rest are still imported."
     )
@@ -57,72 +65,66 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+@dataclass(slots=True)
+class Tally:
+    """What became of the inputs."""
+
+    inputs: int
+    imported: int = 0
+    already_there: int = 0
+    refused: int = 0  # bad input: the file says what is wrong
+    not_written: int = 0  # good input that could not be written (disk, folder)
+
+    def line(self, where: Path, csv: bool) -> str:
+        what = "runs as trace CSVs" if csv else "runs"
+        line = f"imported {self.imported} of {self.inputs} {what} into {where}"
+        if not csv:
+            line += f", {self.already_there} already there"
+        line += f", {self.refused} refused"
+        if self.not_written:
+            line += f", {self.not_written} not written"
+        return line
+
+
 def run(args: argparse.Namespace) -> int:
+    from services.cli.import_destination import CsvWriter, RecordingsWriter, make_folder
     from services.recorder.controller_import import DEFAULT_STATION, check_station_id
     from services.recorder.controller_run import read_controller_run
-    from shared.errors import InputError
+    from shared.errors import BoltwatchError, InputError
 
-    good: list[ControllerRun] = []
-    failed = 0
-    for path in args.runs:
-        try:
-            good.append(read_controller_run(path))
-        except InputError as err:
-            print(f"boltwatch import: {err}", file=sys.stderr)
-            failed += 1
+    tally = Tally(len(args.runs))
+    writer: CsvWriter | RecordingsWriter
     if args.csv_dir is not None:
-        written = _write_csv(good, args.csv_dir)
-        where = args.csv_dir
+        writer = CsvWriter(make_folder(args.csv_dir, "--csv"))
     else:
         station = check_station_id(args.station or DEFAULT_STATION)
-        recordings = recordings_folder(args)
-        written, write_failed = _write_recordings(good, recordings, station, not args.no_rerun)
-        failed += write_failed
-        where = recordings
-    total = len(args.runs)
-    print(
-        f"imported {written} of {total} runs into {where}"
-        + (f"; {failed} failed" if failed else "")
-    )
-    return 2 if failed else 0
+        folder = make_folder(recordings_folder(args), "recordings folder")
+        writer = RecordingsWriter(folder, station, rerun=not args.no_rerun)
+    with writer:
+        for path in args.runs:
+            try:
+                controller_run = read_controller_run(path)
+            except InputError as err:
+                _error(str(err))
+                tally.refused += 1
+                continue
+            try:
+                done = writer.write(controller_run)
+            except BoltwatchError as err:
+                _error(f"{path}: not written: {err}")
+                tally.not_written += 1
+                continue
+            except Exception as err:  # a fault of ours must not stop the batch either
+                _error(f"{path}: not written: internal error {type(err).__name__}: {err}")
+                tally.not_written += 1
+                continue
+            if done:
+                tally.imported += 1
+            else:
+                tally.already_there += 1
+    print(tally.line(writer.folder, csv=args.csv_dir is not None))
+    return 2 if tally.refused or tally.not_written else 0
 
 
-def _write_csv(runs: list[ControllerRun], out_dir: Path) -> int:
-    from shared.trace import write_trace
-
-    out_dir.mkdir(parents=True, exist_ok=True)
-    for run in runs:
-        target = out_dir / f"{run.source.stem}.csv"
-        rows = zip(run.time_s, run.torque_nm, run.angle_deg, [None] * len(run), strict=True)
-        count = write_trace(target, rows)
-        print(f"{run.source} -> {target} ({count} samples)")
-    return len(runs)
-
-
-def _write_recordings(
-    runs: list[ControllerRun], recordings: Path, station: str, rerun: bool
-) -> tuple[int, int]:
-    """(runs written or already there, runs that could not be written)."""
-    from services.recorder.controller_import import import_run
-
-    options = None
-    if rerun and runs:
-        from services.recorder.rerun_sink import RerunOptions
-
-        options = RerunOptions()
-    done = failed = 0
-    for run in runs:
-        try:
-            imported = import_run(run, recordings, station, options)
-        except OSError as err:
-            print(f"boltwatch import: {run.source}: cannot write into {recordings}: {err}",
-                  file=sys.stderr)  # fmt: skip
-            failed += 1
-            continue
-        done += 1
-        if imported.mcap is None:
-            print(f"{run.source}: run {run.run_id} already in {imported.existing}, skipped")
-        else:
-            extra = f" + {imported.rrd.name}" if imported.rrd is not None else ""
-            print(f"{run.source} -> {imported.mcap}{extra} ({imported.samples} samples)")
-    return done, failed
+def _error(line: str) -> None:
+    print(f"boltwatch import: {line}", file=sys.stderr)

@@ -28,7 +28,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--out", type=Path, default=None, metavar="RUN.png", help="default: beside the recording"
     )
-    add_run_option(parser, "run id to draw")
+    add_run_option(
+        parser,
+        "run id to draw (default: the run with the most samples; the output names the others)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -38,5 +41,10 @@ def run(args: argparse.Namespace) -> int:
     run = draw_run(args.recording, target, args.run)
     if not run.complete:
         warn_damaged_recording(NAME, run.state, "drew what is readable")
-    print(f"wrote {target}: {len(run.samples)} samples, {len(run.events)} stick-slip events")
+    others = [other for other in run.runs_in_file if other != run.run_id]
+    also = f" (other runs in the file: {', '.join(map(str, others))})" if others else ""
+    print(
+        f"wrote {target}: run {run.run_id}, {len(run.samples)} samples, "
+        f"{len(run.events)} stick-slip events{also}"
+    )
     return 0

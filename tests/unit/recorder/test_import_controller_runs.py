@@ -1,7 +1,10 @@
 """``boltwatch import``: the real CS351 runs become recordings like live ones; bad files say so.
 
-Every real run in ``../shared/data/cs351-real-runs`` is imported into MCAP
-with the recorder's own writer, read back with the mcap reader (samples
+The four real runs shipped in ``tests/data/cs351-real-runs`` are always
+imported (a bare clone has nothing else); the ten of the team handbook
+(``../shared/data/cs351-real-runs``) are the same check, wider, skipped with
+the reason where they are not beside the checkout. Each is imported into
+MCAP with the recorder's own writer, read back with the mcap reader (samples
 decoded with ``json`` alone), and opened by ``boltwatch export`` and
 ``boltwatch inspect``. Broken copies (cut, wrong types, missing fields) each
 give one line naming the file and the fault, and do not stop the others.
@@ -9,6 +12,7 @@ give one line naming the file and the fault, and do not stop the others.
 
 from __future__ import annotations
 
+import csv
 import json
 import shutil
 from datetime import UTC, datetime
@@ -20,38 +24,69 @@ from mcap.reader import make_reader
 from services.cli.main import main
 from services.recorder.controller_run import read_controller_run
 from shared.codec import json_schema
-from shared.messages import Sample
+from shared.messages import MESSAGE_TYPES
 from shared.trace import read_trace
+from tests.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 
-#: ../shared/data beside the checkout (tests/paths.py: HANDBOOK_DATA), never copied here.
-#: This folder has no __init__.py, so it is found from this file.
-HANDBOOK_DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
-RUNS = sorted((HANDBOOK_DATA / "cs351-real-runs").glob("Ch_*.json"))
+SHIPPED = sorted(PROJECT_REAL_RUNS.glob("Ch_*.json"))
+HANDBOOK = sorted(HANDBOOK_REAL_RUNS.glob("Ch_*.json"))
+NEEDS_HANDBOOK = pytest.mark.skipif(
+    len(HANDBOOK) != 10,
+    reason=f"the ten real runs of the team handbook are not beside the checkout "
+    f"({HANDBOOK_REAL_RUNS}); the four shipped ones are checked instead",
+)
+REAL_RUN_SETS = [
+    pytest.param(SHIPPED, id="shipped-4"),
+    pytest.param(HANDBOOK, id="handbook-10", marks=NEEDS_HANDBOOK),
+]
 
 
+def test_the_project_ships_real_runs_of_both_classes_with_source_and_licence() -> None:
+    assert [path.name for path in SHIPPED] == [
+        "Ch_000001596334.json",
+        "Ch_000001596339.json",
+        "Ch_000001621524.json",
+        "Ch_000001621527.json",
+    ]
+    readme = (PROJECT_REAL_RUNS / "README.md").read_text()
+    for needed in ("CC BY 4.0", "West", "Deuse", "arXiv:2505.11925", "test extract"):
+        assert needed in readme
+    with (PROJECT_REAL_RUNS / "labels.csv").open() as handle:
+        labels = list(csv.DictReader(handle))
+    assert [row["file_name"] for row in labels] == [path.name for path in SHIPPED]
+    assert {row["class_value"] for row in labels} == {"001_test-class-1", "101_test-class-2"}
+    for row in labels:
+        run = read_controller_run(PROJECT_REAL_RUNS / row["file_name"])
+        assert str(run.run_id) == row["run_id"]
+        assert run.verdict.part_id == row["workpiece_id"]
+
+
+@pytest.mark.parametrize("runs", REAL_RUN_SETS)
 def test_every_real_run_imports_as_a_live_recording(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    runs: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert len(RUNS) == 10
     recordings = tmp_path / "recordings"
-    args = ["import", *map(str, RUNS), "--recordings", str(recordings), "--no-rerun"]
+    args = ["import", *map(str, runs), "--recordings", str(recordings), "--no-rerun"]
     assert main(args) == 0
-    assert f"imported 10 of 10 runs into {recordings}" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert out.splitlines()[-1] == (
+        f"imported {len(runs)} of {len(runs)} runs into {recordings}, 0 already there, 0 refused"
+    )
 
-    for source in RUNS:
+    for source in runs:
         run = read_controller_run(source)
-        day = _day(run.started_ns)
-        (path,) = recordings.glob(f"cs351/{day}/cs351_run{run.run_id}_*.mcap")
+        (path,) = recordings.glob(f"cs351/{_day(run.started_ns)}/cs351_run{run.run_id}_*.mcap")
         with path.open("rb") as handle:
             reader = make_reader(handle)
             summary = reader.get_summary()
             assert summary is not None
-            schemas = {schema.name: schema for schema in summary.schemas.values()}
-            assert json.loads(schemas["boltwatch.Sample"].data) == json_schema(Sample)
-            assert {(c.topic, c.message_encoding) for c in summary.channels.values()} == {
-                ("boltwatch/cs351/samples", "json"),
-                ("boltwatch/cs351/tool", "json"),
-            }
+            schemas = {schema.id: schema for schema in summary.schemas.values()}
+            channels = {c.topic: c for c in summary.channels.values()}
+            for topic, channel in channels.items():  # every channel schema'd, as live
+                schema = schemas[channel.schema_id]
+                assert channel.message_encoding == "json"
+                assert json.loads(schema.data) == json_schema(MESSAGE_TYPES[schema.name]), topic
+            assert {"boltwatch/cs351/samples", "boltwatch/cs351/tool"} <= set(channels)
             samples = [
                 (message, json.loads(message.data))  # json alone, no code of ours
                 for _, channel, message in reader.iter_messages(topics=["boltwatch/cs351/samples"])
@@ -62,7 +97,7 @@ def test_every_real_run_imports_as_a_live_recording(
         assert [data["torque_nm"] for _, data in samples] == run.torque_nm
         assert [data["force_n"] for _, data in samples] == [None] * len(run)
         times = [data["time_ns"] for _, data in samples]
-        assert times == [run.started_ns + round(t * 1e9) for t in run.time_s]  # own timing
+        assert times == [run.date_ns + round(t * 1e9) for t in run.time_s]  # own timing
         assert [m.log_time for m, _ in samples] == times
         assert [m.sequence for m, _ in samples] == list(range(len(run)))
         assert metadata["station"]["station"] == "cs351"
@@ -74,7 +109,7 @@ def test_every_real_run_imports_as_a_live_recording(
         assert metadata["controller"]["source_file"] == source.name
         assert metadata["controller"]["hardware"] == "CS351"
 
-    first = read_controller_run(RUNS[0])
+    first = read_controller_run(runs[0])
     assert len(set(first.time_s)) < len(first)  # the repeated timestamps stayed
 
 
@@ -86,14 +121,16 @@ def test_export_inspect_and_rerun_work_on_an_imported_run(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     recordings = tmp_path / "recordings"
-    assert main(["import", str(RUNS[0]), "--recordings", str(recordings), "--station", "l2"]) == 0
+    assert (
+        main(["import", str(SHIPPED[0]), "--recordings", str(recordings), "--station", "l2"]) == 0
+    )
     (mcap,) = recordings.glob("l2/2022-09-05/l2_run1596334_134339.mcap")
     assert mcap.with_suffix(".rrd").is_file()
 
-    csv = tmp_path / "run.csv"
-    assert main(["export", str(mcap), "--out", str(csv)]) == 0
-    trace = read_trace(csv)
-    run = read_controller_run(RUNS[0])
+    out_csv = tmp_path / "run.csv"
+    assert main(["export", str(mcap), "--out", str(out_csv)]) == 0
+    trace = read_trace(out_csv)
+    run = read_controller_run(SHIPPED[0])
     assert len(trace) == len(run) and not trace.has_force
     assert list(trace.torque_nm) == pytest.approx(run.torque_nm, abs=1e-4)
 
@@ -101,20 +138,24 @@ def test_export_inspect_and_rerun_work_on_an_imported_run(
     assert main(["inspect", str(mcap), "--out", str(png)]) == 0
     assert png.stat().st_size > 10_000
 
-    again = main(["import", str(RUNS[0]), "--recordings", str(recordings), "--station", "l2"])
-    assert again == 0 and "already in" in capsys.readouterr().out
+    capsys.readouterr()
+    again = main(["import", str(SHIPPED[0]), "--recordings", str(recordings), "--station", "l2"])
+    out = capsys.readouterr().out
+    assert again == 0 and "already in" in out
+    assert out.splitlines()[-1].startswith("imported 0 of 1 runs")  # skipped is not imported
+    assert out.splitlines()[-1].endswith(", 1 already there, 0 refused")
     assert len(list(recordings.glob("l2/*/*.mcap"))) == 1  # never a second copy
 
 
 def test_csv_output_stays_available(tmp_path: Path) -> None:
-    assert main(["import", str(RUNS[0]), "--csv", str(tmp_path)]) == 0
-    trace = read_trace(tmp_path / f"{RUNS[0].stem}.csv")
-    assert len(trace) == len(read_controller_run(RUNS[0]))
+    assert main(["import", str(SHIPPED[0]), "--csv", str(tmp_path)]) == 0
+    trace = read_trace(tmp_path / f"{SHIPPED[0].stem}.csv")
+    assert len(trace) == len(read_controller_run(SHIPPED[0]))
 
 
 def broken_copies(folder: Path) -> dict[str, tuple[Path, str]]:
     """name -> (a broken copy of a real run, what its error must say)."""
-    text = RUNS[0].read_text()
+    text = SHIPPED[0].read_text()
     document = json.loads(text)
     out: dict[str, tuple[Path, str]] = {}
 
@@ -143,6 +184,13 @@ def broken_copies(folder: Path) -> dict[str, tuple[Path, str]]:
     bad_date = dict(document, date="yesterday")
     put("bad_date", json.dumps(bad_date), "'date': expected 'YYYY-MM-DD HH:MM:SS'")
     put("not_a_run", json.dumps([1, 2]), "expected a JSON object (a CS351 run), got list")
+    bad_nominal = json.loads(text)
+    bad_nominal["tightening steps"][3]["tightening functions"][0]["nom"] = "1.4"
+    put(
+        "bad_nominal",
+        json.dumps(bad_nominal),
+        "tightening steps[3].tightening functions[0].nom: expected a finite number, got '1.4'",
+    )
     return out
 
 
@@ -150,21 +198,23 @@ def test_broken_controller_files_each_give_one_line_and_the_good_ones_are_import
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     broken = broken_copies(tmp_path)
-    good = [tmp_path / RUNS[1].name, tmp_path / RUNS[6].name]
-    for path in good:
-        shutil.copyfile(RUNS[[r.name for r in RUNS].index(path.name)], path)
+    good = [tmp_path / SHIPPED[1].name, tmp_path / SHIPPED[2].name]
+    for source, path in zip(SHIPPED[1:3], good, strict=True):
+        shutil.copyfile(source, path)
     inputs = [good[0], *(path for path, _ in broken.values()), good[1]]
     recordings = tmp_path / "recordings"
 
     status = main(["import", *map(str, inputs), "--recordings", str(recordings), "--no-rerun"])
 
-    assert status == 2  # some failed
+    assert status == 2  # some refused
     captured = capsys.readouterr()
     errors = captured.err.strip().splitlines()
     assert len(errors) == len(broken)  # one line per bad file
     for (path, expected), line in zip(broken.values(), errors, strict=True):
         assert line.startswith(f"boltwatch import: {path}: "), line
         assert expected in line, line
-    assert f"imported 2 of {len(inputs)} runs" in captured.out
-    assert f"{len(broken)} failed" in captured.out
+    assert captured.out.splitlines()[-1] == (
+        f"imported 2 of {len(inputs)} runs into {recordings}, 0 already there, "
+        f"{len(broken)} refused"
+    )
     assert len(list(recordings.glob("cs351/*/*.mcap"))) == 2

@@ -17,6 +17,9 @@ from shared.errors import CanDatabaseError, InputError
 from shared.messages import (
     MESSAGE_TYPES,
     BusStats,
+    ControllerFunction,
+    ControllerResult,
+    ControllerStep,
     Prediction,
     RunSummary,
     Sample,
@@ -55,6 +58,31 @@ EXAMPLES = [
         [Prediction(1, 0.27, 192.0, 53300.0)],
     ),
     StopDecision("st1", 4711, 5, 0.3, "plateau_closest", "next 57.4 kN", 190.0, 55e3, 57e3, 6),
+    StopDecision("st1", 4711, 5, 0.3, "target_reached", "", 1.4, None, 1.41, 5, advisory=True),
+    ControllerResult(
+        "cs351",
+        1596334,
+        955000040,
+        0,
+        9,
+        "OK",
+        "1",
+        "30000000008730",
+        "Nm",
+        37,
+        -1,
+        -1,
+        -1,
+        -1,
+        -1,
+        -1,
+        -1,
+        None,
+        [
+            ControllerStep("Finding", "OK", "1", 96, [ControllerFunction("TF Angle", 100, 100.25)]),
+            ControllerStep("Tightening 1.4", "NOK", "2", 73, []),
+        ],
+    ),
     RunSummary(
         "st1",
         4711,
@@ -128,3 +156,27 @@ def test_keys() -> None:
     assert keys.split_key("boltwatch/st1/health/predictor") == ("st1", "health/predictor")
     with pytest.raises(ValueError, match="not a boltwatch station key"):
         keys.split_key("other/st1/samples")
+
+
+def test_a_live_decision_without_advisory_still_decodes_and_validates() -> None:
+    """``advisory`` came later with a default: older payloads stay valid, and mean live."""
+    from services.recorder.incoming import classify  # what the recorder files it as
+
+    old = {
+        "station": "st1",
+        "run_id": 7,
+        "time_ns": 5,
+        "time_s": 0.3,
+        "reason": "plateau_closest",
+        "detail": "",
+        "torque_nm": 190.0,
+        "force_n": 5.5e4,
+        "predicted_force_n": 5.7e4,
+        "decided_ns": 6,
+    }
+    payload = json.dumps(old).encode()
+    jsonschema.validate(old, json_schema(StopDecision))
+    assert decode(StopDecision, payload).advisory is False
+    received = classify("boltwatch/st1/decision", payload, 10)
+    assert received.message is not None and received.message.advisory is False
+    assert "advisory" not in json_schema(StopDecision)["required"]

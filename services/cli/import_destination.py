@@ -1,0 +1,118 @@
+"""Where ``boltwatch import`` puts runs: the recordings folder, or trace CSVs in a folder.
+
+Both write each run whole or not at all (a temporary name in the same
+folder, renamed when complete) and print one line per run. The destination
+folder is made, or refused with one line (a file in its place, a file on
+its way, no permission), before any run is read.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from shared.errors import InputError
+
+if TYPE_CHECKING:
+    from services.recorder.controller_run import ControllerRun
+    from services.recorder.rerun_sink import RerunOptions
+
+
+def make_folder(folder: Path, what: str) -> Path:
+    """``folder``, made if missing; InputError naming it, what it is for, and why not."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except FileExistsError as err:
+        raise InputError(f"{folder}: {what}: is a file, expected a folder") from err
+    except NotADirectoryError as err:
+        blocking = next((p for p in folder.parents if p.exists() and not p.is_dir()), None)
+        why = f"{blocking} is a file, not a folder" if blocking else "a part of it is a file"
+        raise InputError(f"{folder}: {what}: cannot be made: {why}") from err
+    except OSError as err:
+        raise InputError(f"{folder}: {what}: cannot be made: {err.strerror}") from err
+    return folder
+
+
+def write_csv_whole(target: Path, rows: Iterable[tuple[float, float, float, float | None]]) -> int:
+    """:func:`shared.trace.write_trace` under a temporary name, renamed when complete."""
+    from services.recorder.import_files import remove_temporary, temporary_path
+    from shared.trace import write_trace
+
+    temporary = temporary_path(target)
+    try:
+        count = write_trace(temporary, rows)
+        os.replace(temporary, target)
+    except BaseException:
+        remove_temporary([temporary])
+        raise
+    return count
+
+
+class CsvWriter:
+    """Each run as ``<folder>/<source stem>.csv``, time from its first sample."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+
+    def write(self, run: ControllerRun) -> bool:
+        """Write the run's trace; True (a CSV is always written, over an older one)."""
+        from services.recorder.controller_import import RunNotWrittenError
+        from services.recorder.recorder import describe_os_error
+
+        target = self.folder / f"{run.source.stem}.csv"
+        rows = zip(run.run_time_s, run.torque_nm, run.angle_deg, [None] * len(run), strict=True)
+        try:
+            count = write_csv_whole(target, rows)
+        except OSError as err:
+            raise RunNotWrittenError(describe_os_error(err, target)) from err
+        print(f"{run.source} -> {target} ({count} samples)")
+        return True
+
+    def __enter__(self) -> CsvWriter:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        pass
+
+
+class RecordingsWriter:
+    """Each run into the recordings folder, with its predictor replay and wear-ledger count."""
+
+    def __init__(self, folder: Path, station: str, rerun: bool) -> None:
+        from services.recorder.wear_ledger import WearLedger, ledger_path
+
+        self.folder = folder
+        self._station = station
+        self._options: RerunOptions | None = None
+        if rerun:
+            from services.recorder.rerun_sink import RerunOptions
+
+            self._options = RerunOptions()
+        self._ledger = WearLedger(ledger_path(folder))
+
+    def write(self, run: ControllerRun) -> bool:
+        """Import the run; True when written now, False when it was already there."""
+        from services.cli.controller_replay import replay_run
+        from services.recorder.controller_import import import_run
+
+        replay = replay_run(self._station, run)
+        imported = import_run(run, self.folder, self._station, self._options, replay, self._ledger)
+        if imported.mcap is None:
+            print(f"{run.source}: run {run.run_id} already in {imported.existing}, skipped")
+            return False
+        summary = replay.summary
+        extra = f" + {imported.rrd.name}" if imported.rrd is not None else ""
+        replaced = "".join(f"; replaced the unfinished {path.name}" for path in imported.replaced)
+        print(
+            f"{run.source} -> {imported.mcap}{extra} ({imported.samples} samples, "
+            f"{summary.events} events, I_process {summary.process_intensity:.3g}{replaced})"
+        )
+        return True
+
+    def __enter__(self) -> RecordingsWriter:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self._ledger.close()
