@@ -74,6 +74,9 @@ class ToolState:
     program_id: int
     state: ToolStateName
     time_ns: int
+    # done / aborted: the StopCommand boltwatch sent the tool in this run (its reason);
+    # None: none went out, the tool stopped by itself (its own shutoff or limits)
+    stop_command: StopReasonName | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,6 +100,7 @@ class BusStats:
     stop_commands: int
     unsent_samples: int = 0  # published while the session had no router: lost, counted
     late_decisions: int = 0  # stop decisions for a run the tool was no longer running
+    repeated_runs: int = 0  # ToolStatus starting a run id that had started already: ignored
     started_ns: int = 0  # when this acquisition process started: a new value, a new process
 
 
@@ -180,11 +184,16 @@ class RunSummary:
     reached_torque_nm: float
     error_pct: float | None  # (reached - target) / target, of force if measured else torque
     events: int
-    stop_reason: StopReasonName | None  # None: the tool stopped by itself
+    # what stopped the tool: the reason of the StopCommand that went out in this run (as the
+    # acquisition reported it); None: the tool stopped by itself
+    stop_reason: StopReasonName | None
     process_intensity: float
     samples: int
     started_ns: int
     ended_ns: int
+    # the predictor's decision when it did not stop the tool (it came after the tool had
+    # stopped, or its StopCommand never went out): a late decision, not the stop reason
+    late_decision: StopReasonName | None = None
 
 
 @dataclass(frozen=True, slots=True)

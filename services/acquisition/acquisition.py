@@ -11,7 +11,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Callable
 from typing import Protocol
 
@@ -27,11 +27,21 @@ from services.acquisition.frame_decoder import (
 )
 from services.acquisition.pairing import AssembledSample, SampleAssembler
 from shared.can_database import StationDatabase
-from shared.messages import BusStats, Sample, StopDecision, StopReason, ToolRunState, ToolState
+from shared.messages import (
+    BusStats,
+    Sample,
+    StopDecision,
+    StopReason,
+    StopReasonName,
+    ToolRunState,
+    ToolState,
+)
 
 LOG = logging.getLogger(__name__)
 
 RECEIVE_ERROR_BACKOFF_S = 0.05
+#: run ids remembered as started: a ToolStatus starting one of them again is ignored
+STARTED_RUNS_KEPT = 64
 
 
 class Outlet(Protocol):
@@ -73,6 +83,9 @@ class Acquisition:
         self._send_lock = threading.Lock()
         self._tool: ToolStatusFrame | None = None
         self._stopped_run: int | None = None
+        self._stopped_reason: StopReasonName | None = None
+        self._started_runs: deque[int] = deque(maxlen=STARTED_RUNS_KEPT)
+        self._repeated_runs = 0
 
     # -- receiving ---------------------------------------------------------------------
 
@@ -143,11 +156,23 @@ class Acquisition:
             or previous.run_id != frame.run_id
             or previous.state != ToolRunState.RUNNING
         )
+        if starts_run and frame.run_id in self._started_runs:
+            # a run id starts once, however its state flips: one run, one summary, one file
+            self._repeated_runs += 1
+            if self._repeated_runs in (1, 10, 100) or self._repeated_runs % 1000 == 0:
+                LOG.warning(
+                    "run %d started again (ToolStatus flipping?): ignored (#%d)",
+                    frame.run_id,
+                    self._repeated_runs,
+                )
+            return
         if previous is not None and (starts_run or frame.state != ToolRunState.RUNNING):
             self._emit(self._assembler.finish_run())  # leftovers belong to the old run
         if starts_run:
+            self._started_runs.append(frame.run_id)
             self._assembler.start_run()
         self._tool = frame
+        ended = frame.state in (ToolRunState.DONE, ToolRunState.ABORTED)
         self._outlet.tool_state(
             ToolState(
                 self.station_id,
@@ -156,6 +181,9 @@ class Acquisition:
                 frame.program_id,
                 state_name,  # type: ignore[arg-type]
                 time_ns,
+                stop_command=(
+                    self._stopped_reason if ended and self._stopped_run == frame.run_id else None
+                ),
             )
         )
         LOG.info("run %d: %s (program %d)", frame.run_id, state_name, frame.program_id)
@@ -187,6 +215,7 @@ class Acquisition:
                 LOG.error("StopCommand for run %d could not be sent: %s", decision.run_id, err)
                 return False
             self._stopped_run = decision.run_id
+            self._stopped_reason = decision.reason
             self._stop_commands += 1
         lag_ms = (self._clock_ns() - decision.time_ns) / 1e6
         LOG.info(
@@ -221,4 +250,5 @@ class Acquisition:
             unsent_samples=self._unsent_samples(),
             late_decisions=self._late_decisions,
             started_ns=self._started_ns,
+            repeated_runs=self._repeated_runs,
         )

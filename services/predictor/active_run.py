@@ -79,7 +79,12 @@ class ActiveRun:
         return self.decision
 
     def summary(self, end: ToolState) -> RunSummary:
-        """The run's summary when the tool reports done or aborted."""
+        """The run's summary when the tool reports done or aborted.
+
+        What stopped the tool is the acquisition's word (``end.stop_command``:
+        the StopCommand it sent), not this predictor's: a decision that came
+        too late, or never reached the tool, is reported as ``late_decision``.
+        """
         last = self.last
         reached_force = last.force_n if last is not None and self.settings.has_force else None
         reached_torque = last.torque_nm if last is not None else 0.0
@@ -102,7 +107,12 @@ class ActiveRun:
             reached_torque_nm=reached_torque,
             error_pct=error_pct,
             events=self.core.events,
-            stop_reason=self.decision.reason if self.decision is not None else None,
+            stop_reason=end.stop_command,
+            late_decision=(
+                self.decision.reason
+                if self.decision is not None and end.stop_command is None
+                else None
+            ),
             process_intensity=self.core.process_intensity,
             samples=self.samples,
             started_ns=self.started_ns,

@@ -20,6 +20,7 @@ import argparse
 import logging
 import threading
 import time
+from collections import deque
 from collections.abc import Sequence
 from typing import Any
 
@@ -44,6 +45,8 @@ _decode_tool_state = codec.decoder(ToolState)
 
 #: how long to ask the line whether another predictor already serves a station
 PEER_CHECK_TIMEOUT_S = 1.0
+#: run ids remembered per station: a ToolState starting one of them again is ignored
+STARTED_RUNS_KEPT = 64
 
 
 class PredictorService:
@@ -67,6 +70,8 @@ class PredictorService:
         self.dropped_samples = 0
         self.unfinished_runs = 0  # runs whose end never arrived (a network outage)
         self.bad_payloads = 0
+        self.repeated_runs = 0  # a run id that started again after it had started: ignored
+        self._started: dict[str, deque[int]] = {}  # per station, the run ids that started
         self._inbox: Inbox = inbox(session, list(self._stations), self.handle)
         self._tokens = [
             session.liveliness().declare_token(keys.health_key(station_id, "predictor"))
@@ -154,6 +159,11 @@ class PredictorService:
         if state.state == "running":
             if run_key in self._runs:
                 return
+            started = self._started.setdefault(state.station, deque(maxlen=STARTED_RUNS_KEPT))
+            if state.run_id in started:  # a run id starts once, however its state flips
+                self.repeated_runs += 1
+                return
+            started.append(state.run_id)
             self._forget_unfinished_runs(state.station)
             try:
                 program = served.program(state.program_id)

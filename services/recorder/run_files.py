@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import logging
 import re
+from collections import deque
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -41,6 +42,8 @@ if TYPE_CHECKING:  # rerun is imported only when .rrd files are wanted
 LOG = logging.getLogger(__name__)
 
 _UNSAFE = re.compile(r"[^A-Za-z0-9_-]")
+#: run ids remembered per station: a ToolState starting one of them again opens no file
+STARTED_RUNS_KEPT = 64
 _ENDED_STATES = ("done", "aborted")
 
 
@@ -110,6 +113,7 @@ class StationFiles:
         self._rerun = rerun
         self._rerun_sinks: dict[McapSink, RerunSink] = {}
         self._run_started: tuple[int | None, int] = (None, 0)  # (run_id, ToolState time_ns)
+        self._started_runs: deque[int | None] = deque(maxlen=STARTED_RUNS_KEPT)
 
     def write(self, received: Received) -> None:
         now_ns = received.log_time_ns
@@ -191,8 +195,11 @@ class StationFiles:
         return sum(s.unflushed_messages for s in (self.previous, self.current) if s is not None)
 
     def _is_new_run(self, run_id: int | None) -> bool:
-        current = self.current
-        return current is None or current.run_id != run_id or self._run_ended
+        """A run id starts once: its ToolState flipping back to running opens no new file."""
+        if run_id in self._started_runs:
+            return False
+        self._started_runs.append(run_id)
+        return True
 
     def _start_run(self, run_id: int | None, now_ns: int) -> None:
         if self.previous is not None:

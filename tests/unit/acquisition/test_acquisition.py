@@ -126,3 +126,43 @@ def test_torque_only_station_publishes_without_force(buses: tuple[can.BusABC, ca
     tool.send(frame("ToolSensors", Torque=1.5, Angle=3.0, Counter=0))
     drain(acquisition, station)
     assert [(s.sequence, s.force_n) for s in outlet.samples] == [(0, None)]
+
+
+def test_a_run_id_starts_once_however_its_state_flips(
+    buses: tuple[can.BusABC, can.BusABC],
+) -> None:
+    """Issue 15: ToolStatus flipping every 5 ms for one run id gave 63 rows and 69 files."""
+    tool, station = buses
+    outlet = ListOutlet()
+    acquisition = Acquisition("st1", False, station, DATABASE, outlet)
+    for _ in range(30):
+        tool.send(status(42, 1))
+        tool.send(status(42, 2))
+    tool.send(status(43, 1))  # the next run starts as usual
+    drain(acquisition, station)
+    assert [(s.run_id, s.state) for s in outlet.states] == [
+        (42, "running"),
+        (42, "done"),
+        (43, "running"),
+    ]
+    assert acquisition.stats().repeated_runs == 29
+
+
+def test_the_done_state_says_whether_boltwatch_stopped_the_tool(
+    buses: tuple[can.BusABC, can.BusABC],
+) -> None:
+    """Issue 15: a run summary must say what actually stopped the tool."""
+    tool, station = buses
+    outlet = ListOutlet()
+    acquisition = Acquisition("st1", False, station, DATABASE, outlet)
+    tool.send(status(42, 1))
+    drain(acquisition, station)
+    assert acquisition.send_stop(decision(42))
+    tool.send(status(42, 2))
+    tool.send(status(43, 1))  # this run the tool stops by itself; a decision comes late
+    tool.send(status(43, 3))
+    drain(acquisition, station)
+    assert not acquisition.send_stop(decision(43))
+    ends = [(s.run_id, s.state, s.stop_command) for s in outlet.states if s.state != "running"]
+    assert ends == [(42, "done", "plateau_closest"), (43, "aborted", None)]
+    assert acquisition.stats().late_decisions == 1

@@ -27,6 +27,7 @@ from shared.messages import (
     Sample,
     StickSlipEvent,
     StopDecision,
+    StopReasonName,
     ToolState,
 )
 from shared.zenoh_session import zenoh_config
@@ -130,8 +131,15 @@ class StationFeed:
             for publisher in (self.tool, self.samples):
                 wait_for_subscriber(publisher)
 
-    def state(self, run_id: int, program_id: int, name: str, at_ns: int) -> None:
-        state = ToolState(self.station_id, run_id, 3, program_id, name, at_ns)  # type: ignore[arg-type]
+    def state(
+        self,
+        run_id: int,
+        program_id: int,
+        name: str,
+        at_ns: int,
+        stop_command: StopReasonName | None = None,
+    ) -> None:
+        state = ToolState(self.station_id, run_id, 3, program_id, name, at_ns, stop_command)  # type: ignore[arg-type]
         self.tool.put(codec.encode(state))
 
     def sample(self, run_id: int, sequence: int, row: tuple[float, float, float, float]) -> None:
@@ -168,7 +176,10 @@ def collect(
     return by_key
 
 
-def check_run(by_key: dict[str, list[bytes]], station: str, trace: SyntheticTrace) -> None:
+def check_run(
+    by_key: dict[str, list[bytes]], station: str, trace: SyntheticTrace, acted: bool = True
+) -> None:
+    """``acted``: the acquisition reported that its StopCommand went out for the run."""
     events = [codec.decode(StickSlipEvent, p) for p in by_key.get(f"{station}/events", [])]
     intensities = [codec.decode(Intensity, p) for p in by_key.get(f"{station}/intensity", [])]
     decisions = [codec.decode(StopDecision, p) for p in by_key.get(f"{station}/decision", [])]
@@ -185,7 +196,10 @@ def check_run(by_key: dict[str, list[bytes]], station: str, trace: SyntheticTrac
     assert decision.reason == "plateau_closest"
     assert decision.force_n == pytest.approx(30_056.0, abs=150.0)
     assert summary.station == station and summary.program_id == PROGRAM_OF[station]
-    assert summary.stop_reason == "plateau_closest"
+    if acted:
+        assert (summary.stop_reason, summary.late_decision) == ("plateau_closest", None)
+    else:  # the tool stopped by itself: the decision was late, not the stop reason
+        assert (summary.stop_reason, summary.late_decision) == (None, "plateau_closest")
     assert summary.events == len(events)
     assert summary.samples == len(trace.rows())  # no sample of another station counted
     assert summary.error_pct is not None
@@ -212,15 +226,17 @@ def test_one_service_predicts_each_station_with_its_own_configuration(
         for i, row in enumerate(rows):
             for feed in (*feeds, unserved):
                 feed.sample(42, i, row)
-        for feed in feeds:
-            feed.state(42, PROGRAM_OF[feed.station_id], "done", START_NS + 2_000_000_000)
-        unserved.state(42, 1, "done", START_NS + 2_000_000_000)
+        end_ns = START_NS + 2_000_000_000
+        # pt1's acquisition sent the StopCommand; pt2's did not (the decision came late)
+        feeds[0].state(42, PROGRAM_OF["pt1"], "done", end_ns, stop_command="plateau_closest")
+        feeds[1].state(42, PROGRAM_OF["pt2"], "done", end_ns)
+        unserved.state(42, 1, "done", end_ns)
         by_key = collect(received, until={"pt1/runs", "pt2/runs"})
         received.undeclare()
         for feed in (*feeds, unserved):
             feed.close()
     check_run(by_key, "pt1", trace)
-    check_run(by_key, "pt2", trace)
+    check_run(by_key, "pt2", trace, acted=False)
     predictor_topics = (keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS)
     assert not [key for key in by_key if key.startswith("pt3/") and key[4:] in predictor_topics]
     assert service.dropped_samples == 1
