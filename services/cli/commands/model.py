@@ -21,6 +21,8 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from services.cli.command_options import check_png_target
+
 if TYPE_CHECKING:
     from shared.model.envelope_check import EventMetrics, Share
     from shared.model.stiffness import JointConstants
@@ -97,9 +99,9 @@ def run(args: argparse.Namespace) -> int:
 
     report = joint_report(joint, args.speed, target_force_n, target_torque_nm)
     if args.plot is not None:
+        check_png_target(args.plot, "the plot")
         from shared.model.figures import draw_joint_figure
 
-        _check_png(args.plot)
         draw_joint_figure(joint, args.speed, report["time"]["model_time_at_target_s"], args.plot)
         report["plot"] = str(args.plot)
     if args.json:
@@ -112,15 +114,6 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_png(path: Path) -> None:
-    from shared.errors import InputError
-
-    if path.suffix.lower() != ".png":
-        raise InputError(f"{path}: the plot is written as PNG; give a path ending in .png")
-    if not path.parent.exists():
-        raise InputError(f"{path}: folder {path.parent} does not exist")
-
-
 def _validate(args: argparse.Namespace) -> int:
     """Tighten the validation grid on the rig; report the shares inside the envelopes."""
     from shared.config.joint import load_joint
@@ -128,7 +121,7 @@ def _validate(args: argparse.Namespace) -> int:
     from shared.model.envelope_check import envelope_shares
 
     if args.out is not None:
-        _check_png(args.out)
+        check_png_target(args.out, "the figure")
     rows = []
     reference = None
     for joint_file, length_mm, speed in VALIDATION_GRID:

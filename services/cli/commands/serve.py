@@ -50,7 +50,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         elif name != "router":
             add_station_file_option(sub)
         sub.add_argument("--log-level", default=None, help="DEBUG, INFO (default), WARNING")
-        sub.set_defaults(service_package=package)
+        sub.set_defaults(service_package=package, command_label=f"{NAME} {name}")
         importlib.import_module(f"{package}.arguments").add_arguments(sub)
 
 

@@ -1,0 +1,123 @@
+"""What a plant engineer reads when a path or a value is wrong: one line naming the file (or
+the option), what is wrong and why, exit status 2 (issue 14, item 5).
+
+These pin the words for the cases the issue names and for each mechanism: OSErrors told
+by ``services/cli/error_lines.py``.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from collections.abc import Iterator
+
+import pytest
+
+from services.cli.main import main
+from tests.unit.cli.bad_arguments import LOG_LINE, Workspace
+
+
+def fails_with(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    """Run ``boltwatch ARGV`` in-process; it must exit 2 with one line on stderr: that line."""
+    try:
+        status = main(argv)
+    except SystemExit as exit_:  # argparse refused a value
+        status = int(exit_.code or 0)
+    err = capsys.readouterr().err
+    lines = [
+        line
+        for line in err.splitlines()
+        if line.strip() and not line.startswith((" ", "usage:")) and not LOG_LINE.match(line)
+    ]
+    assert status == 2, err
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+@pytest.fixture
+def workspace() -> Iterator[Workspace]:
+    with Workspace() as space:
+        yield space
+
+
+# -- paths: the OSError of any command, told in one line -----------------------------------
+
+
+@pytest.mark.parametrize(
+    ("argv", "line"),
+    [
+        (
+            ["export", "good.mcap", "--out", "no-folder/run.csv"],
+            "boltwatch export: no-folder/run.csv: folder no-folder does not exist",
+        ),
+        (
+            ["export", "good.mcap", "--out", "a-file.txt/run.csv"],
+            "boltwatch export: a-file.txt/run.csv: a-file.txt is a file, not a folder",
+        ),
+        (
+            ["export", "good.mcap", "--out", "a-folder"],
+            "boltwatch export: a-folder: is a folder, not a file",
+        ),
+        (
+            ["inspect", "good.mcap", "--out", "no-folder/run.png"],
+            "boltwatch inspect: no-folder/run.png: folder no-folder does not exist",
+        ),
+        (
+            ["model", "--joint", "joint.toml", "--plot", "a-file.txt/x/joint.png"],
+            "boltwatch model: a-file.txt/x/joint.png: a-file.txt is a file, not a folder",
+        ),
+        (
+            ["recover", "good.mcap", "--out", "a-folder"],
+            "boltwatch recover: a-folder: is a folder, not a file",
+        ),
+        (
+            ["simulate", "--config", "station.toml", "--out", "no-folder/run.csv"],
+            "boltwatch simulate: no-folder/run.csv: folder no-folder does not exist",
+        ),
+        (
+            ["wear", "service", "7", "--recordings", "a-file.txt"],
+            "boltwatch wear: a-file.txt: already exists and is not a folder",
+        ),
+    ],
+    ids=lambda value: value[0] if isinstance(value, list) else "",
+)
+def test_a_bad_path_is_one_line_naming_it(
+    argv: list[str], line: str, workspace: Workspace, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert fails_with(argv, capsys) == line
+
+
+def test_a_picture_that_is_not_a_png_is_refused_before_drawing(
+    workspace: Workspace, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """matplotlib would have written ``run.png`` beside a ``--out run`` (and into /dev for
+    ``--out /dev/full``) and said it wrote ``run``."""
+    line = fails_with(["inspect", "good.mcap", "--out", "run"], capsys)
+    assert (
+        line == "boltwatch inspect: run: the report is written as PNG; give a path ending in .png"
+    )
+    assert sorted(p.name for p in workspace.path.glob("run*")) == []
+
+
+def test_a_recovery_into_a_device_leaves_the_device(
+    workspace: Workspace, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``recover --out /dev/full`` removed /dev/full when the copy failed (run as root); the
+    workspace's own ``full`` (a /dev/full made with mknod) stands in for it."""
+    device = workspace.path / "full"
+    if not device.exists():
+        pytest.skip("no permission to make a device file here (needs CAP_MKNOD)")
+    line = fails_with(["recover", "good.mcap", "--out", "full"], capsys)
+    assert line == "boltwatch recover: full: no space left on device"
+    assert stat.S_ISCHR(os.stat(device).st_mode)
+    line = fails_with(["export", "good.mcap", "--out", "full"], capsys)
+    assert line == "boltwatch export: full: no space left on device"
+
+
+def test_recover_names_a_missing_source_and_writes_nothing(
+    workspace: Workspace, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The target used to be opened first: a missing source was reported as its target."""
+    line = fails_with(["recover", "no-folder/run.mcap"], capsys)
+    assert line == "boltwatch recover: no-folder/run.mcap: file not found"
+    assert not (workspace.path / "no-folder").exists()
