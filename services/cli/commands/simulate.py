@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
 
     station = load_station(args.config)
     config = station.config
-    program = choose_program(config, args.program)
+    program = choose_program(station, args.program)
     seed = choose_seed(args.seed, config.rig.seed)
     has_force = config.station.has_force_sensor
     physics = TighteningPhysics(JointConstants.of(station.joint), program, config.rig, seed)

@@ -2,12 +2,14 @@
 the option), what is wrong and why, exit status 2 (issue 14, item 5).
 
 These pin the words for the cases the issue names and for each mechanism: OSErrors told
-by ``services/cli/error_lines.py``.
+by ``services/cli/error_lines.py``, numbers refused while parsing
+(``shared/option_types.py``).
 """
 
 from __future__ import annotations
 
 import os
+import re
 import stat
 from collections.abc import Iterator
 
@@ -121,3 +123,44 @@ def test_recover_names_a_missing_source_and_writes_nothing(
     line = fails_with(["recover", "no-folder/run.mcap"], capsys)
     assert line == "boltwatch recover: no-folder/run.mcap: file not found"
     assert not (workspace.path / "no-folder").exists()
+
+
+# -- numbers and words refused while the command line is parsed ----------------------------
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["serve", "acquisition", "--stats-interval-s", "nan"], "--stats-interval-s: expected a"),
+        (["serve", "acquisition", "--stats-interval-s", "0"], "--stats-interval-s: expected a"),
+        (["serve", "recorder", "--rerun-port", "0"], "--rerun-port: expected a port number"),
+        (["serve", "rig", "--log-level", "loud"], "--log-level: invalid choice: 'LOUD'"),
+        (["status", "--listen-s", "inf"], "--listen-s: expected a number above 0 up to"),
+        (["up", "--startup-timeout-s", "-1"], "--startup-timeout-s: expected a number above"),
+        (["model", "--speed", "1e308"], "--speed: expected a number from 0.001 up to 1000 rad/s"),
+        (["model", "--target-torque", "inf"], "--target-torque: expected a number above 0"),
+        (["wear", "service", "99999999999999999999"], "tool: expected a tool id from 0 to 65535"),
+    ],
+    ids=lambda value: " ".join(value[:2]) if isinstance(value, list) else "",
+)
+def test_an_impossible_number_is_refused_before_anything_runs(
+    argv: list[str], expected: str, workspace: Workspace, capsys: pytest.CaptureFixture[str]
+) -> None:
+    line = fails_with(argv, capsys)
+    assert line.startswith(f"boltwatch {' '.join(argv[: 2 if argv[0] == 'serve' else 1])}")
+    assert expected in line
+
+
+def test_up_refuses_an_unknown_program_and_numbers_past_its_ranges(
+    workspace: Workspace, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--program 99`` was a KeyError; ``--stations 10**17`` built ids for ever and
+    ``--runs 10**17`` started the whole station before the rig refused it."""
+    line = fails_with(["up", "--config", "station.toml", "--program", "99"], capsys)
+    assert line == "boltwatch up: station.toml: no program 99 (--program; the file has 1, 2)"
+    line = fails_with(["up", "--config", "station.toml", "--stations", str(10**17)], capsys)
+    assert re.fullmatch(
+        r"boltwatch up: station.toml: can.port: \d+ \+ \d+ stations exceeds 65535", line
+    )
+    line = fails_with(["up", "--config", "station.toml", "--runs", str(10**17)], capsys)
+    assert line.startswith("boltwatch up: --runs must be at most ")
