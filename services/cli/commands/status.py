@@ -73,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
     from services.cli.station_status_text import format_report
     from shared.zenoh_session import zenoh_config
 
-    if args.connect:
+    if args.connect is not None:
         endpoint, config = (
             args.connect,
             zenoh_config("client", [args.connect], connect_timeout_ms=CONNECT_TIMEOUT_MS),
@@ -115,11 +115,12 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
     from services.cli.station_status import StatusCollector
     from shared import keys
     from shared.errors import TransportError
+    from shared.zenoh_session import zenoh_reason
 
     try:
         session = zenoh.open(config)
     except zenoh.ZError as err:
-        reason = str(err).split(" at ", 1)[0]  # drop the Rust source location
+        reason = zenoh_reason(err)
         raise TransportError(
             f"cannot reach the zenoh router at {endpoint} within "
             f"{CONNECT_TIMEOUT_MS / 1000:.0f} s ({reason}); is 'boltwatch serve router' "

@@ -1,9 +1,10 @@
 """What a plant engineer reads when a path or a value is wrong: one line naming the file (or
 the option), what is wrong and why, exit status 2 (issue 14, item 5).
 
-These pin the words for the cases the issue names and for each mechanism: OSErrors told
-by ``services/cli/error_lines.py``, numbers refused while parsing
-(``shared/option_types.py``).
+The no-traceback tests (``test_no_traceback.py``) drive every command with every kind of
+bad value; these pin the words for the cases the issue names and for each mechanism:
+OSErrors told by ``services/cli/error_lines.py``, numbers refused while parsing
+(``shared/option_types.py``), endpoints, station files that are not text.
 """
 
 from __future__ import annotations
@@ -164,3 +165,57 @@ def test_up_refuses_an_unknown_program_and_numbers_past_its_ranges(
     )
     line = fails_with(["up", "--config", "station.toml", "--runs", str(10**17)], capsys)
     assert line.startswith("boltwatch up: --runs must be at most ")
+
+
+# -- endpoints and zenoh's own words --------------------------------------------------------
+
+
+def test_an_endpoint_zenoh_cannot_parse_is_named(
+    workspace: Workspace, capsys: pytest.CaptureFixture[str]
+) -> None:
+    expected = "expected <protocol>/<address>:<port>, e.g. tcp/127.0.0.1:7447"
+    line = fails_with(["status", "--connect", "notanendpoint"], capsys)
+    assert line == f"boltwatch status: zenoh endpoint 'notanendpoint': {expected}"
+    line = fails_with(["serve", "router", "--listen", "tcp/"], capsys)
+    assert line == f"boltwatch serve router: zenoh endpoint 'tcp/': {expected}"
+    station = workspace.path / "station.toml"
+    station.write_text(
+        re.sub(r'connect = \["[^"]*"\]', 'connect = ["router"]', station.read_text())
+    )
+    line = fails_with(["health", "rig", "--config", "station.toml"], capsys)
+    assert line == (
+        f"boltwatch health: station.toml: zenoh.connect[0]: not a zenoh endpoint: {expected}"
+        " (got 'router')"
+    )
+
+
+def test_zenoh_errors_lose_their_rust_source_locations(
+    workspace: Workspace, capsys: pytest.CaptureFixture[str]
+) -> None:
+    line = fails_with(["serve", "predictor", "--config", "station.toml"], capsys)
+    assert "no zenoh router at tcp/127.0.0.1:" in line and line.endswith("Timeout!")
+    line = fails_with(["serve", "router", "--access-control", "empty.toml"], capsys)
+    assert line.endswith(
+        "policies): line 1, column 1: expected array, boolean, null, number, object, or string"
+    )
+
+
+# -- files that are not what they should be --------------------------------------------------
+
+
+def test_a_station_file_that_is_not_text_or_is_empty_is_one_line(
+    workspace: Workspace, capsys: pytest.CaptureFixture[str]
+) -> None:
+    line = fails_with(["simulate", "--config", "binary.bin", "--out", "run.csv"], capsys)
+    assert re.fullmatch(r"boltwatch simulate: binary.bin: not a text file \(byte \d+: .+\)", line)
+    line = fails_with(["serve", "router", "--access-control", "binary.bin"], capsys)
+    assert line.startswith("boltwatch serve router: --access-control binary.bin: not a text file")
+    line = fails_with(["status", "--config", "empty.toml"], capsys)
+    assert line == (
+        "boltwatch status: empty.toml: station, can, zenoh, programs, recorder: Field required"
+    )
+    line = fails_with(["model", "--joint", "station.toml"], capsys)
+    assert line.startswith(
+        "boltwatch model: station.toml: name, material, screw, extension, friction: "
+        "Field required; station, can, zenoh, programs, predictor, rig, recorder: unknown keys"
+    )
