@@ -13,6 +13,9 @@ name, see that package's docstring). How a command ends:
   reports for any tool whose reader went away);
 - Ctrl-C: exit status 130.
 
+Started with standard output closed (``>&-``, a supervisor that closes it),
+what a command prints goes to /dev/null: a service must run all the same.
+
 Usage errors (an unknown option, a value argparse refuses) end with
 argparse's usage line and message, exit status 2.
 """
@@ -21,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pkgutil
 import signal
 import sys
@@ -70,10 +74,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     command = getattr(args, "command_label", args.command)  # "serve rig", not just "serve"
+    if sys.stdout is None:  # started with standard output closed
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 (open for the life of the process)
     try:
         status = int(args.handler(args))
-        if sys.stdout is not None:  # None: started with standard output closed
-            sys.stdout.flush()  # a closed pipe fails here, not in Python's flush at exit
+        sys.stdout.flush()  # a closed pipe fails here, not in Python's flush at exit
         return status
     except BoltwatchError as err:
         return _failed(command, str(err))

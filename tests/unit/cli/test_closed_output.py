@@ -8,6 +8,7 @@ is a resource limit of the process.
 from __future__ import annotations
 
 import fcntl
+import os
 import resource
 import signal
 import subprocess
@@ -77,3 +78,20 @@ def test_a_write_cut_by_a_file_size_limit_names_the_file() -> None:
     assert result.stderr == (
         "boltwatch export: run.csv: file too large (a file size limit was reached)\n"
     )
+
+
+def test_a_command_started_with_its_output_closed_runs_all_the_same(tmp_path: Path) -> None:
+    """``boltwatch predict ... >&-``: Python has no sys.stdout then (it was an AttributeError);
+    what would be printed goes to /dev/null, as a service under a supervisor needs."""
+    trace = tmp_path / "run.csv"
+    assert main(["simulate", "--config", str(STATION_FILE), "--out", str(trace)]) == 0
+    result = subprocess.run(
+        boltwatch("predict", str(trace), "--target-force", "56000"),
+        cwd=REPO,
+        stderr=subprocess.PIPE,
+        text=True,
+        timeout=60,
+        check=False,
+        preexec_fn=lambda: os.close(1),
+    )
+    assert (result.returncode, result.stderr) == (0, "")
