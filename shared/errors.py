@@ -10,9 +10,17 @@
 
 Every error carries one line a person can act on: which file, which key,
 what was expected. Boundaries re-raise with ``raise X from err``.
+
+An ``OSError`` is not wrapped: the command line turns it into one line from
+its ``filename`` and ``errno``. :func:`naming` makes sure it has a filename
+(a write that fails on a full disk names none).
 """
 
 from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
 
 
 class BoltwatchError(Exception):
@@ -33,3 +41,14 @@ class CanDatabaseError(BoltwatchError):
 
 class TransportError(BoltwatchError):
     """A zenoh session or CAN bus could not be opened."""
+
+
+@contextlib.contextmanager
+def naming(path: str | os.PathLike[str]) -> Iterator[None]:
+    """An ``OSError`` raised inside that names no file is raised again naming ``path``."""
+    try:
+        yield
+    except OSError as err:
+        if err.filename is not None or err.errno is None:
+            raise
+        raise OSError(err.errno, err.strerror, os.fspath(path)) from err

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from shared.errors import InputError
+from shared.errors import InputError, naming
 
 HEADER = ("time_s", "torque_nm", "angle_deg", "force_n")
 
@@ -112,7 +112,7 @@ def _parse_cell(cell: str, path: Path, line_number: int, index: int) -> float:
 def write_trace(path: Path, rows: Iterable[tuple[float, float, float, float | None]]) -> int:
     """Write rows ``(time_s, torque_nm, angle_deg, force_n or None)``; returns the row count."""
     count = 0
-    with Path(path).open("w", newline="") as handle:
+    with naming(path), Path(path).open("w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(HEADER)
         for time_s, torque_nm, angle_deg, force_n in rows:

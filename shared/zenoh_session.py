@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import json
 import logging
+import re
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -25,8 +26,8 @@ from pathlib import Path
 
 import zenoh
 
-from shared.config.station import ZenohSection
-from shared.errors import TransportError
+from shared.config.station import ENDPOINT_EXPECTED, ZenohSection
+from shared.errors import ConfigError, TransportError
 
 LOG = logging.getLogger(__name__)
 
@@ -60,8 +61,8 @@ def zenoh_config(
     config = zenoh.Config()
     config.insert_json5("mode", json.dumps(mode))
     config.insert_json5("scouting/multicast/enabled", "false")
-    config.insert_json5("connect/endpoints", json.dumps(list(connect)))
-    config.insert_json5("listen/endpoints", json.dumps(list(listen)))
+    _insert_endpoints(config, "connect/endpoints", connect)
+    _insert_endpoints(config, "listen/endpoints", listen)
     retry = {
         "period_init_ms": min(RECONNECT_PERIOD_INIT_MS, reconnect_period_max_ms),
         "period_max_ms": reconnect_period_max_ms,
@@ -73,6 +74,31 @@ def zenoh_config(
     if tls is not None:
         _insert_tls(config, tls)
     return config
+
+
+def _insert_endpoints(config: zenoh.Config, key: str, endpoints: Sequence[str]) -> None:
+    """Endpoints zenoh cannot parse (``--connect notanendpoint``) are a ConfigError naming
+    the endpoint."""
+    for endpoint in endpoints:
+        try:
+            zenoh.Config().insert_json5(key, json.dumps([endpoint]))
+        except zenoh.ZError as err:
+            raise ConfigError(f"zenoh endpoint {endpoint!r}: {ENDPOINT_EXPECTED}") from err
+    config.insert_json5(key, json.dumps(list(endpoints)))
+
+
+def zenoh_reason(err: zenoh.ZError) -> str:
+    """A zenoh error's message without the Rust source locations (`` at /root/.cargo/...``)."""
+    text = str(err)
+    match = re.search(r'msg: "(.*?)(?: at /\S+)?"', text)  # Json5Err(Message { msg: "..." })
+    if match:
+        text = match.group(1)
+    text = re.sub(r"\s+at /\S+\.rs:\d+\.?", "", text)
+    # a JSON5 parse error drawn over several lines: "--> 1:1\n |\n1 | x\n | ^---\n = expected ..."
+    drawn = re.search(r"--> (\d+):(\d+).*= (.+)$", text)
+    if drawn:
+        text = f"line {drawn[1]}, column {drawn[2]}: {drawn[3]}"
+    return " ".join(text.replace("\\n", " ").split())
 
 
 def _insert_tls(config: zenoh.Config, tls: TlsFiles) -> None:
@@ -147,7 +173,7 @@ def open_from(config: zenoh.Config) -> zenoh.Session:
     try:
         session = zenoh.open(config)
     except zenoh.ZError as err:
-        raise TransportError(f"cannot open zenoh session: {err}") from err
+        raise TransportError(f"cannot open zenoh session: {zenoh_reason(err)}") from err
     LOG.info("zenoh session %s open", session.zid())
     return session
 

@@ -9,7 +9,9 @@ command that takes it:
 - ``--config FILE`` (one or several): the station file(s), by default
   ``config/station.toml``;
 - ``--recordings DIR`` and ``--config FILE`` (wear, import): the recordings
-  folder, by default the station file's ``recorder.folder``.
+  folder, by default the station file's ``recorder.folder``;
+- a PNG to draw (inspect ``--out``, model ``--plot``/``--out``): checked
+  before the work, see :func:`check_png_target`.
 
 Light imports only: every command module imports this for ``boltwatch --help``.
 """
@@ -17,8 +19,12 @@ Light imports only: every command module imports this for ``boltwatch --help``.
 from __future__ import annotations
 
 import argparse
+import errno
+import os
 import sys
 from pathlib import Path
+
+from shared.errors import InputError
 
 #: The station file a command reads when none is given.
 DEFAULT_STATION_FILE = Path("config/station.toml")
@@ -85,3 +91,13 @@ def recordings_folder(args: argparse.Namespace) -> Path:
     from shared.config import load_station
 
     return load_station(args.config).recordings_folder
+
+
+def check_png_target(path: Path, what: str) -> None:
+    """A picture is written as PNG, into a folder that exists: say so before drawing it
+    (a bad folder is the OSError that writing would meet, told as every command tells it)."""
+    if path.suffix.lower() != ".png":
+        raise InputError(f"{path}: {what} is written as PNG; give a path ending in .png")
+    if not path.parent.is_dir():
+        code = errno.ENOTDIR if path.parent.exists() else errno.ENOENT
+        raise OSError(code, os.strerror(code), str(path))

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from shared.option_types import port_number
+
 DEFAULT_RERUN_GRPC_PORT = 9876
 DEFAULT_RERUN_WEB_PORT = 9090
 
@@ -32,13 +34,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     rerun.add_argument(
         "--rerun-port",
-        type=int,
+        type=port_number,
         default=DEFAULT_RERUN_GRPC_PORT,
         help=f"gRPC port of --rerun-serve (default {DEFAULT_RERUN_GRPC_PORT})",
     )
     rerun.add_argument(
         "--rerun-web-port",
-        type=int,
+        type=port_number,
         default=DEFAULT_RERUN_WEB_PORT,
         help=f"HTTP port of --rerun-web (default {DEFAULT_RERUN_WEB_PORT})",
     )

@@ -7,15 +7,17 @@ attachments; the writer then adds the summary and footer the original lacks.
 
 from __future__ import annotations
 
+import itertools
 import logging
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
 from mcap.records import Attachment, Channel, Header, Message, Metadata, Schema
 from mcap.writer import CompressionType, Writer
 
-from services.recorder.recording_reader import RecordingScan
-from shared.errors import InputError
+from services.recorder.recording_reader import McapRecord, RecordingScan
+from shared.errors import InputError, naming
 
 LOG = logging.getLogger(__name__)
 
@@ -55,11 +57,14 @@ def recover(source: Path, target: Path | None = None) -> RecoveryReport:
     if target.resolve() == source.resolve():
         raise InputError(f"{target}: the recovered file must not replace the damaged one")
     scan = RecordingScan(source)
+    records = scan.records()
+    first = next(records, None)  # a missing, unreadable or non-MCAP source fails here, first
     try:
-        with target.open("wb") as handle:
-            messages, channels = _copy(scan, Writer(handle, compression=CompressionType.ZSTD))
+        with naming(target), target.open("wb") as handle:
+            writer = Writer(handle, compression=CompressionType.ZSTD)
+            messages, channels = _copy(itertools.chain([first] if first else [], records), writer)
     except BaseException:
-        target.unlink(missing_ok=True)
+        remove_unfinished(target)
         raise
     report = RecoveryReport(
         source=source,
@@ -75,13 +80,20 @@ def recover(source: Path, target: Path | None = None) -> RecoveryReport:
     return report
 
 
-def _copy(scan: RecordingScan, writer: Writer) -> tuple[int, int]:
-    """Copy the scan's complete records into ``writer``; (messages, channels) copied."""
+def remove_unfinished(target: Path) -> None:
+    """Remove a half-written ``target`` if it is a regular file; a device or a pipe named as
+    the target (``--out /dev/null``) is never removed."""
+    if target.is_file():
+        target.unlink(missing_ok=True)
+
+
+def _copy(records: Iterable[McapRecord], writer: Writer) -> tuple[int, int]:
+    """Copy complete records into ``writer``; (messages, channels) copied."""
     schema_ids: dict[int, int] = {}
     channel_ids: dict[int, int] = {}
     messages = 0
     started = False
-    for record in scan.records():
+    for record in records:
         if isinstance(record, Header):
             writer.start(profile=record.profile, library=record.library)
             started = True

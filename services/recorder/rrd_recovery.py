@@ -22,6 +22,7 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
+from services.recorder.recovery import remove_unfinished
 from services.recorder.rerun_blueprint import TORQUE
 from shared.errors import InputError
 
@@ -99,11 +100,11 @@ def recover_rrd(source: Path, target: Path | None = None) -> RrdRecovery:
     check = check_rrd(source)
     result = _rerun("rrd", "merge", "--continue-on-error", "-o", str(target), str(source))
     if result.returncode != 0 or not check_rrd(target).ok:
-        target.unlink(missing_ok=True)
+        remove_unfinished(target)
         raise InputError(f"{source}: nothing readable in it ({check.problem or 'not an .rrd'})")
     rows = rows_by_entity(target)
     if not rows:
-        target.unlink(missing_ok=True)
+        remove_unfinished(target)
         raise InputError(f"{source}: no complete chunk in it ({check.problem or 'empty'})")
     return RrdRecovery(source, target, check.problem, rows)
 

@@ -33,6 +33,7 @@ from services.recorder.post_mortem_panels import (
     draw_torque,
 )
 from services.recorder.post_mortem_run import RecordedRun, read_run
+from shared.errors import naming
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -94,7 +95,8 @@ def draw_run(source: Path, target: Path, run_id: int | None = None) -> RecordedR
 
     run = read_run(source, run_id)
     figure = build_figure(run)
-    figure.savefig(target)
+    with naming(target):
+        figure.savefig(target, format="png")
     return run
 
 

@@ -4,18 +4,23 @@ from __future__ import annotations
 
 import numpy as np
 
-from shared.config.station import Program, StationConfig
+from shared.config.station import LoadedStation, Program
 from shared.errors import ConfigError
 
 
-def choose_program(config: StationConfig, program_id: int | None) -> Program:
-    """The program ``program_id``, or the station's first; unknown ids are a ConfigError."""
+def choose_program(station: LoadedStation, program_id: int | None) -> Program:
+    """The program ``program_id`` (``--program``), or the station's first; an unknown id is a
+    ConfigError naming the station file and the programs it has."""
+    config = station.config
     if program_id is None:
         return config.programs[0]
     try:
         return config.program(program_id)
     except KeyError as err:
-        raise ConfigError(str(err.args[0])) from err
+        known = ", ".join(str(program.id) for program in config.programs)
+        raise ConfigError(
+            f"{station.path}: no program {program_id} (--program; the file has {known})"
+        ) from err
 
 
 def choose_seed(cli_seed: int | None, config_seed: int | None) -> int:

@@ -41,7 +41,7 @@ RUN_ID_MAX = 0xFFFF_FFFF  # RunId is 32 bits on CAN
 def main(args: argparse.Namespace) -> int:
     station = load_station(args.config)
     config = station.config
-    program = choose_program(config, args.program)
+    program = choose_program(station, args.program)
     if args.runs is not None and args.runs < 1:
         raise ConfigError(f"--runs must be at least 1 (got {args.runs})")
     seed = choose_seed(args.seed, config.rig.seed)

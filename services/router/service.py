@@ -21,7 +21,7 @@ import zenoh
 
 from shared.errors import ConfigError
 from shared.service_runtime import ServiceRunner
-from shared.zenoh_session import TlsFiles, open_from, zenoh_config
+from shared.zenoh_session import TlsFiles, open_from, zenoh_config, zenoh_reason
 
 LOG = logging.getLogger(__name__)
 
@@ -69,15 +69,19 @@ def _check_readable(option: str, path: Path) -> None:
 
 def _insert_access_control(config: zenoh.Config, path: Path) -> None:
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except OSError as err:
         raise ConfigError(f"--access-control {path}: cannot be read: {err.strerror}") from err
+    except UnicodeDecodeError as err:
+        raise ConfigError(
+            f"--access-control {path}: not a text file (byte {err.start}: {err.reason})"
+        ) from err
     try:
         config.insert_json5("access_control", text)
     except zenoh.ZError as err:
         raise ConfigError(
             f"{path}: not a zenoh access_control section (enabled, default_permission, "
-            f"rules, subjects, policies): {err}"
+            f"rules, subjects, policies): {zenoh_reason(err)}"
         ) from err
 
 

@@ -85,10 +85,6 @@ def derive_stations(base_path: Path, count: int, folder: Path) -> list[Path]:
     base = load_station(base_path)
     raw = read_toml(base_path)
     config = base.config
-    ids = derived_ids(base.station_id, count)
-    for id_ in ids:
-        if len(id_) > 64:
-            raise ConfigError(f"{base_path}: station.id: derived id {id_!r} is too long")
     if config.can.interface == "socketcan" and count > 1:
         raise ConfigError(
             f"{base_path}: can.interface: 'socketcan' is one real bus; derive simulated "
@@ -107,6 +103,10 @@ def derive_stations(base_path: Path, count: int, folder: Path) -> list[Path]:
             f"{base_path}: station.tool_id: {config.station.tool_id} + {count - 1} "
             f"stations exceeds {MAX_TOOL_ID}"
         )
+    ids = derived_ids(base.station_id, count)  # count is bounded by the tool ids now
+    for id_ in ids:
+        if len(id_) > 64:
+            raise ConfigError(f"{base_path}: station.id: derived id {id_!r} is too long")
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
     for i, station_id in enumerate(ids):

@@ -35,6 +35,8 @@ def read_toml(path: Path) -> dict[str, Any]:
         raise ConfigError(f"{path}: file not found") from err
     except tomllib.TOMLDecodeError as err:
         raise ConfigError(f"{path}: not valid TOML: {err}") from err
+    except UnicodeDecodeError as err:
+        raise ConfigError(f"{path}: not a text file (byte {err.start}: {err.reason})") from err
     except OSError as err:
         raise ConfigError(f"{path}: cannot be read: {err.strerror}") from err
 
@@ -48,21 +50,40 @@ def validate(model: type[ModelT], data: dict[str, Any], path: Path) -> ModelT:
 
 
 def describe_validation_error(err: ValidationError, model: type[BaseModel], path: Path) -> str:
-    """One line per problem, ``file: key: message (got value)``; the first problem leads."""
-    lines = []
+    """One line, ``file: key: message (got value)``; more problems follow, ``; ``-separated,
+    missing and unknown keys of one table named together (an empty file:
+    ``file: station, can, zenoh, programs, recorder: Field required``)."""
+    parts: list[str | tuple[str, tuple[int | str, ...]]] = []
+    grouped: dict[tuple[str, tuple[int | str, ...]], list[str]] = {}
     for problem in err.errors():
         location = problem["loc"]
         key = dotted_key(location)
-        if problem["type"] == "extra_forbidden":
-            allowed = allowed_keys(model, location[:-1])
-            hint = f"; expected one of: {', '.join(allowed)}" if allowed else ""
-            lines.append(f"{path}: {key}: unknown key{hint}")
+        if problem["type"] in ("extra_forbidden", "missing"):
+            group = (problem["type"], location[:-1])
+            if group not in grouped:
+                grouped[group] = []
+                parts.append(group)
+            grouped[group].append(key)
             continue
-        message = problem["msg"].removeprefix("Value error, ")
+        message = " ".join(problem["msg"].removeprefix("Value error, ").split())
         got = problem.get("input")
-        shown = "" if isinstance(got, dict) or problem["type"] == "missing" else f" (got {got!r})"
-        lines.append(f"{path}: {key or '(top level)'}: {message}{shown}")
-    return "\n".join(lines)
+        shown = "" if isinstance(got, dict) else f" (got {got!r})"
+        parts.append(f"{key or '(top level)'}: {message}{shown}")
+    lines = [
+        part if isinstance(part, str) else _group_line(part, grouped[part], model) for part in parts
+    ]
+    return f"{path}: " + "; ".join(lines)
+
+
+def _group_line(
+    group: tuple[str, tuple[int | str, ...]], keys: list[str], model: type[BaseModel]
+) -> str:
+    kind, table = group
+    if kind == "missing":
+        return f"{', '.join(keys)}: Field required"
+    allowed = allowed_keys(model, table)
+    hint = f"; expected one of: {', '.join(allowed)}" if allowed else ""
+    return f"{', '.join(keys)}: unknown key{'s' if len(keys) > 1 else ''}{hint}"
 
 
 def dotted_key(location: tuple[int | str, ...]) -> str:

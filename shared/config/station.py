@@ -7,10 +7,11 @@ embedded simulated station). Paths inside it (``station.joint``, ``can.dbc``,
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import Field, ValidationInfo, field_validator, model_validator
+from pydantic import AfterValidator, Field, ValidationInfo, field_validator, model_validator
 
 from shared.can_database import StationDatabase
 from shared.config.joint import JointConfig, load_joint
@@ -19,6 +20,19 @@ from shared.errors import CanDatabaseError, ConfigError
 from shared.sensor_range import SensorRange
 
 StationId = str
+
+#: a zenoh endpoint: ``<protocol>/<address>[?<metadata>][#<config>]``
+ENDPOINT_FORM = re.compile(r"[A-Za-z0-9_-]+/[^?#\s]+(\?[^#\s]*)?(#\S*)?")
+ENDPOINT_EXPECTED = "expected <protocol>/<address>:<port>, e.g. tcp/127.0.0.1:7447"
+
+
+def _endpoint(text: str) -> str:
+    if not ENDPOINT_FORM.fullmatch(text):
+        raise ValueError(f"not a zenoh endpoint: {ENDPOINT_EXPECTED}")
+    return text
+
+
+Endpoint = Annotated[str, AfterValidator(_endpoint)]
 
 
 class StationSection(StrictModel):
@@ -47,8 +61,8 @@ class ZenohSection(StrictModel):
     """How a service joins the line: its router, reconnection, and TLS (see README, Security)."""
 
     mode: Literal["peer", "client"] = "client"
-    connect: list[str] = Field(default_factory=list, description="e.g. tcp/127.0.0.1:7447")
-    listen: list[str] = Field(default_factory=list)
+    connect: list[Endpoint] = Field(default_factory=list, description="e.g. tcp/127.0.0.1:7447")
+    listen: list[Endpoint] = Field(default_factory=list)
     connect_timeout_s: float | None = Field(
         default=None,
         gt=0,

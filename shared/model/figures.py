@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from shared.config.joint import JointConfig
+from shared.errors import naming
 from shared.model.angles import angle_ratio
 from shared.model.joint_model import JointModel
 from shared.model.resonance import extension_natural_frequency_hz
@@ -91,7 +92,8 @@ def draw_joint_figure(
     for ax in axes.flat:
         ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout(rect=(0, 0, 1, 0.97))
-    fig.savefig(path, dpi=90)
+    with naming(path):
+        fig.savefig(path, dpi=90)
     plt.close(fig)
 
 
@@ -284,5 +286,6 @@ def draw_validation_figure(name: str, model: Any, metrics: Any, path: Path) -> N
     for ax in axes.flat:
         ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
-    fig.savefig(path, dpi=90)
+    with naming(path):
+        fig.savefig(path, dpi=90)
     plt.close(fig)

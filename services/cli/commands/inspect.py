@@ -8,6 +8,7 @@ from pathlib import Path
 from services.cli.command_options import (
     add_recording_argument,
     add_run_option,
+    check_png_target,
     warn_damaged_recording,
 )
 
@@ -38,6 +39,7 @@ def run(args: argparse.Namespace) -> int:
     from services.recorder.run_plot import draw_run
 
     target = args.out or args.recording.with_suffix(".png")
+    check_png_target(target, "the report")
     run = draw_run(args.recording, target, args.run)
     if not run.complete:
         warn_damaged_recording(NAME, run.state, "drew what is readable")

@@ -21,6 +21,9 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from services.cli.command_options import check_png_target
+from shared.option_types import float_in
+
 if TYPE_CHECKING:
     from shared.model.envelope_check import EventMetrics, Share
     from shared.model.stiffness import JointConstants
@@ -33,6 +36,12 @@ DEFAULT_SPEED_RAD_S = 0.5
 DEFAULT_TARGET_FORCE_N = 56_000.0
 DEFAULT_TARGET_TORQUE_NM = 200.0
 
+#: what a tightening tool can be asked for: motor speed (1 mrad/s to ~9500 rpm), preload up
+#: to 10 MN (beyond an M100 bolt), torque up to 100 kNm (a large hydraulic wrench)
+SPEED_RAD_S = float_in(0.001, 1000.0, "rad/s")
+TARGET_FORCE_N = float_in(0.0, 1e7, "N", low_allowed=False)
+TARGET_TORQUE_NM = float_in(0.0, 1e5, "Nm", low_allowed=False)
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
@@ -43,21 +52,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--speed",
-        type=float,
+        type=SPEED_RAD_S,
         default=DEFAULT_SPEED_RAD_S,
         metavar="RAD_S",
         help=f"constant motor speed φ̇_m in rad/s (default: {DEFAULT_SPEED_RAD_S})",
     )
     parser.add_argument(
         "--target-force",
-        type=float,
+        type=TARGET_FORCE_N,
         default=None,
         metavar="N",
         help="target preload in N (default: 56000 when no target is given)",
     )
     parser.add_argument(
         "--target-torque",
-        type=float,
+        type=TARGET_TORQUE_NM,
         default=None,
         metavar="NM",
         help="target torque in Nm (default: 200 when no target is given)",
@@ -97,9 +106,9 @@ def run(args: argparse.Namespace) -> int:
 
     report = joint_report(joint, args.speed, target_force_n, target_torque_nm)
     if args.plot is not None:
+        check_png_target(args.plot, "the plot")
         from shared.model.figures import draw_joint_figure
 
-        _check_png(args.plot)
         draw_joint_figure(joint, args.speed, report["time"]["model_time_at_target_s"], args.plot)
         report["plot"] = str(args.plot)
     if args.json:
@@ -112,15 +121,6 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_png(path: Path) -> None:
-    from shared.errors import InputError
-
-    if path.suffix.lower() != ".png":
-        raise InputError(f"{path}: the plot is written as PNG; give a path ending in .png")
-    if not path.parent.exists():
-        raise InputError(f"{path}: folder {path.parent} does not exist")
-
-
 def _validate(args: argparse.Namespace) -> int:
     """Tighten the validation grid on the rig; report the shares inside the envelopes."""
     from shared.config.joint import load_joint
@@ -128,7 +128,7 @@ def _validate(args: argparse.Namespace) -> int:
     from shared.model.envelope_check import envelope_shares
 
     if args.out is not None:
-        _check_png(args.out)
+        check_png_target(args.out, "the figure")
     rows = []
     reference = None
     for joint_file, length_mm, speed in VALIDATION_GRID:

@@ -27,6 +27,8 @@ SERVICES = {
     "router": "services.router",
 }
 
+LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR")
+
 #: services of the line that one process runs for several stations (``--config A B ...``)
 MULTI_STATION = ("predictor", "recorder")
 
@@ -49,8 +51,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
             )
         elif name != "router":
             add_station_file_option(sub)
-        sub.add_argument("--log-level", default=None, help="DEBUG, INFO (default), WARNING")
-        sub.set_defaults(service_package=package)
+        sub.add_argument(
+            "--log-level",
+            type=str.upper,
+            choices=LOG_LEVELS,
+            default=None,
+            help="DEBUG, INFO (default), WARNING, ERROR",
+        )
+        sub.set_defaults(service_package=package, command_label=f"{NAME} {name}")
         importlib.import_module(f"{package}.arguments").add_arguments(sub)
 
 

@@ -40,13 +40,12 @@ def run(args: argparse.Namespace) -> int:
     from services.rig.physics import TighteningPhysics
     from services.rig.selection import choose_program, choose_seed
     from shared.config import load_station
-    from shared.errors import InputError
     from shared.model.stiffness import JointConstants
     from shared.trace import write_trace
 
     station = load_station(args.config)
     config = station.config
-    program = choose_program(config, args.program)
+    program = choose_program(station, args.program)
     seed = choose_seed(args.seed, config.rig.seed)
     has_force = config.station.has_force_sensor
     physics = TighteningPhysics(JointConstants.of(station.joint), program, config.rig, seed)
@@ -63,10 +62,7 @@ def run(args: argparse.Namespace) -> int:
     while not controller.finished:
         m = controller.tick()
         rows.append((m.time_s, m.torque_nm, m.angle_deg, m.force_n if has_force else None))
-    try:
-        count = write_trace(args.out, rows)
-    except OSError as err:
-        raise InputError(f"{args.out}: cannot be written: {err.strerror}") from err
+    count = write_trace(args.out, rows)  # an OSError names the file (boltwatch main)
     print(
         f"{count} samples written to {args.out}: {physics.time_s:.3f} s, "
         f"{physics.slip_count} slips, final force {physics.true_force_n:.0f} N "

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from services.cli.command_options import DEFAULT_STATION_FILE
+from shared.option_types import seconds
 
 if TYPE_CHECKING:
     import zenoh
@@ -59,7 +60,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--listen-s",
-        type=float,
+        type=seconds,
         default=2.0,
         metavar="S",
         help="seconds to listen for messages (default: 2.0; BusStats come once a second)",
@@ -70,12 +71,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from services.cli.station_status import to_json
     from services.cli.station_status_text import format_report
-    from shared.errors import InputError
     from shared.zenoh_session import zenoh_config
 
-    if not args.listen_s > 0:
-        raise InputError(f"--listen-s must be a positive number of seconds (got {args.listen_s})")
-    if args.connect:
+    if args.connect is not None:
         endpoint, config = (
             args.connect,
             zenoh_config("client", [args.connect], connect_timeout_ms=CONNECT_TIMEOUT_MS),
@@ -117,11 +115,12 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
     from services.cli.station_status import StatusCollector
     from shared import keys
     from shared.errors import TransportError
+    from shared.zenoh_session import zenoh_reason
 
     try:
         session = zenoh.open(config)
     except zenoh.ZError as err:
-        reason = str(err).split(" at ", 1)[0]  # drop the Rust source location
+        reason = zenoh_reason(err)
         raise TransportError(
             f"cannot reach the zenoh router at {endpoint} within "
             f"{CONNECT_TIMEOUT_MS / 1000:.0f} s ({reason}); is 'boltwatch serve router' "

@@ -21,10 +21,12 @@ from __future__ import annotations
 import argparse
 import signal
 import sys
+import time
 from datetime import UTC, datetime
 from types import FrameType
 
 from services.cli.command_options import add_station_file_option
+from shared.option_types import seconds
 
 NAME = "up"
 HELP = "run the simulated station (or --stations N) end to end: rig, acquisition, predictor, ..."
@@ -50,7 +52,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--startup-timeout-s",
-        type=float,
+        type=seconds,
         default=60.0,
         help="how long services may take to come up (default 60 s)",
     )
@@ -58,6 +60,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from services.cli.station_run import StationRun
+    from services.rig.selection import choose_program
+    from services.rig.service import RUN_ID_MAX
     from shared.config import derive_stations, load_line, load_station
     from shared.errors import ConfigError
 
@@ -65,12 +69,14 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--runs must be at least 1 (got {args.runs})")
     if args.stations < 1:
         raise ConfigError(f"--stations must be at least 1 (got {args.stations})")
+    first_run_id = int(time.time())  # what the rig numbers its first run with
+    if first_run_id + args.runs - 1 > RUN_ID_MAX:
+        raise ConfigError(
+            f"--runs must be at most {RUN_ID_MAX - first_run_id + 1} (got {args.runs}): run ids "
+            f"count from the current Unix time and end at {RUN_ID_MAX}"
+        )
     station = load_station(args.config)
-    program = (
-        station.config.program(args.program)
-        if args.program is not None
-        else station.config.programs[0]
-    )
+    program = choose_program(station, args.program)
     if station.config.zenoh.mode != "client" or not station.config.zenoh.connect:
         raise ConfigError(
             f"{station.path}: zenoh: boltwatch up runs a router and needs mode = 'client' "
@@ -87,8 +93,8 @@ def run(args: argparse.Namespace) -> int:
     def on_signal(signum: int, _frame: FrameType | None) -> None:
         raise StoppedBySignalError(signal.Signals(signum).name)
 
-    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGTERM, signal.SIGHUP)}
     station_run = StationRun(stations, program, args.runs, log_dir, args.startup_timeout_s)
+    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGTERM, signal.SIGHUP)}
     try:
         return station_run.run()
     except (KeyboardInterrupt, StoppedBySignalError):

@@ -11,9 +11,13 @@ from __future__ import annotations
 import argparse
 
 from services.cli.command_options import add_recordings_folder_options, recordings_folder
+from shared.option_types import int_in
 
 NAME = "wear"
 HELP = "show the wear ledger per tool, or record a tool's service"
+
+#: the largest tool id (station.tool_id in a station file; 16 bits on CAN)
+MAX_TOOL_ID = 65535
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -25,7 +29,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "runs at every station; --station ST lists the tools that ran at ST."
     )
     parser.add_argument("action", nargs="?", choices=["service"], help="record a service")
-    parser.add_argument("tool", nargs="?", type=int, help="tool id (with 'service')")
+    parser.add_argument(
+        "tool", nargs="?", type=int_in(0, MAX_TOOL_ID, "a tool id"), help="tool id (with 'service')"
+    )
     parser.add_argument("--note", default="", help="what was done (with 'service')")
     add_recordings_folder_options(parser, "recordings folder holding wear.sqlite")
     parser.add_argument(

@@ -65,8 +65,6 @@ def test_plot_is_written(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
 @pytest.mark.parametrize(
     ("argv", "error", "match"),
     [
-        (("--speed", "-1"), InputError, "--speed"),
-        (("--target-force", "0"), InputError, "--target-force"),
         (("--plot", "out.svg"), InputError, "PNG"),
         (("--joint", "no/such/joint.toml"), ConfigError, "file not found"),
     ],
@@ -77,3 +75,17 @@ def test_bad_input_is_one_clear_line(
     with pytest.raises(error, match=match) as info:
         run(*argv)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [("--speed", "-1"), ("--speed", "1e308"), ("--target-force", "0"), ("--target-torque", "inf")],
+)
+def test_impossible_numbers_are_refused_while_parsing(
+    argv: tuple[str, ...], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """1e308 rad/s and an infinite torque target were a ZeroDivisionError in the report."""
+    with pytest.raises(SystemExit) as info:
+        run(*argv)
+    assert info.value.code == 2
+    assert f"argument {argv[0]}: expected a number" in capsys.readouterr().err
