@@ -44,6 +44,10 @@ def write_csv_whole(target: Path, rows: Iterable[tuple[float, float, float, floa
     try:
         count = write_trace(temporary, rows)
         os.replace(temporary, target)
+    except OSError as err:
+        remove_temporary([temporary])
+        # a person looks for the file the run was going to, not for a hidden one that is gone
+        raise OSError(err.errno, err.strerror, os.fspath(target)) from err
     except BaseException:
         remove_temporary([temporary])
         raise
