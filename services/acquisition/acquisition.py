@@ -105,7 +105,8 @@ class Acquisition:
     def handle(self, message: can.Message) -> None:
         """Handle one received frame; bad frames are counted, never raised."""
         self._frames += 1
-        time_ns = round(message.timestamp * 1e9) if message.timestamp else self._clock_ns()
+        bus_timed = bool(message.timestamp)  # the driver's (kernel's) receive time
+        time_ns = round(message.timestamp * 1e9) if bus_timed else self._clock_ns()
         frame = self._decoder.decode(
             message.arbitration_id,
             message.data,
@@ -114,7 +115,9 @@ class Acquisition:
         )
         if isinstance(frame, ToolSensorsFrame):
             self._emit(
-                self._assembler.tool_frame(frame.counter, frame.torque_nm, frame.angle_deg, time_ns)
+                self._assembler.tool_frame(
+                    frame.counter, frame.torque_nm, frame.angle_deg, time_ns, bus_timed
+                )
             )
         elif isinstance(frame, JointSensorsFrame):
             self._emit(self._assembler.joint_frame(frame.counter, frame.force_n, time_ns))

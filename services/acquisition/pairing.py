@@ -91,7 +91,7 @@ class SampleAssembler:
         self._last_time_ns = 0
         self._last_sequence = -1
         #: dropped frames (counter, time_ns, frames in a row ending with it), oldest first
-        self._candidates: list[tuple[int, int, int]] = []
+        self._candidates: list[tuple[int, int | None, int]] = []
         self._pending_tools: list[_PendingTool] = []  # in sequence order
         self._pending_forces: dict[int, float] = {}  # counter -> force of JointSensors
 
@@ -111,10 +111,20 @@ class SampleAssembler:
         self._pending_forces.clear()
 
     def tool_frame(
-        self, counter: int, torque_nm: float, angle_deg: float, time_ns: int
+        self,
+        counter: int,
+        torque_nm: float,
+        angle_deg: float,
+        time_ns: int,
+        bus_timed: bool = True,
     ) -> list[AssembledSample]:
-        """A ToolSensors frame arrived; returns the samples it completes, in order."""
-        sequence = self._unroll(counter, time_ns)
+        """A ToolSensors frame arrived; returns the samples it completes, in order.
+
+        ``bus_timed``: ``time_ns`` is the bus driver's receive time. When it is not
+        (an interface without timestamps: frames read late come bunched), the time
+        between frames says nothing of a gap and is not used to judge one.
+        """
+        sequence = self._unroll(counter, time_ns if bus_timed else None)
         if sequence is None:
             return []
         pending = _PendingTool(sequence, counter, time_ns, torque_nm, angle_deg)
@@ -146,8 +156,11 @@ class SampleAssembler:
         self._pending_forces[counter] = force_n
         return []
 
-    def _unroll(self, counter: int, time_ns: int) -> int | None:
-        """Sequence number of a ToolSensors Counter, counting gaps; None to drop the frame."""
+    def _unroll(self, counter: int, time_ns: int | None) -> int | None:
+        """Sequence number of a ToolSensors Counter, counting gaps; None to drop the frame.
+
+        ``time_ns`` None: no receive time to judge a gap by; any jump ahead is a gap.
+        """
         if self._last_counter is None:
             step = 1
         else:
@@ -157,29 +170,31 @@ class SampleAssembler:
                 return None
             if step > BACKWARDS_THRESHOLD:
                 return self._candidate(counter, time_ns, "backwards")
-            if step > _plausible_steps(time_ns - self._last_time_ns):
+            if time_ns is not None and step > _plausible_steps(time_ns - self._last_time_ns):
                 return self._candidate(counter, time_ns, "implausible")
             if step > 1:
                 self.counters.counter_gaps += 1
                 self.counters.missed_samples += step - 1
         return self._accept(counter, time_ns, step)
 
-    def _accept(self, counter: int, time_ns: int, step: int) -> int:
+    def _accept(self, counter: int, time_ns: int | None, step: int) -> int:
         self._last_counter = counter
-        self._last_time_ns = time_ns
+        if time_ns is not None:
+            self._last_time_ns = time_ns
         self._last_sequence += step
         self._candidates.clear()
         return self._last_sequence
 
     def _candidate(
-        self, counter: int, time_ns: int, fault: Literal["backwards", "implausible"]
+        self, counter: int, time_ns: int | None, fault: Literal["backwards", "implausible"]
     ) -> int | None:
         """A frame off the count: dropped, unless it ends a run of dropped frames that go on
         from each other as the tool's own would (:data:`RESYNC_FRAMES`): then it moved."""
         chain = 1
         for old_counter, old_time_ns, old_chain in self._candidates:
             step = (counter - old_counter) % COUNTER_MODULO
-            if 0 < step <= _plausible_steps(time_ns - old_time_ns):
+            elapsed_ns = 0 if time_ns is None or old_time_ns is None else time_ns - old_time_ns
+            if 0 < step <= _plausible_steps(elapsed_ns):
                 chain = max(chain, old_chain + 1)
         if chain >= RESYNC_FRAMES:
             self.counters.resyncs += 1
