@@ -10,8 +10,13 @@ and the force plateau F_j the peak sits on:
 - K2 = ΔF/Δt · φ̇_m                              eq. 32
 - K3 = ΔT/t · φ̇_m                               eq. 33
 - T_mean,j = (T_max,j + T_min,j)/2              eq. 66
-- I_j = ΔT_j · T_mean,j · f_ss,j                eq. 67
+- I_j = ΔT_j · |T_mean,j| · f_ss,j              eq. 67
 - I_process = Σ_(j≥2) I_j                       eq. 68
+
+The paper's T_mean is positive (a tightening); a transducer that counts
+the other direction negative, or a drop around zero torque, would make I_j
+negative and subtract wear. The magnitude wears the tool alike, so
+|T_mean| is used and no event's intensity is below zero.
 
 t is the time since the run's first sample; φ̇_m is the program's motor
 speed when known, else measured from the angle between the two peaks.
@@ -41,8 +46,8 @@ def torque_mean_nm(peak_torque_nm: float, min_torque_nm: float) -> float:
 
 
 def event_intensity(torque_drop_nm: float, mean_torque_nm: float, f_ss_hz: float) -> float:
-    """I_j = ΔT_j · T_mean,j · f_ss,j (eq. 67), Nm²/s."""
-    return torque_drop_nm * mean_torque_nm * f_ss_hz
+    """I_j = ΔT_j · |T_mean,j| · f_ss,j (eq. 67), Nm²/s; never negative."""
+    return torque_drop_nm * abs(mean_torque_nm) * f_ss_hz
 
 
 def compute_figures(

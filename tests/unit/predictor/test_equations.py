@@ -158,3 +158,8 @@ def test_force_history_means() -> None:
     assert history.mean(1, 3) == pytest.approx(3.0)
     assert history.plateau_before(-1, 5) == pytest.approx((4.0 + 5.0 + 6.0) / 3)  # 2nd half
     assert history.plateau_after(3) == pytest.approx(5.5)
+
+
+def test_an_event_around_negative_torque_wears_the_tool_too() -> None:
+    """Issue 15: random frames gave a negative process intensity (-2e9) in the wear ledger."""
+    assert event_intensity(2.0, -3.0, 4.0) == event_intensity(2.0, 3.0, 4.0) == 24.0
