@@ -13,6 +13,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from shared import folders
 from shared.errors import InputError
 
 if TYPE_CHECKING:
@@ -23,16 +24,9 @@ if TYPE_CHECKING:
 def make_folder(folder: Path, what: str) -> Path:
     """``folder``, made if missing; InputError naming it, what it is for, and why not."""
     try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except FileExistsError as err:
-        raise InputError(f"{folder}: {what}: is a file, expected a folder") from err
-    except NotADirectoryError as err:
-        blocking = next((p for p in folder.parents if p.exists() and not p.is_dir()), None)
-        why = f"{blocking} is a file, not a folder" if blocking else "a part of it is a file"
-        raise InputError(f"{folder}: {what}: cannot be made: {why}") from err
-    except OSError as err:
-        raise InputError(f"{folder}: {what}: cannot be made: {err.strerror}") from err
-    return folder
+        return folders.make_folder(folder)
+    except folders.FolderError as err:
+        raise InputError(f"{folder}: {what}: {err}") from err
 
 
 def write_csv_whole(target: Path, rows: Iterable[tuple[float, float, float, float | None]]) -> int:

@@ -296,6 +296,7 @@ def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
 def main(args: argparse.Namespace) -> int:
     loaded = load_line(args.config)  # serve recorder: one or more files, always a list
     served_stations(loaded)  # bad combinations fail before zenoh is opened
+    loaded[0].make_recordings_folder()  # and a folder that can never be made
     session = open_session(loaded[0].config.zenoh)
     live = start_rerun_live(args)
     try:

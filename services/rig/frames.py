@@ -2,7 +2,11 @@
 
 The tool controller sends ToolSensors and ToolStatus, the force sensor node
 JointSensors; both listen for StopCommand. Ids, layout and scaling come from
-:class:`~shared.can_database.StationDatabase`, never from this file.
+:class:`~shared.can_database.StationDatabase`, never from this file. A
+reading beyond what its signal can carry is sent at the end of the range, as
+a real transducer saturates at full scale (the predictor counts it as
+``saturated``); the station file's limits are checked against the range at
+start (a limit beyond it is a configuration error).
 """
 
 from __future__ import annotations
@@ -11,6 +15,7 @@ import can
 
 from shared.can_database import COUNTER_MODULO, StationDatabase
 from shared.messages import ToolRunState
+from shared.sensor_range import SensorRange
 
 
 class RigFrames:
@@ -18,6 +23,10 @@ class RigFrames:
 
     def __init__(self, database: StationDatabase) -> None:
         self._database = database
+        sensor_range = SensorRange.of_database(database)
+        self._torque_nm = sensor_range.torque_nm
+        self._angle_deg = sensor_range.angle_deg
+        self._force_n = sensor_range.force_n
         self._extended = {
             name: database.is_extended(name)
             for name in ("ToolSensors", "JointSensors", "ToolStatus")
@@ -34,14 +43,18 @@ class RigFrames:
         return self._message(
             "ToolSensors",
             self._database.tool_sensors_id,
-            {"Torque": torque_nm, "Angle": angle_deg, "Counter": counter % COUNTER_MODULO},
+            {
+                "Torque": _saturated(torque_nm, self._torque_nm),
+                "Angle": _saturated(angle_deg, self._angle_deg),
+                "Counter": counter % COUNTER_MODULO,
+            },
         )
 
     def joint_sensors(self, force_n: float, counter: int) -> can.Message:
         return self._message(
             "JointSensors",
             self._database.joint_sensors_id,
-            {"Force": force_n, "Counter": counter % COUNTER_MODULO},
+            {"Force": _saturated(force_n, self._force_n), "Counter": counter % COUNTER_MODULO},
         )
 
     def tool_status(
@@ -62,3 +75,9 @@ class RigFrames:
         except Exception:  # cantools raises several kinds on a short or garbled frame
             return None
         return int(signals["RunId"])
+
+
+def _saturated(value: float, bounds: tuple[float, float]) -> float:
+    """``value`` held to the signal's range, as a transducer at full scale."""
+    low, high = bounds
+    return min(max(value, low), high)

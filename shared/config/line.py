@@ -74,16 +74,12 @@ def derived_ids(base_id: str, count: int) -> list[str]:
     return [f"{prefix}{first + i}" for i in range(count)]
 
 
-def derive_stations(base_path: Path, count: int, folder: Path) -> list[Path]:
-    """Write ``count`` station files derived from ``base_path`` into ``folder``.
-
-    Returns their paths (``folder/<id>.toml``), each already checked with
-    :func:`load_station` and all together with :func:`load_line`.
-    """
+def check_derivable(base_path: Path, count: int) -> tuple[LoadedStation, list[str]]:
+    """(the base station, the derived ids) of ``count`` stations from ``base_path``;
+    ConfigError naming the file and key when they cannot be derived. Writes nothing."""
     if count < 1:
         raise ConfigError(f"--stations must be at least 1 (got {count})")
     base = load_station(base_path)
-    raw = read_toml(base_path)
     config = base.config
     if config.can.interface == "socketcan" and count > 1:
         raise ConfigError(
@@ -107,6 +103,17 @@ def derive_stations(base_path: Path, count: int, folder: Path) -> list[Path]:
     for id_ in ids:
         if len(id_) > 64:
             raise ConfigError(f"{base_path}: station.id: derived id {id_!r} is too long")
+    return base, ids
+
+
+def derive_stations(base_path: Path, count: int, folder: Path) -> list[Path]:
+    """Write ``count`` station files derived from ``base_path`` into ``folder``.
+
+    Returns their paths (``folder/<id>.toml``), each already checked with
+    :func:`load_station` and all together with :func:`load_line`.
+    """
+    base, ids = check_derivable(base_path, count)
+    raw = read_toml(base_path)
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
     for i, station_id in enumerate(ids):

@@ -17,6 +17,7 @@ from shared.can_database import StationDatabase
 from shared.config.joint import JointConfig, load_joint
 from shared.config.loading import StrictModel, read_toml, resolve_relative, validate
 from shared.errors import CanDatabaseError, ConfigError
+from shared.folders import FolderError, make_folder
 from shared.sensor_range import SensorRange
 
 StationId = str
@@ -141,6 +142,40 @@ class Program(StrictModel):
             raise ValueError("give target_force_n, target_torque_nm, or both")
         return self
 
+    @model_validator(mode="after")
+    def _limits_leave_room_for_the_target(self) -> Program:
+        """A hard limit at or below its target would end every run on the limit."""
+        for limit, target, unit in (
+            ("max_force_n", "target_force_n", "N"),
+            ("max_torque_nm", "target_torque_nm", "Nm"),
+        ):
+            limit_value, target_value = getattr(self, limit), getattr(self, target)
+            if limit_value is not None and target_value is not None and limit_value <= target_value:
+                raise ValueError(
+                    f"{limit} {limit_value:g} {unit} is not above {target} {target_value:g} "
+                    f"{unit}: every run would end on the tool's hard limit"
+                )
+        if self.target_force_n is not None and self.start_force_n >= self.target_force_n:
+            raise ValueError(
+                f"start_force_n {self.start_force_n:g} N is not below target_force_n "
+                f"{self.target_force_n:g} N: the run would start past its target"
+            )
+        return self
+
+    def limits_beyond(self, sensor_range: SensorRange) -> str | None:
+        """What of this program's hard limits its sensors cannot report, or None."""
+        for key, value, (low, high), unit in (
+            ("max_torque_nm", self.max_torque_nm, sensor_range.torque_nm, "Nm"),
+            ("max_force_n", self.max_force_n, sensor_range.force_n, "N"),
+            ("max_angle_deg", self.max_angle_deg, sensor_range.angle_deg, "deg"),
+        ):
+            if value is not None and not low < value < high:
+                return (
+                    f"{key}: {value:g} {unit} is beyond what the sensor can report "
+                    f"({low:g} to {high:g} {unit})"
+                )
+        return None
+
 
 class PredictorSection(StrictModel):
     window_samples: int = Field(
@@ -234,6 +269,19 @@ class LoadedStation:
     def recordings_folder(self) -> Path:
         return resolve_relative(self.config.recorder.folder, self.path)
 
+    def make_recordings_folder(self) -> Path:
+        """The recordings folder, made if missing; ConfigError (file, key, why) if it cannot be.
+
+        Called at a service's start: a folder that can never be made is a
+        configuration error, while a disk that fails later is a fault the
+        recorder rides out (README, "Faults").
+        """
+        folder = self.recordings_folder
+        try:
+            return make_folder(folder)
+        except FolderError as err:
+            raise ConfigError(f"{self.path}: recorder.folder: {folder}: {err}") from err
+
 
 def load_station(path: Path) -> LoadedStation:
     """Load a station file and the joint file it names; every error names file and key."""
@@ -249,4 +297,12 @@ def load_station(path: Path) -> LoadedStation:
         sensor_range = SensorRange.of_database(StationDatabase(dbc_path))
     except CanDatabaseError as err:
         raise ConfigError(f"{path}: can.dbc: {err}") from err
+    for index, program in enumerate(config.programs):
+        beyond = program.limits_beyond(sensor_range)
+        if beyond is not None:
+            raise ConfigError(
+                f"{path}: programs[{index}].{beyond} in the scaling of {dbc_path}: the tool could "
+                "never send a reading at its own limit (widen the signal in the DBC or lower "
+                "the limit)"
+            )
     return LoadedStation(path, config, load_joint(joint_path), sensor_range)

@@ -63,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     from services.rig.selection import choose_program
     from services.rig.service import RUN_ID_MAX
     from shared.config import derive_stations, load_line, load_station
+    from shared.config.line import check_derivable
     from shared.errors import ConfigError
 
     if args.runs < 1:
@@ -82,6 +83,9 @@ def run(args: argparse.Namespace) -> int:
             f"{station.path}: zenoh: boltwatch up runs a router and needs mode = 'client' "
             "with connect = [its endpoint]"
         )
+    if args.stations > 1:
+        check_derivable(args.config, args.stations)  # its numbers, before anything is written
+    station.make_recordings_folder()  # its logs go there too: refused now, naming the key
     stamp = datetime.now(UTC).strftime("%Y%m%d-%H%M%S")
     log_dir = station.recordings_folder / "logs" / f"up-{stamp}"
     stations = (

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -86,3 +87,71 @@ def test_joint_file_checks_physics(tmp_path: Path) -> None:
     path.write_text(text.replace("mu_slip = 0.35", "mu_slip = 0.45"))
     with pytest.raises(ConfigError, match="friction: mu_slip must not exceed mu_stick"):
         load_joint(path)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "expected"),
+    [
+        (
+            "max_force_n = 75000.0",
+            "max_force_n = 50000.0",
+            "programs[0]: max_force_n 50000 N is not above target_force_n 56000 N",
+        ),
+        (
+            "max_torque_nm = 320.0",
+            "max_torque_nm = 200.0",
+            "programs[0]: max_torque_nm 200 Nm is not above target_torque_nm 200 Nm",
+        ),
+        (
+            "start_force_n = 10000.0",
+            "start_force_n = 60000.0",
+            "programs[0]: start_force_n 60000 N is not below target_force_n 56000 N",
+        ),
+    ],
+)
+def test_a_program_that_cannot_work_is_refused_at_start(
+    tmp_path: Path, old: str, new: str, expected: str
+) -> None:
+    """Issue 15: max_force_n below the target was accepted and every run ended on force_limit."""
+    path = write_station(tmp_path, "")
+    path.write_text(path.read_text().replace(old, new, 1))
+    with pytest.raises(ConfigError, match=r"^" + re.escape(f"{path}: {expected}")):
+        load_station(path)
+
+
+def test_a_dbc_scaling_that_cannot_carry_the_limits_is_refused_at_start(tmp_path: Path) -> None:
+    """Issue 15: a DBC scaling too narrow for the torque crashed the rig (OverflowError)."""
+    narrow = tmp_path / "narrow.dbc"
+    narrow.write_text(
+        (CONFIG / "can" / "station.dbc")
+        .read_text()
+        .replace(
+            'SG_ Torque : 0|24@1- (0.001,0) [-8388.608|8388.607] "Nm"',
+            'SG_ Torque : 0|16@1- (0.001,0) [-32.768|32.767] "Nm"',
+        )
+    )
+    path = write_station(tmp_path, "")
+    path.write_text(path.read_text().replace(f'"{CONFIG}/can/station.dbc"', f'"{narrow}"'))
+    with pytest.raises(ConfigError) as caught:
+        load_station(path)
+    assert str(caught.value).startswith(
+        f"{path}: programs[0].max_torque_nm: 320 Nm is beyond what the sensor can report "
+        f"(-32.768 to 32.767 Nm) in the scaling of {narrow}"
+    )
+
+
+def test_a_recordings_folder_that_cannot_be_made_is_refused_naming_the_key(
+    tmp_path: Path,
+) -> None:
+    """Issue 15: ``[recorder] folder`` under a file was a NotADirectoryError traceback."""
+    (tmp_path / "afile").write_text("not a folder")
+    path = write_station(tmp_path, "")
+    text = path.read_text()
+    path.write_text(text.replace('folder = "../recordings"', 'folder = "afile/recordings"'))
+    station = load_station(path)
+    with pytest.raises(ConfigError) as caught:
+        station.make_recordings_folder()
+    assert str(caught.value) == (
+        f"{path}: recorder.folder: {tmp_path}/afile/recordings: cannot be made: "
+        f"{tmp_path}/afile is a file, not a folder"
+    )

@@ -1,0 +1,26 @@
+"""Making a folder, and saying plainly why one cannot be made."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from shared.errors import BoltwatchError
+
+
+class FolderError(BoltwatchError):
+    """A folder cannot be made; the message says why (no path: the caller names it)."""
+
+
+def make_folder(folder: Path) -> Path:
+    """``folder`` with its parents, made if missing; FolderError saying why it cannot be."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except FileExistsError as err:
+        raise FolderError("is a file, expected a folder") from err
+    except NotADirectoryError as err:
+        blocking = next((p for p in folder.parents if p.exists() and not p.is_dir()), None)
+        why = f"{blocking} is a file, not a folder" if blocking else "a part of it is a file"
+        raise FolderError(f"cannot be made: {why}") from err
+    except OSError as err:
+        raise FolderError(f"cannot be made: {err.strerror}") from err
+    return folder
