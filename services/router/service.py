@@ -7,7 +7,9 @@ docker-compose.yml); this one needs nothing but the Python wheel.
 With ``--tls-*`` it takes only TLS connections from services whose
 certificate the line's CA signed (mutual TLS); with ``--access-control`` it
 enforces zenoh's access control, e.g. only a station's predictor may put
-its decisions (README, Security).
+its decisions (README, Security). Listening in plain tcp on anything but
+loopback, it warns loudly at start: any node that reaches the port can then
+stop a tool, write the wear ledger and read the whole line.
 """
 
 from __future__ import annotations
@@ -26,6 +28,26 @@ from shared.zenoh_session import TlsFiles, open_from, zenoh_config, zenoh_reason
 LOG = logging.getLogger(__name__)
 
 DEFAULT_LISTEN = "tcp/127.0.0.1:7447"
+_LOOPBACK_HOSTS = ("127.", "[::1]", "localhost")
+
+
+def exposure_warning(endpoints: list[str]) -> str | None:
+    """What an unauthenticated node can do on this line, when a plain endpoint is not loopback."""
+    exposed = [
+        endpoint
+        for endpoint in endpoints
+        if not endpoint.startswith("tls/")
+        and not endpoint.split("/", 1)[-1].startswith(_LOOPBACK_HOSTS)
+    ]
+    if not exposed:
+        return None
+    return (
+        f"the line listens in plain {', '.join(exposed)} with no TLS: any node that reaches "
+        "it can stop a tool (a StopDecision), write the wear ledger (a RunSummary) and read "
+        "every sample, unauthenticated. On a plant network run the router with mutual TLS "
+        "and access control (--listen tls/HOST:PORT --tls-root-ca --tls-cert --tls-key "
+        "--access-control; README, Security)"
+    )
 
 
 def router_config(args: argparse.Namespace) -> zenoh.Config:
@@ -90,6 +112,9 @@ def main(args: argparse.Namespace) -> int:
     endpoints = args.listen or [DEFAULT_LISTEN]
     with open_from(config):
         LOG.info("zenoh router listening on %s", ", ".join(endpoints))
+        warning = exposure_warning(endpoints)
+        if warning is not None:
+            LOG.warning("UNPROTECTED LINE: %s", warning)
         if args.access_control is not None:
             LOG.info("access control from %s", args.access_control)
 

@@ -17,8 +17,11 @@ run is under way, then starts it again as compose ``restart:`` or systemd would:
 
 from __future__ import annotations
 
+import os
+import signal
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -45,8 +48,8 @@ def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[LiveStation]:
         yield running
 
 
-def kill_mid_run(station: LiveStation, service: str) -> int:
-    """Kill ``service`` while a run is SAMPLES_BEFORE_KILL samples in; that run's id."""
+def wait_mid_run(station: LiveStation) -> int:
+    """The run under way once it is SAMPLES_BEFORE_KILL samples in, before any decision."""
 
     def under_way() -> bool:
         run_id = station.running_run()
@@ -57,8 +60,14 @@ def kill_mid_run(station: LiveStation, service: str) -> int:
         )
 
     station.wait_for(under_way, "a run under way")
-    killed_run = station.running_run()
-    assert killed_run is not None
+    run_id = station.running_run()
+    assert run_id is not None
+    return run_id
+
+
+def kill_mid_run(station: LiveStation, service: str) -> int:
+    """Kill ``service`` while a run is SAMPLES_BEFORE_KILL samples in; that run's id."""
+    killed_run = wait_mid_run(station)
     station.kill(service)
     return killed_run
 
@@ -121,4 +130,33 @@ def test_a_service_killed_mid_run(station: LiveStation, service: str, tmp_path: 
 
     station.start(service)
     station.wait_alive((service,))
+    check_next_run_normal(station)
+
+
+def test_a_predictor_paused_mid_run_is_a_late_decision_not_the_stop_reason(
+    station: LiveStation,
+) -> None:
+    """Issue 15: a predictor paused 3 s (SIGSTOP / SIGCONT): the tool stopped by its own
+    shutoff and the acquisition ignored the late decision, but the summary said
+    ``plateau_closest``. What stopped the tool is the acquisition's word now."""
+    run_id = wait_mid_run(station)
+    predictor = station.process("predictor")
+    os.kill(predictor.pid, signal.SIGSTOP)
+    try:
+        station.wait_for(lambda: station.can.runs()[run_id].ended, f"run {run_id} to end")
+        time.sleep(3.0)  # the issue's probe: paused for 3 s
+    finally:
+        os.kill(predictor.pid, signal.SIGCONT)
+    assert_tool_stopped_safely(station, run_id)
+    summary = None
+
+    def summarised() -> bool:
+        nonlocal summary
+        summary = next((s for s in station.summaries() if s.run_id == run_id), None)
+        return summary is not None
+
+    station.wait_for(summarised, f"the summary of run {run_id}")
+    assert summary is not None
+    assert summary.stop_reason is None, summary  # the tool stopped by itself
+    assert summary.late_decision is not None, summary  # the predictor decided, too late
     check_next_run_normal(station)

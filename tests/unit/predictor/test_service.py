@@ -289,3 +289,29 @@ def test_a_run_whose_end_never_arrived_is_forgotten_when_the_next_starts(
         feed.close()
     assert service.unfinished_runs == 1
     assert service.dropped_samples == 1
+
+
+def test_a_run_id_counts_once_however_its_state_flips(
+    service: PredictorService, endpoint: str
+) -> None:
+    """Issue 15: a ToolStatus flipping for one run id gave a row (a summary) per flip."""
+    rows = staircase().rows()
+    with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
+        wait_for_token(session, keys.health_key("pt1", "predictor"))
+        summaries = session.declare_subscriber(
+            keys.station_key("pt1", keys.RUNS), zenoh.handlers.FifoChannel(100)
+        )
+        feed = StationFeed(session, "pt1")
+        for flip in range(5):
+            feed.state(42, PROGRAM_OF["pt1"], "running", START_NS + flip)
+            for i, row in enumerate(rows[:20]):
+                feed.sample(42, i, row)
+            feed.state(42, PROGRAM_OF["pt1"], "done", START_NS + flip + 1)
+        feed.state(43, PROGRAM_OF["pt1"], "running", START_NS + 10)
+        feed.state(43, PROGRAM_OF["pt1"], "done", START_NS + 11)
+        got = collect(summaries, until={"pt1/runs"}, settle_s=1.0)
+        summaries.undeclare()
+        feed.close()
+    runs = [codec.decode(RunSummary, payload).run_id for payload in got["pt1/runs"]]
+    assert runs == [42, 43]
+    assert service.repeated_runs == 4

@@ -129,3 +129,22 @@ def test_a_file_over_its_byte_limit_continues(tmp_path: Path, station: LoadedSta
     assert len(files.closed_paths) > 1
     assert sum(counts(p).get("samples", 0) for p in files.closed_paths) == 1000
     assert all(p.stat().st_size < 40_000 for p in files.closed_paths)
+
+
+def test_a_run_id_is_one_file_however_its_state_flips(
+    tmp_path: Path, station: LoadedStation
+) -> None:
+    """Issue 15: ToolStatus flipping every 5 ms for one run id made 69 MCAP files."""
+    files = StationFiles("st1", tmp_path, LIMITS, FileMetadata(station))
+    t = T0_NS
+    items = []
+    for flip in range(30):
+        t += 5_000_000
+        items.append(("tool", tool(42, "running" if flip % 2 == 0 else "done", t), t))
+        items.append(("samples", sample(42, flip, t + 1), t + 1))
+    items.append(("tool", tool(43, "running", t + SECOND_NS), t + SECOND_NS))
+    feed(files, items)
+    files.close()
+    names = sorted(p.name for p in files.closed_paths)
+    assert names == ["st1_run42_221320.mcap", "st1_run43_221321.mcap"]
+    assert counts(tmp_path / "st1" / "2023-11-14" / names[0]) == {"tool": 30, "samples": 30}
