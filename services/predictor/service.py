@@ -20,15 +20,15 @@ import argparse
 import logging
 import threading
 import time
-from collections import deque
 from collections.abc import Sequence
 from typing import Any
 
 import zenoh
 
-from services.predictor.active_run import ActiveRun, Outgoing
+from services.predictor.active_run import Outgoing
 from services.predictor.served_station import ServedStation
 from services.predictor.station_inbox import Inbox, InboxFactory, StationInbox
+from services.predictor.station_runs import StationRuns
 from shared import codec, keys
 from shared.config import LoadedStation, load_line
 from shared.config.line import stations_by_id
@@ -45,8 +45,6 @@ _decode_tool_state = codec.decoder(ToolState)
 
 #: how long to ask the line whether another predictor already serves a station
 PEER_CHECK_TIMEOUT_S = 1.0
-#: run ids remembered per station: a ToolState starting one of them again is ignored
-STARTED_RUNS_KEPT = 64
 
 
 class PredictorService:
@@ -65,13 +63,11 @@ class PredictorService:
             for station_id, station in stations_by_id(served).items()
         }
         self._refuse_stations_served_elsewhere()
-        self._runs: dict[tuple[str, int], ActiveRun] = {}
+        self._runs = {
+            station_id: StationRuns(served) for station_id, served in self._stations.items()
+        }
         self._publishers: dict[tuple[str, str], Any] = {}
-        self.dropped_samples = 0
-        self.unfinished_runs = 0  # runs whose end never arrived (a network outage)
         self.bad_payloads = 0
-        self.repeated_runs = 0  # a run id that started again after it had started: ignored
-        self._started: dict[str, deque[int]] = {}  # per station, the run ids that started
         self._inbox: Inbox = inbox(session, list(self._stations), self.handle)
         self._tokens = [
             session.liveliness().declare_token(keys.health_key(station_id, "predictor"))
@@ -125,18 +121,18 @@ class PredictorService:
 
     def handle(self, station_id: str, topic: str, payload: bytes) -> None:
         """Dispatch one message received on a served station's ``topic`` key."""
-        served = self._stations.get(station_id)
-        if served is None:  # cannot happen: the inbox only subscribes to served stations
+        runs = self._runs.get(station_id)
+        if runs is None:  # cannot happen: the inbox only subscribes to served stations
             return
         try:
             if topic == keys.SAMPLES:
                 sample = _decode_sample(payload)
                 if self._belongs(sample.station, station_id, topic):
-                    self._on_sample(sample)
+                    self._on_sample(runs, sample)
             elif topic == keys.TOOL:
                 state = _decode_tool_state(payload)
                 if self._belongs(state.station, station_id, topic):
-                    self._on_tool(served, state)
+                    self._on_tool(runs, state)
         except InputError as err:
             self.bad_payloads += 1
             LOG.warning("ignored a bad %s payload of %s: %s", topic, station_id, err)
@@ -154,60 +150,28 @@ class PredictorService:
         )
         return False
 
-    def _on_tool(self, served: ServedStation, state: ToolState) -> None:
-        run_key = (state.station, state.run_id)
-        if state.state == "running":
-            if run_key in self._runs:
-                return
-            started = self._started.setdefault(state.station, deque(maxlen=STARTED_RUNS_KEPT))
-            if state.run_id in started:  # a run id starts once, however its state flips
-                self.repeated_runs += 1
-                return
-            started.append(state.run_id)
-            self._forget_unfinished_runs(state.station)
-            try:
-                program = served.program(state.program_id)
-            except KeyError as err:
-                LOG.error("run %s: %s; not predicting this run", state.run_id, err.args[0])
-                return
-            self._runs[run_key] = ActiveRun(state, program, served.settings(program))
-            LOG.debug("%s run %s started (program %s)", state.station, state.run_id, program.id)
-        elif state.state in ("done", "aborted"):
-            run = self._runs.pop(run_key, None)
-            if run is None:
-                return
-            summary = run.summary(state)
+    def _on_tool(self, runs: StationRuns, state: ToolState) -> None:
+        summary = runs.on_tool(state)
+        if summary is not None:
             self._publish(state.station, keys.RUNS, summary)
-            LOG.info(
-                "%s run %s %s: %d events, stop %s, error %s %%, %s",
-                state.station,
-                state.run_id,
-                state.state,
-                summary.events,
-                summary.stop_reason,
-                f"{summary.error_pct:.2f}" if summary.error_pct is not None else "-",
-                run.core.input_report.as_dict(),
-            )
 
-    def _forget_unfinished_runs(self, station: str) -> None:
-        """A new run of ``station`` starts: its older runs have ended, unheard (an outage)."""
-        for run_key in [key for key in self._runs if key[0] == station]:
-            run = self._runs.pop(run_key)
-            self.unfinished_runs += 1
-            LOG.warning(
-                "%s run %s: its end never arrived (network outage?); no summary, %s",
-                station,
-                run_key[1],
-                run.core.input_report.as_dict(),
-            )
-
-    def _on_sample(self, sample: Sample) -> None:
-        run = self._runs.get((sample.station, sample.run_id))
-        if run is None:
-            self.dropped_samples += 1
-            return
-        for message in run.on_sample(sample, time.time_ns()):
+    def _on_sample(self, runs: StationRuns, sample: Sample) -> None:
+        for message in runs.on_sample(sample, time.time_ns()):
             self._send(sample.station, message)
+
+    @property
+    def dropped_samples(self) -> int:
+        return sum(runs.dropped_samples for runs in self._runs.values())
+
+    @property
+    def unfinished_runs(self) -> int:
+        """Runs whose end never arrived (a network outage)."""
+        return sum(runs.unfinished_runs for runs in self._runs.values())
+
+    @property
+    def repeated_runs(self) -> int:
+        """Run ids that started again after they had started: ignored."""
+        return sum(runs.repeated_runs for runs in self._runs.values())
 
     def _send(self, station: str, message: Outgoing) -> None:
         if isinstance(message, StopDecision):

@@ -1,0 +1,100 @@
+"""The runs of one station as the predictor follows them: states and samples in, messages out.
+
+Pure (no zenoh, no clock of its own): the same object serves the line
+predictor (:mod:`.service`, fed from zenoh) and the edge predictor
+(:mod:`.edge_predictor`, fed on the acquisition's CAN thread). Rules:
+
+- ``running`` starts a run (an :class:`ActiveRun` with the station's
+  settings for its program); a run id starts once, however its state flips
+  (counted in :attr:`repeated_runs`);
+- a new run of the station ends its older ones, unheard (their ``done`` was
+  lost in an outage: counted in :attr:`unfinished_runs`, no summary);
+- ``done`` / ``aborted`` ends a run: its :class:`RunSummary`;
+- a sample of no running run is dropped and counted (:attr:`dropped_samples`).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import deque
+
+from services.predictor.active_run import ActiveRun, Outgoing
+from services.predictor.served_station import ServedStation
+from shared.messages import RunSummary, Sample, ToolState
+
+LOG = logging.getLogger(__name__)
+
+#: run ids remembered: a ToolState starting one of them again is ignored
+STARTED_RUNS_KEPT = 64
+
+
+class StationRuns:
+    """The active runs of one served station."""
+
+    def __init__(self, served: ServedStation) -> None:
+        self.served = served
+        self._runs: dict[int, ActiveRun] = {}
+        self._started: deque[int] = deque(maxlen=STARTED_RUNS_KEPT)
+        self.dropped_samples = 0
+        self.unfinished_runs = 0  # runs whose end never arrived (a network outage)
+        self.repeated_runs = 0  # a run id that started again after it had started: ignored
+
+    def on_tool(self, state: ToolState) -> RunSummary | None:
+        """A run state of the station; the run's summary when it ended."""
+        if state.state == "running":
+            self._start(state)
+            return None
+        if state.state not in ("done", "aborted"):
+            return None
+        run = self._runs.pop(state.run_id, None)
+        if run is None:
+            return None
+        summary = run.summary(state)
+        LOG.info(
+            "%s run %s %s: %d events, stop %s%s, error %s %%, %s",
+            state.station,
+            state.run_id,
+            state.state,
+            summary.events,
+            summary.stop_reason or "by the tool",
+            f" (late decision: {summary.late_decision})" if summary.late_decision else "",
+            f"{summary.error_pct:.2f}" if summary.error_pct is not None else "-",
+            run.core.input_report.as_dict(),
+        )
+        return summary
+
+    def on_sample(self, sample: Sample, wall_ns: int) -> list[Outgoing]:
+        """Feed a sample to its run; the events, intensities and decision it produced."""
+        run = self._runs.get(sample.run_id)
+        if run is None:
+            self.dropped_samples += 1
+            return []
+        return run.on_sample(sample, wall_ns)
+
+    def _start(self, state: ToolState) -> None:
+        if state.run_id in self._runs:
+            return
+        if state.run_id in self._started:  # a run id starts once, however its state flips
+            self.repeated_runs += 1
+            return
+        self._started.append(state.run_id)
+        self._forget_unfinished_runs()
+        try:
+            program = self.served.program(state.program_id)
+        except KeyError as err:
+            LOG.error("run %s: %s; not predicting this run", state.run_id, err.args[0])
+            return
+        self._runs[state.run_id] = ActiveRun(state, program, self.served.settings(program))
+        LOG.debug("%s run %s started (program %s)", state.station, state.run_id, program.id)
+
+    def _forget_unfinished_runs(self) -> None:
+        """A new run starts: the older ones have ended, unheard (an outage)."""
+        for run_id, run in list(self._runs.items()):
+            del self._runs[run_id]
+            self.unfinished_runs += 1
+            LOG.warning(
+                "%s run %s: its end never arrived (network outage?); no summary, %s",
+                run.state.station,
+                run_id,
+                run.core.input_report.as_dict(),
+            )
