@@ -25,6 +25,9 @@ CONTRACT: dict[str, tuple[str, ...]] = {
 }
 
 COUNTER_MODULO = 1 << 16
+#: ToolSensors (and JointSensors) are sent at this rate while a run is under way
+#: (contract): the Counter is the tool's sample clock, one step per 1/SAMPLE_RATE_HZ s.
+SAMPLE_RATE_HZ = 1000.0
 
 
 class StationDatabase:

@@ -93,8 +93,8 @@ def decoder(message_type: type[MessageT]) -> Callable[[bytes | bytearray], Messa
     def decode_flat(payload: bytes | bytearray) -> MessageT:
         try:
             data = loads(payload)
-            if len(data) != field_count:
-                raise KeyError
+            if type(data) is not dict or len(data) != field_count:
+                raise KeyError  # the slow path names what is wrong
             values = list(map(data.__getitem__, names))
         except (ValueError, TypeError) as err:
             raise InputError(f"not a valid {flat.type_name} message: {err}") from err

@@ -62,6 +62,10 @@ class Sample:
     torque_nm: float
     angle_deg: float
     force_n: float | None  # None on torque-only stations or when JointSensors was lost
+    # the sample's time on the tool's own clock, seconds since the run's first sample
+    # (sequence / the contract's 1 kHz; a controller's own time for an import): what the
+    # predictor decides on, free of receive jitter. None: unknown, the receive time stands in
+    time_s: float | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -2,8 +2,18 @@
 
 :class:`Acquisition` owns the bus reading and the fault counters; where its
 output goes is an :class:`Outlet` (zenoh in the service, a list in tests).
-``send_stop`` may be called from another thread (the zenoh decision callback)
-and turns a decision for the running run into one CAN ``StopCommand``.
+With a :class:`~services.acquisition.decider.Decider` (the station's edge
+predictor) every complete sample is decided on right here, on the CAN
+thread, before it is published: a decision goes out as a ``StopCommand``
+within the same call (the stop path of one sample). ``send_stop`` may also be
+called from another thread (the zenoh decision callback: a predictor
+elsewhere on the line) and turns a decision for the running run into one CAN
+``StopCommand``.
+
+Each sample carries its time on the tool's own clock (``Sample.time_s``:
+its unrolled Counter at the contract's sample rate), which the predictor
+decides on: the receive time (``time_ns``) jitters with the host's
+scheduling, the Counter does not.
 """
 
 from __future__ import annotations
@@ -17,6 +27,7 @@ from typing import Protocol
 
 import can
 
+from services.acquisition.decider import Decider
 from services.acquisition.frame_decoder import (
     FrameDecoder,
     JointSensorsFrame,
@@ -26,7 +37,7 @@ from services.acquisition.frame_decoder import (
     ToolStatusFrame,
 )
 from services.acquisition.pairing import AssembledSample, SampleAssembler
-from shared.can_database import StationDatabase
+from shared.can_database import SAMPLE_RATE_HZ, StationDatabase
 from shared.messages import (
     BusStats,
     Sample,
@@ -64,8 +75,11 @@ class Acquisition:
         outlet: Outlet,
         clock_ns: Callable[[], int] = time.time_ns,
         unsent_samples: Callable[[], int] = lambda: 0,
+        decider: Decider | None = None,
     ) -> None:
-        """``unsent_samples``: how many samples the outlet could not deliver (no router)."""
+        """``unsent_samples``: how many samples the outlet could not deliver (no router);
+        ``decider``: decides on each sample on this thread (the edge predictor), or None."""
+        self._decider = decider
         self.station_id = station_id
         self._unsent_samples = unsent_samples
         self._bus = bus
@@ -132,18 +146,23 @@ class Acquisition:
 
     def _emit(self, samples: list[AssembledSample]) -> None:
         run_id = self._tool.run_id if self._tool is not None else 0
-        for sample in samples:
-            self._outlet.sample(
-                Sample(
-                    self.station_id,
-                    run_id,
-                    sample.sequence,
-                    sample.time_ns,
-                    sample.torque_nm,
-                    sample.angle_deg,
-                    sample.force_n,
-                )
+        decider = self._decider
+        for assembled in samples:
+            sample = Sample(
+                self.station_id,
+                run_id,
+                assembled.sequence,
+                assembled.time_ns,
+                assembled.torque_nm,
+                assembled.angle_deg,
+                assembled.force_n,
+                assembled.sequence / SAMPLE_RATE_HZ,
             )
+            if decider is not None:
+                decision = decider.on_sample(sample)
+                if decision is not None:
+                    self.send_stop(decision)  # before anything else: the stop path
+            self._outlet.sample(sample)
 
     def _tool_status(self, frame: ToolStatusFrame, time_ns: int) -> None:
         try:
@@ -176,19 +195,20 @@ class Acquisition:
             self._assembler.start_run()
         self._tool = frame
         ended = frame.state in (ToolRunState.DONE, ToolRunState.ABORTED)
-        self._outlet.tool_state(
-            ToolState(
-                self.station_id,
-                frame.run_id,
-                frame.tool_id,
-                frame.program_id,
-                state_name,  # type: ignore[arg-type]
-                time_ns,
-                stop_command=(
-                    self._stopped_reason if ended and self._stopped_run == frame.run_id else None
-                ),
-            )
+        state = ToolState(
+            self.station_id,
+            frame.run_id,
+            frame.tool_id,
+            frame.program_id,
+            state_name,  # type: ignore[arg-type]
+            time_ns,
+            stop_command=(
+                self._stopped_reason if ended and self._stopped_run == frame.run_id else None
+            ),
         )
+        if self._decider is not None:
+            self._decider.on_tool_state(state)
+        self._outlet.tool_state(state)
         LOG.info("run %d: %s (program %d)", frame.run_id, state_name, frame.program_id)
 
     # -- stopping ------------------------------------------------------------------------

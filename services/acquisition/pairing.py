@@ -32,7 +32,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from shared.can_database import COUNTER_MODULO
+from shared.can_database import COUNTER_MODULO, SAMPLE_RATE_HZ
 
 #: How many samples a ToolSensors frame may wait for its JointSensors partner.
 PAIRING_TOLERANCE = 2
@@ -40,8 +40,6 @@ PAIRING_TOLERANCE = 2
 #: Counter steps above this count as going backwards rather than a gap ahead.
 BACKWARDS_THRESHOLD = COUNTER_MODULO // 2
 
-#: The contract's sample rate (DESIGN, CAN): ToolSensors at 1 kHz while running.
-SAMPLE_RATE_HZ = 1000.0
 #: Samples a gap may exceed what the elapsed time explains (frames that arrive bunched).
 JITTER_SAMPLES = 5
 #: Dropped frames kept to recognise a Counter that really moved ...

@@ -1,5 +1,9 @@
 """Publish the acquisition's output on zenoh (``samples``, ``tool``, ``bus``).
 
+Through the station's :class:`~shared.queued_publisher.QueuedPublisher`:
+the CAN thread only queues (it is the stop path), a thread of the
+publisher's own encodes and puts, in order.
+
 While the session has no router (it restarts, the network is cut) zenoh has
 nowhere to send a sample: it is lost. The outlet counts those samples
 (``unsent_samples``, reported in BusStats) and logs each outage once when it
@@ -14,28 +18,18 @@ import logging
 import zenoh
 
 from shared import keys
-from shared.codec import encode
 from shared.messages import BusStats, Sample, ToolState
+from shared.queued_publisher import QueuedPublisher
 from shared.zenoh_session import RouterLink
 
 LOG = logging.getLogger(__name__)
 
 
 class ZenohOutlet:
-    """One declared publisher per key; samples and run states share a priority so
-    that a run's ``done`` never overtakes its last samples."""
+    """The acquisition's outlet on the station's queued publisher."""
 
-    def __init__(self, session: zenoh.Session, station_id: str) -> None:
-        def publisher(topic: str) -> zenoh.Publisher:
-            return session.declare_publisher(
-                keys.station_key(station_id, topic),
-                congestion_control=zenoh.CongestionControl.BLOCK,
-                express=True,  # no batching: the stop path is latency-critical
-            )
-
-        self._samples = publisher(keys.SAMPLES)
-        self._tool = publisher(keys.TOOL)
-        self._bus = publisher(keys.BUS)
+    def __init__(self, session: zenoh.Session, publisher: QueuedPublisher) -> None:
+        self._publish = publisher.publish
         self.unsent_samples = 0
         self._unsent_at_outage_start = 0
         self.link = RouterLink(session, self._link_changed)
@@ -45,13 +39,13 @@ class ZenohOutlet:
     def sample(self, sample: Sample) -> None:
         if not self.link.connected:
             self.unsent_samples += 1
-        self._samples.put(encode(sample))
+        self._publish(keys.SAMPLES, sample)
 
     def tool_state(self, state: ToolState) -> None:
-        self._tool.put(encode(state))
+        self._publish(keys.TOOL, state)
 
     def bus_stats(self, stats: BusStats) -> None:
-        self._bus.put(encode(stats))
+        self._publish(keys.BUS, stats)
 
     def _link_changed(self, connected: bool, outage_s: float) -> None:
         if connected:
@@ -68,5 +62,3 @@ class ZenohOutlet:
 
     def close(self) -> None:
         self.link.close()
-        for publisher in (self._samples, self._tool, self._bus):
-            publisher.undeclare()

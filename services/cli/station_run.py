@@ -1,10 +1,12 @@
 """One ``boltwatch up``: bring simulated stations up, run tightenings, report.
 
 One station (the default) or a line of N (``--stations N``): one router, ONE
-recorder and ONE predictor serving every station file, and per station an
-acquisition and a rig. Watches the line from its own zenoh client session:
-liveliness tokens for readiness, ``runs`` for the table, ``bus`` for each
-acquisition's counters.
+recorder serving every station file, and per station an acquisition and a
+rig. A station decides where its ``[predictor] placement`` says: in its
+acquisition (``edge``, the default) or in ONE line predictor serving every
+station placed on the line. Watches the line from its own zenoh client
+session: liveliness tokens for readiness, ``runs`` for the table, ``bus``
+for each acquisition's counters.
 """
 
 from __future__ import annotations
@@ -28,10 +30,9 @@ from shared.zenoh_session import open_from, zenoh_config
 
 LOG = logging.getLogger(__name__)
 
-LINE_SERVICES = ("recorder", "predictor")
-STATION_SERVICES = ("acquisition",)
 #: every service whose liveliness token each station must show before the rigs start
-SERVICES = (*LINE_SERVICES, *STATION_SERVICES)
+#: (an edge predictor's token comes from the station's acquisition)
+SERVICES = ("recorder", "predictor", "acquisition")
 SUMMARY_WAIT_S = 5.0
 RECORDER_DRAIN_S = 1.0
 #: above this many files the report counts recordings per station instead of listing them
@@ -80,6 +81,11 @@ class StationRun:
         ]
         return [*per_station, ["predictor"], ["recorder"], ["router"]]
 
+    @property
+    def line_predicted(self) -> list[LoadedStation]:
+        """The stations that decide in the line's predictor (placement ``line``)."""
+        return [s for s in self.stations if s.config.predictor.placement == "line"]
+
     # -- the whole thing -----------------------------------------------------------------
 
     def run(self) -> int:
@@ -93,12 +99,12 @@ class StationRun:
             )
             for topic in (keys.RUNS, keys.BUS)
         ]
-        for service in LINE_SERVICES:
-            self.supervisor.start(service)
+        self.supervisor.start("recorder")
+        if self.line_predicted:
+            self.supervisor.start("predictor", config_paths=[s.path for s in self.line_predicted])
         for station in self.stations:
-            for service in STATION_SERVICES:
-                name = self.process_name(service, station.station_id)
-                self.supervisor.start(service, name=name, config_paths=[station.path])
+            name = self.process_name("acquisition", station.station_id)
+            self.supervisor.start("acquisition", name=name, config_paths=[station.path])
         self._wait_until_alive()
         print(f"services up after {time.time() - self.started_s:.1f} s; tightening...\n")
         print(run_table.header(self.line))

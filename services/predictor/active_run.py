@@ -38,17 +38,18 @@ class ActiveRun:
         self.last: Sample | None = None
         self.decision: StopDecision | None = None
 
-    def _time_s(self, time_ns: int) -> float:
-        return (time_ns - self.started_ns) / 1e9
+    def _time_s(self, sample: Sample) -> float:
+        """The sample's run time: on the tool's own clock when it has one (no receive jitter)."""
+        if sample.time_s is not None:
+            return sample.time_s
+        return (sample.time_ns - self.started_ns) / 1e9
 
     def on_sample(self, sample: Sample, wall_ns: int) -> list[Outgoing]:
         """Feed one sample; the messages to publish because of it."""
         self.samples += 1
         self.last = sample
         force = sample.force_n if sample.force_n is not None else math.nan
-        outputs = self.core.update(
-            self._time_s(sample.time_ns), sample.torque_nm, force, sample.angle_deg
-        )
+        outputs = self.core.update(self._time_s(sample), sample.torque_nm, force, sample.angle_deg)
         if not outputs:
             return []
         messages: list[Outgoing] = []

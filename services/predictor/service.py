@@ -28,11 +28,12 @@ import zenoh
 from services.predictor.active_run import Outgoing
 from services.predictor.served_station import ServedStation
 from services.predictor.station_inbox import Inbox, InboxFactory, StationInbox
+from services.predictor.station_refusal import refuse_stations_served_elsewhere
 from services.predictor.station_runs import StationRuns
 from shared import codec, keys
 from shared.config import LoadedStation, load_line
 from shared.config.line import stations_by_id
-from shared.errors import ConfigError, InputError
+from shared.errors import InputError
 from shared.messages import Intensity, Sample, StopDecision, ToolState
 from shared.receive_threads import use_one_receive_thread
 from shared.service_runtime import ServiceRunner
@@ -42,9 +43,6 @@ LOG = logging.getLogger(__name__)
 
 _decode_sample = codec.decoder(Sample)
 _decode_tool_state = codec.decoder(ToolState)
-
-#: how long to ask the line whether another predictor already serves a station
-PEER_CHECK_TIMEOUT_S = 1.0
 
 
 class PredictorService:
@@ -62,7 +60,7 @@ class PredictorService:
             station_id: ServedStation(station)
             for station_id, station in stations_by_id(served).items()
         }
-        self._refuse_stations_served_elsewhere()
+        refuse_stations_served_elsewhere(session, self._stations)
         self._runs = {
             station_id: StationRuns(served) for station_id, served in self._stations.items()
         }
@@ -77,23 +75,6 @@ class PredictorService:
     @property
     def station_ids(self) -> list[str]:
         return list(self._stations)
-
-    def _refuse_stations_served_elsewhere(self) -> None:
-        served_elsewhere = set()
-        replies = self._session.liveliness().get(
-            keys.health_key("*", "predictor"), timeout=PEER_CHECK_TIMEOUT_S
-        )
-        for reply in replies:
-            if reply.ok is not None:
-                station_id, _ = keys.split_key(str(reply.ok.key_expr))
-                served_elsewhere.add(station_id)
-        clash = sorted(served_elsewhere & set(self._stations))
-        if clash:
-            raise ConfigError(
-                f"station(s) {', '.join(clash)} already have a predictor on the line "
-                f"({keys.health_key(clash[0], 'predictor')} is alive); "
-                "two predictors must not decide for one station"
-            )
 
     def close(self) -> None:
         self._inbox.close()

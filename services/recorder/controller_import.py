@@ -102,10 +102,10 @@ def controller_messages(
     outputs = replay.outputs if replay is not None else []
     next_output = 0
     yield keys.TOOL, _state(station, run, "running", started_ns), started_ns
-    for sequence, (time_ns, torque, angle) in enumerate(
-        zip(run.times_ns, run.torque_nm, run.angle_deg, strict=True)
+    for sequence, (time_ns, time_s, torque, angle) in enumerate(
+        zip(run.times_ns, run.run_time_s, run.torque_nm, run.angle_deg, strict=True)
     ):
-        sample = Sample(station, run.run_id, sequence, time_ns, torque, angle, None)
+        sample = Sample(station, run.run_id, sequence, time_ns, torque, angle, None, time_s)
         yield keys.SAMPLES, sample, time_ns
         while next_output < len(outputs) and outputs[next_output][0] <= sequence:
             _, topic, message = outputs[next_output]

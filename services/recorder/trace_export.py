@@ -1,9 +1,14 @@
 """A recording's samples as the offline trace CSV (``time_s,torque_nm,angle_deg,force_n``).
 
-``time_s`` counts from the first exported sample of the run (``Sample.time_ns``,
-the acquisition time). A file may hold samples of more than one run (a
-recorder started mid-run); the run exported is the one asked for, else the
-one with the most samples. Damaged files export what is readable.
+``time_s`` counts from the first exported sample of the run, on the clock
+the predictor decided on: the sample's own clock (``Sample.time_s``: the
+tool's Counter at its sample rate, or a controller's time for an import)
+when the recording has it, else the acquisition's receive time
+(``Sample.time_ns``, recordings made before the sample clock). So
+``boltwatch predict`` on the export sees exactly what the live predictor saw.
+A file may hold samples of more than one run (a recorder started mid-run);
+the run exported is the one asked for, else the one with the most samples.
+Damaged files export what is readable.
 """
 
 from __future__ import annotations
@@ -62,12 +67,20 @@ def export_trace(
         known = ", ".join(str(run) for run in sorted(runs))
         raise InputError(f"{source}: no samples of run {run_id} (runs in the file: {known})")
     chosen = [sample for sample in samples if sample["run_id"] == run_id]
-    t0_ns = chosen[0]["time_ns"]
     rows = write_trace(
         target,
         (
-            ((s["time_ns"] - t0_ns) / 1e9, s["torque_nm"], s["angle_deg"], s["force_n"])
-            for s in chosen
+            (time_s, s["torque_nm"], s["angle_deg"], s["force_n"])
+            for time_s, s in zip(run_times_s(chosen), chosen, strict=True)
         ),
     )
     return ExportReport(target, run_id, rows, scan.complete, scan.describe())
+
+
+def run_times_s(samples: list[dict[str, Any]]) -> list[float]:
+    """Each sample's time since the first, on its own clock when every sample has one."""
+    if all(sample.get("time_s") is not None for sample in samples):
+        t0_s = samples[0]["time_s"]
+        return [sample["time_s"] - t0_s for sample in samples]
+    t0_ns = samples[0]["time_ns"]
+    return [(sample["time_ns"] - t0_ns) / 1e9 for sample in samples]

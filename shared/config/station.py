@@ -178,6 +178,13 @@ class Program(StrictModel):
 
 
 class PredictorSection(StrictModel):
+    placement: Literal["edge", "line"] = Field(
+        default="edge",
+        description=(
+            "edge: the acquisition decides on its own CAN thread (the stop path of one "
+            "sample); line: a separate 'boltwatch serve predictor' decides over zenoh"
+        ),
+    )
     window_samples: int = Field(
         default=5, ge=3, le=200, description="n of eqs. 43-45 (why 5: predictor core settings)"
     )

@@ -1,28 +1,32 @@
-"""Stop-path latency: CAN sample in -> StopCommand back on the CAN bus, over real processes.
+"""Stop path: CAN sample in -> StopCommand on the CAN bus, over the real processes (not a test).
 
-Run on demand (not collected by pytest)::
+Run on demand::
 
-    .venv/bin/python tests/benchmarks/bench_stop_path.py [--runs 30]
+    .venv/bin/python tests/benchmarks/bench_stop_path.py [--stops 1000]
+        [--placement edge|line|before] [--repo PATH]
 
-The router, acquisition and predictor run as ``boltwatch serve`` processes on
-an isolated station file (own zenoh port, own udp_multicast port); the rig
-runs as ``boltwatch serve rig --runs N`` with a short program (lower target,
-faster motor) so that N runs take about a second each. The benchmark listens
-on the same CAN bus for StopCommand frames and on zenoh for decisions and
-events. Per run it reports:
+The whole simulated station runs as ``boltwatch serve`` processes on an
+isolated station file (own zenoh and udp_multicast ports): the router, the
+recorder, the acquisition (with the station's predictor on its CAN thread,
+``--placement edge``, the default; or a separate ``serve predictor``,
+``--placement line``, the layout before the edge stop path) and the rig. The
+rig plays two programs, half the stops each:
 
-- ``stop path``: StopCommand receive time on the benchmark's CAN socket minus
-  ``StopDecision.time_ns`` (the CAN receive time of the deciding sample in
-  the acquisition). Both are kernel receive timestamps (SO_TIMESTAMPNS,
-  CLOCK_REALTIME) of the same host, so they compare directly;
-- its two halves: ``decide`` = ``decided_ns - time_ns`` (sample in, through
-  zenoh to the predictor and through the core, until the decision is
-  published) and ``act`` = StopCommand heard minus ``decided_ns`` (zenoh to
-  the acquisition, CAN send, multicast delivery);
-- ``lead``: from the StopCommand to the next stick-slip event that the last
-  event before the decision predicted (``Prediction.time_s``, horizon 1, or
-  the first prediction still ahead). This is the predictor's own forecast,
-  not the rig's ground truth, which the rig does not publish.
+- **hard limit**: the acquisition's station file gives the program a torque
+  limit of 60 Nm, the rig's own file 320 Nm: the predictor stops the tool on
+  ``torque_limit`` (two samples over it) long before the rig's own limit;
+- **plateau**: a preload target 4 kN above the start, so every run ends on a
+  plateau decision (``plateau_closest``) or the target (``target_reached``).
+
+Per stop: the StopCommand's kernel receive time on this benchmark's CAN
+socket minus ``StopDecision.time_ns``, the kernel receive time in the
+acquisition of the sample that decided (both CLOCK_REALTIME on one host).
+Reported: p50 / p90 / p99 / max over all stops and per kind, the stops lost
+(a decision with no StopCommand heard, or a run the rig ended by itself),
+and what the machine itself lost meanwhile: the steal column of
+``/proc/stat`` (the host's share of this VM's CPU time). ``--repo PATH``
+starts the services from another checkout (the code before a change, side by
+side); the benchmark's own code (files, listener) stays this one's.
 """
 
 from __future__ import annotations
@@ -50,25 +54,45 @@ from shared import keys  # noqa: E402
 from shared.can_database import StationDatabase  # noqa: E402
 from shared.codec import decode  # noqa: E402
 from shared.config import load_station  # noqa: E402
-from shared.messages import RunSummary, StickSlipEvent, StopDecision  # noqa: E402
+from shared.messages import RunSummary, StopDecision  # noqa: E402
 from shared.zenoh_session import zenoh_config  # noqa: E402
 from tests.system.can_injector import HeardStop, StopListener  # noqa: E402
-from tests.system.station_files import free_tcp_port, serve, write_station  # noqa: E402
+from tests.system.station_files import free_tcp_port, write_station  # noqa: E402
 
 STATION = "st1"
-#: The short program: program 1 of the embedded station, to a lower preload, faster.
-SHORT_PROGRAM = {
-    "target_force_n = 56000.0": "target_force_n = 24000.0",
-    "motor_speed_rad_s = 0.5": "motor_speed_rad_s = 1.0",
-}
+HARD_LIMIT_PROGRAM, PLATEAU_PROGRAM = 1, 2
+#: both programs start at 10 kN and move fast: a run lasts about a tenth of a second
+PROGRAMS = """
+[[programs]]
+id = 1
+name = "hard limit"
+target_force_n = 70000.0
+motor_speed_rad_s = 1.0
+start_force_n = 10000.0
+max_torque_nm = {torque_limit_nm}
+max_force_n = 75000.0
+max_angle_deg = 150.0
+max_time_s = 3.0
+
+[[programs]]
+id = 2
+name = "plateau"
+target_force_n = 14000.0
+motor_speed_rad_s = 1.0
+start_force_n = 10000.0
+max_torque_nm = 320.0
+max_force_n = 75000.0
+max_angle_deg = 150.0
+max_time_s = 3.0
+"""
+ACQUISITION_TORQUE_LIMIT_NM = 60.0
+RIG_TORQUE_LIMIT_NM = 320.0
 START_TIMEOUT_S = 30.0
-RUN_TIMEOUT_S = 15.0  # per run, generous on a loaded machine
 
 
 @dataclass
 class Heard:
     decisions: dict[int, StopDecision] = field(default_factory=dict)
-    events: dict[int, list[StickSlipEvent]] = field(default_factory=dict)
     summaries: dict[int, RunSummary] = field(default_factory=dict)
     lock: threading.Lock = field(default_factory=threading.Lock)
 
@@ -79,45 +103,61 @@ class Heard:
             if topic == keys.DECISION:
                 decision = decode(StopDecision, payload)
                 self.decisions.setdefault(decision.run_id, decision)
-            elif topic == keys.EVENTS:
-                event = decode(StickSlipEvent, payload)
-                self.events.setdefault(event.run_id, []).append(event)
             elif topic == keys.RUNS:
                 summary = decode(RunSummary, payload)
                 self.summaries[summary.run_id] = summary
 
 
-def tighten(
-    rig_args: list[str],
-    log: Path,
-    runs: int,
-    heard: Heard,
-    processes: list[subprocess.Popen[bytes]],
-    run_timeout_s: float = RUN_TIMEOUT_S,
-) -> tuple[subprocess.Popen[bytes], float]:
-    """Serve the rig (added to ``processes``) until its ``runs`` end, then wait up to
-    5 s for their summaries; the rig's process and the seconds it all took."""
-    rig = serve(rig_args, log)
-    processes.append(rig)
-    started = time.monotonic()
-    rig.wait(timeout=run_timeout_s * runs)
-    deadline = time.monotonic() + 5.0
-    while len(heard.summaries) < runs and time.monotonic() < deadline:
-        time.sleep(0.1)
-    return rig, time.monotonic() - started
+def station_files(folder: Path, placement: str) -> tuple[Path, Path]:
+    """(the services' station file, the rig's): the same station, the rig's limits higher."""
+    port = free_tcp_port()
+    common = {"pause_between_runs_s = 0.3": "pause_between_runs_s = 0.05"}
+    if placement != "before":  # a checkout from before the key knows only the line's predictor
+        common["[predictor]\nwindow_samples = 5"] = (
+            f'[predictor]\nplacement = "{placement}"\nwindow_samples = 5'
+        )
+    services = write_station(folder, zenoh_port=port, replacements=common)
+    text = services.read_text()
+    start = text.index("[[programs]]")
+    end = text.index("[predictor]")
+    programs = text[start:end]
+    services.write_text(
+        text.replace(programs, PROGRAMS.format(torque_limit_nm=ACQUISITION_TORQUE_LIMIT_NM) + "\n")
+    )
+    rig = folder / "rig.toml"
+    rig.write_text(
+        services.read_text().replace(
+            f"max_torque_nm = {ACQUISITION_TORQUE_LIMIT_NM}",
+            f"max_torque_nm = {RIG_TORQUE_LIMIT_NM}",
+        )
+    )
+    return services, rig
 
 
-@dataclass(frozen=True)
-class RunFigures:
-    run_id: int
-    reason: str
-    stop_path_ms: float
-    decide_ms: float
-    act_ms: float
-    lead_ms: float | None
+def serve_from(repo: Path, args: list[str], log: Path) -> subprocess.Popen[bytes]:
+    with log.open("ab") as out:
+        return subprocess.Popen(
+            [sys.executable, "-m", "services.cli", "serve", *args],
+            cwd=repo,
+            env={**_environment(), "PYTHONPATH": str(repo)},
+            stdout=out,
+            stderr=subprocess.STDOUT,
+        )
 
 
-def wait_alive(session: zenoh.Session, services: set[str], processes: list[Path]) -> None:
+def _environment() -> dict[str, str]:
+    import os
+
+    return dict(os.environ)
+
+
+def cpu_times() -> tuple[int, int]:
+    """(all CPU time, of it stolen by the host), in USER_HZ ticks since boot."""
+    fields = [int(v) for v in Path("/proc/stat").read_text().splitlines()[0].split()[1:]]
+    return sum(fields[:8]), fields[7]
+
+
+def wait_alive(session: zenoh.Session, services: set[str], logs: list[Path]) -> None:
     deadline = time.monotonic() + START_TIMEOUT_S
     missing = set(services)
     while missing:
@@ -125,134 +165,136 @@ def wait_alive(session: zenoh.Session, services: set[str], processes: list[Path]
             if reply.ok is not None:
                 missing.discard(str(reply.ok.key_expr).rsplit("/", 1)[-1])
         if time.monotonic() > deadline:
-            logs = ", ".join(str(p) for p in processes)
-            raise SystemExit(f"not alive after {START_TIMEOUT_S:.0f} s: {missing} (logs: {logs})")
+            raise SystemExit(f"not alive after {START_TIMEOUT_S:.0f} s: {missing} (logs {logs})")
         time.sleep(0.1)
 
 
-def lead_ms(decision: StopDecision, events: list[StickSlipEvent], stop_s: float) -> float | None:
-    """Predicted next slip minus the StopCommand's time, both since run start (ms)."""
-    before = [e for e in events if e.time_s <= decision.time_s and e.predictions]
-    if not before:
-        return None
-    ahead = [p.time_s for p in before[-1].predictions if p.time_s > stop_s]
-    return (min(ahead) - stop_s) * 1e3 if ahead else None
+@dataclass(frozen=True)
+class Stop:
+    run_id: int
+    program: int
+    reason: str
+    path_ms: float  # StopCommand heard - deciding sample received
 
 
-def figures(heard: Heard, stops: list[HeardStop]) -> tuple[list[RunFigures], list[str]]:
-    out: list[RunFigures] = []
-    notes: list[str] = []
-    first_stop: dict[int, HeardStop] = {}
+def stops_of(
+    heard: Heard, stops: list[HeardStop], programs: dict[int, int]
+) -> tuple[list[Stop], list[str]]:
+    first: dict[int, HeardStop] = {}
     for stop in stops:
-        first_stop.setdefault(stop.run_id, stop)
-    extra = len(stops) - len(first_stop)
-    if extra:
-        notes.append(f"{extra} StopCommand(s) beyond one per run")
-    for run_id in sorted(heard.summaries):
+        first.setdefault(stop.run_id, stop)
+    out, lost = [], []
+    for run_id, program in sorted(programs.items()):
         decision = heard.decisions.get(run_id)
-        heard_stop = first_stop.get(run_id)
-        if decision is None or heard_stop is None:
-            ended = heard.summaries[run_id].tool_state
-            notes.append(
-                f"run {run_id}: decision={decision is not None} stop heard="
-                f"{heard_stop is not None} ({ended})"
-            )
+        summary = heard.summaries.get(run_id)
+        if decision is None:
+            lost.append(f"run {run_id}: no decision ({summary.tool_state if summary else '?'})")
             continue
-        stop_path_ns = heard_stop.received_ns - decision.time_ns
-        stop_s = decision.time_s + stop_path_ns / 1e9
-        out.append(
-            RunFigures(
-                run_id,
-                decision.reason,
-                stop_path_ns / 1e6,
-                (decision.decided_ns - decision.time_ns) / 1e6,
-                (heard_stop.received_ns - decision.decided_ns) / 1e6,
-                lead_ms(decision, heard.events.get(run_id, []), stop_s),
-            )
-        )
-    return out, notes
+        heard_stop = first.get(run_id)
+        if heard_stop is None:
+            late = summary.late_decision if summary else None
+            lost.append(f"run {run_id}: {decision.reason} decided, no StopCommand (late: {late})")
+            continue
+        path_ms = (heard_stop.received_ns - decision.time_ns) / 1e6
+        out.append(Stop(run_id, program, decision.reason, path_ms))
+    return out, lost
 
 
-def table(rows: list[RunFigures]) -> str:
-    def line(name: str, values: list[float]) -> str:
-        if not values:
-            return f"{name:<26}{'-':>8}"
-        p50, p90, p99 = np.percentile(values, [50, 90, 99])
-        cells = (p50, p90, p99, max(values), min(values), statistics.fmean(values))
-        return f"{name:<26}" + "".join(f"{v:>8.2f}" for v in cells) + f"{len(values):>6}"
-
-    header = f"{'ms':<26}" + "".join(f"{h:>8}" for h in ("p50", "p90", "p99", "max", "min", "mean"))
-    leads = [r.lead_ms for r in rows if r.lead_ms is not None]
-    return "\n".join(
-        [
-            header + f"{'n':>6}",
-            line("stop path (sample->CAN)", [r.stop_path_ms for r in rows]),
-            line("  decide (sample->decision)", [r.decide_ms for r in rows]),
-            line("  act (decision->CAN)", [r.act_ms for r in rows]),
-            line("lead (CAN stop->next slip)", leads),
-        ]
-    )
+def line(name: str, values: list[float]) -> str:
+    if not values:
+        return f"{name:<28}{'-':>8}"
+    p50, p90, p99 = np.percentile(values, [50, 90, 99])
+    cells = (p50, p90, p99, max(values), statistics.fmean(values))
+    return f"{name:<28}" + "".join(f"{v:>8.3f}" for v in cells) + f"{len(values):>7}"
 
 
-def run(runs: int, folder: Path) -> int:
-    port = free_tcp_port()
-    path = write_station(folder, zenoh_port=port, replacements=SHORT_PROGRAM)
-    station = load_station(path)
+def run(args: argparse.Namespace, folder: Path) -> int:
+    services_file, rig_file = station_files(folder, args.placement)
+    station = load_station(services_file)
     database = StationDatabase(station.dbc_path)
-    endpoint = f"tcp/127.0.0.1:{port}"
-    logs = {name: folder / f"{name}.log" for name in ("router", "acquisition", "predictor", "rig")}
+    endpoint = station.config.zenoh.connect[0]
+    logs = {n: folder / f"{n}.log" for n in ("router", "recorder", "acquisition", "predictor")}
     processes: list[subprocess.Popen[bytes]] = []
     heard = Heard()
+    programs: dict[int, int] = {}
+    repo = args.repo.resolve()
     try:
-        processes.append(serve(["router", "--listen", endpoint], logs["router"]))
-        for name in ("acquisition", "predictor"):
-            processes.append(serve([name, "--config", str(path)], logs[name]))
+        processes.append(serve_from(repo, ["router", "--listen", endpoint], logs["router"]))
+        names = ["recorder", "acquisition"] + (["predictor"] if args.placement != "edge" else [])
+        for name in names:
+            extra = ["--no-rerun"] if name == "recorder" else []
+            processes.append(
+                serve_from(repo, [name, "--config", str(services_file), *extra], logs[name])
+            )
         with (
             zenoh.open(zenoh_config("client", [endpoint])) as session,
             StopListener(station.config.can, database) as listener,
         ):
             subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard.on_sample)
             try:
-                wait_alive(session, {"acquisition", "predictor"}, list(logs.values()))
+                wait_alive(session, {"recorder", "acquisition", "predictor"}, list(logs.values()))
+                cpu_before = cpu_times()
+                started = time.monotonic()
                 first_run_id = int(time.time())
-                rig_args = ["rig", "--config", str(path), "--runs", str(runs)]
-                rig_args += ["--program", "1", "--first-run-id", str(first_run_id)]
-                rig, elapsed_s = tighten(rig_args, logs["rig"], runs, heard, processes)
+                per_program = args.stops // 2
+                for index, program in enumerate((HARD_LIMIT_PROGRAM, PLATEAU_PROGRAM)):
+                    run_id = first_run_id + index * per_program
+                    rig_log = folder / f"rig-{program}.log"
+                    rig_args = ["rig", "--config", str(rig_file), "--runs", str(per_program)]
+                    rig_args += ["--program", str(program), "--first-run-id", str(run_id)]
+                    rig = serve_from(repo, rig_args, rig_log)
+                    rig.wait(timeout=per_program * 3.0 + 60.0)
+                    if rig.returncode != 0:
+                        raise SystemExit(f"rig exited {rig.returncode}, see {rig_log}")
+                    programs.update({run_id + k: program for k in range(per_program)})
+                elapsed_s = time.monotonic() - started
+                cpu_after = cpu_times()
+                time.sleep(2.0)  # the last summaries
             finally:
                 subscriber.undeclare()
-            stops = listener.heard
+            heard_stops = listener.heard
     finally:
         for process in reversed(processes):
             stop_process(process, grace_s=10.0)
 
     with heard.lock:
-        rows, notes = figures(heard, stops)
-    reasons = Counter(r.reason for r in rows)
-    print(f"stop path over {len(rows)} of {runs} runs ({elapsed_s:.0f} s), reasons {dict(reasons)}")
-    print(table(rows))
-    errors = [abs(s.error_pct) for s in heard.summaries.values() if s.error_pct is not None]
-    if errors:
-        print(
-            f"|reached - target| / target: median {statistics.median(errors):.2f} %, "
-            f"max {max(errors):.2f} % over {len(errors)} runs"
-        )
-    for note in notes:
-        print("note:", note)
-    if rig.returncode != 0:
-        print(f"rig exited {rig.returncode}, see {logs['rig']}")
-    return 0 if rows else 1
+        stops, lost = stops_of(heard, heard_stops, programs)
+    total, steal = (after - before for after, before in zip(cpu_after, cpu_before, strict=True))
+    print(
+        f"stop path, placement {args.placement}, services from {repo}: {len(stops)} stops of "
+        f"{len(programs)} runs in {elapsed_s:.0f} s; the host stole {100.0 * steal / total:.1f} % "
+        "of this VM's CPU time meanwhile"
+    )
+    header = f"{'ms':<28}" + "".join(f"{h:>8}" for h in ("p50", "p90", "p99", "max", "mean"))
+    print(header + f"{'n':>7}")
+    print(line("all stops", [s.path_ms for s in stops]))
+    for program, name in ((HARD_LIMIT_PROGRAM, "hard limit"), (PLATEAU_PROGRAM, "plateau")):
+        print(line(f"  {name}", [s.path_ms for s in stops if s.program == program]))
+    print("reasons:", dict(Counter(s.reason for s in stops)))
+    print(f"lost: {len(lost)}")
+    for note in lost[:20]:
+        print("  ", note)
+    return 0 if stops and not lost else 1
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--runs", type=int, default=30, help="tightening runs (default 30)")
-    parser.add_argument("--keep", type=Path, default=None, help="keep station file and logs here")
+    parser.add_argument("--stops", type=int, default=1000, help="runs, each one stop (1000)")
+    parser.add_argument(
+        "--placement",
+        choices=("edge", "line", "before"),
+        default="edge",
+        help="where the decision runs; 'before': a --repo from before [predictor] placement "
+        "(a separate predictor, the station file without the key)",
+    )
+    parser.add_argument("--repo", type=Path, default=REPO, help="checkout to serve from")
+    parser.add_argument("--keep", type=Path, default=None, help="keep files and logs here")
     args = parser.parse_args(argv)
     if args.keep is not None:
         args.keep.mkdir(parents=True, exist_ok=True)
-        return run(args.runs, args.keep)
+        return run(args, args.keep)
     with tempfile.TemporaryDirectory(prefix="bench-stop-path-") as folder:
-        return run(args.runs, Path(folder))
+        return run(args, Path(folder))
 
 
 if __name__ == "__main__":

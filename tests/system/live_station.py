@@ -130,7 +130,7 @@ class LiveStation:
 
     def __init__(self, folder: Path, recorder_args: tuple[str, ...] = ("--no-rerun",)) -> None:
         self.folder = folder
-        self.station_file = write_station(folder)
+        self.station_file = write_station(folder, placement="line")  # a predictor process
         self.loaded = load_station(self.station_file)
         self.recordings = self.loaded.recordings_folder
         self.supervisor = StationSupervisor(self.station_file, folder / "logs")

@@ -28,11 +28,14 @@ def write_station(
     zenoh_port: int | None = None,
     zenoh_mode: str = "client",
     replacements: dict[str, str] | None = None,
+    placement: str | None = None,
 ) -> Path:
     """A copy of config/station.toml isolated for one test; returns its path.
 
     ``zenoh_mode="peer"`` makes the services listen on nothing and connect to
     ``zenoh_port`` (where the test runs its own router or peer session).
+    ``placement``: the ``[predictor] placement`` ("line": a separate predictor
+    process decides over zenoh; default: the shipped file's, the edge).
     """
     zenoh_port = zenoh_port or free_tcp_port()
     text = STATION_FILE.read_text()
@@ -41,6 +44,8 @@ def write_station(
     text = text.replace('mode = "client"', f'mode = "{zenoh_mode}"')
     text = text.replace("tcp/127.0.0.1:7447", f"tcp/127.0.0.1:{zenoh_port}")
     text = text.replace('folder = "../recordings"', f'folder = "{folder / "recordings"}"')
+    if placement is not None:
+        text = text.replace("[predictor]\n", f'[predictor]\nplacement = "{placement}"\n', 1)
     for old, new in (replacements or {}).items():
         if old not in text:
             raise AssertionError(f"station template has no {old!r}")

@@ -90,6 +90,7 @@ def station_files(tmp_path: Path) -> list[Path]:
         path = write_station(
             folder,
             zenoh_port=7447,
+            placement="line",  # each station host runs its own predictor process
             replacements={
                 "tcp/127.0.0.1:7447": ENDPOINT,
                 'id = "st1"': f'id = "st{index}"',

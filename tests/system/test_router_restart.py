@@ -115,6 +115,7 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
     path = write_station(
         tmp_path,
         zenoh_port=port,
+        placement="line",  # the line's predictor, reconnecting like every service
         replacements={
             'mode = "client"': f'mode = "client"\nreconnect_period_max_s = {RECONNECT_PERIOD_MAX_S}'
         },

@@ -67,4 +67,8 @@ def run(args: argparse.Namespace) -> int:
 
     setup_logging(args.service, args.log_level)
     service = importlib.import_module(f"{args.service_package}.service")
+    if args.service == "acquisition":  # the station's predictor may decide in it (edge)
+        from services.predictor.edge_predictor import EdgePredictor
+
+        return int(service.main(args, decider_factory=EdgePredictor))
     return int(service.main(args))

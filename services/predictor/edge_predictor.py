@@ -1,0 +1,79 @@
+"""The predictor of one station on its acquisition's CAN thread: the stop path of one sample.
+
+Where the decision runs (README, "Where the decision runs"): a station whose
+``[predictor] placement`` is ``"edge"`` (the default) decides in its
+acquisition process, on the thread that reads the CAN bus. Each complete
+sample goes from the frame decoder through :class:`StationRuns` (the same
+run bookkeeping and predictor core as the line predictor) and, when the core
+decides, back to the bus as a ``StopCommand`` in the same call: no zenoh hop,
+no second process, no router between the sample and the stop.
+
+It still publishes on zenoh everything the line predictor publishes
+(``events``, ``intensity``, ``decision``, ``runs``), through the station's
+queued publisher: the CAN thread only queues. It holds the station's
+``health/predictor`` token, so ``boltwatch status`` sees the station's
+predictor, and a second predictor for the station (a line predictor) is
+refused, as two line predictors are.
+
+It implements the acquisition's ``Decider`` protocol
+(``services/acquisition/decider.py``) by shape; the CLI joins the two.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+
+import zenoh
+
+from services.predictor.served_station import ServedStation
+from services.predictor.station_refusal import refuse_stations_served_elsewhere
+from services.predictor.station_runs import StationRuns
+from shared import keys
+from shared.config import LoadedStation
+from shared.messages import Intensity, Sample, StopDecision, ToolState
+
+LOG = logging.getLogger(__name__)
+
+#: (topic, message) -> None, never waiting: the station's queued publisher
+Publish = Callable[[str, object], None]
+
+
+class EdgePredictor:
+    """One station's runs, decided on the calling (CAN) thread."""
+
+    def __init__(self, session: zenoh.Session, station: LoadedStation, publish: Publish) -> None:
+        refuse_stations_served_elsewhere(session, [station.station_id])
+        self._runs = StationRuns(ServedStation(station))
+        self._publish = publish
+        self._token = session.liveliness().declare_token(
+            keys.health_key(station.station_id, "predictor")
+        )
+        LOG.info(
+            "predictor of %s on the acquisition's CAN thread (placement edge)", station.station_id
+        )
+
+    def on_tool_state(self, state: ToolState) -> None:
+        summary = self._runs.on_tool(state)
+        if summary is not None:
+            self._publish(keys.RUNS, summary)
+
+    def on_sample(self, sample: Sample) -> StopDecision | None:
+        decision = None
+        for message in self._runs.on_sample(sample, time.time_ns()):
+            if isinstance(message, StopDecision):  # the acquisition sends and logs the stop
+                decision = message
+                self._publish(keys.DECISION, message)
+            elif isinstance(message, Intensity):
+                self._publish(keys.INTENSITY, message)
+            else:
+                self._publish(keys.EVENTS, message)
+        return decision
+
+    @property
+    def runs(self) -> StationRuns:
+        return self._runs
+
+    def close(self) -> None:
+        self._token.undeclare()
