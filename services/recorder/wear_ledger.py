@@ -17,6 +17,9 @@ The file is ``<recordings>/wear.sqlite`` in WAL mode: the recorder writes,
 reader holding a read transaction never blocks the writer, nor the writer a
 reader. Each run is one transaction: a writer killed mid-run loses that run
 only, and the file stays consistent (``tests/system/test_wear_ledger_kill.py``).
+
+A run enters only within what its tool can have taken
+(:mod:`.wear_bound`: :class:`~.wear_bound.RefusedSummaryError` otherwise).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from services.recorder.wear_bound import RefusedSummaryError, RunLimits, refusal
 from shared.errors import InputError
 from shared.messages import RunSummary
 
@@ -114,8 +118,14 @@ class WearLedger:
         except sqlite3.Error as err:
             raise InputError(f"{self.path}: not a usable wear ledger: {err}") from err
 
-    def add_run(self, summary: RunSummary, recorded_ns: int) -> bool:
-        """Count a run once; False when (station, run_id) was already in the ledger."""
+    def add_run(self, summary: RunSummary, recorded_ns: int, limits: RunLimits) -> bool:
+        """Count a run once; False when (station, run_id) was already in the ledger.
+
+        RefusedSummaryError when the summary is beyond ``limits`` (:mod:`.wear_bound`).
+        """
+        reason = refusal(summary, limits)
+        if reason is not None:
+            raise RefusedSummaryError(summary, reason)
         with self._db:
             cursor = self._db.execute(
                 "INSERT OR IGNORE INTO runs VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",

@@ -319,3 +319,12 @@ def test_a_recorder_that_cannot_write_says_so_and_why() -> None:
     assert "NOT RECORDING: [Errno 28] No space left on device (lag - (no samples)" in text
     assert "3 write errors" in text
     assert "42 samples missing" in text
+
+
+def test_summaries_the_wear_ledger_refused_show() -> None:
+    collector = StatusCollector()
+    feed(collector, keys.RECORDER, recorder_stats(T0, refused_summaries=2))
+    report = collector.report("e", 2.0, T0)
+    text = format_report(report)
+    assert "0 write errors, 2 run summaries refused by the wear ledger, " in text
+    assert to_json(report)["stations"]["st1"]["recorder"]["refused_summaries"] == 2
