@@ -211,6 +211,8 @@ class RecorderStats:
     missing_samples: int = 0  # published by the acquisition (BusStats) but never received
     # RunSummaries of this station the wear ledger refused (beyond what the run can carry)
     refused_summaries: int = 0
+    # runs (of every station) waiting in memory for the wear ledger (failing or broken)
+    waiting_summaries: int = 0
 
 
 @dataclass(frozen=True, slots=True)

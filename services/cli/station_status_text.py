@@ -83,8 +83,11 @@ def _recorder_text(recorder: RecorderHealth | None) -> str:
     counts = (
         f"{recorder.messages} messages, {recorder.missing_samples} samples missing, "
         f"{recorder.write_errors} write errors, {recorder.refused_summaries} run summaries "
-        f"refused by the wear ledger, {recorder.age_s:.1f} s ago"
+        f"refused by the wear ledger"
     )
+    if recorder.waiting_summaries:
+        counts += f", {recorder.waiting_summaries} runs waiting for the wear ledger"
+    counts += f", {recorder.age_s:.1f} s ago"
     if not recorder.recording:
         return f"NOT RECORDING: {recorder.last_error or 'write failing'} ({lag}, {counts})"
     text = f"recording, {lag}, {counts}"

@@ -112,10 +112,12 @@ class RecorderHealth:
         last_error: str | None,
         recording: bool,
         refused_summaries: Mapping[str, int] | None = None,
+        waiting_summaries: int = 0,
     ) -> list[RecorderStats]:
         """One RecorderStats per station; starts the next lag window.
 
-        ``refused_summaries``: per station, RunSummaries the wear ledger refused.
+        ``refused_summaries``: per station, RunSummaries the wear ledger refused;
+        ``waiting_summaries``: runs waiting in memory for the ledger (all stations).
         """
         refused = refused_summaries or {}
         out: list[RecorderStats] = []
@@ -134,6 +136,7 @@ class RecorderHealth:
                     recording=recording,
                     missing_samples=counts.missing_samples,
                     refused_summaries=refused.get(station, 0),
+                    waiting_summaries=waiting_summaries,
                 )
             )
         return out

@@ -164,6 +164,8 @@ class RecorderService:
                 now = time.monotonic()
                 if now >= next_tick:
                     self.recorder.tick(time.time_ns())
+                    if self.wear is not None:
+                        self.wear.tick(time.time_ns())
                     next_tick = now + self._tick_s
                 if now >= next_stats and not self.view_only:
                     self._publish_stats(time.time_ns())
@@ -204,6 +206,7 @@ class RecorderService:
             last_error,
             recorder.recording_ok,
             refused_summaries=wear.refused if wear else None,
+            waiting_summaries=wear.waiting if wear else 0,
         )
 
     def _file(self, messages: list[Message]) -> None:
