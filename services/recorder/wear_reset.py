@@ -57,7 +57,7 @@ def reset_ledger(path: Path) -> LedgerReset | None:
 def problem_of(path: Path) -> str | None:
     """What makes the ledger at ``path`` broken, read through; None when it is healthy."""
     try:
-        ledger = WearLedger(path)
+        ledger = WearLedger(path, read_only=True)
     except BrokenLedgerError as err:
         return err.what
     try:
