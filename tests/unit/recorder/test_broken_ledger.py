@@ -184,8 +184,13 @@ def test_reset_refuses_a_ledger_a_process_has_open(tmp_path: Path) -> None:
     assert reset(tmp_path).returncode == 0  # closed: now it moves
 
 
-WHEN = ["random bytes before start", "emptied before start", "emptied while running",
-        "another schema before start"]  # fmt: skip
+WHEN = [
+    "random bytes before start",
+    "emptied before start",
+    "emptied while running",
+    "another schema before start",
+    "corrupt pages before start",
+]
 
 
 @pytest.mark.parametrize("when", WHEN)
@@ -196,7 +201,12 @@ def test_the_recorder_records_on_and_counts_the_waiting_runs_once_reset(
     recordings = station.recordings_folder
     ledger_file = recordings / "wear.sqlite"
     recordings.mkdir(parents=True, exist_ok=True)
-    breaks = {"random": random_bytes, "emptied": empty, "another": another_schema}
+    breaks = {
+        "random": random_bytes,
+        "emptied": empty,
+        "another": another_schema,
+        "corrupt": corrupt_pages,
+    }
     if when.endswith("before start"):
         breaks[when.split(maxsplit=1)[0]](ledger_file)
     recorder = RunningRecorder(station)
