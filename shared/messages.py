@@ -213,6 +213,10 @@ class RecorderStats:
     last_error: str | None  # the newest write error, None when writing is healthy
     recording: bool  # False while the recordings folder cannot be written
     missing_samples: int = 0  # published by the acquisition (BusStats) but never received
+    # RunSummaries of this station the wear ledger refused (beyond what the run can carry)
+    refused_summaries: int = 0
+    # runs (of every station) waiting in memory for the wear ledger (failing or broken)
+    waiting_summaries: int = 0
 
 
 @dataclass(frozen=True, slots=True)

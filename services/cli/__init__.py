@@ -2,7 +2,8 @@
 
 - :mod:`.main` (entry point), :mod:`.commands` (one module per subcommand),
   :mod:`.command_options` (options several commands share)
-- ``boltwatch up``: :mod:`.station_run`, :mod:`.station_supervisor`, :mod:`.run_table`
+- ``boltwatch up``: :mod:`.station_run`, :mod:`.station_supervisor`, :mod:`.run_table`,
+  :mod:`.run_tally` (which summaries count: runs seen starting, once)
 - ``boltwatch status``: :mod:`.station_status`, :mod:`.station_status_text`
 - ``boltwatch import``: :mod:`.import_destination` (recordings or trace CSVs),
   :mod:`.controller_replay` (the predictor over an imported run: here, because

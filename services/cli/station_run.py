@@ -5,8 +5,9 @@ recorder serving every station file, and per station an acquisition and a
 rig. A station decides where its ``[predictor] placement`` says: in its
 acquisition (``edge``, the default) or in ONE line predictor serving every
 station placed on the line. Watches the line from its own zenoh client
-session: liveliness tokens for readiness, ``runs`` for the table, ``bus``
-for each acquisition's counters.
+session: liveliness tokens for readiness, ``tool`` and ``runs`` for the
+table (a summary counts only for a run seen starting on the tool channel,
+once: :mod:`services.cli.run_tally`), ``bus`` for each acquisition's counters.
 """
 
 from __future__ import annotations
@@ -20,12 +21,13 @@ from pathlib import Path
 import zenoh
 
 from services.cli import run_table
+from services.cli.run_tally import RunTally
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
 from shared import keys
 from shared.codec import decode
 from shared.config import LoadedStation, Program
 from shared.errors import BoltwatchError, TransportError
-from shared.messages import BusStats, RunSummary
+from shared.messages import BusStats, RunSummary, ToolState
 from shared.zenoh_session import open_from, zenoh_config
 
 LOG = logging.getLogger(__name__)
@@ -59,7 +61,7 @@ class StationRun:
         self.startup_timeout_s = startup_timeout_s
         self.line = len(self.stations) > 1
         self.supervisor = StationSupervisor([s.path for s in self.stations], log_dir)
-        self.summaries: dict[str, list[RunSummary]] = {s.station_id: [] for s in self.stations}
+        self.tally = RunTally(s.station_id for s in self.stations)
         self.bus_stats: dict[str, BusStats] = {}
         self.started_s = time.time()
         self._session: zenoh.Session | None = None
@@ -68,6 +70,11 @@ class StationRun:
     def process_name(self, service: str, station_id: str) -> str:
         """``rig`` for the one station of ``up``; ``rig-st2`` on a line."""
         return f"{service}-{station_id}" if self.line else service
+
+    @property
+    def summaries(self) -> dict[str, list[RunSummary]]:
+        """The counted summaries of each station (runs seen starting, once each)."""
+        return self.tally.summaries
 
     @property
     def station_ids(self) -> list[str]:
@@ -97,7 +104,7 @@ class StationRun:
             self._session.declare_subscriber(
                 keys.station_key("*", topic), zenoh.handlers.FifoChannel(10000)
             )
-            for topic in (keys.RUNS, keys.BUS)
+            for topic in (keys.TOOL, keys.RUNS, keys.BUS)  # a run's start before its summary
         ]
         self.supervisor.start("recorder")
         if self.line_predicted:
@@ -210,10 +217,12 @@ class StationRun:
             if station_id not in self.summaries:
                 continue  # another station on the same router: not ours to report
             try:
-                if topic == keys.RUNS:
+                if topic == keys.TOOL:
+                    self.tally.tool_state(station_id, decode(ToolState, sample.payload.to_bytes()))
+                elif topic == keys.RUNS:
                     summary = decode(RunSummary, sample.payload.to_bytes())
-                    self.summaries[station_id].append(summary)
-                    print(run_table.row(summary, self.line), flush=True)
+                    if self.tally.summary(station_id, summary):
+                        print(run_table.row(summary, self.line), flush=True)
                 elif topic == keys.BUS:
                     self.bus_stats[station_id] = decode(BusStats, sample.payload.to_bytes())
             except BoltwatchError as err:
@@ -250,6 +259,9 @@ class StationRun:
             for summary in every_summary:
                 print(run_table.row(summary, self.line))
             print(run_table.totals(every_summary))
+        left_out = self.tally.note()
+        if left_out is not None:
+            print(left_out)
         for station_id in self.station_ids:
             stats = self.bus_stats.get(station_id)
             if stats is not None:

@@ -23,7 +23,8 @@ Per station:
   second): lag of samples into the recorder (p50/max over its last second,
   None when no samples came), messages written, samples the acquisition
   published that never reached the recorder, write errors and whether it is
-  recording.
+  recording, run summaries the wear ledger refused and runs waiting in memory
+  for a failing or broken ledger (its error is the ``last_error``).
 """
 
 from __future__ import annotations
@@ -127,6 +128,8 @@ class RecorderHealth:
     write_errors: int
     last_error: str | None
     age_s: float  # since the latest RecorderStats was received
+    refused_summaries: int = 0  # RunSummaries the wear ledger refused (beyond their bound)
+    waiting_summaries: int = 0  # runs waiting in the recorder's memory for the wear ledger
 
 
 @dataclass(frozen=True)
@@ -284,6 +287,8 @@ def _recorder_health(
         write_errors=stats.write_errors,
         last_error=stats.last_error,
         age_s=_age_s(received_ns, now_ns),
+        refused_summaries=stats.refused_summaries,
+        waiting_summaries=stats.waiting_summaries,
     )
 
 

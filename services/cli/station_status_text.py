@@ -82,8 +82,12 @@ def _recorder_text(recorder: RecorderHealth | None) -> str:
         lag = f"lag p50 {recorder.lag_p50_ms:.1f} ms, max {recorder.lag_max_ms:.1f} ms"
     counts = (
         f"{recorder.messages} messages, {recorder.missing_samples} samples missing, "
-        f"{recorder.write_errors} write errors, {recorder.age_s:.1f} s ago"
+        f"{recorder.write_errors} write errors, {recorder.refused_summaries} run summaries "
+        f"refused by the wear ledger"
     )
+    if recorder.waiting_summaries:
+        counts += f", {recorder.waiting_summaries} runs waiting for the wear ledger"
+    counts += f", {recorder.age_s:.1f} s ago"
     if not recorder.recording:
         return f"NOT RECORDING: {recorder.last_error or 'write failing'} ({lag}, {counts})"
     text = f"recording, {lag}, {counts}"

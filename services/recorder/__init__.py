@@ -7,8 +7,12 @@ Files, one concept each:
   (payloads into files, disk faults), :mod:`.run_files` (one file per run),
   :mod:`.mcap_sink`, :mod:`.file_metadata`, :mod:`.recorder_health`
 - Rerun: :mod:`.rerun_sink`, :mod:`.rerun_streams`, :mod:`.rerun_blueprint`
-- wear: :mod:`.wear_ledger` (SQLite), :mod:`.wear_watch` (summaries in, alerts
-  out), :mod:`.wear_table`
+- wear: :mod:`.wear_ledger` (SQLite), :mod:`.wear_bound` (what a run can have
+  taken: the bound a summary must keep), :mod:`.wear_ledger_file` (a ledger made
+  whole, a broken one recognised and moved aside), :mod:`.wear_watch`
+  (summaries in, alerts out, a failing or broken ledger waited out),
+  :mod:`.wear_waiting` (runs still waiting when the recorder stops),
+  :mod:`.wear_reset` (``boltwatch wear reset``), :mod:`.wear_table`
 - reading back: :mod:`.recording_reader`, :mod:`.json_decoder`,
   :mod:`.trace_export`, :mod:`.recovery`, :mod:`.rrd_recovery`, and the
   post-mortem :mod:`.run_plot`, :mod:`.post_mortem_run`,

@@ -22,6 +22,12 @@ and counted in the wear ledger (by (station, run): never twice) before its
 files get their real names, so a run in the folder is a run in the ledger.
 The recording is not written here: this package may not import the
 predictor; the command line replays it and hands the messages in.
+
+The ledger counts an imported run within the same bound as a live one
+(:mod:`.wear_bound`), with the controller's own torque shutoff as the
+tool's limit (:func:`controller_limits`) and no time limit but the run's
+own duration (a controller run may last any time); a run beyond it is
+refused and not written.
 """
 
 from __future__ import annotations
@@ -49,6 +55,7 @@ from services.recorder.incoming import Received, classify
 from services.recorder.mcap_sink import McapSink
 from services.recorder.recorder import describe_os_error
 from services.recorder.run_files import file_path
+from services.recorder.wear_bound import CONTRACT_LIMITS, RunLimits
 from shared import keys
 from shared.codec import encode
 from shared.errors import BoltwatchError, InputError
@@ -60,6 +67,9 @@ if TYPE_CHECKING:
 
 STATION_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 DEFAULT_STATION = "cs351"
+#: The controller's torque shutoff: a monitoring function whose limit stops the step
+#: (``MFs``; ``MF`` functions only judge).
+TORQUE_SHUTOFF = "MFs TorqueMax"
 
 
 class RunNotWrittenError(BoltwatchError):
@@ -120,6 +130,27 @@ def controller_messages(
         yield keys.RUNS, replay.summary, end_ns
 
 
+def controller_limits(run: ControllerRun) -> RunLimits:
+    """The run's torque limit for the wear ledger: the largest ``MFs TorqueMax`` nominal of
+    its steps (the contract DBC's torque range when it has none); no time limit."""
+    shutoffs = [
+        function.nominal
+        for step in run.steps
+        for function in step.functions
+        if function.name == TORQUE_SHUTOFF and function.nominal is not None and function.nominal > 0
+    ]
+    if not shutoffs:
+        return RunLimits(
+            CONTRACT_LIMITS.torque_limit_nm,
+            None,
+            f"the contract DBC's torque range (the run has no {TORQUE_SHUTOFF})",
+        )
+    top = max(shutoffs)
+    return RunLimits(
+        min(top, CONTRACT_LIMITS.torque_limit_nm), None, f"the controller's {TORQUE_SHUTOFF}"
+    )
+
+
 def run_end_ns(run: ControllerRun) -> int:
     """When the run ended: one nanosecond after its last sample (``ToolState`` done)."""
     return run.times_ns[-1] + 1
@@ -143,7 +174,7 @@ def import_run(
     copies = [read_copy(path) for path in run_files(day, prefix)] if day.is_dir() else []
     finished = next((copy for copy in copies if copy.holds(len(run))), None)
     if finished is not None:
-        counted = _count(ledger, finished.summary)
+        counted = _count(ledger, finished.summary, controller_limits(run))
         return ImportedRun(run.source, None, None, len(run), finished.path, newly_counted=counted)
     unfinished = [copy.path for copy in copies if copy.imported]
     if day.is_dir():
@@ -154,7 +185,9 @@ def import_run(
     if rrd:  # the .rrd first: a .mcap under its real name means the run is complete
         moves.insert(0, (temporary_path(target).with_suffix(".rrd"), target.with_suffix(".rrd")))
     try:
-        counted = _count(ledger, replay.summary if replay is not None else None)
+        counted = _count(
+            ledger, replay.summary if replay is not None else None, controller_limits(run)
+        )
     except BoltwatchError:
         remove_temporary([temporary for temporary, _ in moves])
         raise
@@ -270,12 +303,15 @@ def _open_rerun(run: ControllerRun, station: str, target: Path, options: RerunOp
         ) from err
 
 
-def _count(ledger: WearLedger | None, summary: RunSummary | None) -> bool:
-    """Add the run to the wear ledger; True when it was not in it yet."""
+def _count(ledger: WearLedger | None, summary: RunSummary | None, limits: RunLimits) -> bool:
+    """Add the run to the wear ledger; True when it was not in it yet.
+
+    RefusedSummaryError (bad input) when the run is beyond ``limits``.
+    """
     if ledger is None or summary is None:
         return False
     try:
-        return ledger.add_run(summary, time.time_ns())
+        return ledger.add_run(summary, time.time_ns(), limits)
     except sqlite3.Error as err:
         raise RunNotWrittenError(
             f"{ledger.path}: the wear ledger cannot be written: {err}"

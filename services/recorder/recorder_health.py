@@ -30,6 +30,7 @@ lease loses samples while no session ever sees its router go.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from shared.messages import RecorderStats
@@ -105,9 +106,20 @@ class RecorderHealth:
         return 0 if counts is None else counts.messages
 
     def report(
-        self, now_ns: int, write_errors: int, last_error: str | None, recording: bool
+        self,
+        now_ns: int,
+        write_errors: int,
+        last_error: str | None,
+        recording: bool,
+        refused_summaries: Mapping[str, int] | None = None,
+        waiting_summaries: int = 0,
     ) -> list[RecorderStats]:
-        """One RecorderStats per station; starts the next lag window."""
+        """One RecorderStats per station; starts the next lag window.
+
+        ``refused_summaries``: per station, RunSummaries the wear ledger refused;
+        ``waiting_summaries``: runs waiting in memory for the ledger (all stations).
+        """
+        refused = refused_summaries or {}
         out: list[RecorderStats] = []
         for station, counts in self._stations.items():
             p50_ms, max_ms = lag_figures_ms(counts.lags_ns)
@@ -123,6 +135,8 @@ class RecorderHealth:
                     last_error=last_error,
                     recording=recording,
                     missing_samples=counts.missing_samples,
+                    refused_summaries=refused.get(station, 0),
+                    waiting_summaries=waiting_summaries,
                 )
             )
         return out

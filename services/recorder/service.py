@@ -43,6 +43,7 @@ from services.recorder.line_inbox import LineInbox, Message
 from services.recorder.recorder import Recorder
 from services.recorder.recorder_health import RecorderHealth
 from services.recorder.run_files import FileLimits
+from services.recorder.wear_bound import StationLimits
 from services.recorder.wear_ledger import WearLedger, ledger_path
 from services.recorder.wear_watch import ALERT_TOPIC, WearAlert, WearWatch
 from shared import keys
@@ -126,7 +127,10 @@ class RecorderService:
         self.wear: WearWatch | None = None
         if not view_only:
             self.wear = WearWatch(
-                self._ledger_file, first.config.recorder.wear_service_threshold, self._publish_alert
+                self._ledger_file,
+                first.config.recorder.wear_service_threshold,
+                self._publish_alert,
+                StationLimits(stations).of,
             )
         self._inbox = LineInbox(session, keys.EVERYTHING)
         self._queryables = [
@@ -160,6 +164,8 @@ class RecorderService:
                 now = time.monotonic()
                 if now >= next_tick:
                     self.recorder.tick(time.time_ns())
+                    if self.wear is not None:
+                        self.wear.tick(time.time_ns())
                     next_tick = now + self._tick_s
                 if now >= next_stats and not self.view_only:
                     self._publish_stats(time.time_ns())
@@ -194,7 +200,14 @@ class RecorderService:
         last_error = recorder.last_write_error or (
             f"wear ledger: {wear.last_ledger_error}" if wear and wear.last_ledger_error else None
         )
-        return self.health.report(now_ns, write_errors, last_error, recorder.recording_ok)
+        return self.health.report(
+            now_ns,
+            write_errors,
+            last_error,
+            recorder.recording_ok,
+            refused_summaries=wear.refused if wear else None,
+            waiting_summaries=wear.waiting if wear else 0,
+        )
 
     def _file(self, messages: list[Message]) -> None:
         filed_ns = time.time_ns()  # the lag counts the wait in the inbox too

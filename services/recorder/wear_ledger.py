@@ -17,16 +17,34 @@ The file is ``<recordings>/wear.sqlite`` in WAL mode: the recorder writes,
 reader holding a read transaction never blocks the writer, nor the writer a
 reader. Each run is one transaction: a writer killed mid-run loses that run
 only, and the file stays consistent (``tests/system/test_wear_ledger_kill.py``).
+
+A run enters only within what its tool can have taken
+(:mod:`.wear_bound`: :class:`~.wear_bound.RefusedSummaryError` otherwise).
+A file at the path that is no ledger (empty, not SQLite, another schema,
+corrupt) is never written into: :class:`~.wear_ledger_file.BrokenLedgerError`
+(:mod:`.wear_ledger_file`: how a new ledger is made, and a broken one
+recognised and moved aside).
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import sqlite3
+from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from services.recorder.wear_bound import RefusedSummaryError, RunLimits, refusal
+from services.recorder.wear_ledger_file import (
+    BrokenLedgerError,
+    create_ledger,
+    file_problem,
+    identity,
+    is_broken_error,
+    schema_problem,
+)
 from shared.errors import InputError
 from shared.messages import RunSummary
 
@@ -96,27 +114,84 @@ class WearLedger:
     """The ledger file through one connection, for one thread at a time."""
 
     def __init__(self, path: Path, read_only: bool = False, busy_timeout_s: float = 10.0) -> None:
+        """Open the ledger at ``path`` (the writer makes it when there is none).
+
+        BrokenLedgerError when the file there is no usable ledger; InputError when
+        SQLite cannot open it otherwise (OSError: the folder cannot be made).
+        """
         self.path = Path(path)
+        if read_only and not self.path.is_file():
+            raise InputError(f"{self.path}: no wear ledger here (nothing recorded yet?)")
+        if not read_only:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            if not self.path.exists():
+                create_ledger(self.path, _SCHEMA)
+        problem = file_problem(self.path)
+        if problem is not None:
+            raise BrokenLedgerError(self.path, problem)
+        db: sqlite3.Connection | None = None
         try:
             if read_only:
-                if not self.path.is_file():
-                    raise InputError(f"{self.path}: no wear ledger here (nothing recorded yet?)")
                 uri = f"{self.path.resolve().as_uri()}?mode=ro"
-                self._db = sqlite3.connect(uri, uri=True, timeout=busy_timeout_s)
+                db = sqlite3.connect(uri, uri=True, timeout=busy_timeout_s)
             else:
-                self.path.parent.mkdir(parents=True, exist_ok=True)
                 # Opened by the thread that builds the service, then used by its worker only.
-                self._db = sqlite3.connect(
-                    self.path, timeout=busy_timeout_s, check_same_thread=False
-                )
-                self._db.execute("PRAGMA journal_mode=WAL")
-                self._db.executescript(_SCHEMA)
-        except sqlite3.Error as err:
+                db = sqlite3.connect(self.path, timeout=busy_timeout_s, check_same_thread=False)
+            #: the file this connection reads and writes: another one at the path is not it
+            self.identity = identity(self.path)
+            problem = schema_problem(db)
+            if problem is not None:
+                raise BrokenLedgerError(self.path, problem)
+            if not read_only:
+                db.execute("PRAGMA journal_mode=WAL")
+                db.executescript(_SCHEMA)
+        except (sqlite3.Error, BrokenLedgerError) as err:
+            if db is not None:
+                db.close()
+            if isinstance(err, BrokenLedgerError):
+                raise
+            if is_broken_error(err):
+                raise BrokenLedgerError(self.path, str(err)) from err
             raise InputError(f"{self.path}: not a usable wear ledger: {err}") from err
+        self._db = db
 
-    def add_run(self, summary: RunSummary, recorded_ns: int) -> bool:
-        """Count a run once; False when (station, run_id) was already in the ledger."""
-        with self._db:
+    @contextlib.contextmanager
+    def _reading_the_file(self) -> Iterator[None]:
+        """SQLite finding the file damaged is a BrokenLedgerError; other errors stay."""
+        try:
+            yield
+        except sqlite3.Error as err:
+            if is_broken_error(err):
+                raise BrokenLedgerError(self.path, str(err)) from err
+            raise
+
+    def file_changed(self) -> str | None:
+        """What happened to the file this ledger opened, or None: removed, replaced by
+        another file, emptied or overwritten (OSError when the path cannot be read)."""
+        try:
+            now = identity(self.path)
+        except FileNotFoundError:
+            return "it was removed"
+        if now != self.identity:
+            return "another file took its place"
+        return file_problem(self.path)
+
+    def verify(self) -> None:
+        """Read the whole file through (``PRAGMA quick_check``); BrokenLedgerError if damaged."""
+        with self._reading_the_file():
+            rows = [str(row[0]) for row in self._db.execute("PRAGMA quick_check")]
+        if rows != ["ok"]:
+            raise BrokenLedgerError(self.path, f"corrupt: {'; '.join(rows[:3])}")
+
+    def add_run(self, summary: RunSummary, recorded_ns: int, limits: RunLimits) -> bool:
+        """Count a run once; False when (station, run_id) was already in the ledger.
+
+        RefusedSummaryError when the summary is beyond ``limits`` (:mod:`.wear_bound`).
+        """
+        reason = refusal(summary, limits)
+        if reason is not None:
+            raise RefusedSummaryError(summary, reason)
+        with self._reading_the_file(), self._db:
             cursor = self._db.execute(
                 "INSERT OR IGNORE INTO runs VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 (
@@ -137,7 +212,7 @@ class WearLedger:
 
     def record_service(self, tool_id: int, note: str, serviced_ns: int) -> None:
         """A service of ``tool_id`` now: starts a new interval, keeps the history."""
-        with self._db:
+        with self._reading_the_file(), self._db:
             self._db.execute(
                 "INSERT INTO services (tool_id, serviced_ns, note) VALUES (?, ?, ?)",
                 (tool_id, serviced_ns, note),
@@ -145,6 +220,10 @@ class WearLedger:
 
     def tool_ids(self, station: str | None = None) -> list[int]:
         """Every tool in the ledger, or those that ran at ``station``; by id."""
+        with self._reading_the_file():
+            return self._tool_ids(station)
+
+    def _tool_ids(self, station: str | None) -> list[int]:
         if station is not None:
             rows = self._db.execute(
                 "SELECT DISTINCT tool_id FROM runs WHERE station = ? ORDER BY tool_id", (station,)
@@ -162,7 +241,7 @@ class WearLedger:
     def tool(self, tool_id: int) -> ToolWear:
         """One tool's line (zeros for a tool the ledger has never seen)."""
         # One read transaction, so the figures agree with each other under a live writer.
-        with self._db:
+        with self._reading_the_file(), self._db:
             self._db.execute("BEGIN")
             runs, total = self._db.execute(
                 "SELECT COUNT(*), COALESCE(SUM(process_intensity), 0.0) FROM runs "

@@ -22,6 +22,7 @@ import pytest
 
 from services.recorder.recorder import RETRY_INTERVAL_NS
 from services.recorder.recording_reader import RecordingScan
+from services.recorder.wear_bound import CONTRACT_LIMITS
 from services.recorder.wear_ledger import WearLedger
 from shared.messages import RunSummary
 from tests.paths import REPO
@@ -151,7 +152,7 @@ def test_a_file_size_limit_gives_efbig_and_the_next_run_is_recorded(tmp_path: Pa
 
 def _summary(run_id: int) -> RunSummary:
     return RunSummary(
-        "st1", run_id, 7, 1, "done", 4e4, None, 4.1e4, 150.0, 2.5, 12, None, 1e6, 1500, 0, 1
+        "st1", run_id, 7, 1, "done", 4e4, None, 4.1e4, 150.0, 2.5, 12, None, 1e6, 1500, 0, 2 * 10**9
     )
 
 
@@ -159,15 +160,15 @@ def test_a_full_disk_does_not_corrupt_the_wear_ledger(tmp_path: Path) -> None:
     with tmpfs(tmp_path / "recordings", 1 << 20) as recordings:
         ledger_file = recordings / "wear.sqlite"
         with WearLedger(ledger_file) as ledger:
-            assert ledger.add_run(_summary(1), 1)
+            assert ledger.add_run(_summary(1), 1, CONTRACT_LIMITS)
             filler = fill_up(recordings)
             big = [_summary(n) for n in range(2, 2000)]
             with pytest.raises(sqlite3.OperationalError):
                 for summary in big:  # the WAL grows until the disk refuses it
-                    ledger.add_run(summary, 2)
+                    ledger.add_run(summary, 2, CONTRACT_LIMITS)
             filler.unlink()
         with WearLedger(ledger_file) as ledger:
-            assert ledger.add_run(_summary(9999), 3)
+            assert ledger.add_run(_summary(9999), 3, CONTRACT_LIMITS)
             (tool,) = ledger.tools()
         check = sqlite3.connect(ledger_file).execute("PRAGMA integrity_check").fetchone()
         assert check == ("ok",)

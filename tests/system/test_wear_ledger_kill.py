@@ -24,6 +24,7 @@ from pathlib import Path
 
 import pytest
 
+from services.recorder.wear_bound import CONTRACT_LIMITS
 from services.recorder.wear_ledger import WearLedger
 from shared.messages import RunSummary
 from tests.paths import REPO
@@ -33,21 +34,23 @@ pytestmark = pytest.mark.system
 KILLS = 12
 TOOL = 7
 T0_NS = 1_700_000_000_000_000_000
+S_NS = 1_000_000_000
 
 #: Intensity of run n: exact binary fractions, so sums compare exactly.
 WRITER = textwrap.dedent(
     """
     import sys
+    from services.recorder.wear_bound import CONTRACT_LIMITS
     from services.recorder.wear_watch import WearWatch
     from shared.messages import RunSummary
 
     path, first = sys.argv[1], int(sys.argv[2])
-    watch = WearWatch(path, None, lambda alert: None)
+    watch = WearWatch(path, None, lambda alert: None, lambda summary: CONTRACT_LIMITS)
     run_id = first
     while True:
         summary = RunSummary(
             "st1" if run_id % 2 else "st2", run_id, 7, 1, "done", None, 20.0, None, 19.5,
-            -2.5, 3, None, run_id * 0.25, 1000, run_id * 1000, run_id * 1000 + 500,
+            -2.5, 3, None, run_id * 0.25, 1000, run_id * 10**10, run_id * 10**10 + 2 * 10**9,
         )
         counted = watch.on_summary(summary, run_id)
         print(f"{'counted' if counted is not None else 'repeated'} {run_id}", flush=True)
@@ -124,7 +127,7 @@ def test_kill_9_loses_at_most_the_run_being_written_and_never_counts_twice(
 def summary(run_id: int, station: str = "st1") -> RunSummary:
     return RunSummary(
         station, run_id, TOOL, 1, "done", None, 20.0, None, 19.5, -2.5, 3, None,
-        intensity(run_id), 1000, T0_NS + run_id, T0_NS + run_id + 1,
+        intensity(run_id), 1000, T0_NS + run_id * S_NS, T0_NS + run_id * S_NS + 2 * S_NS,
     )  # fmt: skip
 
 
@@ -147,7 +150,7 @@ HOLD_READ = textwrap.dedent(
 def test_a_reader_holding_a_read_transaction_never_blocks_the_writer(tmp_path: Path) -> None:
     path = tmp_path / "wear.sqlite"
     with WearLedger(path) as ledger:
-        ledger.add_run(summary(1), T0_NS)
+        ledger.add_run(summary(1), T0_NS, CONTRACT_LIMITS)
     reader = subprocess.Popen(
         [sys.executable, "-c", HOLD_READ, path.resolve().as_uri()],
         stdin=subprocess.PIPE,
@@ -160,7 +163,7 @@ def test_a_reader_holding_a_read_transaction_never_blocks_the_writer(tmp_path: P
         # busy timeout 0: any lock wait would raise "database is locked" at once
         with WearLedger(path, busy_timeout_s=0.0) as writer:
             for run_id in range(2, 52):
-                assert writer.add_run(summary(run_id), T0_NS)
+                assert writer.add_run(summary(run_id), T0_NS, CONTRACT_LIMITS)
             assert writer.tool(TOOL).runs == 51
         reader.stdin.write("go\n")
         reader.stdin.flush()
@@ -190,7 +193,7 @@ def test_boltwatch_wear_reads_while_a_writer_holds_its_transaction(tmp_path: Pat
     path = tmp_path / "wear.sqlite"
     with WearLedger(path) as ledger:
         for run_id in (1, 2):
-            ledger.add_run(summary(run_id, station=f"st{run_id}"), T0_NS)
+            ledger.add_run(summary(run_id, station=f"st{run_id}"), T0_NS, CONTRACT_LIMITS)
     writer = subprocess.Popen(
         [sys.executable, "-c", HOLD_WRITE, str(path)],
         stdin=subprocess.PIPE,

@@ -90,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
     from services.cli.import_destination import CsvWriter, RecordingsWriter, make_folder
     from services.recorder.controller_import import DEFAULT_STATION, check_station_id
     from services.recorder.controller_run import read_controller_run
+    from services.recorder.wear_bound import RefusedSummaryError
     from shared.errors import BoltwatchError, InputError
 
     tally = Tally(len(args.runs))
@@ -110,6 +111,10 @@ def run(args: argparse.Namespace) -> int:
                 continue
             try:
                 done = writer.write(controller_run)
+            except RefusedSummaryError as err:  # the replay's figures: bad input, not the disk
+                _error(f"{path}: refused: {err}")
+                tally.refused += 1
+                continue
             except BoltwatchError as err:
                 _error(f"{path}: not written: {err}")
                 tally.not_written += 1

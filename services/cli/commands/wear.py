@@ -4,17 +4,22 @@
 
     boltwatch wear [--recordings DIR] [--station ST]      the table, one line per tool
     boltwatch wear service TOOL --note TEXT               record a service of TOOL
+    boltwatch wear reset [--recordings DIR]               a broken ledger moved aside, a new one
+
+A broken ledger (empty, not SQLite, another schema, corrupt) is one line
+naming the file, what is wrong and the reset command, exit status 2.
 """
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from services.cli.command_options import add_recordings_folder_options, recordings_folder
 from shared.option_types import int_in
 
 NAME = "wear"
-HELP = "show the wear ledger per tool, or record a tool's service"
+HELP = "show the wear ledger per tool, record a tool's service, or replace a broken ledger"
 
 #: the largest tool id (station.tool_id in a station file; 16 bits on CAN)
 MAX_TOOL_ID = 65535
@@ -26,9 +31,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "its runs, intensity per run, worst runs and the intensity since the last service. "
         "'boltwatch wear service TOOL --note TEXT' records a service: the interval count "
         "restarts, the history stays. Tools are plant assets: a tool's totals count its "
-        "runs at every station; --station ST lists the tools that ran at ST."
+        "runs at every station; --station ST lists the tools that ran at ST. "
+        "'boltwatch wear reset' moves a broken ledger (empty, not SQLite, another schema, "
+        "corrupt) aside, keeping it as wear.sqlite.broken-<UTC time>, and starts a new one; "
+        "a running recorder then counts the runs it kept waiting into the new ledger. "
+        "It refuses a healthy ledger and one a process has open."
     )
-    parser.add_argument("action", nargs="?", choices=["service"], help="record a service")
+    parser.add_argument(
+        "action",
+        nargs="?",
+        choices=["service", "reset"],
+        help="service: record a service of TOOL; reset: replace a broken ledger",
+    )
     parser.add_argument(
         "tool", nargs="?", type=int_in(0, MAX_TOOL_ID, "a tool id"), help="tool id (with 'service')"
     )
@@ -52,6 +66,8 @@ def run(args: argparse.Namespace) -> int:
     from shared.errors import InputError
 
     path = ledger_path(recordings_folder(args))
+    if args.action == "reset":
+        return _reset(args, path)
     if args.action == "service":
         if args.tool is None:
             raise InputError("give the tool id: boltwatch wear service TOOL --note TEXT")
@@ -66,4 +82,23 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps([tool.to_dict() for tool in tools], indent=2))
     else:
         print(format_table(tools, args.station))
+    return 0
+
+
+def _reset(args: argparse.Namespace, path: Path) -> int:
+    from services.recorder.wear_reset import reset_ledger
+    from shared.errors import InputError
+
+    if args.tool is not None:
+        raise InputError("reset takes no tool id: boltwatch wear reset [--recordings DIR]")
+    done = reset_ledger(path)
+    if done is None:
+        print(f"no wear ledger at {path}: nothing to reset (the recorder starts one)")
+        return 0
+    kept = ", ".join(str(name) for name in done.kept)
+    print(
+        f"moved the broken wear ledger {path} aside ({done.broken}); kept as {kept}; "
+        f"started a new ledger at {done.ledger}: a running recorder counts the runs it "
+        "kept waiting into it within seconds"
+    )
     return 0

@@ -319,3 +319,34 @@ def test_a_recorder_that_cannot_write_says_so_and_why() -> None:
     assert "NOT RECORDING: [Errno 28] No space left on device (lag - (no samples)" in text
     assert "3 write errors" in text
     assert "42 samples missing" in text
+
+
+def test_a_broken_wear_ledger_and_refused_summaries_show_while_recording_goes_on() -> None:
+    broken = (
+        "wear ledger: recordings/wear.sqlite: not a usable wear ledger: it is empty (0 bytes); "
+        "move it aside and start a new ledger: boltwatch wear reset --recordings recordings"
+    )
+    stats = recorder_stats(
+        T0, last_error=broken, write_errors=1, refused_summaries=2, waiting_summaries=3
+    )
+    collector = StatusCollector()
+    feed(collector, keys.RECORDER, stats)
+
+    report = collector.report("e", 2.0, T0)
+    (status,) = report.stations
+    assert status.recorder is not None and status.recorder.recording
+    text = format_report(report)
+    assert "recorder      recording, lag p50 1.2 ms" in text
+    assert "2 run summaries refused by the wear ledger, 3 runs waiting for the wear ledger" in text
+    assert text.rstrip().endswith(f"last error: {broken}")
+    recorder = to_json(report)["stations"]["st1"]["recorder"]
+    assert (recorder["refused_summaries"], recorder["waiting_summaries"]) == (2, 3)
+
+
+def test_summaries_the_wear_ledger_refused_show() -> None:
+    collector = StatusCollector()
+    feed(collector, keys.RECORDER, recorder_stats(T0, refused_summaries=2))
+    report = collector.report("e", 2.0, T0)
+    text = format_report(report)
+    assert "0 write errors, 2 run summaries refused by the wear ledger, " in text
+    assert to_json(report)["stations"]["st1"]["recorder"]["refused_summaries"] == 2

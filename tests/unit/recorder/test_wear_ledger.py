@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
+from services.recorder.wear_bound import CONTRACT_LIMITS as LIMITS
 from services.recorder.wear_ledger import WearLedger, ledger_path
 from shared.errors import InputError
 from shared.messages import RunSummary
@@ -20,15 +21,15 @@ def summary(run_id: int, intensity: float, tool_id: int = 7, station: str = "st1
     ended = T0_NS + run_id * S_NS
     return RunSummary(
         station, run_id, tool_id, 1, "done", 56e3, None, 55e3, 120.0, -1.8, 4,
-        "plateau_closest", intensity, 3000, ended - S_NS // 2, ended,
+        "plateau_closest", intensity, 500, ended - S_NS // 2, ended,
     )  # fmt: skip
 
 
 def test_totals_follow_eq_69_and_worst_runs_lead(tmp_path: Path) -> None:
     with WearLedger(tmp_path / "wear.sqlite") as ledger:
         for run_id, intensity in enumerate([0.5, 2.0, 1.0, 0.25], start=1):
-            assert ledger.add_run(summary(run_id, intensity), T0_NS)
-        assert ledger.add_run(summary(1, 9.0, tool_id=8, station="st2"), T0_NS)
+            assert ledger.add_run(summary(run_id, intensity), T0_NS, LIMITS)
+        assert ledger.add_run(summary(1, 9.0, tool_id=8, station="st2"), T0_NS, LIMITS)
         wear = ledger.tool(7)
     assert (wear.runs, wear.total_intensity, wear.intensity_per_run) == (4, 3.75, 3.75 / 4)
     worst = [(r.run_id, r.process_intensity) for r in wear.worst_runs]
@@ -40,20 +41,20 @@ def test_totals_follow_eq_69_and_worst_runs_lead(tmp_path: Path) -> None:
 def test_a_repeated_summary_or_a_restart_never_counts_twice(tmp_path: Path) -> None:
     path = tmp_path / "wear.sqlite"
     with WearLedger(path) as ledger:
-        assert ledger.add_run(summary(1, 1.0), T0_NS)
-        assert not ledger.add_run(summary(1, 1.0), T0_NS + 1)  # redelivered
+        assert ledger.add_run(summary(1, 1.0), T0_NS, LIMITS)
+        assert not ledger.add_run(summary(1, 1.0), T0_NS + 1, LIMITS)  # redelivered
     with WearLedger(path) as ledger:  # the recorder restarted and sees run 1 again
-        assert not ledger.add_run(summary(1, 1.0), T0_NS + 2)
-        assert ledger.add_run(summary(2, 0.5), T0_NS + 3)
+        assert not ledger.add_run(summary(1, 1.0), T0_NS + 2, LIMITS)
+        assert ledger.add_run(summary(2, 0.5), T0_NS + 3, LIMITS)
         assert (ledger.tool(7).runs, ledger.tool(7).total_intensity) == (2, 1.5)
 
 
 def test_a_service_restarts_the_interval_and_keeps_history(tmp_path: Path) -> None:
     with WearLedger(tmp_path / "wear.sqlite") as ledger:
-        ledger.add_run(summary(1, 1.0), T0_NS)
-        ledger.add_run(summary(2, 2.0), T0_NS)
+        ledger.add_run(summary(1, 1.0), T0_NS, LIMITS)
+        ledger.add_run(summary(2, 2.0), T0_NS, LIMITS)
         ledger.record_service(7, "new socket", T0_NS + 2 * S_NS + 1)  # after run 2 ended
-        ledger.add_run(summary(3, 0.5), T0_NS)
+        ledger.add_run(summary(3, 0.5), T0_NS, LIMITS)
         wear = ledger.tool(7)
         assert ledger.tool_ids() == [7]
     assert (wear.runs, wear.total_intensity) == (3, 3.5)
@@ -82,7 +83,7 @@ def test_a_reader_sees_consistent_lines_while_the_recorder_writes(tmp_path: Path
     thread.start()
     try:
         for run_id in range(1, runs + 1):
-            writer.add_run(summary(run_id, 1.0), T0_NS)
+            writer.add_run(summary(run_id, 1.0), T0_NS, LIMITS)
     finally:
         done.set()
         thread.join(10)
@@ -98,7 +99,7 @@ def test_cli_prints_the_table_and_records_services(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     with WearLedger(ledger_path(tmp_path)) as ledger:
-        ledger.add_run(summary(1, 1.5), T0_NS)
+        ledger.add_run(summary(1, 1.5), T0_NS, LIMITS)
     assert main(["wear", "--recordings", str(tmp_path)]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].split()[:4] == ["tool", "runs", "I_total", "I/run"]
@@ -121,10 +122,11 @@ def test_a_tool_is_one_asset_across_stations_and_a_station_lists_its_tools(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     with WearLedger(ledger_path(tmp_path)) as ledger:
-        ledger.add_run(summary(1, 1.0, tool_id=7, station="st1"), T0_NS)
-        ledger.add_run(summary(2, 2.0, tool_id=7, station="st2"), T0_NS)  # tool moved
-        ledger.add_run(summary(3, 4.0, tool_id=8, station="st2"), T0_NS)
-        ledger.add_run(summary(1, 8.0, tool_id=9, station="st3"), T0_NS)  # same run id, other st
+        ledger.add_run(summary(1, 1.0, tool_id=7, station="st1"), T0_NS, LIMITS)
+        ledger.add_run(summary(2, 2.0, tool_id=7, station="st2"), T0_NS, LIMITS)  # tool moved
+        ledger.add_run(summary(3, 4.0, tool_id=8, station="st2"), T0_NS, LIMITS)
+        # the same run id at another station
+        ledger.add_run(summary(1, 8.0, tool_id=9, station="st3"), T0_NS, LIMITS)
         assert ledger.tool_ids() == [7, 8, 9]
         assert ledger.tool_ids(station="st1") == [7]
         assert [t.tool_id for t in ledger.tools(station="st2")] == [7, 8]

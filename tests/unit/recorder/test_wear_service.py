@@ -21,6 +21,7 @@ from shared.config import LoadedStation, load_station
 from shared.messages import RunSummary, ToolState
 
 T0_NS = 1_700_000_000_000_000_000
+S_NS = 1_000_000_000
 THRESHOLD = 2.0
 
 
@@ -39,7 +40,7 @@ def summary(run_id: int, intensity: float) -> bytes:
     return encode(
         RunSummary(
             "st1", run_id, 7, 1, "done", 56e3, None, 55e3, 120.0, -1.8, 4, None, intensity,
-            3000, T0_NS + run_id, T0_NS + run_id + 1,
+            3000, T0_NS + run_id * S_NS, T0_NS + run_id * S_NS + 3 * S_NS,
         )
     )  # fmt: skip
 
@@ -90,6 +91,7 @@ def test_summaries_count_once_and_a_due_tool_raises_an_alert(
 
 def test_a_ledger_that_cannot_be_written_keeps_the_runs_until_it_can(tmp_path: Path) -> None:
     """A file where the ledger's folder should be: logged, nothing raised, counted later."""
+    from services.recorder.wear_bound import CONTRACT_LIMITS
     from services.recorder.wear_ledger import WearLedger
     from services.recorder.wear_watch import WearWatch
     from shared.codec import decode
@@ -97,7 +99,7 @@ def test_a_ledger_that_cannot_be_written_keeps_the_runs_until_it_can(tmp_path: P
     blocker = tmp_path / "recordings"
     blocker.write_text("not a folder")
     ledger_file = blocker / "wear.sqlite"
-    watch = WearWatch(ledger_file, None, lambda _alert: None)
+    watch = WearWatch(ledger_file, None, lambda _alert: None, lambda _summary: CONTRACT_LIMITS)
     for run_id in (1, 2):
         assert watch.on_summary(decode(RunSummary, summary(run_id, 1.0)), T0_NS) is None
     assert watch.ledger_errors == 2 and watch.last_ledger_error is not None
@@ -108,3 +110,33 @@ def test_a_ledger_that_cannot_be_written_keeps_the_runs_until_it_can(tmp_path: P
     assert wear is not None and wear.runs == 3 and watch.last_ledger_error is None
     with WearLedger(ledger_file, read_only=True) as ledger:
         assert ledger.tool(7).total_intensity == pytest.approx(3.0)
+
+
+def test_summaries_beyond_their_bound_are_refused_counted_and_said_in_recorder_stats(
+    recorder: RunningRecorder, publisher_session: zenoh.Session
+) -> None:
+    """The issue's probes on a running recorder: negative intensity (-2e9) and 9e11 (random
+    frames on the ToolSensors id), a forged 1e15: none in the ledger, each counted."""
+    from shared.codec import decode
+    from shared.messages import RecorderStats
+
+    stats: list[RecorderStats] = []
+    subscriber = publisher_session.declare_subscriber(
+        keys.station_key("st1", keys.RECORDER),
+        lambda sample: stats.append(decode(RecorderStats, sample.payload.to_bytes())),
+    )
+    runs = publisher_session.declare_publisher(keys.station_key("st1", keys.RUNS))
+    wait_until(lambda: has_subscribers(runs), "the recorder")
+    for run_id, intensity in ((1, 1.5), (2, -2e9), (3, 9e11), (4, 1e15), (5, 2.5)):
+        runs.put(summary(run_id, intensity))
+    wear = recorder.service.wear
+    assert wear is not None
+    wait_until(lambda: wear.counted + sum(wear.refused.values()) == 5, "the summaries")
+    assert (wear.counted, dict(wear.refused)) == (2, {"st1": 3})
+    wait_until(lambda: any(s.refused_summaries == 3 for s in stats), "RecorderStats")
+    replies = list(publisher_session.get(keys.station_key("st1", keys.WEAR), timeout=10))
+    assert len(replies) == 1 and replies[0].ok is not None
+    (line,) = json.loads(replies[0].ok.payload.to_bytes())["tools"]
+    assert (line["runs"], line["total_intensity"]) == (2, 4.0)
+    subscriber.undeclare()
+    runs.undeclare()
