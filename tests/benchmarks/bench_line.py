@@ -51,7 +51,7 @@ from shared.codec import decode, encode  # noqa: E402
 from shared.config import derive_stations, load_station  # noqa: E402
 from shared.messages import RecorderStats, RunSummary, ToolState  # noqa: E402
 from shared.zenoh_session import zenoh_config  # noqa: E402
-from tests.benchmarks.bench_stop_path import (  # noqa: E402
+from tests.benchmarks.line_station_runs import (  # noqa: E402
     SHORT_PROGRAM,
     Heard,
     figures,

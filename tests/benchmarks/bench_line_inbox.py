@@ -67,7 +67,7 @@ from shared.messages import RunSummary  # noqa: E402
 from shared.service_runtime import ServiceRunner  # noqa: E402
 from shared.zenoh_session import open_session, zenoh_config  # noqa: E402
 from tests.benchmarks.bench_line import cpu_s, wait_alive  # noqa: E402
-from tests.benchmarks.bench_stop_path import SHORT_PROGRAM  # noqa: E402
+from tests.benchmarks.line_station_runs import SHORT_PROGRAM  # noqa: E402
 from tests.system.station_files import free_tcp_port, serve, write_station  # noqa: E402
 from tests.unit.predictor.synthetic import staircase  # noqa: E402
 

@@ -1,0 +1,128 @@
+"""One station's runs through the real processes, as the line benchmarks drive them.
+
+What ``bench_line.py`` and ``bench_line_inbox.py`` share (until session 5 these
+lived in ``bench_stop_path.py``, whose stop path is now measured on its own):
+a short program, what is heard of each run on zenoh, the rig driven for N
+runs, and the stop path per run (StopCommand heard minus the deciding
+sample's receive time, both kernel timestamps).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import zenoh
+
+from shared import keys
+from shared.codec import decode
+from shared.messages import RunSummary, StickSlipEvent, StopDecision
+from tests.system.can_injector import HeardStop
+from tests.system.station_files import serve
+
+#: The short program: program 1 of the embedded station, to a lower preload, faster.
+SHORT_PROGRAM = {
+    # the line benchmarks measure the line predictor: one process serves every station
+    "[predictor]\n": '[predictor]\nplacement = "line"\n',
+    "target_force_n = 56000.0": "target_force_n = 24000.0",
+    "motor_speed_rad_s = 0.5": "motor_speed_rad_s = 1.0",
+}
+RUN_TIMEOUT_S = 15.0  # per run, generous on a loaded machine
+
+
+@dataclass
+class Heard:
+    decisions: dict[int, StopDecision] = field(default_factory=dict)
+    events: dict[int, list[StickSlipEvent]] = field(default_factory=dict)
+    summaries: dict[int, RunSummary] = field(default_factory=dict)
+    lock: threading.Lock = field(default_factory=threading.Lock)
+
+    def on_sample(self, sample: zenoh.Sample) -> None:
+        topic = str(sample.key_expr).rsplit("/", 1)[-1]
+        payload = sample.payload.to_bytes()
+        with self.lock:
+            if topic == keys.DECISION:
+                decision = decode(StopDecision, payload)
+                self.decisions.setdefault(decision.run_id, decision)
+            elif topic == keys.EVENTS:
+                event = decode(StickSlipEvent, payload)
+                self.events.setdefault(event.run_id, []).append(event)
+            elif topic == keys.RUNS:
+                summary = decode(RunSummary, payload)
+                self.summaries[summary.run_id] = summary
+
+
+def tighten(
+    rig_args: list[str],
+    log: Path,
+    runs: int,
+    heard: Heard,
+    processes: list[subprocess.Popen[bytes]],
+    run_timeout_s: float = RUN_TIMEOUT_S,
+) -> tuple[subprocess.Popen[bytes], float]:
+    """Serve the rig (added to ``processes``) until its ``runs`` end, then wait up to
+    5 s for their summaries; the rig's process and the seconds it all took."""
+    rig = serve(rig_args, log)
+    processes.append(rig)
+    started = time.monotonic()
+    rig.wait(timeout=run_timeout_s * runs)
+    deadline = time.monotonic() + 5.0
+    while len(heard.summaries) < runs and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return rig, time.monotonic() - started
+
+
+@dataclass(frozen=True)
+class RunFigures:
+    run_id: int
+    reason: str
+    stop_path_ms: float
+    decide_ms: float
+    act_ms: float
+    lead_ms: float | None
+
+
+def lead_ms(decision: StopDecision, events: list[StickSlipEvent], stop_s: float) -> float | None:
+    """Predicted next slip minus the StopCommand's time, both since run start (ms)."""
+    before = [e for e in events if e.time_s <= decision.time_s and e.predictions]
+    if not before:
+        return None
+    ahead = [p.time_s for p in before[-1].predictions if p.time_s > stop_s]
+    return (min(ahead) - stop_s) * 1e3 if ahead else None
+
+
+def figures(heard: Heard, stops: list[HeardStop]) -> tuple[list[RunFigures], list[str]]:
+    out: list[RunFigures] = []
+    notes: list[str] = []
+    first_stop: dict[int, HeardStop] = {}
+    for stop in stops:
+        first_stop.setdefault(stop.run_id, stop)
+    extra = len(stops) - len(first_stop)
+    if extra:
+        notes.append(f"{extra} StopCommand(s) beyond one per run")
+    for run_id in sorted(heard.summaries):
+        decision = heard.decisions.get(run_id)
+        heard_stop = first_stop.get(run_id)
+        if decision is None or heard_stop is None:
+            ended = heard.summaries[run_id].tool_state
+            notes.append(
+                f"run {run_id}: decision={decision is not None} stop heard="
+                f"{heard_stop is not None} ({ended})"
+            )
+            continue
+        stop_path_ns = heard_stop.received_ns - decision.time_ns
+        stop_s = decision.time_s + stop_path_ns / 1e9
+        out.append(
+            RunFigures(
+                run_id,
+                decision.reason,
+                stop_path_ns / 1e6,
+                (decision.decided_ns - decision.time_ns) / 1e6,
+                (heard_stop.received_ns - decision.decided_ns) / 1e6,
+                lead_ms(decision, heard.events.get(run_id, []), stop_s),
+            )
+        )
+    return out, notes
