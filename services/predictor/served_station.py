@@ -17,7 +17,7 @@ class ServedStation:
     def __init__(self, station: LoadedStation) -> None:
         self.station = station
         self.station_id = station.station_id
-        self.constants = JointConstants.of(station.joint)
+        self._constants: dict[int, JointConstants] = {}  # by program: its joint's
 
     def program(self, program_id: int) -> Program:
         """The station's program; KeyError names the station and its known ids."""
@@ -26,10 +26,14 @@ class ServedStation:
     def settings(self, program: Program) -> PredictorSettings:
         """The core's settings for one run of ``program`` at this station."""
         config = self.station.config
+        constants = self._constants.get(program.id)
+        if constants is None:
+            constants = JointConstants.of(self.station.joint_of(program.id))
+            self._constants[program.id] = constants
         return PredictorSettings.of(
             program,
             config.predictor,
             config.station.has_force_sensor,
-            self.constants,
+            constants,
             self.station.sensor_range,
         )

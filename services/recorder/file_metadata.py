@@ -122,5 +122,6 @@ def _configured(loaded: LoadedStation, program_id: int | None) -> Metadata:
             records["program"] = {"id": str(program_id), "error": "not in the station file"}
         else:
             records["program"] = flatten(program.model_dump(mode="json"))
-    records["joint"] = flatten(loaded.joint.model_dump(mode="json"))
+    joint = loaded.joint if program_id is None else loaded.joint_of(program_id)
+    records["joint"] = flatten(joint.model_dump(mode="json"))
     return records

@@ -51,7 +51,7 @@ def main(args: argparse.Namespace) -> int:
     if first_run_id < 0 or last_run_id > RUN_ID_MAX:
         raise ConfigError(f"--first-run-id must keep run ids within 0..{RUN_ID_MAX}")
     frames = RigFrames(StationDatabase(station.dbc_path))
-    constants = JointConstants.of(station.joint)
+    constants = JointConstants.of(station.joint_of(program.id))
     LOG.info(
         "rig: station %s, program %d (%s), first run %d, seed %d, runs %s",
         config.station.id,

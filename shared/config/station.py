@@ -135,6 +135,11 @@ class Program(StrictModel):
     max_force_n: float | None = Field(default=None, gt=0)
     max_angle_deg: float = Field(gt=0)
     max_time_s: float = Field(gt=0)
+    joint: Path | None = Field(
+        default=None,
+        description="the joint this program tightens, relative to the station file "
+        "(default: the station's station.joint)",
+    )
 
     @model_validator(mode="after")
     def _has_a_target(self) -> Program:
@@ -252,11 +257,18 @@ class LoadedStation:
     """A validated station file with its paths resolved and its joint loaded."""
 
     def __init__(
-        self, path: Path, config: StationConfig, joint: JointConfig, sensor_range: SensorRange
+        self,
+        path: Path,
+        config: StationConfig,
+        joint: JointConfig,
+        sensor_range: SensorRange,
+        program_joints: dict[int, JointConfig] | None = None,
     ) -> None:
         self.path = path
         self.config = config
         self.joint = joint
+        #: the joints of the programs that name their own (``programs[].joint``), by id
+        self.program_joints = program_joints or {}
         #: what the station's sensors can measure: the ranges of its DBC's signals
         self.sensor_range = sensor_range
 
@@ -271,6 +283,10 @@ class LoadedStation:
     @property
     def joint_path(self) -> Path:
         return resolve_relative(self.config.station.joint, self.path)
+
+    def joint_of(self, program_id: int) -> JointConfig:
+        """The joint program ``program_id`` tightens: its own, else the station's."""
+        return self.program_joints.get(program_id, self.joint)
 
     @property
     def recordings_folder(self) -> Path:
@@ -312,4 +328,13 @@ def load_station(path: Path) -> LoadedStation:
                 "never send a reading at its own limit (widen the signal in the DBC or lower "
                 "the limit)"
             )
-    return LoadedStation(path, config, load_joint(joint_path), sensor_range)
+    program_joints = {}
+    for index, program in enumerate(config.programs):
+        if program.joint is not None:
+            program_joint = resolve_relative(program.joint, path)
+            if not program_joint.is_file():
+                raise ConfigError(
+                    f"{path}: programs[{index}].joint: file not found: {program_joint}"
+                )
+            program_joints[program.id] = load_joint(program_joint)
+    return LoadedStation(path, config, load_joint(joint_path), sensor_range, program_joints)

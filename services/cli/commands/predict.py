@@ -47,6 +47,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="samples in the peak-detection window (default 5, see the predictor docs)",
     )
     parser.add_argument(
+        "--config",
+        type=Path,
+        default=None,
+        metavar="STATION.toml",
+        help="decide as this station decides --program: its targets, limits, motor speed, the "
+        "program's joint, its DBC's sensor range and [predictor] section (options given here "
+        "replace the file's)",
+    )
+    parser.add_argument(
+        "--program", type=int, default=None, metavar="ID", help="the program of --config"
+    )
+    parser.add_argument(
         "--dbc",
         type=Path,
         default=None,
@@ -65,65 +77,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import json
-    import math
     import sys
 
-    from services.predictor.core import DEFAULT_WINDOW_SAMPLES, PredictorCore, PredictorSettings
+    from services.cli.predict_settings import predict_settings
+    from services.predictor.core import PredictorCore
     from services.predictor.trace_replay import json_safe, output_record, replay
-    from shared.errors import InputError
-    from shared.sensor_range import CONTRACT_RANGE, SensorRange
     from shared.trace import read_trace
 
-    if args.target_force is None and args.target_torque is None:
-        raise InputError("give --target-force N, --target-torque NM, or both")
-    for name in ("target_force", "target_torque"):
-        value = getattr(args, name)
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise InputError(
-                f"--{name.replace('_', '-')} must be a finite number > 0 (got {value})"
-            )
-    window = args.window if args.window is not None else DEFAULT_WINDOW_SAMPLES
-    if not 3 <= window <= 200:
-        raise InputError(f"--window must be between 3 and 200 samples (got {window})")
-    constants = None
-    if args.joint is not None:
-        from shared.config import load_joint
-        from shared.errors import ConfigError
-        from shared.model import JointConstants
-
-        try:
-            constants = JointConstants.of(load_joint(args.joint))
-        except ConfigError as err:
-            raise InputError(str(err)) from err
-    sensor_range = CONTRACT_RANGE
-    if args.dbc is not None:
-        from shared.can_database import StationDatabase
-        from shared.errors import CanDatabaseError
-
-        try:
-            sensor_range = SensorRange.of_database(StationDatabase(args.dbc))
-        except CanDatabaseError as err:
-            raise InputError(str(err)) from err
     trace = read_trace(args.trace)
-    has_force = args.target_force is not None and trace.has_force
-    settings = PredictorSettings(
-        target_force_n=args.target_force if has_force else None,
-        target_torque_nm=args.target_torque,
-        has_force=has_force,
-        window_samples=window,
-        constants=constants,
-        sensor_range=sensor_range,
-    )
-    if args.target_force is not None and not trace.has_force:
-        if args.target_torque is None:
-            raise InputError(
-                f"{args.trace}: no force values in the trace; give --target-torque for "
-                "torque-only mode"
-            )
-        print(
-            f"boltwatch predict: {args.trace}: no force values, torque-only mode",
-            file=sys.stderr,
-        )
+    settings, note = predict_settings(args, trace.has_force)
+    if note is not None:
+        print(f"boltwatch predict: {note}", file=sys.stderr)
     core = PredictorCore(settings)
     out = sys.stdout
     for output in replay(core, trace):

@@ -48,7 +48,9 @@ def run(args: argparse.Namespace) -> int:
     program = choose_program(station, args.program)
     seed = choose_seed(args.seed, config.rig.seed)
     has_force = config.station.has_force_sensor
-    physics = TighteningPhysics(JointConstants.of(station.joint), program, config.rig, seed)
+    physics = TighteningPhysics(
+        JointConstants.of(station.joint_of(program.id)), program, config.rig, seed
+    )
     controller = RunController(
         physics,
         program,

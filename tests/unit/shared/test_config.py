@@ -155,3 +155,19 @@ def test_a_recordings_folder_that_cannot_be_made_is_refused_naming_the_key(
         f"{path}: recorder.folder: {tmp_path}/afile/recordings: cannot be made: "
         f"{tmp_path}/afile is a file, not a folder"
     )
+
+
+def test_a_program_may_tighten_a_joint_of_its_own(tmp_path: Path) -> None:
+    """One station, several bolts: each program's joint feeds its predictor and its rig."""
+    path = write_station(tmp_path, "")
+    text = path.read_text().replace(
+        "max_time_s = 4.0", f'max_time_s = 4.0\njoint = "{CONFIG}/joints/paper-section-3-4.toml"'
+    )
+    path.write_text(text)
+    station = load_station(path)
+    assert station.joint_of(1) is station.joint  # program 1 names none: the station's
+    assert station.joint_of(2) == load_joint(CONFIG / "joints" / "paper-section-3-4.toml")
+    assert station.joint_of(2) != station.joint
+    path.write_text(text.replace("paper-section-3-4.toml", "missing.toml"))
+    with pytest.raises(ConfigError, match=r"programs\[1\]\.joint: file not found"):
+        load_station(path)
