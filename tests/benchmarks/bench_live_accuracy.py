@@ -25,7 +25,8 @@ Per joint, |F_reached - F_target| / F_target of:
 - **offline replay**: the recorded run exported from its MCAP and predicted
   again with the station's settings (what ``boltwatch predict --config
   --program`` does); the joint simulated again (same seed) and halted one
-  sample after the sample that decided offline (a controller's reaction);
+  sample after the sample that decided offline (a controller's reaction), or
+  at the tool's own shutoff at the target if that comes first, as live;
 - **oracle**: the closest reachable end (``bench_predictor_accuracy.oracle``);
 - **conventional**: the shutoff inside the tool controller, one sample of
   latency, no network (``bench_predictor_accuracy.conventional``).
@@ -65,6 +66,7 @@ from services.predictor.core import CoreDecision, PredictorCore, PredictorSettin
 from services.predictor.trace_replay import replay  # noqa: E402
 from services.recorder.trace_export import export_trace  # noqa: E402
 from services.rig.frames import RigFrames  # noqa: E402
+from services.rig.physics import Measurement  # noqa: E402
 from services.rig.realtime import RealtimeRig, ToolIdentity  # noqa: E402
 from shared import keys  # noqa: E402
 from shared.can_bus import open_bus  # noqa: E402
@@ -221,7 +223,13 @@ def tighten_live(
 
 
 def offline(
-    live: LiveRun, joint: Joint, number: int, recordings: Path, station_file: Path, folder: Path
+    live: LiveRun,
+    joint: Joint,
+    number: int,
+    recordings: Path,
+    station_file: Path,
+    folder: Path,
+    torque_only: bool,
 ) -> tuple[float, float, tuple[str, float] | None]:
     """(reached force, torque, (reason, time_s) decided) of the recorded run replayed."""
     (mcap,) = recordings.rglob(f"st1_run{live.run_id}_*.mcap")
@@ -242,10 +250,19 @@ def offline(
          if isinstance(o, CoreDecision)),
         None,
     )  # fmt: skip
-    # halt the same joint one sample after the sample that decided (sample k: t = k ms)
+    # halt the same joint one sample after the sample that decided (sample k: t = k ms), or
+    # after the tool's own shutoff at the target, whichever comes first: as the live rig
     at_sample = -1 if decided is None else round(decided[1] * 1000.0)
     count = iter(range(10**9))
-    result = run(joint, lambda _m: "offline" if next(count) == at_sample else None)
+
+    def stop(m: Measurement) -> str | None:
+        if next(count) == at_sample:
+            return "offline"
+        if torque_only:
+            return "shutoff" if m.torque_nm >= joint.target_torque_nm else None
+        return "shutoff" if m.force_n >= joint.target_force_n else None
+
+    result = run(joint, stop)
     return result.reached_n, result.reached_torque_nm, decided
 
 
@@ -316,7 +333,7 @@ def measure(args: argparse.Namespace, joints: list[Joint], folder: Path) -> int:
         best = oracle(joint)
         conv = conventional(joint, args.torque_only)
         reached, reached_torque, decided = offline(
-            live, joint, number, station.recordings_folder, station_file, folder
+            live, joint, number, station.recordings_folder, station_file, folder, args.torque_only
         )
         stopped_by[live.stopped_by] += 1
         if live.decision is not None and decided is not None:

@@ -3,7 +3,7 @@
 Run on demand::
 
     .venv/bin/python tests/benchmarks/bench_stop_path.py [--stops 1000]
-        [--placement edge|line|before] [--repo PATH]
+        [--placement edge|line|before] [--repo PATH] [--stations N]
 
 The whole simulated station runs as ``boltwatch serve`` processes on an
 isolated station file (own zenoh and udp_multicast ports): the router, the
@@ -24,14 +24,20 @@ acquisition of the sample that decided (both CLOCK_REALTIME on one host).
 Reported: p50 / p90 / p99 / max over all stops and per kind, the stops lost
 (a decision with no StopCommand heard, or a run the rig ended by itself),
 and what the machine itself lost meanwhile: the steal column of
-``/proc/stat`` (the host's share of this VM's CPU time). ``--repo PATH``
-starts the services from another checkout (the code before a change, side by
-side); the benchmark's own code (files, listener) stays this one's.
+``/proc/stat`` (the host's share of this VM's CPU time).
+
+``--stations N``: a line of N stations (derived as ``boltwatch up
+--stations`` derives them), each with its own tool and bus, on one router
+and one recorder; the stops split evenly. ``--repo PATH`` starts the
+services from another checkout (the code before a change, side by side);
+the benchmark's own code (files, listener) stays this one's.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import statistics
 import subprocess
 import sys
@@ -53,7 +59,7 @@ from services.cli.station_supervisor import stop_process  # noqa: E402
 from shared import keys  # noqa: E402
 from shared.can_database import StationDatabase  # noqa: E402
 from shared.codec import decode  # noqa: E402
-from shared.config import load_station  # noqa: E402
+from shared.config import LoadedStation, derive_stations, load_station  # noqa: E402
 from shared.messages import RunSummary, StopDecision  # noqa: E402
 from shared.zenoh_session import zenoh_config  # noqa: E402
 from tests.system.can_injector import HeardStop, StopListener  # noqa: E402
@@ -92,8 +98,8 @@ START_TIMEOUT_S = 30.0
 
 @dataclass
 class Heard:
-    decisions: dict[int, StopDecision] = field(default_factory=dict)
-    summaries: dict[int, RunSummary] = field(default_factory=dict)
+    decisions: dict[tuple[str, int], StopDecision] = field(default_factory=dict)
+    summaries: dict[tuple[str, int], RunSummary] = field(default_factory=dict)
     lock: threading.Lock = field(default_factory=threading.Lock)
 
     def on_sample(self, sample: zenoh.Sample) -> None:
@@ -102,10 +108,10 @@ class Heard:
         with self.lock:
             if topic == keys.DECISION:
                 decision = decode(StopDecision, payload)
-                self.decisions.setdefault(decision.run_id, decision)
+                self.decisions.setdefault((decision.station, decision.run_id), decision)
             elif topic == keys.RUNS:
                 summary = decode(RunSummary, payload)
-                self.summaries[summary.run_id] = summary
+                self.summaries[(summary.station, summary.run_id)] = summary
 
 
 def station_files(folder: Path, placement: str) -> tuple[Path, Path]:
@@ -139,16 +145,10 @@ def serve_from(repo: Path, args: list[str], log: Path) -> subprocess.Popen[bytes
         return subprocess.Popen(
             [sys.executable, "-m", "services.cli", "serve", *args],
             cwd=repo,
-            env={**_environment(), "PYTHONPATH": str(repo)},
+            env={**os.environ, "PYTHONPATH": str(repo)},
             stdout=out,
             stderr=subprocess.STDOUT,
         )
-
-
-def _environment() -> dict[str, str]:
-    import os
-
-    return dict(os.environ)
 
 
 def cpu_times() -> tuple[int, int]:
@@ -157,11 +157,11 @@ def cpu_times() -> tuple[int, int]:
     return sum(fields[:8]), fields[7]
 
 
-def wait_alive(session: zenoh.Session, services: set[str], logs: list[Path]) -> None:
+def wait_alive(session: zenoh.Session, station_id: str, logs: list[Path]) -> None:
     deadline = time.monotonic() + START_TIMEOUT_S
-    missing = set(services)
+    missing = {"recorder", "acquisition", "predictor"}
     while missing:
-        for reply in session.liveliness().get(keys.health_key(STATION, "*")):
+        for reply in session.liveliness().get(keys.health_key(station_id, "*")):
             if reply.ok is not None:
                 missing.discard(str(reply.ok.key_expr).rsplit("/", 1)[-1])
         if time.monotonic() > deadline:
@@ -171,6 +171,7 @@ def wait_alive(session: zenoh.Session, services: set[str], logs: list[Path]) -> 
 
 @dataclass(frozen=True)
 class Stop:
+    station: str
     run_id: int
     program: int
     reason: str
@@ -178,29 +179,33 @@ class Stop:
 
 
 def stops_of(
-    heard: Heard, stops: list[HeardStop], programs: dict[int, int]
+    heard: Heard, stops: dict[str, list[HeardStop]], programs: dict[tuple[str, int], int]
 ) -> tuple[list[Stop], list[str]]:
-    first: dict[int, HeardStop] = {}
-    for stop in stops:
-        first.setdefault(stop.run_id, stop)
+    first: dict[tuple[str, int], HeardStop] = {}
+    for station, heard_stops in stops.items():
+        for stop in heard_stops:
+            first.setdefault((station, stop.run_id), stop)
     out, lost = [], []
-    for run_id, program in sorted(programs.items()):
-        decision = heard.decisions.get(run_id)
-        summary = heard.summaries.get(run_id)
+    for (station, run_id), program in sorted(programs.items()):
+        decision = heard.decisions.get((station, run_id))
+        summary = heard.summaries.get((station, run_id))
         if decision is None:
-            lost.append(f"run {run_id}: no decision ({summary.tool_state if summary else '?'})")
+            state = summary.tool_state if summary else "?"
+            lost.append(f"{station} run {run_id}: no decision ({state})")
             continue
-        heard_stop = first.get(run_id)
+        heard_stop = first.get((station, run_id))
         if heard_stop is None:
             late = summary.late_decision if summary else None
-            lost.append(f"run {run_id}: {decision.reason} decided, no StopCommand (late: {late})")
+            lost.append(
+                f"{station} run {run_id}: {decision.reason} decided, no StopCommand (late: {late})"
+            )
             continue
         path_ms = (heard_stop.received_ns - decision.time_ns) / 1e6
-        out.append(Stop(run_id, program, decision.reason, path_ms))
+        out.append(Stop(station, run_id, program, decision.reason, path_ms))
     return out, lost
 
 
-def line(name: str, values: list[float]) -> str:
+def row(name: str, values: list[float]) -> str:
     if not values:
         return f"{name:<28}{'-':>8}"
     p50, p90, p99 = np.percentile(values, [50, 90, 99])
@@ -208,73 +213,115 @@ def line(name: str, values: list[float]) -> str:
     return f"{name:<28}" + "".join(f"{v:>8.3f}" for v in cells) + f"{len(values):>7}"
 
 
-def run(args: argparse.Namespace, folder: Path) -> int:
-    services_file, rig_file = station_files(folder, args.placement)
-    station = load_station(services_file)
-    database = StationDatabase(station.dbc_path)
-    endpoint = station.config.zenoh.connect[0]
-    logs = {n: folder / f"{n}.log" for n in ("router", "recorder", "acquisition", "predictor")}
-    processes: list[subprocess.Popen[bytes]] = []
-    heard = Heard()
-    programs: dict[int, int] = {}
-    repo = args.repo.resolve()
-    try:
-        processes.append(serve_from(repo, ["router", "--listen", endpoint], logs["router"]))
-        names = ["recorder", "acquisition"] + (["predictor"] if args.placement != "edge" else [])
-        for name in names:
-            extra = ["--no-rerun"] if name == "recorder" else []
-            processes.append(
-                serve_from(repo, [name, "--config", str(services_file), *extra], logs[name])
-            )
-        with (
-            zenoh.open(zenoh_config("client", [endpoint])) as session,
-            StopListener(station.config.can, database) as listener,
-        ):
-            subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard.on_sample)
-            try:
-                wait_alive(session, {"recorder", "acquisition", "predictor"}, list(logs.values()))
-                cpu_before = cpu_times()
-                started = time.monotonic()
-                first_run_id = int(time.time())
-                per_program = args.stops // 2
-                for index, program in enumerate((HARD_LIMIT_PROGRAM, PLATEAU_PROGRAM)):
-                    run_id = first_run_id + index * per_program
-                    rig_log = folder / f"rig-{program}.log"
-                    rig_args = ["rig", "--config", str(rig_file), "--runs", str(per_program)]
-                    rig_args += ["--program", str(program), "--first-run-id", str(run_id)]
-                    rig = serve_from(repo, rig_args, rig_log)
-                    rig.wait(timeout=per_program * 3.0 + 60.0)
-                    if rig.returncode != 0:
-                        raise SystemExit(f"rig exited {rig.returncode}, see {rig_log}")
-                    programs.update({run_id + k: program for k in range(per_program)})
-                elapsed_s = time.monotonic() - started
-                cpu_after = cpu_times()
-                time.sleep(2.0)  # the last summaries
-            finally:
-                subscriber.undeclare()
-            heard_stops = listener.heard
-    finally:
-        for process in reversed(processes):
+@dataclass
+class Line:
+    """The benchmark's line: station files, services, what was heard."""
+
+    args: argparse.Namespace
+    folder: Path
+    services_paths: list[Path]
+    rig_paths: list[Path]
+    processes: list[subprocess.Popen[bytes]] = field(default_factory=list)
+    heard: Heard = field(default_factory=Heard)
+    programs: dict[tuple[str, int], int] = field(default_factory=dict)
+
+    @property
+    def stations(self) -> list[LoadedStation]:
+        return [load_station(path) for path in self.services_paths]
+
+    def serve(self, name: str, arguments: list[str]) -> subprocess.Popen[bytes]:
+        process = serve_from(self.args.repo.resolve(), arguments, self.folder / f"{name}.log")
+        self.processes.append(process)
+        return process
+
+    def start(self, endpoint: str) -> None:
+        self.serve("router", ["router", "--listen", endpoint])
+        configs = [str(path) for path in self.services_paths]
+        self.serve("recorder", ["recorder", "--config", *configs, "--no-rerun"])
+        if self.args.placement != "edge":
+            self.serve("predictor", ["predictor", "--config", *configs])
+        for path in self.services_paths:
+            self.serve(f"acquisition-{path.stem}", ["acquisition", "--config", str(path)])
+
+    def tighten(self, stations: list[LoadedStation]) -> None:
+        """Every station's rig plays each program for its share of the stops, in parallel."""
+        first_run_id = int(time.time())
+        per_program = self.args.stops // (2 * len(stations))
+        for index, program in enumerate((HARD_LIMIT_PROGRAM, PLATEAU_PROGRAM)):
+            run_id = first_run_id + index * per_program
+            rigs = []
+            for station, rig_path in zip(stations, self.rig_paths, strict=True):
+                name = f"rig-{station.station_id}-{program}"
+                arguments = ["rig", "--config", str(rig_path), "--runs", str(per_program)]
+                arguments += ["--program", str(program), "--first-run-id", str(run_id)]
+                rigs.append((self.serve(name, arguments), name))
+                for k in range(per_program):
+                    self.programs[(station.station_id, run_id + k)] = program
+            for rig, name in rigs:
+                rig.wait(timeout=per_program * 3.0 + 60.0)
+                if rig.returncode != 0:
+                    raise SystemExit(f"{name} exited {rig.returncode}, see {self.folder}")
+
+    def stop(self) -> None:
+        for process in reversed(self.processes):
             stop_process(process, grace_s=10.0)
 
-    with heard.lock:
-        stops, lost = stops_of(heard, heard_stops, programs)
+
+def run(args: argparse.Namespace, folder: Path) -> int:
+    services_file, rig_file = station_files(folder, args.placement)
+    line = Line(args, folder, [services_file], [rig_file])
+    if args.stations > 1:
+        line.services_paths = derive_stations(services_file, args.stations, folder / "services")
+        line.rig_paths = derive_stations(rig_file, args.stations, folder / "rigs")
+    stations = line.stations
+    database = StationDatabase(stations[0].dbc_path)
+    endpoint = stations[0].config.zenoh.connect[0]
+    try:
+        line.start(endpoint)
+        with contextlib.ExitStack() as listening:
+            session = listening.enter_context(zenoh.open(zenoh_config("client", [endpoint])))
+            listeners = {
+                s.station_id: listening.enter_context(StopListener(s.config.can, database))
+                for s in stations
+            }
+            subscriber = session.declare_subscriber(
+                keys.station_key("*", "*"), line.heard.on_sample
+            )
+            listening.callback(subscriber.undeclare)
+            for station in stations:
+                wait_alive(session, station.station_id, [folder])
+            cpu_before, started = cpu_times(), time.monotonic()
+            line.tighten(stations)
+            elapsed_s, cpu_after = time.monotonic() - started, cpu_times()
+            time.sleep(2.0)  # the last summaries
+            heard_stops = {station_id: listener.heard for station_id, listener in listeners.items()}
+    finally:
+        line.stop()
+    with line.heard.lock:
+        stops, lost = stops_of(line.heard, heard_stops, line.programs)
     total, steal = (after - before for after, before in zip(cpu_after, cpu_before, strict=True))
     print(
-        f"stop path, placement {args.placement}, services from {repo}: {len(stops)} stops of "
-        f"{len(programs)} runs in {elapsed_s:.0f} s; the host stole {100.0 * steal / total:.1f} % "
-        "of this VM's CPU time meanwhile"
+        f"stop path, {len(stations)} station(s), placement {args.placement}, services from "
+        f"{args.repo.resolve()}: {len(stops)} stops of {len(line.programs)} runs in "
+        f"{elapsed_s:.0f} s; the host stole {100.0 * steal / total:.1f} % of this VM's CPU "
+        "time meanwhile"
     )
-    header = f"{'ms':<28}" + "".join(f"{h:>8}" for h in ("p50", "p90", "p99", "max", "mean"))
-    print(header + f"{'n':>7}")
-    print(line("all stops", [s.path_ms for s in stops]))
-    for program, name in ((HARD_LIMIT_PROGRAM, "hard limit"), (PLATEAU_PROGRAM, "plateau")):
-        print(line(f"  {name}", [s.path_ms for s in stops if s.program == program]))
-    print("reasons:", dict(Counter(s.reason for s in stops)))
+    print_table(stops, [s.station_id for s in stations] if len(stations) > 1 else [])
     print(f"lost: {len(lost)}")
     for note in lost[:20]:
         print("  ", note)
     return 0 if stops and not lost else 1
+
+
+def print_table(stops: list[Stop], station_ids: list[str]) -> None:
+    header = f"{'ms':<28}" + "".join(f"{h:>8}" for h in ("p50", "p90", "p99", "max", "mean"))
+    print(header + f"{'n':>7}")
+    print(row("all stops", [s.path_ms for s in stops]))
+    for program, name in ((HARD_LIMIT_PROGRAM, "hard limit"), (PLATEAU_PROGRAM, "plateau")):
+        print(row(f"  {name}", [s.path_ms for s in stops if s.program == program]))
+    for station_id in station_ids:
+        print(row(f"  {station_id}", [s.path_ms for s in stops if s.station == station_id]))
+    print("reasons:", dict(Counter(s.reason for s in stops)))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -288,6 +335,9 @@ def main(argv: list[str] | None = None) -> int:
         "(a separate predictor, the station file without the key)",
     )
     parser.add_argument("--repo", type=Path, default=REPO, help="checkout to serve from")
+    parser.add_argument(
+        "--stations", type=int, default=1, help="stations on the line, each its own tool (1)"
+    )
     parser.add_argument("--keep", type=Path, default=None, help="keep files and logs here")
     args = parser.parse_args(argv)
     if args.keep is not None:
