@@ -137,3 +137,24 @@ def test_predict_takes_the_sensor_range_of_a_dbc(
     assert summary["input"]["implausible"] == 1  # type: ignore[index]
     assert main(["predict", str(path), "--target-force", "1", "--dbc", str(tmp_path)]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_predict_decides_as_a_station_decides_its_program(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--config --program: the station's targets, limits, speed and joint (live = offline)."""
+    trace = tmp_path / "run.csv"
+    write_trace(trace, staircase(torque_noise_nm=0.2, force_noise_n=30.0).csv_rows())
+    station = Path(__file__).resolve().parents[3] / "config" / "station.toml"
+    assert main(["predict", str(trace), "--config", str(station), "--program", "2"]) == 0
+    # program 2's target is 40 kN: this staircase never gets there, and no limit fires
+    assert [r for r in lines(capsys.readouterr().out) if r["type"] == "stop"] == []
+    command = ["predict", str(trace), "--config", str(station), "--program", "2"]
+    assert main([*command, "--target-force", "30400"]) == 0  # an option replaces the file's
+    (stop,) = [r for r in lines(capsys.readouterr().out) if r["type"] == "stop"]
+    assert stop["reason"] in ("plateau_closest", "target_reached")
+    assert main(["predict", str(trace), "--config", str(station)]) == 2
+    assert "--config needs --program ID" in capsys.readouterr().err
+    assert main(["predict", str(trace), "--config", str(station), "--program", "9"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no program 9" in err[0] and "known: 1, 2" in err[0]
