@@ -128,9 +128,16 @@ class Heard:
 class LiveStation:
     """The station's processes; :meth:`close` stops them all and closes the watchers."""
 
-    def __init__(self, folder: Path, recorder_args: tuple[str, ...] = ("--no-rerun",)) -> None:
+    def __init__(
+        self,
+        folder: Path,
+        recorder_args: tuple[str, ...] = ("--no-rerun",),
+        placement: str = "line",
+    ) -> None:
+        """``placement``: "line" (a predictor process of its own) or "edge" (in the acquisition)."""
         self.folder = folder
-        self.station_file = write_station(folder, placement="line")  # a predictor process
+        self.placement = placement
+        self.station_file = write_station(folder, placement=placement)
         self.loaded = load_station(self.station_file)
         self.recordings = self.loaded.recordings_folder
         self.supervisor = StationSupervisor(self.station_file, folder / "logs")
@@ -144,9 +151,10 @@ class LiveStation:
         self._subscriber = self.session.declare_subscriber(
             keys.station_key(STATION, "*"), self.heard.on_sample
         )
-        for service in SERVICES:
+        processes = [s for s in SERVICES if placement == "line" or s != "predictor"]
+        for service in processes:
             self.start(service)
-        self.wait_alive(SERVICES)
+        self.wait_alive(SERVICES)  # an edge predictor's token comes from the acquisition
         self.supervisor.start("rig", ["--program", str(PROGRAM), "--first-run-id", "1000"])
 
     def start(self, service: str) -> ManagedProcess:
@@ -243,9 +251,9 @@ class LiveStation:
 
 @contextlib.contextmanager
 def live_station(
-    folder: Path, recorder_args: tuple[str, ...] = ("--no-rerun",)
+    folder: Path, recorder_args: tuple[str, ...] = ("--no-rerun",), placement: str = "line"
 ) -> Iterator[LiveStation]:
-    station = LiveStation(folder, recorder_args)
+    station = LiveStation(folder, recorder_args, placement)
     try:
         yield station
     finally:

@@ -160,3 +160,19 @@ def test_a_predictor_paused_mid_run_is_a_late_decision_not_the_stop_reason(
     assert summary.stop_reason is None, summary  # the tool stopped by itself
     assert summary.late_decision is not None, summary  # the predictor decided, too late
     check_next_run_normal(station)
+
+
+def test_an_edge_station_whose_acquisition_dies_stops_by_the_tool_and_comes_back(
+    tmp_path_factory: pytest.TempPathFactory,
+) -> None:
+    """The edge layout: the station's predictor lives in its acquisition, so killing that
+    process kills both; the tool stops by its own shutoff (never blind), and the restarted
+    acquisition decides the next run again (issue 16: the fault table still holds)."""
+    with live_station(tmp_path_factory.mktemp("edge-kill"), placement="edge") as station:
+        station.wait_runs_summarised(1)
+        killed_run = kill_mid_run(station, "acquisition")
+        assert_tool_stopped_safely(station, killed_run)
+        assert not station.decided(killed_run)
+        station.start("acquisition")
+        station.wait_alive(("acquisition", "predictor"))
+        check_next_run_normal(station)
