@@ -23,6 +23,7 @@ from services.router.service import router_config
 from shared import keys
 from shared.config import load_line, load_station
 from shared.config.loading import resolve_relative
+from tests.access_rules import put_keys_granted
 from tests.compose_layout import (
     BASE_FILE,
     CERTS_SCRIPT,
@@ -155,9 +156,11 @@ def test_dockerfile_installs_the_package_and_runs_the_cli() -> None:
 # -- docker-compose.tls.yml over docker-compose.yml: mutual TLS, one identity per container --
 
 TLS_TEXT = TLS_FILE.read_text()
+PREDICTOR_PUTS = {keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS}
 ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), per station
-    "acquisition": {keys.SAMPLES, keys.TOOL, keys.BUS},
-    "predictor": {keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS},
+    # the acquisition hosts the station's predictor (placement "edge") and publishes for it
+    "acquisition": {keys.SAMPLES, keys.TOOL, keys.BUS} | PREDICTOR_PUTS,
+    "predictor": PREDICTOR_PUTS,
     "recorder": {keys.RECORDER, keys.WEAR, f"{keys.WEAR}/**"},
 }
 needs_openssl = pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl")
@@ -195,19 +198,6 @@ def tls_line(tmp_path_factory: pytest.TempPathFactory) -> TlsLine:
     if shutil.which("openssl") is None:
         pytest.skip("needs the openssl CLI (config/security/make-compose-certs.sh)")
     return TlsLine(tmp_path_factory.mktemp("compose-tls"))
-
-
-def put_keys_granted(acl: dict[str, Any], common_name: str) -> set[str]:
-    """Key expressions ``common_name`` may put into the router (ingress), by the ACL."""
-    subjects = {s["id"] for s in acl["subjects"] if common_name in s["cert_common_names"]}
-    rules = {rule["id"]: rule for rule in acl["rules"]}
-    granted: set[str] = set()
-    for policy in acl["policies"]:
-        if subjects & set(policy["subjects"]):
-            for rule in (rules[r] for r in policy["rules"]):
-                if "put" in rule["messages"] and "ingress" in rule["flows"]:
-                    granted |= set(rule["key_exprs"])
-    return granted
 
 
 def test_tls_override_covers_every_service_and_requires_its_variables() -> None:
