@@ -1,8 +1,10 @@
 """docker-compose.yml and the Dockerfile, checked by parsing (no Docker engine here).
 
 The line layout: one router, one recorder for the line (every station file),
-an optional Rerun viewer (profile), and per station an acquisition, a rig
-and a predictor with that station's own file.
+an optional Rerun viewer (profile), and per station an acquisition (which
+holds the station's predictor: placement "edge") and a rig with that
+station's own file. Where each station's predictor runs:
+tests/unit/test_compose_placement.py.
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ from tests.compose_layout import (
     MissingVariableError,
     certificate_field,
     common_name,
+    config_files,
+    host_path,
     load_merged,
     make_compose_certs,
     split_volume,
@@ -43,18 +47,8 @@ COMPOSE_TEXT = (REPO / "docker-compose.yml").read_text()
 COMPOSE = yaml.safe_load(COMPOSE_TEXT)
 SERVICES: dict[str, Any] = COMPOSE["services"]
 STATIONS = ("st1", "st2")
-PER_STATION = ("acquisition", "rig", "predictor")
+PER_STATION = ("acquisition", "rig")
 VARIABLE = re.compile(r"\$\{([^}]*)\}")
-
-
-def host_path(container_path: str, volumes: list[str]) -> Path:
-    """Map a path inside the container to the repository through the service's mounts."""
-    for volume in volumes:
-        source, target = split_volume(volume)
-        if container_path.startswith(target + "/"):
-            assert source.startswith("./"), f"{container_path} is not mounted from the repository"
-            return (REPO / source / container_path[len(target) + 1 :]).resolve()
-    raise AssertionError(f"{container_path} is not under any mount of {volumes}")
 
 
 def served_role(name: str) -> str:
@@ -65,12 +59,6 @@ def served_role(name: str) -> str:
 def health_role(name: str) -> str:
     """The health token a service holds: the viewer is a recorder that says ``viewer``."""
     return "viewer" if name == "viewer" else served_role(name)
-
-
-def config_files(command: list[str]) -> list[str]:
-    """The ``--config`` files of a boltwatch command, one or several, as the CLI parses them."""
-    config = build_parser().parse_args(command).config
-    return [str(file) for file in (config if isinstance(config, list) else [config])]
 
 
 def station_files(name: str) -> list[Path]:
@@ -306,6 +294,8 @@ def station_settings(path: Path) -> dict[str, Any]:
 @needs_openssl
 def test_identity_folders_hold_no_ca_key_and_keys_are_private(tls_line: TlsLine) -> None:
     names = {expected_identity(name) for name in SERVICES} | {"line-monitor"}
+    made = {p.name for p in tls_line.certs.iterdir()}
+    assert made == names | {"line-ca"}, "only the identities the compose files use (+ operator)"
     for name in names:
         folder = tls_line.certs / name
         shown = {p.name for p in folder.iterdir()}
