@@ -12,11 +12,14 @@ message, as compose does.
 :class:`ContainerFiles` lays out what one service sees at its mount targets
 under a folder (config copied, identity linked), with absolute container paths
 inside its TOML files rewritten to that folder, so its commands and station
-files can run on this machine.
+files can run on this machine. :func:`host_path` maps a container path of the
+plain file to the repository; :func:`config_files` reads a command's
+``--config`` files as the CLI parses them.
 """
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import subprocess
@@ -26,6 +29,7 @@ from typing import Any
 
 import yaml
 
+from services.cli.main import build_parser
 from tests.paths import REPO
 
 BASE_FILE = REPO / "docker-compose.yml"
@@ -69,9 +73,12 @@ def load_merged(files: list[Path], env: Mapping[str, str]) -> dict[str, Any]:
     return merged
 
 
-def make_compose_certs(out: Path) -> None:
-    """The identities of docker-compose.tls.yml, by config/security/make-compose-certs.sh."""
-    subprocess.run([str(CERTS_SCRIPT), str(out)], check=True, capture_output=True, cwd=out.parent)
+def make_compose_certs(out: Path, extra_identities: tuple[str, ...] = ()) -> None:
+    """The identities of docker-compose.tls.yml, by config/security/make-compose-certs.sh
+    (and ``extra_identities``, its ``EXTRA_IDENTITIES``)."""
+    env = os.environ | {"EXTRA_IDENTITIES": " ".join(extra_identities)}
+    script = [str(CERTS_SCRIPT), str(out)]
+    subprocess.run(script, check=True, capture_output=True, cwd=out.parent, env=env)
 
 
 def certificate_field(pem: Path, option: str) -> str:
@@ -96,6 +103,22 @@ def split_volume(volume: str) -> tuple[str, str]:
     match = MOUNT.fullmatch(volume)
     assert match, f"not a SOURCE:TARGET mount: {volume}"
     return match.group(1), match.group(2)
+
+
+def host_path(container_path: str, volumes: list[str]) -> Path:
+    """Map a path inside the container to the repository through the service's mounts."""
+    for volume in volumes:
+        source, target = split_volume(volume)
+        if container_path.startswith(target + "/"):
+            assert source.startswith("./"), f"{container_path} is not mounted from the repository"
+            return (REPO / source / container_path[len(target) + 1 :]).resolve()
+    raise AssertionError(f"{container_path} is not under any mount of {volumes}")
+
+
+def config_files(command: list[str]) -> list[str]:
+    """The ``--config`` files of a boltwatch command, one or several, as the CLI parses them."""
+    config = build_parser().parse_args(command).config
+    return [str(file) for file in (config if isinstance(config, list) else [config])]
 
 
 def _merge(base: Any, override: Any, path: tuple[str, ...]) -> Any:

@@ -7,12 +7,16 @@
 #
 # Every container gets its own identity: OUT_DIR/<name>/ holds ca.pem (the line's
 # CA), identity.pem (a certificate whose common name is <name>) and identity.key,
-# and is mounted read-only at /etc/boltwatch-identity. The names are the access
-# control's subjects (services/router/access_control.py):
+# and is mounted read-only at /etc/boltwatch-identity. It makes only the identities
+# the compose files use (and the operator's); the names are the access control's
+# subjects (services/router/access_control.py):
 #   router                                   the router (server certificate, names "router")
 #                                            + acl.json5, the access control for STATION...
 #   line-recorder, line-viewer, line-monitor the line's recorder, the live viewer, the operator
-#   <st>-acquisition, <st>-predictor, <st>-rig   for each station
+#   <st>-acquisition, <st>-rig               for each station (the acquisition holds the
+#                                            station's predictor: placement "edge")
+# EXTRA_IDENTITIES="st1-predictor ..." makes more, e.g. for a line predictor
+# (placement "line": docker-compose.tls.yml says how to add one).
 # OUT_DIR/line-ca/ is config/security/make-certs.sh's folder: the CA's key (ca.key) is
 # there and is never mounted; keep it offline. Running again reuses the CA and
 # re-issues every identity. Keys are 0600; the containers run as uid 10001
@@ -36,8 +40,12 @@ owner_uid=${BOLTWATCH_UID:-10001}
 
 names=(line-recorder line-viewer line-monitor)
 for station in "${stations[@]}"; do
-    names+=("$station-acquisition" "$station-predictor" "$station-rig")
+    names+=("$station-acquisition" "$station-rig")
 done
+if [[ -n ${EXTRA_IDENTITIES:-} ]]; then
+    read -r -a extra <<<"$EXTRA_IDENTITIES"
+    names+=("${extra[@]}")
+fi
 
 # The services reach the router as "router" (the compose service name).
 ROUTER_SAN="DNS:router${ROUTER_SAN:+,$ROUTER_SAN}" "$here/make-certs.sh" "$out/line-ca" "${names[@]}" >/dev/null

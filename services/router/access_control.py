@@ -7,10 +7,15 @@ common name ``<station>-<role>``, or one of the line's observers
 may declare subscribers, queryables and liveliness tokens under
 ``boltwatch/**`` and receive what is published there; only
 
-- ``<st>-acquisition`` may put ``boltwatch/<st>/samples``, ``tool``, ``bus``,
-- ``<st>-predictor`` may put ``boltwatch/<st>/events``, ``intensity``,
-  ``decision``, ``runs``,
+- ``<st>-acquisition`` may put ``boltwatch/<st>/samples``, ``tool``, ``bus``
+  and the predictor's keys ``events``, ``intensity``, ``decision``, ``runs``
+  (it hosts the station's predictor: ``[predictor] placement = "edge"``, the
+  default),
+- ``<st>-predictor`` may put the predictor's keys (a line predictor,
+  ``boltwatch serve predictor`` for a station with ``placement = "line"``),
 - ``line-recorder`` may put ``boltwatch/<st>/recorder`` and ``wear/**``.
+
+No one else may put a station's decision.
 
 Anyone else (another common name, a certificate for another station) gets
 nothing through the router. The router enforces it on what enters it
@@ -71,7 +76,10 @@ def line_access_control(stations: list[str]) -> dict[str, Any]:
         for name in names.values():
             subjects.append({"id": name, "cert_common_names": [name]})
             everyone.append(name)
-        for role, topics in (("acquisition", ACQUISITION_TOPICS), ("predictor", PREDICTOR_TOPICS)):
+        for role, topics in (
+            ("acquisition", ACQUISITION_TOPICS + PREDICTOR_TOPICS),  # + the edge predictor
+            ("predictor", PREDICTOR_TOPICS),
+        ):
             rule_id = f"{station}-{role}-puts"
             rules.append(
                 _rule(rule_id, ["put"], ["ingress"], [keys.station_key(station, t) for t in topics])

@@ -9,10 +9,15 @@ with two things changed for loopback: the router is ``127.0.0.1`` on a free port
 instead of ``router:7447`` (the router's certificate names 127.0.0.1 too), and
 the station's CAN multicast port is a free one. Health checks run as the
 containers run them: ``boltwatch health ...`` with that container's identity.
+
+The station's predictor is in its acquisition (placement "edge"): no predictor
+container runs, ``boltwatch health predictor`` is answered by acquisition-st1's
+token, and its decisions reach the line under st1-acquisition's certificate.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import re
 import shutil
@@ -30,7 +35,10 @@ import zenoh
 from services.cli.station_supervisor import stop_process
 from services.recorder.testing import has_subscribers
 from shared import keys
+from shared.codec import decode
 from shared.config import load_station
+from shared.errors import BoltwatchError
+from shared.messages import RunSummary, StopDecision
 from shared.zenoh_session import open_session
 from tests.compose_layout import (
     BASE_FILE,
@@ -49,12 +57,14 @@ pytestmark = [
     pytest.mark.skipif(shutil.which("openssl") is None, reason="needs the openssl CLI"),
 ]
 
-RUNNING = ("router", "acquisition-st1", "predictor-st1", "rig-st1", "recorder")
+RUNNING = ("router", "acquisition-st1", "rig-st1", "recorder")
 TLS_STATIONS = "/etc/boltwatch/compose/tls"
 HEALTHY_WITHIN_S = 60.0
 NOT_ALIVE = 1  # `boltwatch health`: 1 not alive (yet), 2 router unreachable or bad file
 HEARD_WITHIN_S = 60.0
 DECISION = keys.station_key("st1", keys.DECISION)
+SAMPLES = keys.station_key("st1", keys.SAMPLES)
+RUNS = keys.station_key("st1", keys.RUNS)
 
 
 class ComposeLine:
@@ -99,11 +109,14 @@ class ComposeLine:
         assert command[0] == "serve"
         self.processes[name] = serve(command[1:], self.folder / f"{name}.log")
 
-    def health(self, name: str) -> subprocess.CompletedProcess[str]:
-        """The container's health check (``CMD boltwatch health ...``), once."""
+    def health(self, name: str, service: str | None = None) -> subprocess.CompletedProcess[str]:
+        """The container's health check (``CMD boltwatch health ...``), once; with
+        ``service``, the same check in that container for another service."""
         test = self.services[name]["healthcheck"]["test"]
-        assert test[:2] == ["CMD", "boltwatch"]
+        assert test[:3] == ["CMD", "boltwatch", "health"]
         arguments = self.files(name).arguments(test[2:])
+        if service is not None:
+            arguments[1] = service
         return subprocess.run(
             [sys.executable, "-m", "services.cli", *arguments],
             check=False,
@@ -138,9 +151,12 @@ def line(tmp_path: Path) -> Iterator[ComposeLine]:
 def test_every_service_is_healthy_with_its_own_identity_and_status_sees_them(
     line: ComposeLine,
 ) -> None:
-    """As compose waits on health: retry each container's check until it passes; then the
-    operator's ``boltwatch status`` with the line-monitor identity sees st1's services."""
+    """As compose waits on health: retry each container's check until it passes; the
+    station's predictor is alive though no predictor runs (acquisition-st1 holds its token:
+    ``health predictor`` fails once the acquisition stops); the operator's ``boltwatch
+    status`` with the line-monitor identity sees st1's services, its predictor among them."""
     line.session("router").close()  # the router takes TLS sessions now: 2 is a real failure
+    assert not any(name.startswith("predictor") for name in line.services), "edge layout"
     deadline = time.monotonic() + HEALTHY_WITHIN_S
     for name in RUNNING:
         while (checked := line.health(name)).returncode != 0:
@@ -150,6 +166,9 @@ def test_every_service_is_healthy_with_its_own_identity_and_status_sees_them(
             assert exited is None, f"{name} exited ({exited}):\n{line.log(name)}"
             assert time.monotonic() < deadline, f"{name} never healthy: {said}\n{line.log(name)}"
             time.sleep(0.5)
+    # Its predictor's token is declared before its own: healthy acquisition, alive predictor.
+    predictor = line.health("acquisition-st1", service="predictor")
+    assert predictor.returncode == 0, f"{predictor.stdout}{predictor.stderr}"
     monitor_file = line.files("recorder", identity="line-monitor").host(
         f"{TLS_STATIONS}/station1.toml"
     )
@@ -164,9 +183,27 @@ def test_every_service_is_healthy_with_its_own_identity_and_status_sees_them(
     services = json.loads(status.stdout)["stations"]["st1"]["services"]
     alive = {service for service, up in services.items() if up}
     assert {"acquisition", "predictor", "rig", "recorder"} <= alive
+    stop_process(line.processes["acquisition-st1"], grace_s=10.0)
+    deadline = time.monotonic() + HEALTHY_WITHIN_S
+    while (gone := line.health("acquisition-st1", service="predictor")).returncode != NOT_ALIVE:
+        assert gone.returncode == 0, f"{gone.stdout}{gone.stderr}"
+        assert time.monotonic() < deadline, "st1's predictor outlived its acquisition"
+        time.sleep(0.5)
 
 
-def test_data_flows_and_only_st1s_predictor_may_decide_for_st1(line: ComposeLine) -> None:
+def decoded(kind: type[Any], payloads: list[bytes]) -> list[Any]:
+    """The payloads that are ``kind`` messages (hand-put test markers are not)."""
+    messages = []
+    for payload in payloads:
+        with contextlib.suppress(BoltwatchError):
+            messages.append(decode(kind, payload))
+    return messages
+
+
+def test_data_flows_and_only_st1s_acquisition_may_decide_for_st1(line: ComposeLine) -> None:
+    """acquisition-st1's edge predictor stops the tool and its decisions and run summaries
+    reach the line under st1-acquisition's certificate; another station's acquisition
+    certificate mounted in acquisition-st1 cannot put st1's decision or samples."""
     heard: dict[str, list[bytes]] = {}
     arrived = threading.Condition()
 
@@ -181,33 +218,43 @@ def test_data_flows_and_only_st1s_predictor_may_decide_for_st1(line: ComposeLine
                 logs = "\n".join(f"-- {n}:\n{line.log(n)}" for n in RUNNING)
                 raise AssertionError(f"never heard {what} (heard {sorted(heard)})\n{logs}")
 
+    def stopped_by_the_edge_predictor(h: dict[str, list[bytes]]) -> bool:
+        reasons = {d.reason for d in decoded(StopDecision, h.get(DECISION, []))}
+        return any(r.stop_reason in reasons for r in decoded(RunSummary, h.get(RUNS, [])))
+
     sessions: list[zenoh.Session] = []
     try:
         # The operator's identity, as `boltwatch status` would use it (line-monitor).
         monitor = line.session("recorder", identity="line-monitor")
         sessions.append(monitor)
         subscriber = monitor.declare_subscriber(keys.station_key("st1", "*"), on_sample)
-        samples, recorder = (keys.station_key("st1", t) for t in (keys.SAMPLES, keys.RECORDER))
+        recorder = keys.station_key("st1", keys.RECORDER)
         # The acquisition's and the recorder's own certificates may put their keys.
-        wait_for("st1's samples and recorder stats", lambda h: samples in h and recorder in h)
+        wait_for("st1's samples and recorder stats", lambda h: SAMPLES in h and recorder in h)
+        # The predictor in acquisition-st1 decided, stopped the tool, summed the run up.
+        wait_for("a run stopped by st1's edge predictor", stopped_by_the_edge_predictor)
 
-        impostor = line.session("predictor-st1", identity="st2-predictor")
-        legit = line.session("predictor-st1")
+        impostor = line.session("acquisition-st1", identity="st2-acquisition")
+        legit = line.session("acquisition-st1")
         sessions += [impostor, legit]
         decisions = monitor.declare_subscriber(keys.station_key("*", keys.DECISION), on_sample)
         publisher = legit.declare_publisher(DECISION)
-        own_key = keys.station_key("st2", keys.DECISION)  # what st2's predictor may decide
+        own_key = keys.station_key("st2", keys.DECISION)  # what st2's acquisition may decide
         own = impostor.declare_publisher(own_key)
         deadline = time.monotonic() + HEARD_WITHIN_S
         while not (has_subscribers(publisher) and has_subscribers(own)):
             assert time.monotonic() < deadline, "no subscriber matched the decisions"
             time.sleep(0.05)
-        impostor.put(DECISION, b"impostor")  # first: if it got through it would land first
-        own.put(b"st2-own")  # after it on the same link: heard, so the one before was handled
-        publisher.put(b"st1-predictor")
+        # First: if they got through they would land first.
+        impostor.put(DECISION, b"impostor-decision")
+        impostor.put(SAMPLES, b"impostor-sample")
+        own.put(b"st2-own")  # after them on the same link: heard, so those before were handled
+        publisher.put(b"st1-acquisition")
         wait_for("st2's own decision", lambda h: b"st2-own" in h.get(own_key, []))
-        wait_for("st1-predictor's decision", lambda h: b"st1-predictor" in h.get(DECISION, []))
-        assert b"impostor" not in heard[DECISION], "st2's predictor decided for st1"
+        wait_for("st1-acquisition's decision", lambda h: b"st1-acquisition" in h.get(DECISION, []))
+        with arrived:
+            assert b"impostor-decision" not in heard[DECISION], "st2's acquisition decided for st1"
+            assert b"impostor-sample" not in heard[SAMPLES], "st2's acquisition put st1's samples"
         own.undeclare()
         decisions.undeclare()
         publisher.undeclare()

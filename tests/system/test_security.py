@@ -1,10 +1,10 @@
-"""A router with mutual TLS and access control: only st1's predictor may decide for st1.
+"""A router with mutual TLS and access control: only st1's own services may decide for st1.
 
 Certificates are made by the documented script (config/security/make-certs.sh,
 the ``openssl`` CLI) into the test's folder; the router runs as
 ``boltwatch serve router`` with ``--tls-*`` and the access control that
-services/router/access_control.py writes for st1. Sessions are opened the way
-services open them: from a ``[zenoh]`` section with ``tls_*`` keys.
+services/router/access_control.py writes for st1 and st2. Sessions are opened the
+way services open them: from a ``[zenoh]`` section with ``tls_*`` keys.
 """
 
 from __future__ import annotations
@@ -37,7 +37,8 @@ pytestmark = [
 ]
 
 DECISION = keys.station_key("st1", keys.DECISION)
-NAMES = ("st1-predictor", "st1-acquisition", "line-recorder", "rogue")
+OTHER_DECISION = keys.station_key("st2", keys.DECISION)
+NAMES = ("st1-predictor", "st1-acquisition", "st2-acquisition", "line-recorder", "rogue")
 OPEN_TIMEOUT_S = 20.0
 REFUSED_TIMEOUT_S = 2.0
 
@@ -48,7 +49,7 @@ class SecureLine:
         script = REPO / "config" / "security" / "make-certs.sh"
         subprocess.run([str(script), str(self.certs), *NAMES], check=True, capture_output=True)
         acl = folder / "access_control.json5"
-        acl.write_text(json.dumps(line_access_control(["st1"])))
+        acl.write_text(json.dumps(line_access_control(["st1", "st2"])))
         self.port = free_tcp_port()
         self.endpoint = f"tls/127.0.0.1:{self.port}"
         tls = [f"--tls-{k}={self.certs / v}" for k, v in self._router_files().items()]
@@ -90,36 +91,50 @@ def line(tmp_path: Path) -> Iterator[SecureLine]:
         stop_process(started.router, grace_s=10.0)
 
 
-def test_only_the_stations_predictor_may_put_its_decision(line: SecureLine) -> None:
-    heard: list[bytes] = []
-    arrived = threading.Event()
+def test_only_the_stations_acquisition_and_predictor_may_put_its_decision(
+    line: SecureLine,
+) -> None:
+    """st1-acquisition (its edge predictor) and st1-predictor (a line predictor) decide for
+    st1; an unknown name and st2's acquisition do not."""
+    heard: dict[str, list[bytes]] = {}
+    arrived = threading.Condition()
 
     def on_decision(sample: zenoh.Sample) -> None:
-        heard.append(sample.payload.to_bytes())
-        if sample.payload.to_bytes() == b"predictor":
-            arrived.set()
+        with arrived:
+            heard.setdefault(str(sample.key_expr), []).append(sample.payload.to_bytes())
+            arrived.notify_all()
 
     sessions = []
     try:
         monitor = open_session(line.section("line-recorder"))
         sessions.append(monitor)
-        subscriber = monitor.declare_subscriber(DECISION, on_decision)
-        for name in ("rogue", "st1-acquisition", "st1-predictor"):
+        subscriber = monitor.declare_subscriber(keys.station_key("*", keys.DECISION), on_decision)
+        for name in ("rogue", "st2-acquisition", "st1-acquisition", "st1-predictor"):
             sessions.append(open_session(line.section(name)))
-        rogue, acquisition, predictor = sessions[1:]
+        rogue, other_station, acquisition, predictor = sessions[1:]
         # Everyone's connected: the router's subscriber declaration reached the publishers.
+        publishers = [s.declare_publisher(DECISION) for s in (acquisition, predictor)]
+        own = other_station.declare_publisher(OTHER_DECISION)  # what st2's acquisition may put
         deadline = time.monotonic() + OPEN_TIMEOUT_S
-        publisher = predictor.declare_publisher(DECISION)
-        while not has_subscribers(publisher) and time.monotonic() < deadline:
+        while not all(has_subscribers(p) for p in (*publishers, own)):
+            assert time.monotonic() < deadline, "no subscriber matched the decisions"
             time.sleep(0.05)
         # The impostors first: if the router let them through they would arrive first.
         rogue.put(DECISION, b"rogue")
-        acquisition.put(DECISION, b"acquisition")
-        publisher.put(b"predictor")
-        assert arrived.wait(10.0), f"the predictor's decision never arrived (heard {heard})"
-        time.sleep(0.3)  # anything else in flight lands now
-        assert heard == [b"predictor"]
-        publisher.undeclare()
+        other_station.put(DECISION, b"st2-acquisition")
+        own.put(b"st2-own")  # after it on the same link: heard, so the one before was handled
+        for publisher, said in zip(publishers, (b"acquisition", b"predictor"), strict=True):
+            publisher.put(said)
+        with arrived:
+            assert arrived.wait_for(
+                lambda: len(heard.get(DECISION, [])) >= 2 and OTHER_DECISION in heard,
+                timeout=10.0,
+            ), f"the legitimate decisions never arrived (heard {heard})"
+        time.sleep(0.3)  # anything else in flight (the rogue's own link) lands now
+        assert sorted(heard[DECISION]) == [b"acquisition", b"predictor"]
+        assert heard[OTHER_DECISION] == [b"st2-own"]
+        for publisher in (*publishers, own):
+            publisher.undeclare()
         subscriber.undeclare()
     finally:
         for session in sessions:

@@ -1,8 +1,10 @@
 """docker-compose.yml and the Dockerfile, checked by parsing (no Docker engine here).
 
 The line layout: one router, one recorder for the line (every station file),
-an optional Rerun viewer (profile), and per station an acquisition, a rig
-and a predictor with that station's own file.
+an optional Rerun viewer (profile), and per station an acquisition (which
+holds the station's predictor: placement "edge") and a rig with that
+station's own file. Where each station's predictor runs:
+tests/unit/test_compose_placement.py.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from services.router.service import router_config
 from shared import keys
 from shared.config import load_line, load_station
 from shared.config.loading import resolve_relative
+from tests.access_rules import put_keys_granted
 from tests.compose_layout import (
     BASE_FILE,
     CERTS_SCRIPT,
@@ -32,6 +35,8 @@ from tests.compose_layout import (
     MissingVariableError,
     certificate_field,
     common_name,
+    config_files,
+    host_path,
     load_merged,
     make_compose_certs,
     split_volume,
@@ -42,18 +47,8 @@ COMPOSE_TEXT = (REPO / "docker-compose.yml").read_text()
 COMPOSE = yaml.safe_load(COMPOSE_TEXT)
 SERVICES: dict[str, Any] = COMPOSE["services"]
 STATIONS = ("st1", "st2")
-PER_STATION = ("acquisition", "rig", "predictor")
+PER_STATION = ("acquisition", "rig")
 VARIABLE = re.compile(r"\$\{([^}]*)\}")
-
-
-def host_path(container_path: str, volumes: list[str]) -> Path:
-    """Map a path inside the container to the repository through the service's mounts."""
-    for volume in volumes:
-        source, target = split_volume(volume)
-        if container_path.startswith(target + "/"):
-            assert source.startswith("./"), f"{container_path} is not mounted from the repository"
-            return (REPO / source / container_path[len(target) + 1 :]).resolve()
-    raise AssertionError(f"{container_path} is not under any mount of {volumes}")
 
 
 def served_role(name: str) -> str:
@@ -64,12 +59,6 @@ def served_role(name: str) -> str:
 def health_role(name: str) -> str:
     """The health token a service holds: the viewer is a recorder that says ``viewer``."""
     return "viewer" if name == "viewer" else served_role(name)
-
-
-def config_files(command: list[str]) -> list[str]:
-    """The ``--config`` files of a boltwatch command, one or several, as the CLI parses them."""
-    config = build_parser().parse_args(command).config
-    return [str(file) for file in (config if isinstance(config, list) else [config])]
 
 
 def station_files(name: str) -> list[Path]:
@@ -155,9 +144,11 @@ def test_dockerfile_installs_the_package_and_runs_the_cli() -> None:
 # -- docker-compose.tls.yml over docker-compose.yml: mutual TLS, one identity per container --
 
 TLS_TEXT = TLS_FILE.read_text()
+PREDICTOR_PUTS = {keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS}
 ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), per station
-    "acquisition": {keys.SAMPLES, keys.TOOL, keys.BUS},
-    "predictor": {keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS},
+    # the acquisition hosts the station's predictor (placement "edge") and publishes for it
+    "acquisition": {keys.SAMPLES, keys.TOOL, keys.BUS} | PREDICTOR_PUTS,
+    "predictor": PREDICTOR_PUTS,
     "recorder": {keys.RECORDER, keys.WEAR, f"{keys.WEAR}/**"},
 }
 needs_openssl = pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl")
@@ -195,19 +186,6 @@ def tls_line(tmp_path_factory: pytest.TempPathFactory) -> TlsLine:
     if shutil.which("openssl") is None:
         pytest.skip("needs the openssl CLI (config/security/make-compose-certs.sh)")
     return TlsLine(tmp_path_factory.mktemp("compose-tls"))
-
-
-def put_keys_granted(acl: dict[str, Any], common_name: str) -> set[str]:
-    """Key expressions ``common_name`` may put into the router (ingress), by the ACL."""
-    subjects = {s["id"] for s in acl["subjects"] if common_name in s["cert_common_names"]}
-    rules = {rule["id"]: rule for rule in acl["rules"]}
-    granted: set[str] = set()
-    for policy in acl["policies"]:
-        if subjects & set(policy["subjects"]):
-            for rule in (rules[r] for r in policy["rules"]):
-                if "put" in rule["messages"] and "ingress" in rule["flows"]:
-                    granted |= set(rule["key_exprs"])
-    return granted
 
 
 def test_tls_override_covers_every_service_and_requires_its_variables() -> None:
@@ -316,6 +294,8 @@ def station_settings(path: Path) -> dict[str, Any]:
 @needs_openssl
 def test_identity_folders_hold_no_ca_key_and_keys_are_private(tls_line: TlsLine) -> None:
     names = {expected_identity(name) for name in SERVICES} | {"line-monitor"}
+    made = {p.name for p in tls_line.certs.iterdir()}
+    assert made == names | {"line-ca"}, "only the identities the compose files use (+ operator)"
     for name in names:
         folder = tls_line.certs / name
         shown = {p.name for p in folder.iterdir()}

@@ -1,0 +1,55 @@
+"""The line's access control: who may put what (services/router/access_control.py)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from services.router.access_control import (
+    ACQUISITION_TOPICS,
+    PREDICTOR_TOPICS,
+    line_access_control,
+)
+from shared import keys
+from tests.access_rules import common_names, put_keys_granted
+from tests.paths import CONFIG
+
+STATIONS = ["st1", "st2", "st3"]
+
+
+def station_keys(station: str, topics: tuple[str, ...]) -> set[str]:
+    return {keys.station_key(station, topic) for topic in topics}
+
+
+@pytest.mark.parametrize("station", STATIONS)
+def test_the_acquisition_hosts_the_stations_predictor_and_may_put_its_keys(station: str) -> None:
+    """placement "edge" (the default): the station's predictor publishes from its acquisition."""
+    acl = line_access_control(STATIONS)
+    assert put_keys_granted(acl, f"{station}-acquisition") == station_keys(
+        station, ACQUISITION_TOPICS + PREDICTOR_TOPICS
+    )
+
+
+@pytest.mark.parametrize("station", STATIONS)
+def test_a_line_predictor_may_put_only_the_predictors_keys(station: str) -> None:
+    """placement "line": ``boltwatch serve predictor`` presents ``<st>-predictor``."""
+    acl = line_access_control(STATIONS)
+    assert put_keys_granted(acl, f"{station}-predictor") == station_keys(station, PREDICTOR_TOPICS)
+
+
+@pytest.mark.parametrize("station", STATIONS)
+def test_no_other_identity_may_put_a_stations_decision(station: str) -> None:
+    acl = line_access_control(STATIONS)
+    decision = keys.station_key(station, keys.DECISION)
+    deciders = {name for name in common_names(acl) if decision in put_keys_granted(acl, name)}
+    assert deciders == {f"{station}-acquisition", f"{station}-predictor"}
+    assert not any(decision in put_keys_granted(acl, n) for n in ("rogue", "router"))
+
+
+def test_the_shipped_access_control_is_the_one_made_for_st1() -> None:
+    """config/security/access_control.json5 is ``python -m services.router.access_control st1``."""
+    text = (CONFIG / "security" / "access_control.json5").read_text()
+    header, body = text.split("\n", 1)
+    assert header.startswith("//")
+    assert json.loads(body) == line_access_control(["st1"])
