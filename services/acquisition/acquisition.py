@@ -100,6 +100,7 @@ class Acquisition:
         self._stopped_reason: StopReasonName | None = None
         self._started_runs: deque[int] = deque(maxlen=STARTED_RUNS_KEPT)
         self._repeated_runs = 0
+        self._decider_errors = 0
 
     # -- receiving ---------------------------------------------------------------------
 
@@ -159,9 +160,13 @@ class Acquisition:
                 assembled.sequence / SAMPLE_RATE_HZ,
             )
             if decider is not None:
-                decision = decider.on_sample(sample)
-                if decision is not None:
-                    self.send_stop(decision)  # before anything else: the stop path
+                try:
+                    decision = decider.on_sample(sample)
+                except Exception:  # a fault in the predictor: its tool's own shutoff holds
+                    self._decider_failed()
+                else:
+                    if decision is not None:
+                        self.send_stop(decision)  # before anything else: the stop path
             self._outlet.sample(sample)
 
     def _tool_status(self, frame: ToolStatusFrame, time_ns: int) -> None:
@@ -207,9 +212,21 @@ class Acquisition:
             ),
         )
         if self._decider is not None:
-            self._decider.on_tool_state(state)
+            try:
+                self._decider.on_tool_state(state)
+            except Exception:
+                self._decider_failed()
         self._outlet.tool_state(state)
         LOG.info("run %d: %s (program %d)", frame.run_id, state_name, frame.program_id)
+
+    def _decider_failed(self) -> None:
+        """The predictor raised: logged (rate-limited), counted; samples still flow."""
+        self._decider_errors += 1
+        if self._decider_errors in (1, 10, 100) or self._decider_errors % 1000 == 0:
+            LOG.exception(
+                "the station's predictor failed (#%d); the tool's own shutoff stops this run",
+                self._decider_errors,
+            )
 
     # -- stopping ------------------------------------------------------------------------
 

@@ -166,3 +166,57 @@ def test_the_done_state_says_whether_boltwatch_stopped_the_tool(
     ends = [(s.run_id, s.state, s.stop_command) for s in outlet.states if s.state != "running"]
     assert ends == [(42, "done", "plateau_closest"), (43, "aborted", None)]
     assert acquisition.stats().late_decisions == 1
+
+
+class RecordingDecider:
+    """A Decider that decides at one sample, or fails at every one."""
+
+    def __init__(self, decide_at: int | None = None, fail: bool = False) -> None:
+        self.decide_at = decide_at
+        self.fail = fail
+        self.states: list[str] = []
+
+    def on_tool_state(self, state: ToolState) -> None:
+        self.states.append(state.state)
+
+    def on_sample(self, sample: Sample) -> StopDecision | None:
+        if self.fail:
+            raise RuntimeError("a bug in the predictor")
+        return decision(sample.run_id) if sample.sequence == self.decide_at else None
+
+
+def play(tool: can.BusABC, samples: int) -> None:
+    tool.send(status(42, 1))
+    for counter in range(samples):
+        tool.send(frame("ToolSensors", Torque=10.0, Angle=0.1 * counter, Counter=counter))
+
+
+def test_an_edge_decision_goes_out_on_the_can_thread_at_its_sample(
+    buses: tuple[can.BusABC, can.BusABC],
+) -> None:
+    """Issue 16: the stop path of one sample: the decider's decision is a StopCommand
+    within the call that handled its sample, before the sample is published."""
+    tool, station = buses
+    outlet = ListOutlet()
+    decider = RecordingDecider(decide_at=3)
+    acquisition = Acquisition("st1", False, station, DATABASE, outlet, decider=decider)
+    play(tool, 6)
+    drain(acquisition, station)
+    assert decider.states == ["running"]
+    assert acquisition.stats().stop_commands == 1
+    stop = tool.recv(1.0)
+    assert stop is not None and stop.arbitration_id == FRAME_IDS["StopCommand"]
+    assert [s.time_s for s in outlet.samples] == [k / 1000.0 for k in range(6)]  # sample clock
+
+
+def test_a_failing_predictor_never_stops_the_samples(
+    buses: tuple[can.BusABC, can.BusABC],
+) -> None:
+    tool, station = buses
+    outlet = ListOutlet()
+    acquisition = Acquisition(
+        "st1", False, station, DATABASE, outlet, decider=RecordingDecider(fail=True)
+    )
+    play(tool, 20)
+    drain(acquisition, station)
+    assert len(outlet.samples) == 20 and acquisition.stats().stop_commands == 0
