@@ -24,9 +24,10 @@ Per joint, |F_reached - F_target| / F_target of:
 - **live**: the run above, through CAN, zenoh and the real processes;
 - **offline replay**: the recorded run exported from its MCAP and predicted
   again with the station's settings (what ``boltwatch predict --config
-  --program`` does); the joint simulated again (same seed) and halted one
-  sample after the sample that decided offline (a controller's reaction), or
-  at the tool's own shutoff at the target if that comes first, as live;
+  --program`` does); the joint simulated again (same seed) and halted at the
+  sample that decided offline, or at the tool's own shutoff at the target if
+  that comes first, as the live rig halts (it halts the moment a StopCommand
+  arrives: live, a fraction of a millisecond after the deciding sample);
 - **oracle**: the closest reachable end (``bench_predictor_accuracy.oracle``);
 - **conventional**: the shutoff inside the tool controller, one sample of
   latency, no network (``bench_predictor_accuracy.conventional``).
@@ -66,7 +67,6 @@ from services.predictor.core import CoreDecision, PredictorCore, PredictorSettin
 from services.predictor.trace_replay import replay  # noqa: E402
 from services.recorder.trace_export import export_trace  # noqa: E402
 from services.rig.frames import RigFrames  # noqa: E402
-from services.rig.physics import Measurement  # noqa: E402
 from services.rig.realtime import RealtimeRig, ToolIdentity  # noqa: E402
 from shared import keys  # noqa: E402
 from shared.can_bus import open_bus  # noqa: E402
@@ -84,8 +84,10 @@ from tests.benchmarks.bench_predictor_accuracy import (  # noqa: E402
     conventional,
     draw_joint,
     error,
+    finish,
+    max_samples,
     oracle,
-    run,
+    physics,
     stats,
     torque_error,
 )
@@ -250,20 +252,21 @@ def offline(
          if isinstance(o, CoreDecision)),
         None,
     )  # fmt: skip
-    # halt the same joint one sample after the sample that decided (sample k: t = k ms), or
-    # after the tool's own shutoff at the target, whichever comes first: as the live rig
+    # the same joint again (same seed), halted at the sample that decided offline, or at
+    # the tool's own shutoff at the target if that comes first: as the live rig halts
     at_sample = -1 if decided is None else round(decided[1] * 1000.0)
-    count = iter(range(10**9))
-
-    def stop(m: Measurement) -> str | None:
-        if next(count) == at_sample:
-            return "offline"
-        if torque_only:
-            return "shutoff" if m.torque_nm >= joint.target_torque_nm else None
-        return "shutoff" if m.force_n >= joint.target_force_n else None
-
-    result = run(joint, stop)
-    return result.reached_n, result.reached_torque_nm, decided
+    sim = physics(joint)
+    for index in range(max_samples(joint)):
+        m = sim.advance()
+        value, target = (
+            (m.torque_nm, joint.target_torque_nm)
+            if torque_only
+            else (m.force_n, joint.target_force_n)
+        )
+        if index == at_sample or value >= target:
+            break
+    reached_n, reached_torque_nm = finish(sim)
+    return reached_n, reached_torque_nm, decided
 
 
 def report(rows: dict[str, list[float]], title: str, oracle_name: str) -> None:
