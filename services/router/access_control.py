@@ -9,7 +9,7 @@ may declare subscribers, queryables and liveliness tokens under
 
 - ``<st>-acquisition`` may put ``boltwatch/<st>/samples``, ``tool``, ``bus``,
 - ``<st>-predictor`` may put ``boltwatch/<st>/events``, ``intensity``,
-  ``decision``, ``runs``,
+  ``decision``, ``runs``, ``predictor`` (its stats),
 - ``line-recorder`` may put ``boltwatch/<st>/recorder`` and ``wear/**``.
 
 Anyone else (another common name, a certificate for another station) gets
@@ -30,7 +30,7 @@ from typing import Any
 from shared import keys
 
 ACQUISITION_TOPICS = (keys.SAMPLES, keys.TOOL, keys.BUS)
-PREDICTOR_TOPICS = (keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS)
+PREDICTOR_TOPICS = (keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS, keys.PREDICTOR)
 RECORDER_TOPICS = (keys.RECORDER, keys.WEAR, f"{keys.WEAR}/**")
 LINE_OBSERVERS = ("line-recorder", "line-viewer", "line-monitor")
 

@@ -157,7 +157,7 @@ def test_dockerfile_installs_the_package_and_runs_the_cli() -> None:
 TLS_TEXT = TLS_FILE.read_text()
 ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), per station
     "acquisition": {keys.SAMPLES, keys.TOOL, keys.BUS},
-    "predictor": {keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS},
+    "predictor": {keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS, keys.PREDICTOR},
     "recorder": {keys.RECORDER, keys.WEAR, f"{keys.WEAR}/**"},
 }
 needs_openssl = pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl")
