@@ -2,7 +2,8 @@
 
 Subscribes ``boltwatch/<station>/decision`` and turns each decision for the
 running run into a CAN ``StopCommand`` straight from the zenoh callback (the
-shortest stop path); publishes samples, run states and bus counters.
+shortest stop path; a bad payload is counted in ``BusStats.bad_decisions``,
+never raised into zenoh); publishes samples, run states and bus counters.
 """
 
 from __future__ import annotations
@@ -19,16 +20,23 @@ from services.acquisition.zenoh_outlet import ZenohOutlet
 from shared import keys
 from shared.can_bus import open_bus
 from shared.can_database import StationDatabase
-from shared.codec import decode
 from shared.config import load_station
-from shared.errors import BoltwatchError
-from shared.messages import StopDecision
 from shared.service_runtime import ServiceRunner
 from shared.zenoh_session import open_session
 
 LOG = logging.getLogger(__name__)
 
 POLL_TIMEOUT_S = 0.05  # the stop flag is checked at least this often
+
+
+def subscribe_decisions(session: zenoh.Session, acquisition: Acquisition) -> zenoh.Subscriber[None]:
+    """``boltwatch/<st>/decision`` into :meth:`Acquisition.decision`, in zenoh's callback."""
+    key = keys.station_key(acquisition.station_id, keys.DECISION)
+
+    def on_decision(sample: zenoh.Sample) -> None:
+        acquisition.decision(sample.payload.to_bytes(), key)
+
+    return session.declare_subscriber(key, on_decision)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -46,15 +54,7 @@ def main(args: argparse.Namespace) -> int:
             unsent_samples=lambda: outlet.unsent_samples,
         )
 
-        def on_decision(sample: zenoh.Sample) -> None:
-            try:
-                acquisition.send_stop(decode(StopDecision, sample.payload.to_bytes()))
-            except BoltwatchError as err:
-                LOG.error("bad decision message on %s: %s", sample.key_expr, err)
-
-        decisions = session.declare_subscriber(
-            keys.station_key(station_id, keys.DECISION), on_decision
-        )
+        decisions = subscribe_decisions(session, acquisition)
         token = session.liveliness().declare_token(keys.health_key(station_id, "acquisition"))
         LOG.info(
             "acquisition of %s on %s:%s",
