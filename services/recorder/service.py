@@ -258,7 +258,10 @@ class RecorderService:
 
     def _wear_replier(self, station: str) -> Callable[[zenoh.Query], None]:
         def reply(query: zenoh.Query) -> None:
-            self._reply_wear(station, query)
+            # finalized on leaving (the querier's get ends now), not when the Query is freed:
+            # an error's traceback, kept by a log record, would keep it until its timeout
+            with query:
+                self._reply_wear(station, query)
 
         return reply
 

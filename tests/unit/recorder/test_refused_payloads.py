@@ -144,3 +144,22 @@ def test_times_no_recording_can_hold_and_deep_nesting_are_recorded_raw_and_count
     assert lags and max(lags) < 60_000  # no refused sample's time in the lag figures
     refused_lines = [r for r in caplog.records if r.getMessage().startswith("payload on")]
     assert len(refused_lines) == 1 and not any(r.exc_info for r in caplog.records)
+
+
+def test_a_wear_query_the_recorder_cannot_answer_ends_at_once(
+    recorder: RunningRecorder,
+    publisher_session: zenoh.Session,
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """No ledger yet: one error reply, and the query ends with it. Before: the Query stayed
+    alive through the logged error's traceback (a log record keeps it), so zenoh finished
+    it only at the querier's timeout, with a second, "Timeout" reply."""
+    key = keys.station_key("st1", keys.WEAR)
+    for selector, payload in ((key, None), (f"{key}?x=1;;&\u00fe", b"\x00" * 5000)):
+        started = time.monotonic()
+        replies = list(publisher_session.get(selector, payload=payload, timeout=10.0))
+        took_s = time.monotonic() - started
+        assert [r.err is not None for r in replies] == [True]
+        assert b"no wear ledger" in replies[0].err.payload.to_bytes()  # type: ignore[union-attr]
+        assert took_s < 5.0
+    assert caplog.records  # the error was logged, and the log kept it
