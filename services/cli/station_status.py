@@ -22,8 +22,11 @@ Per station:
 - recorder: the latest RecorderStats (``boltwatch/<st>/recorder``, once a
   second): lag of samples into the recorder (p50/max over its last second,
   None when no samples came), messages written, samples the acquisition
-  published that never reached the recorder, write errors and whether it is
-  recording.
+  published that never reached the recorder, payloads it refused (recorded
+  raw), write errors and whether it is recording;
+- predictor: the latest PredictorStats (``boltwatch/<st>/predictor``, once a
+  second): payloads it refused, samples its core could not use, samples of
+  no running run, runs whose end never arrived.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ from shared.codec import decode
 from shared.errors import InputError
 from shared.messages import (
     BusStats,
+    PredictorStats,
     RecorderStats,
     RunSummary,
     Sample,
@@ -65,6 +69,8 @@ class _Seen:
     summary: RunSummary | None = None
     recorder: RecorderStats | None = None
     recorder_received_ns: int = 0
+    predictor: PredictorStats | None = None
+    predictor_received_ns: int = 0
     unreadable: int = 0
 
 
@@ -83,6 +89,7 @@ class BusHealth:
     stop_commands: int
     unsent_samples: int  # published with no router reachable
     late_decisions: int  # decisions for a run the tool was no longer running
+    bad_decisions: int = 0  # decision payloads refused (not a valid StopDecision)
 
 
 @dataclass(frozen=True)
@@ -127,6 +134,18 @@ class RecorderHealth:
     write_errors: int
     last_error: str | None
     age_s: float  # since the latest RecorderStats was received
+    bad_payloads: int = 0  # payloads it refused (recorded raw)
+
+
+@dataclass(frozen=True)
+class PredictorHealth:
+    """What the predictor could not use at the station (latest PredictorStats)."""
+
+    bad_payloads: int  # samples and tool payloads refused
+    bad_samples: int  # samples of ended runs its core dropped (bad time or torque)
+    samples_without_run: int
+    unfinished_runs: int
+    age_s: float  # since the latest PredictorStats was received
 
 
 @dataclass(frozen=True)
@@ -141,6 +160,7 @@ class StationStatus:
     last_summary: LastSummary | None
     recorder: RecorderHealth | None  # None: no RecorderStats in the window
     unreadable_messages: int
+    predictor: PredictorHealth | None = None  # None: no PredictorStats in the window
 
 
 @dataclass(frozen=True)
@@ -199,6 +219,9 @@ class StatusCollector:
             elif topic == keys.RECORDER:
                 seen.recorder = decode(RecorderStats, payload)
                 seen.recorder_received_ns = received_ns
+            elif topic == keys.PREDICTOR:
+                seen.predictor = decode(PredictorStats, payload)
+                seen.predictor_received_ns = received_ns
         except InputError:
             seen.unreadable += 1
 
@@ -226,6 +249,7 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
         last_summary=_last_summary(seen.summary, now_ns),
         recorder=_recorder_health(seen.recorder, seen.recorder_received_ns, now_ns),
         unreadable_messages=unreadable,
+        predictor=_predictor_health(seen.predictor, seen.predictor_received_ns, now_ns),
     )
 
 
@@ -267,6 +291,7 @@ def _bus_health(stats: BusStats | None, received_ns: int, now_ns: int) -> BusHea
         stop_commands=stats.stop_commands,
         unsent_samples=stats.unsent_samples,
         late_decisions=stats.late_decisions,
+        bad_decisions=stats.bad_decisions,
     )
 
 
@@ -283,6 +308,21 @@ def _recorder_health(
         missing_samples=stats.missing_samples,
         write_errors=stats.write_errors,
         last_error=stats.last_error,
+        age_s=_age_s(received_ns, now_ns),
+        bad_payloads=stats.bad_payloads,
+    )
+
+
+def _predictor_health(
+    stats: PredictorStats | None, received_ns: int, now_ns: int
+) -> PredictorHealth | None:
+    if stats is None:
+        return None
+    return PredictorHealth(
+        bad_payloads=stats.bad_payloads,
+        bad_samples=stats.bad_samples,
+        samples_without_run=stats.samples_without_run,
+        unfinished_runs=stats.unfinished_runs,
         age_s=_age_s(received_ns, now_ns),
     )
 
