@@ -14,7 +14,7 @@ import zenoh
 
 from services.predictor.service import PredictorService
 from shared import codec, keys
-from shared.messages import PredictorStats, RunSummary, StopDecision
+from shared.messages import PredictorStats, RunSummary, Sample, StopDecision
 from shared.zenoh_session import zenoh_config
 from tests.unit.predictor.live_predictor import (
     PROGRAM_OF,
@@ -57,10 +57,11 @@ def latest_stats(by_key: dict[str, list[bytes]]) -> PredictorStats:
     return codec.decode(PredictorStats, by_key["pt1/predictor"][-1])
 
 
-def test_deeply_nested_payloads_are_counted_and_the_next_run_is_decided(
+def test_deep_nesting_and_impossible_times_are_counted_and_the_next_run_is_decided(
     service: PredictorService, endpoint: str
 ) -> None:
-    """Before: a RecursionError out of the decoder ended the predictor (all stations)."""
+    """Before: a RecursionError out of the decoder ended the predictor (all stations), and
+    a run started at time_ns -1 or 10**30 was predicted on that clock."""
     with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
         wait_for_token(session, keys.health_key("pt1", "predictor"))
         received = session.declare_subscriber("boltwatch/pt1/*", zenoh.handlers.FifoChannel(10_000))
@@ -68,11 +69,15 @@ def test_deeply_nested_payloads_are_counted_and_the_next_run_is_decided(
         for payload in (nested(DEEP), nested(DEEP_WITHIN_SIZE), b'{"a":' * DEEP_WITHIN_SIZE):
             feed.samples.put(payload)
             feed.tool.put(payload)
+        for time_ns in (-1, 10**30):  # times no clock can hold: 0 to 2**63 - 1 ns
+            feed.state(41, PROGRAM_OF["pt1"], "running", time_ns)
+            sample = Sample("pt1", 41, 0, time_ns, 1.0, 1.0, 1.0)
+            feed.samples.put(codec.encode(sample))
         play_run(feed, 42)
         by_key = collect(received, until={"pt1/runs"}, timeout_s=15.0)
         deadline = time.monotonic() + 5.0  # the next PredictorStats after the run
         while time.monotonic() < deadline and (
-            "pt1/predictor" not in by_key or latest_stats(by_key).bad_payloads < 6
+            "pt1/predictor" not in by_key or latest_stats(by_key).bad_payloads < 10
         ):
             by_key.update(collect(received, until={"pt1/predictor"}, timeout_s=1.5))
         received.undeclare()
@@ -80,9 +85,9 @@ def test_deeply_nested_payloads_are_counted_and_the_next_run_is_decided(
     decision, summary = decided(by_key)
     assert decision.reason == "plateau_closest"
     assert summary.stop_reason == "plateau_closest" and summary.samples > 900
-    assert service.bad_payloads == 6
+    assert service.bad_payloads == 10 and service.unfinished_runs == 0  # run 41 never started
     stats = latest_stats(by_key)
-    assert (stats.station, stats.bad_payloads, stats.bad_samples) == ("pt1", 6, 0)
+    assert (stats.station, stats.bad_payloads, stats.bad_samples) == ("pt1", 10, 0)
 
 
 def test_a_sample_stamped_an_hour_ahead_is_one_bad_sample_of_the_live_run(
