@@ -13,13 +13,14 @@ key                        publisher                    payload (see :mod:`share
 ``decision``               predictor                    :class:`StopDecision`
 ``runs``                   predictor                    :class:`RunSummary`, one per run
 ``recorder``               recorder                     :class:`RecorderStats`, once a second
+``predictor``              predictor                    :class:`PredictorStats`, once a second
 ``controller``             import (a controller bridge) :class:`ControllerResult`, one per run
 ``wear``                   recorder (queryable)         wear ledger rows
 ``health/<service>``       every service (liveliness)   -
 =========================  ===========================  =================================
 
-``tool``, ``bus``, ``recorder`` and ``controller`` are additions to DESIGN.md's list:
-services need run boundaries, bus fault counters and recorder health, and a plant needs
+``tool``, ``bus``, ``recorder``, ``predictor`` and ``controller`` are additions to DESIGN.md's list:
+services need run boundaries, bus fault counters, recorder and predictor health, and a plant needs
 its tool controllers' own results (OK/NOK, each step's values); none of those is a sample
 or a run summary.
 """
@@ -36,6 +37,7 @@ INTENSITY = "intensity"
 DECISION = "decision"
 RUNS = "runs"
 RECORDER = "recorder"
+PREDICTOR = "predictor"
 CONTROLLER = "controller"
 WEAR = "wear"
 HEALTH = "health"

@@ -6,6 +6,9 @@ that :func:`shared.codec.json_schema` derives from the dataclass (the same
 schema goes into MCAP, so Foxglove and the mcap CLI decode recordings with no
 code of ours). Times are integer nanoseconds since the Unix epoch (``*_ns``)
 or float seconds since the start of the run (``*_s``); units are in names.
+Every field is bounded (times, ids and counts from 0, station ids a key
+chunk, figures finite, texts of limited length): the aliases of
+:mod:`shared.message_fields` say how, and the decoders refuse the rest.
 """
 
 from __future__ import annotations
@@ -13,6 +16,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import Literal
+
+from shared.message_fields import Count, Id, Measured, StationId, TimeNs
 
 ToolStateName = Literal["idle", "running", "done", "aborted"]
 StopReasonName = Literal[
@@ -55,13 +60,13 @@ class StopReason(IntEnum):
 class Sample:
     """One 1 kHz sample: a ToolSensors frame paired with its JointSensors frame."""
 
-    station: str
-    run_id: int
-    sequence: int  # sample index within the run (the 16-bit CAN Counter, unrolled)
-    time_ns: int  # CAN receive time of the frame that completed the sample
-    torque_nm: float
-    angle_deg: float
-    force_n: float | None  # None on torque-only stations or when JointSensors was lost
+    station: StationId
+    run_id: Id
+    sequence: Count  # sample index within the run (the 16-bit CAN Counter, unrolled)
+    time_ns: TimeNs  # CAN receive time of the frame that completed the sample
+    torque_nm: Measured
+    angle_deg: Measured
+    force_n: Measured | None  # None on torque-only stations or when JointSensors was lost
     # the sample's time on the tool's own clock, seconds since the run's first sample
     # (sequence / the contract's 1 kHz; a controller's own time for an import): what the
     # predictor decides on, free of receive jitter. None: unknown, the receive time stands in
@@ -72,12 +77,12 @@ class Sample:
 class ToolState:
     """The tool's run state (CAN ToolStatus), published when it changes."""
 
-    station: str
-    run_id: int
-    tool_id: int
-    program_id: int
+    station: StationId
+    run_id: Id
+    tool_id: Id
+    program_id: Id
     state: ToolStateName
-    time_ns: int
+    time_ns: TimeNs
     # done / aborted: the StopCommand boltwatch sent the tool in this run (its reason);
     # None: none went out, the tool stopped by itself (its own shutoff or limits)
     stop_command: StopReasonName | None = None
@@ -87,32 +92,33 @@ class ToolState:
 class BusStats:
     """Counters of the acquisition since it started; faults are counted, never fatal."""
 
-    station: str
-    time_ns: int
-    frames: int
-    samples: int
-    unknown_ids: int
-    wrong_length: int
-    decode_errors: int
-    error_frames: int
-    receive_errors: int  # the bus driver raised on receive (bus-off, link down)
-    counter_gaps: int  # times the Counter skipped ahead
-    missed_samples: int  # samples lost in those gaps
-    counter_faults: int  # repeated or backwards Counters, frames dropped
-    unpaired: int  # ToolSensors published without a JointSensors partner
-    orphans: int  # JointSensors dropped: no ToolSensors partner in time
-    stop_commands: int
-    unsent_samples: int = 0  # published while the session had no router: lost, counted
-    late_decisions: int = 0  # stop decisions for a run the tool was no longer running
-    repeated_runs: int = 0  # ToolStatus starting a run id that had started already: ignored
-    started_ns: int = 0  # when this acquisition process started: a new value, a new process
+    station: StationId
+    time_ns: TimeNs
+    frames: Count
+    samples: Count
+    unknown_ids: Count
+    wrong_length: Count
+    decode_errors: Count
+    error_frames: Count
+    receive_errors: Count  # the bus driver raised on receive (bus-off, link down)
+    counter_gaps: Count  # times the Counter skipped ahead
+    missed_samples: Count  # samples lost in those gaps
+    counter_faults: Count  # repeated or backwards Counters, frames dropped
+    unpaired: Count  # ToolSensors published without a JointSensors partner
+    orphans: Count  # JointSensors dropped: no ToolSensors partner in time
+    stop_commands: Count
+    unsent_samples: Count = 0  # published while the session had no router: lost, counted
+    late_decisions: Count = 0  # stop decisions for a run the tool was no longer running
+    repeated_runs: Count = 0  # ToolStatus starting a run id that had started already: ignored
+    started_ns: TimeNs = 0  # when this acquisition process started: a new value, a new process
+    bad_decisions: Count = 0  # decision payloads refused (not a valid StopDecision): no stop
 
 
 @dataclass(frozen=True, slots=True)
 class Prediction:
     """A predicted stick-slip event, ``horizon`` events ahead (1 = the next)."""
 
-    horizon: int
+    horizon: Count
     time_s: float
     peak_torque_nm: float
     plateau_force_n: float | None
@@ -122,10 +128,10 @@ class Prediction:
 class StickSlipEvent:
     """One detected stick-slip event j with its figures (paper Fig. 3, eqs. 31-33, 66-68)."""
 
-    station: str
-    run_id: int
-    index: int  # j, counting from 1 within the run
-    time_ns: int  # receive time of the peak sample
+    station: StationId
+    run_id: Id
+    index: Count  # j, counting from 1 within the run
+    time_ns: TimeNs  # receive time of the peak sample
     time_s: float  # time of the torque peak since run start
     peak_torque_nm: float  # T_max,j
     min_torque_nm: float | None  # T_min,j after the slip
@@ -146,9 +152,9 @@ class StickSlipEvent:
 class Intensity:
     """Vibration intensity: of the last event and of the process so far (eqs. 67, 68)."""
 
-    station: str
-    run_id: int
-    time_ns: int
+    station: StationId
+    run_id: Id
+    time_ns: TimeNs
     event_intensity: float
     process_intensity: float
 
@@ -157,16 +163,16 @@ class Intensity:
 class StopDecision:
     """The predictor's decision to stop the tool now, with its reason."""
 
-    station: str
-    run_id: int
-    time_ns: int  # receive time of the sample at which it was decided
+    station: StationId
+    run_id: Id
+    time_ns: TimeNs  # receive time of the sample at which it was decided
     time_s: float  # the same, since run start
     reason: StopReasonName
     detail: str
-    torque_nm: float
+    torque_nm: Measured  # NaN: no usable torque (an input_fault after non-finite ones)
     force_n: float | None
     predicted_force_n: float | None  # the force the stop is predicted to land on (force target)
-    decided_ns: int  # wall clock when the decision was published (a replay: the sample's time)
+    decided_ns: TimeNs  # wall clock when the decision was published (a replay: the sample's time)
     predicted_torque_nm: float | None = None  # the torque it lands on (torque target)
     # True: decided on a replay of a run a tool controller stopped (``boltwatch import``),
     # never acted on; False (the default, also when absent on the wire): a live decision
@@ -177,24 +183,24 @@ class StopDecision:
 class RunSummary:
     """One tightening run, start to end, as the predictor saw it."""
 
-    station: str
-    run_id: int
-    tool_id: int
-    program_id: int
+    station: StationId
+    run_id: Id
+    tool_id: Id
+    program_id: Id
     tool_state: ToolStateName  # done or aborted
     target_force_n: float | None
     target_torque_nm: float | None
     reached_force_n: float | None
     reached_torque_nm: float
     error_pct: float | None  # (reached - target) / target, of force if measured else torque
-    events: int
+    events: Count
     # what stopped the tool: the reason of the StopCommand that went out in this run (as the
     # acquisition reported it); None: the tool stopped by itself
     stop_reason: StopReasonName | None
     process_intensity: float
-    samples: int
-    started_ns: int
-    ended_ns: int
+    samples: Count
+    started_ns: TimeNs
+    ended_ns: TimeNs
     # the predictor's decision when it did not stop the tool (it came after the tool had
     # stopped, or its StopCommand never went out): a late decision, not the stop reason
     late_decision: StopReasonName | None = None
@@ -204,19 +210,39 @@ class RunSummary:
 class RecorderStats:
     """The recorder's view of one station, once a second: is it keeping up and writing?"""
 
-    station: str
-    time_ns: int
-    messages: int  # messages of this station written since the recorder started
+    station: StationId
+    time_ns: TimeNs
+    messages: Count  # messages of this station written since the recorder started
     lag_p50_ms: float | None  # receive time minus acquisition time of samples, last second
     lag_max_ms: float | None
-    write_errors: int  # failed writes (disk full, read-only folder, ...) since start
+    write_errors: Count  # failed writes (disk full, read-only folder, ...) since start
     last_error: str | None  # the newest write error, None when writing is healthy
     recording: bool  # False while the recordings folder cannot be written
-    missing_samples: int = 0  # published by the acquisition (BusStats) but never received
+    missing_samples: Count = 0  # published by the acquisition (BusStats) but never received
+    # payloads on a message key refused by the decoder (bad JSON, a wrong type, a value out of
+    # its bounds, a time ahead of its arrival): recorded raw on the key's raw channel
+    bad_payloads: Count = 0
     # RunSummaries of this station the wear ledger refused (beyond what the run can carry)
-    refused_summaries: int = 0
+    refused_summaries: Count = 0
     # runs (of every station) waiting in memory for the wear ledger (failing or broken)
-    waiting_summaries: int = 0
+    waiting_summaries: Count = 0
+
+
+@dataclass(frozen=True, slots=True)
+class PredictorStats:
+    """The predictor's counts for one served station since it started, once a second."""
+
+    station: StationId
+    time_ns: TimeNs
+    started_ns: TimeNs  # when this predictor process started: a new value, a new process
+    # samples and tool payloads refused (not a valid message, or naming another station)
+    bad_payloads: Count
+    # samples of ended runs the core could not use: a bad time (NaN, out of order, a jump of
+    # more than its MAX_JUMP_S) or torque (NaN, outside the station's sensor range)
+    bad_samples: Count
+    samples_without_run: Count  # samples of a run that was not running here: dropped
+    unfinished_runs: Count  # runs whose end never arrived (a network outage): no summary
+    repeated_runs: Count  # ToolStates starting a run id that had started already: ignored
 
 
 @dataclass(frozen=True, slots=True)
@@ -241,7 +267,7 @@ class ControllerStep:
     name: str  # e.g. "Finding", "Thread forming", "Tightening 1.4"
     result: str  # "OK" or "NOK" as the controller wrote it ("" when it wrote none)
     quality_code: str
-    samples: int  # samples of the step's graph
+    samples: Count  # samples of the step's graph
     functions: list[ControllerFunction] = field(default_factory=list)
 
 
@@ -254,17 +280,17 @@ class ControllerResult:
     controller's, ``-1`` where it keeps no batch, None where the file had none.
     """
 
-    station: str
-    run_id: int
-    tool_id: int
-    program_id: int
-    time_ns: int  # the run's last sample
+    station: StationId
+    run_id: Id
+    tool_id: Id
+    program_id: Id
+    time_ns: TimeNs  # the run's last sample
     result: str  # "OK" or "NOK": the controller's verdict on the whole run
     quality_code: str
     part_id: str  # ``id code``: the part (work piece) the run tightened
     torque_unit: str
     # trailing samples of the last step's graph that are the tool unloading (``torsion release``)
-    torsion_release_samples: int | None
+    torsion_release_samples: Count | None
     batch_number: int | None
     batch_ok: int | None
     batch_nok: int | None
@@ -288,6 +314,7 @@ MESSAGE_TYPES: dict[str, type] = {
         StopDecision,
         RunSummary,
         RecorderStats,
+        PredictorStats,
         ControllerResult,
     )
 }

@@ -1,1 +1,9 @@
-"""Acquisition: CAN frames in, 1 kHz samples out on zenoh; stop decisions back to CAN."""
+"""Acquisition: CAN frames in, 1 kHz samples out on zenoh; stop decisions back to CAN.
+
+- :mod:`.service` (``boltwatch serve acquisition``: the bus, zenoh, the decision
+  subscriber), :mod:`.arguments`
+- :mod:`.acquisition` (the loop: frames in, samples and run states out, decisions
+  to StopCommands, every fault counted), :mod:`.frame_decoder` (one frame against
+  the DBC), :mod:`.pairing` (the two sensor frames of a sample, by Counter)
+- :mod:`.zenoh_outlet` (samples, run states and bus counters onto zenoh)
+"""

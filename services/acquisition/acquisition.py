@@ -14,6 +14,15 @@ Each sample carries its time on the tool's own clock (``Sample.time_s``:
 its unrolled Counter at the contract's sample rate), which the predictor
 decides on: the receive time (``time_ns``) jitters with the host's
 scheduling, the Counter does not.
+
+``decision`` (a payload) and ``send_stop`` (a decoded decision) may be
+called from another thread (the zenoh decision callback) and turn a decision
+for the running run into one CAN ``StopCommand``. A payload that is not a
+valid :class:`StopDecision` of this station (bad JSON, an unknown reason, a
+string run id, a time no clock can hold, a run id wider than the DBC's
+``RunId``, another station's id) is counted
+in ``BusStats.bad_decisions`` and logged once, then at most every 10 s; a
+good decision after it still stops the tool.
 """
 
 from __future__ import annotations
@@ -37,7 +46,11 @@ from services.acquisition.frame_decoder import (
     ToolStatusFrame,
 )
 from services.acquisition.pairing import AssembledSample, SampleAssembler
+from shared import codec
 from shared.can_database import SAMPLE_RATE_HZ, StationDatabase
+from shared.errors import InputError
+from shared.log_limit import RateLimitedLog
+from shared.message_fields import can_id_bounds
 from shared.messages import (
     BusStats,
     Sample,
@@ -94,6 +107,12 @@ class Acquisition:
         self._receive_errors = 0
         self._stop_commands = 0
         self._late_decisions = 0
+        self._bad_decisions = 0
+        self._decode_decision = codec.decoder(
+            StopDecision, {"run_id": can_id_bounds(database)["run_id"]}
+        )
+        self._log_bad_decision = RateLimitedLog(LOG, logging.ERROR)
+        self._log_late_decision = RateLimitedLog(LOG, logging.WARNING)
         self._send_lock = threading.Lock()
         self._tool: ToolStatusFrame | None = None
         self._stopped_run: int | None = None
@@ -230,12 +249,31 @@ class Acquisition:
 
     # -- stopping ------------------------------------------------------------------------
 
+    def decision(self, payload: bytes, key: str = "decision") -> bool:
+        """A decision payload received on ``key``: a StopCommand if it is a valid decision for
+        the running run (see :meth:`send_stop`); a bad payload is counted, never raised."""
+        try:
+            decision = self._decode_decision(payload)
+            if decision.station != self.station_id:
+                raise InputError(f"a decision of station {decision.station!r}, not of this one")
+        except InputError as err:
+            self._bad_decisions += 1
+            self._log_bad_decision(
+                "bad decision payload on %s ignored (#%d): %s", key, self._bad_decisions, err
+            )
+            return False
+        return self.send_stop(decision)
+
     def send_stop(self, decision: StopDecision) -> bool:
         """Send StopCommand for ``decision`` if it is for the running run; once per run."""
         tool = self._tool
         if tool is None or tool.state != ToolRunState.RUNNING or decision.run_id != tool.run_id:
             self._late_decisions += 1
-            LOG.warning("decision for run %d ignored: the tool is not running it", decision.run_id)
+            self._log_late_decision(
+                "decision for run %d ignored: the tool is not running it (#%d)",
+                decision.run_id,
+                self._late_decisions,
+            )
             return False
         with self._send_lock:
             if self._stopped_run == decision.run_id:
@@ -289,6 +327,7 @@ class Acquisition:
             stop_commands=self._stop_commands,
             unsent_samples=self._unsent_samples(),
             late_decisions=self._late_decisions,
+            bad_decisions=self._bad_decisions,
             started_ns=self._started_ns,
             repeated_runs=self._repeated_runs,
         )

@@ -10,7 +10,9 @@ Where the decision runs is the station file's ``[predictor] placement``:
   on the network cannot stop this station's tool);
 - ``line``: a ``boltwatch serve predictor`` elsewhere decides; this process
   subscribes ``boltwatch/<station>/decision`` and turns each decision for
-  the running run into a ``StopCommand`` straight from the zenoh callback.
+  the running run into a ``StopCommand`` straight from the zenoh callback (a
+  bad payload is counted in ``BusStats.bad_decisions``, never raised into
+  zenoh).
 
 The CAN thread runs under ``SCHED_FIFO`` where allowed (:mod:`shared.realtime`)
 and never waits on zenoh: samples, run states, bus counters and the
@@ -33,10 +35,8 @@ from services.acquisition.zenoh_outlet import ZenohOutlet
 from shared import keys
 from shared.can_bus import open_bus
 from shared.can_database import StationDatabase
-from shared.codec import decode
 from shared.config import load_station
-from shared.errors import BoltwatchError, ConfigError
-from shared.messages import StopDecision
+from shared.errors import ConfigError
 from shared.queued_publisher import QueuedPublisher
 from shared.realtime import STOP_PATH_PRIORITY, use_realtime_priority
 from shared.service_runtime import ServiceRunner
@@ -45,6 +45,16 @@ from shared.zenoh_session import open_session
 LOG = logging.getLogger(__name__)
 
 POLL_TIMEOUT_S = 0.05  # the stop flag is checked at least this often
+
+
+def subscribe_decisions(session: zenoh.Session, acquisition: Acquisition) -> zenoh.Subscriber[None]:
+    """``boltwatch/<st>/decision`` into :meth:`Acquisition.decision`, in zenoh's callback."""
+    key = keys.station_key(acquisition.station_id, keys.DECISION)
+
+    def on_decision(sample: zenoh.Sample) -> None:
+        acquisition.decision(sample.payload.to_bytes(), key)
+
+    return session.declare_subscriber(key, on_decision)
 
 
 def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None) -> int:
@@ -78,16 +88,7 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
             decider=decider,
         )
         if not edge:
-
-            def on_decision(sample: zenoh.Sample) -> None:
-                try:
-                    acquisition.send_stop(decode(StopDecision, sample.payload.to_bytes()))
-                except BoltwatchError as err:
-                    LOG.error("bad decision message on %s: %s", sample.key_expr, err)
-
-            decisions = session.declare_subscriber(
-                keys.station_key(station_id, keys.DECISION), on_decision
-            )
+            decisions = subscribe_decisions(session, acquisition)
             resources.callback(decisions.undeclare)
         token = session.liveliness().declare_token(keys.health_key(station_id, "acquisition"))
         resources.callback(token.undeclare)

@@ -22,9 +22,13 @@ Per station:
 - recorder: the latest RecorderStats (``boltwatch/<st>/recorder``, once a
   second): lag of samples into the recorder (p50/max over its last second,
   None when no samples came), messages written, samples the acquisition
-  published that never reached the recorder, write errors and whether it is
-  recording, run summaries the wear ledger refused and runs waiting in memory
-  for a failing or broken ledger (its error is the ``last_error``).
+  published that never reached the recorder, payloads it refused (recorded
+  raw), write errors and whether it is recording, run summaries the wear
+  ledger refused and runs waiting in memory for a failing or broken ledger
+  (its error is the ``last_error``);
+- predictor: the latest PredictorStats (``boltwatch/<st>/predictor``, once a
+  second): payloads it refused, samples its core could not use, samples of
+  no running run, runs whose end never arrived.
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ from shared.codec import decode
 from shared.errors import InputError
 from shared.messages import (
     BusStats,
+    PredictorStats,
     RecorderStats,
     RunSummary,
     Sample,
@@ -66,6 +71,8 @@ class _Seen:
     summary: RunSummary | None = None
     recorder: RecorderStats | None = None
     recorder_received_ns: int = 0
+    predictor: PredictorStats | None = None
+    predictor_received_ns: int = 0
     unreadable: int = 0
 
 
@@ -84,6 +91,7 @@ class BusHealth:
     stop_commands: int
     unsent_samples: int  # published with no router reachable
     late_decisions: int  # decisions for a run the tool was no longer running
+    bad_decisions: int = 0  # decision payloads refused (not a valid StopDecision)
 
 
 @dataclass(frozen=True)
@@ -130,6 +138,18 @@ class RecorderHealth:
     age_s: float  # since the latest RecorderStats was received
     refused_summaries: int = 0  # RunSummaries the wear ledger refused (beyond their bound)
     waiting_summaries: int = 0  # runs waiting in the recorder's memory for the wear ledger
+    bad_payloads: int = 0  # payloads it refused (recorded raw)
+
+
+@dataclass(frozen=True)
+class PredictorHealth:
+    """What the predictor could not use at the station (latest PredictorStats)."""
+
+    bad_payloads: int  # samples and tool payloads refused
+    bad_samples: int  # samples of ended runs its core dropped (bad time or torque)
+    samples_without_run: int
+    unfinished_runs: int
+    age_s: float  # since the latest PredictorStats was received
 
 
 @dataclass(frozen=True)
@@ -144,6 +164,7 @@ class StationStatus:
     last_summary: LastSummary | None
     recorder: RecorderHealth | None  # None: no RecorderStats in the window
     unreadable_messages: int
+    predictor: PredictorHealth | None = None  # None: no PredictorStats in the window
 
 
 @dataclass(frozen=True)
@@ -202,6 +223,9 @@ class StatusCollector:
             elif topic == keys.RECORDER:
                 seen.recorder = decode(RecorderStats, payload)
                 seen.recorder_received_ns = received_ns
+            elif topic == keys.PREDICTOR:
+                seen.predictor = decode(PredictorStats, payload)
+                seen.predictor_received_ns = received_ns
         except InputError:
             seen.unreadable += 1
 
@@ -229,6 +253,7 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
         last_summary=_last_summary(seen.summary, now_ns),
         recorder=_recorder_health(seen.recorder, seen.recorder_received_ns, now_ns),
         unreadable_messages=unreadable,
+        predictor=_predictor_health(seen.predictor, seen.predictor_received_ns, now_ns),
     )
 
 
@@ -270,6 +295,7 @@ def _bus_health(stats: BusStats | None, received_ns: int, now_ns: int) -> BusHea
         stop_commands=stats.stop_commands,
         unsent_samples=stats.unsent_samples,
         late_decisions=stats.late_decisions,
+        bad_decisions=stats.bad_decisions,
     )
 
 
@@ -289,6 +315,21 @@ def _recorder_health(
         age_s=_age_s(received_ns, now_ns),
         refused_summaries=stats.refused_summaries,
         waiting_summaries=stats.waiting_summaries,
+        bad_payloads=stats.bad_payloads,
+    )
+
+
+def _predictor_health(
+    stats: PredictorStats | None, received_ns: int, now_ns: int
+) -> PredictorHealth | None:
+    if stats is None:
+        return None
+    return PredictorHealth(
+        bad_payloads=stats.bad_payloads,
+        bad_samples=stats.bad_samples,
+        samples_without_run=stats.samples_without_run,
+        unfinished_runs=stats.unfinished_runs,
+        age_s=_age_s(received_ns, now_ns),
     )
 
 

@@ -13,6 +13,7 @@ from services.cli.station_status import (
     LastDecision,
     LastRun,
     LastSummary,
+    PredictorHealth,
     RecorderHealth,
     StationStatus,
     StatusReport,
@@ -55,6 +56,7 @@ def _station_lines(status: StationStatus) -> list[str]:
         line("last run", _run_text(status.last_run)),
         line("last decision", _decision_text(status.last_decision)),
         line("last summary", _summary_text(status.last_summary)),
+        line("predictor", _predictor_text(status.predictor)),
         line("recorder", _recorder_text(status.recorder)),
     ]
     if status.unreadable_messages:
@@ -68,8 +70,19 @@ def _bus_text(bus: BusHealth | None) -> str:
     return (
         f"{bus.counter_gaps} gaps, {bus.missed_samples} missed samples, "
         f"{bus.bad_frames} bad frames, {bus.receive_errors} receive errors, "
-        f"{bus.unsent_samples} unsent samples, {bus.late_decisions} late decisions "
+        f"{bus.unsent_samples} unsent samples, {bus.late_decisions} late decisions, "
+        f"{bus.bad_decisions} bad decisions "
         f"({bus.frames} frames since start, {bus.age_s:.1f} s ago)"
+    )
+
+
+def _predictor_text(predictor: PredictorHealth | None) -> str:
+    if predictor is None:
+        return "- (no predictor stats in the window: predictor down or not serving it?)"
+    return (
+        f"{predictor.bad_payloads} bad payloads, {predictor.bad_samples} bad samples, "
+        f"{predictor.samples_without_run} samples without a run, "
+        f"{predictor.unfinished_runs} unfinished runs ({predictor.age_s:.1f} s ago)"
     )
 
 
@@ -82,8 +95,8 @@ def _recorder_text(recorder: RecorderHealth | None) -> str:
         lag = f"lag p50 {recorder.lag_p50_ms:.1f} ms, max {recorder.lag_max_ms:.1f} ms"
     counts = (
         f"{recorder.messages} messages, {recorder.missing_samples} samples missing, "
-        f"{recorder.write_errors} write errors, {recorder.refused_summaries} run summaries "
-        f"refused by the wear ledger"
+        f"{recorder.bad_payloads} bad payloads, {recorder.write_errors} write errors, "
+        f"{recorder.refused_summaries} run summaries refused by the wear ledger"
     )
     if recorder.waiting_summaries:
         counts += f", {recorder.waiting_summaries} runs waiting for the wear ledger"

@@ -4,6 +4,7 @@
 - :mod:`.service` (zenoh wiring), :mod:`.arguments`, :mod:`.station_inbox`,
   :mod:`.served_station` (one station's configuration), :mod:`.active_run`
   (one run's core and summary), :mod:`.run_messages` (core outputs as messages,
-  live and replayed alike)
+  live and replayed alike), :mod:`.station_counts` (what it could not use, per
+  station: PredictorStats)
 - :mod:`.trace_replay`: the core over an offline trace (``boltwatch predict``)
 """

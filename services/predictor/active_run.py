@@ -35,8 +35,9 @@ class ActiveRun:
         self.core = PredictorCore(settings)
         self.started_ns = state.time_ns
         self.samples = 0
-        self.last: Sample | None = None
+        self.last: Sample | None = None  # the last sample whose torque was a measurement
         self.decision: StopDecision | None = None
+        self._torque_low, self._torque_high = settings.sensor_range.torque_nm
 
     def _time_s(self, sample: Sample) -> float:
         """The sample's run time: on the tool's own clock when it has one (no receive jitter)."""
@@ -47,7 +48,8 @@ class ActiveRun:
     def on_sample(self, sample: Sample, wall_ns: int) -> list[Outgoing]:
         """Feed one sample; the messages to publish because of it."""
         self.samples += 1
-        self.last = sample
+        if self._torque_low <= sample.torque_nm <= self._torque_high:  # NaN is not
+            self.last = sample  # what the run reached is measured, never a bad sample's value
         force = sample.force_n if sample.force_n is not None else math.nan
         outputs = self.core.update(self._time_s(sample), sample.torque_nm, force, sample.angle_deg)
         if not outputs:
@@ -88,6 +90,9 @@ class ActiveRun:
         """
         last = self.last
         reached_force = last.force_n if last is not None and self.settings.has_force else None
+        force_low, force_high = self.settings.sensor_range.force_n
+        if reached_force is not None and not force_low <= reached_force <= force_high:
+            reached_force = None  # the last force was no measurement
         reached_torque = last.torque_nm if last is not None else 0.0
         error_pct = None
         target_force = self.program.target_force_n

@@ -15,6 +15,10 @@ queued publisher: the CAN thread only queues. It holds the station's
 predictor, and a second predictor for the station (a line predictor) is
 refused, as two line predictors are.
 
+What it counts (samples its core could not use, runs that started again,
+...) goes out once a second as the station's ``PredictorStats``, from a
+timer thread of its own through the same queue.
+
 It implements the acquisition's ``Decider`` protocol
 (``services/acquisition/decider.py``) by shape; the CLI joins the two.
 """
@@ -22,6 +26,7 @@ It implements the acquisition's ``Decider`` protocol
 from __future__ import annotations
 
 import logging
+import threading
 import time
 from collections.abc import Callable
 
@@ -38,6 +43,8 @@ LOG = logging.getLogger(__name__)
 
 #: (topic, message) -> None, never waiting: the station's queued publisher
 Publish = Callable[[str, object], None]
+#: how often the station's PredictorStats goes out
+STATS_PERIOD_S = 1.0
 
 
 class EdgePredictor:
@@ -50,6 +57,12 @@ class EdgePredictor:
         self._token = session.liveliness().declare_token(
             keys.health_key(station.station_id, "predictor")
         )
+        self._started_ns = time.time_ns()
+        self._closed = threading.Event()
+        self._stats = threading.Thread(
+            target=self._publish_stats, name="predictor-stats", daemon=True
+        )
+        self._stats.start()
         LOG.info(
             "predictor of %s on the acquisition's CAN thread (placement edge)", station.station_id
         )
@@ -75,5 +88,11 @@ class EdgePredictor:
     def runs(self) -> StationRuns:
         return self._runs
 
+    def _publish_stats(self) -> None:
+        while not self._closed.wait(STATS_PERIOD_S):
+            self._publish(keys.PREDICTOR, self._runs.counts.stats(time.time_ns(), self._started_ns))
+
     def close(self) -> None:
+        self._closed.set()
+        self._stats.join(timeout=5.0)
         self._token.undeclare()

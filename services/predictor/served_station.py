@@ -1,13 +1,22 @@
 """One station a predictor process serves: its own programs, sensors, joint and settings.
 
 A line predictor serves several stations; each run is predicted with the
-configuration of the station it belongs to, never another's.
+configuration of the station it belongs to, never another's. Its samples and
+tool states are decoded with ids only as wide as the station's DBC carries
+them (``RunId``, ``ToolId``, ``ProgramId`` of ``ToolStatus``): they come from
+its CAN bus, and a wider one is no run of this station.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from services.predictor.core import PredictorSettings
+from shared import codec
+from shared.can_database import StationDatabase
 from shared.config import LoadedStation, Program
+from shared.message_fields import can_id_bounds
+from shared.messages import Sample, ToolState
 from shared.model import JointConstants
 
 
@@ -18,6 +27,11 @@ class ServedStation:
         self.station = station
         self.station_id = station.station_id
         self._constants: dict[int, JointConstants] = {}  # by program: its joint's
+        ids = can_id_bounds(StationDatabase(station.dbc_path))
+        self.decode_sample: Callable[[bytes], Sample] = codec.decoder(
+            Sample, {"run_id": ids["run_id"]}
+        )
+        self.decode_tool_state: Callable[[bytes], ToolState] = codec.decoder(ToolState, ids)
 
     def program(self, program_id: int) -> Program:
         """The station's program; KeyError names the station and its known ids."""

@@ -12,6 +12,13 @@ congestion control: a stop must never be dropped), ``runs`` per run. One
 liveliness token ``boltwatch/<st>/health/predictor`` per served station; a
 station that already has a predictor on the line is refused at start-up, so
 two predictors never both decide for one station.
+
+No payload stops the service: what does not decode (bad JSON, nested too
+deeply, too large, a wrong type, a value out of its bounds or an id wider
+than the station's CAN signal) or names another station is counted as a bad
+payload and logged once, then at most every 10 s. What it counted goes out
+per station once a second as :class:`~shared.messages.PredictorStats` on
+``boltwatch/<st>/predictor`` (:mod:`services.predictor.station_counts`).
 """
 
 from __future__ import annotations
@@ -27,6 +34,7 @@ import zenoh
 
 from services.predictor.active_run import Outgoing
 from services.predictor.served_station import ServedStation
+from services.predictor.station_counts import StationCounts
 from services.predictor.station_inbox import Inbox, InboxFactory, StationInbox
 from services.predictor.station_refusal import refuse_stations_served_elsewhere
 from services.predictor.station_runs import StationRuns
@@ -34,6 +42,7 @@ from shared import codec, keys
 from shared.config import LoadedStation, load_line
 from shared.config.line import stations_by_id
 from shared.errors import InputError
+from shared.log_limit import RateLimitedLog
 from shared.messages import Intensity, Sample, StopDecision, ToolState
 from shared.receive_threads import use_one_receive_thread
 from shared.service_runtime import ServiceRunner
@@ -41,8 +50,8 @@ from shared.zenoh_session import open_session
 
 LOG = logging.getLogger(__name__)
 
-_decode_sample = codec.decoder(Sample)
-_decode_tool_state = codec.decoder(ToolState)
+#: how often each served station's PredictorStats goes out
+STATS_PERIOD_S = 1.0
 
 
 class PredictorService:
@@ -65,7 +74,8 @@ class PredictorService:
             station_id: StationRuns(served) for station_id, served in self._stations.items()
         }
         self._publishers: dict[tuple[str, str], Any] = {}
-        self.bad_payloads = 0
+        self.started_ns = time.time_ns()
+        self._log_bad_payload = RateLimitedLog(LOG)
         self._inbox: Inbox = inbox(session, list(self._stations), self.handle)
         self._tokens = [
             session.liveliness().declare_token(keys.health_key(station_id, "predictor"))
@@ -96,38 +106,70 @@ class PredictorService:
         self._inbox.wake()
 
     def work(self, stop: threading.Event) -> None:
-        """The worker: messages are handled by the inbox until ``stop`` is set."""
+        """The worker: messages are handled by the inbox until ``stop`` is set; meanwhile a
+        thread publishes each station's PredictorStats every :data:`STATS_PERIOD_S`."""
         LOG.info("predictor up for station(s) %s", ", ".join(self._stations))
-        self._inbox.serve(stop)
+        done = threading.Event()
+        stats = threading.Thread(
+            target=self._publish_stats_until, args=(stop, done), name="predictor-stats"
+        )
+        stats.start()
+        try:
+            self._inbox.serve(stop)
+        finally:
+            done.set()
+            stats.join()
+
+    def _publish_stats_until(self, stop: threading.Event, done: threading.Event) -> None:
+        while not (stop.is_set() or done.wait(STATS_PERIOD_S)):
+            now_ns = time.time_ns()
+            for runs in self._runs.values():
+                stats = runs.counts.stats(now_ns, self.started_ns)
+                try:
+                    self._session.put(
+                        keys.station_key(stats.station, keys.PREDICTOR), codec.encode(stats)
+                    )
+                except zenoh.ZError as err:  # the session is closing
+                    LOG.debug("predictor stats of %s not published: %s", stats.station, err)
 
     def handle(self, station_id: str, topic: str, payload: bytes) -> None:
         """Dispatch one message received on a served station's ``topic`` key."""
         runs = self._runs.get(station_id)
         if runs is None:  # cannot happen: the inbox only subscribes to served stations
             return
+        served = runs.served
         try:
             if topic == keys.SAMPLES:
-                sample = _decode_sample(payload)
+                sample = served.decode_sample(payload)
                 if self._belongs(sample.station, station_id, topic):
                     self._on_sample(runs, sample)
             elif topic == keys.TOOL:
-                state = _decode_tool_state(payload)
+                state = served.decode_tool_state(payload)
                 if self._belongs(state.station, station_id, topic):
                     self._on_tool(runs, state)
         except InputError as err:
-            self.bad_payloads += 1
-            LOG.warning("ignored a bad %s payload of %s: %s", topic, station_id, err)
+            counts = runs.counts
+            counts.bad_payloads += 1
+            self._log_bad_payload(
+                "ignored a bad %s payload of %s (#%d): %s",
+                topic,
+                station_id,
+                counts.bad_payloads,
+                err,
+            )
 
     def _belongs(self, station_in_payload: str, station_id: str, topic: str) -> bool:
         """A payload naming another station than its key is counted and ignored."""
         if station_in_payload == station_id:
             return True
-        self.bad_payloads += 1
-        LOG.warning(
-            "ignored a %s message on %s that names station %s",
+        counts = self._runs[station_id].counts
+        counts.bad_payloads += 1
+        self._log_bad_payload(
+            "ignored a %s message on %s that names station %s (#%d)",
             topic,
             keys.station_key(station_id, topic),
             station_in_payload,
+            counts.bad_payloads,
         )
         return False
 
@@ -141,18 +183,29 @@ class PredictorService:
             self._send(sample.station, message)
 
     @property
+    def counts(self) -> dict[str, StationCounts]:
+        """What each served station's predictor counted (its PredictorStats)."""
+        return {station_id: runs.counts for station_id, runs in self._runs.items()}
+
+    @property
+    def bad_payloads(self) -> int:
+        """Payloads refused, every served station."""
+        return sum(runs.counts.bad_payloads for runs in self._runs.values())
+
+    @property
     def dropped_samples(self) -> int:
-        return sum(runs.dropped_samples for runs in self._runs.values())
+        """Samples of no running run, every served station."""
+        return sum(runs.counts.samples_without_run for runs in self._runs.values())
 
     @property
     def unfinished_runs(self) -> int:
-        """Runs whose end never arrived (a network outage)."""
-        return sum(runs.unfinished_runs for runs in self._runs.values())
+        """Runs whose end never arrived (a network outage), every served station."""
+        return sum(runs.counts.unfinished_runs for runs in self._runs.values())
 
     @property
     def repeated_runs(self) -> int:
-        """Run ids that started again after they had started: ignored."""
-        return sum(runs.repeated_runs for runs in self._runs.values())
+        """Run ids that started again after they had started (ignored), every served station."""
+        return sum(runs.counts.repeated_runs for runs in self._runs.values())
 
     def _send(self, station: str, message: Outgoing) -> None:
         if isinstance(message, StopDecision):

@@ -10,7 +10,13 @@ predictor (:mod:`.service`, fed from zenoh) and the edge predictor
 - a new run of the station ends its older ones, unheard (their ``done`` was
   lost in an outage: counted in :attr:`unfinished_runs`, no summary);
 - ``done`` / ``aborted`` ends a run: its :class:`RunSummary`;
-- a sample of no running run is dropped and counted (:attr:`dropped_samples`).
+- a sample of no running run is dropped and counted.
+
+What it counts (:attr:`counts`, a :class:`~.station_counts.StationCounts`:
+runs that started again, runs whose end never arrived, samples of no
+running run, samples the core of an ended run could not use) goes out as the
+station's ``PredictorStats`` once a second; the logs of faults that can
+repeat are rate-limited.
 """
 
 from __future__ import annotations
@@ -20,6 +26,8 @@ from collections import deque
 
 from services.predictor.active_run import ActiveRun, Outgoing
 from services.predictor.served_station import ServedStation
+from services.predictor.station_counts import StationCounts
+from shared.log_limit import RateLimitedLog
 from shared.messages import RunSummary, Sample, ToolState
 
 LOG = logging.getLogger(__name__)
@@ -35,9 +43,9 @@ class StationRuns:
         self.served = served
         self._runs: dict[int, ActiveRun] = {}
         self._started: deque[int] = deque(maxlen=STARTED_RUNS_KEPT)
-        self.dropped_samples = 0
-        self.unfinished_runs = 0  # runs whose end never arrived (a network outage)
-        self.repeated_runs = 0  # a run id that started again after it had started: ignored
+        self.counts = StationCounts(served.station_id)
+        self._log_no_program = RateLimitedLog(LOG, logging.ERROR)
+        self._log_unfinished = RateLimitedLog(LOG)
 
     def on_tool(self, state: ToolState) -> RunSummary | None:
         """A run state of the station; the run's summary when it ended."""
@@ -50,6 +58,7 @@ class StationRuns:
         if run is None:
             return None
         summary = run.summary(state)
+        self.counts.run_ended(run.core.input_report)
         LOG.info(
             "%s run %s %s: %d events, stop %s%s, error %s %%, %s",
             state.station,
@@ -67,7 +76,7 @@ class StationRuns:
         """Feed a sample to its run; the events, intensities and decision it produced."""
         run = self._runs.get(sample.run_id)
         if run is None:
-            self.dropped_samples += 1
+            self.counts.samples_without_run += 1
             return []
         return run.on_sample(sample, wall_ns)
 
@@ -75,14 +84,14 @@ class StationRuns:
         if state.run_id in self._runs:
             return
         if state.run_id in self._started:  # a run id starts once, however its state flips
-            self.repeated_runs += 1
+            self.counts.repeated_runs += 1
             return
         self._started.append(state.run_id)
         self._forget_unfinished_runs()
         try:
             program = self.served.program(state.program_id)
         except KeyError as err:
-            LOG.error("run %s: %s; not predicting this run", state.run_id, err.args[0])
+            self._log_no_program("run %s: %s; not predicting this run", state.run_id, err.args[0])
             return
         self._runs[state.run_id] = ActiveRun(state, program, self.served.settings(program))
         LOG.debug("%s run %s started (program %s)", state.station, state.run_id, program.id)
@@ -91,8 +100,9 @@ class StationRuns:
         """A new run starts: the older ones have ended, unheard (an outage)."""
         for run_id, run in list(self._runs.items()):
             del self._runs[run_id]
-            self.unfinished_runs += 1
-            LOG.warning(
+            self.counts.unfinished_runs += 1
+            self.counts.run_ended(run.core.input_report)
+            self._log_unfinished(
                 "%s run %s: its end never arrived (network outage?); no summary, %s",
                 run.state.station,
                 run_id,

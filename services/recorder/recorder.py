@@ -1,8 +1,10 @@
 """The recorder's logic, free of zenoh: received payloads in, MCAP files out.
 
 :class:`Recorder` keeps one :class:`StationFiles` per station seen (the
-recorder subscribes to the whole line), counts payloads that do not decode
-(logged once per key, still recorded raw) and is driven by a clock tick so
+recorder subscribes to the whole line), counts per station the payloads it
+refused (:mod:`.incoming`: still recorded raw) and those on keys that are no
+message of ours (logged once, then at most every 10 s: a flood of bad
+payloads is never a line per message) and is driven by a clock tick so
 files are flushed even when nothing arrives.
 
 Recording is not on the stop path: a disk that fails under it (full,
@@ -28,6 +30,7 @@ from typing import TYPE_CHECKING
 from services.recorder.file_metadata import FileMetadata
 from services.recorder.incoming import Received
 from services.recorder.run_files import FileLimits, StationFiles
+from shared.log_limit import RateLimitedLog
 
 if TYPE_CHECKING:
     from services.recorder.rerun_sink import RerunOptions
@@ -61,8 +64,10 @@ class Recorder:
         self._metadata = metadata
         self._stations: dict[str, StationFiles] = {}
         self.messages = 0
-        self.undecodable: Counter[str] = Counter()
-        self.unknown_keys: Counter[str] = Counter()
+        self.refused: Counter[str] = Counter()  # per station: refused payloads, recorded raw
+        self.unknown_keys: Counter[str] = Counter()  # per station: not a message key, raw
+        self._log_refused = RateLimitedLog(LOG)
+        self._log_unknown = RateLimitedLog(LOG)
         self.write_errors = 0  # OSErrors met on open/write/flush/close
         self.last_write_error: str | None = None
         self.recording_ok = True
@@ -80,9 +85,17 @@ class Recorder:
             )
             self._stations[received.station] = files
         if not received.decodable:
-            self._count(self.undecodable, received, "does not decode as %s")
+            self.refused[received.station] += 1
+            self._log_refused(
+                "payload on %s refused, recorded raw (#%d of %s): %s",
+                received.key,
+                self.refused[received.station],
+                received.station,
+                received.problem,
+            )
         elif received.schema_name is None:
-            self._count(self.unknown_keys, received, "is not a boltwatch message key%s")
+            self.unknown_keys[received.station] += 1
+            self._log_unknown("%s is not a boltwatch message key; recording it raw", received.key)
         self.messages += 1
         now_ns = received.log_time_ns
         waiting = files.current is None and now_ns < self._retry_at_ns  # abandoned, not retried
@@ -117,8 +130,8 @@ class Recorder:
             except OSError as err:
                 self._fault(files, err, self._fault_started_ns, this_message_lost=False)
             closed.extend(files.closed_paths)
-        if self.undecodable:
-            LOG.warning("undecodable payloads, recorded raw: %s", dict(self.undecodable))
+        if self.refused:
+            LOG.warning("refused payloads per station, recorded raw: %s", dict(self.refused))
         if self.dropped_messages:
             LOG.error(
                 "%d messages were not recorded because writing failed (last: %s); "
@@ -184,12 +197,3 @@ class Recorder:
             (now_ns - self._fault_started_ns) / 1e9,
             self._fault_dropped,
         )
-
-    def _count(self, counter: Counter[str], received: Received, what: str) -> None:
-        if counter[received.key] == 0:
-            LOG.warning(
-                "payload on %s " + what + "; recording it raw (logged once per key)",
-                received.key,
-                received.schema_name or "",
-            )
-        counter[received.key] += 1

@@ -7,6 +7,9 @@ recorder falling behind shows here before it loses anything. Each report
 covers the samples since the previous report (about one second); a station
 that sent no samples has no lag (None), not zero.
 
+``bad_payloads`` counts the payloads on a message key that the recorder
+refused (see :mod:`services.recorder.incoming`) and recorded raw.
+
 Write health (``write_errors``, ``last_error``, ``recording``) is read from
 the :class:`~services.recorder.recorder.Recorder`'s ``write_errors``,
 ``last_write_error`` and ``recording_ok`` attributes; until the Recorder
@@ -49,6 +52,7 @@ class _StationCounts:
     acquisition_started_ns: int | None = None  # BusStats.started_ns of the counted process
     missing_before_restart: int = 0  # missing samples of earlier acquisition processes
     missing_samples: int = 0
+    bad_payloads: int = 0  # refused by the decoder, recorded raw
 
     def bus_stats(self, published: int, started_ns: int) -> None:
         """The acquisition started at ``started_ns`` has published ``published`` samples."""
@@ -77,15 +81,23 @@ class RecorderHealth:
         return list(self._stations)
 
     def written(
-        self, station: str, received_ns: int, sample_time_ns: int | None, is_sample: bool = False
+        self,
+        station: str,
+        received_ns: int,
+        sample_time_ns: int | None,
+        is_sample: bool = False,
+        refused: bool = False,
     ) -> None:
         """One message of ``station`` written; a Sample's time when it decoded.
 
         ``is_sample``: it came on the samples key, decodable or not (an
         undecodable one is recorded raw: received, so not missing).
+        ``refused``: a payload on a message key the decoder refused (raw).
         """
         counts = self._counts(station)
         counts.messages += 1
+        if refused:
+            counts.bad_payloads += 1
         if is_sample:
             counts.samples_received += 1
         if sample_time_ns is not None:
@@ -137,6 +149,7 @@ class RecorderHealth:
                     missing_samples=counts.missing_samples,
                     refused_summaries=refused.get(station, 0),
                     waiting_summaries=waiting_summaries,
+                    bad_payloads=counts.bad_payloads,
                 )
             )
         return out

@@ -139,8 +139,12 @@ class StationFiles:
         companion = self._rerun_sinks.get(sink)
         if companion is not None:
             companion.write(received)
-        if sink is self.current and received.schema_name == "boltwatch.ToolState":
-            self._run_ended = received.message.state in _ENDED_STATES
+        if (
+            sink is self.current
+            and received.schema_name == "boltwatch.ToolState"
+            and received.message
+        ):
+            self._run_ended = received.message.state in _ENDED_STATES  # a refused one is raw
         if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
             self.flush(now_ns)
 

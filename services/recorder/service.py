@@ -13,7 +13,9 @@ One process serves several stations (``--config A.toml B.toml``): each
 served station gets its metadata from its own file, its own ``wear``
 queryable and its own health token; they share the recordings folder and
 the ``[recorder]`` settings (an error when the files disagree). Messages of
-a station with no file are recorded too, with minimal metadata.
+a station with no file are recorded too, with minimal metadata. No payload
+stops it: what it refuses (:mod:`services.recorder.incoming`) is recorded
+raw and counted in the station's ``RecorderStats.bad_payloads``.
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
@@ -50,6 +52,7 @@ from shared import keys
 from shared.codec import encode
 from shared.config import LoadedStation, load_line
 from shared.errors import ConfigError
+from shared.message_fields import MAX_TEXT_CHARS
 from shared.messages import RecorderStats
 from shared.service_runtime import ServiceRunner
 from shared.zenoh_session import open_session
@@ -120,6 +123,7 @@ class RecorderService:
         rerun = rerun_options(rerun_files, rerun_live_url)
         metadata = FileMetadata(stations)
         self.station_ids = metadata.station_ids
+        self._sensor_ranges = {station.station_id: station.sensor_range for station in stations}
         self.recorder = Recorder(first.recordings_folder, limits_of(first), metadata, rerun)
         self.health = RecorderHealth(self.station_ids)
         self._ledger_file = ledger_path(first.recordings_folder)
@@ -200,6 +204,8 @@ class RecorderService:
         last_error = recorder.last_write_error or (
             f"wear ledger: {wear.last_ledger_error}" if wear and wear.last_ledger_error else None
         )
+        if last_error is not None:
+            last_error = last_error[:MAX_TEXT_CHARS]  # a long path must not make it unreadable
         return self.health.report(
             now_ns,
             write_errors,
@@ -216,14 +222,16 @@ class RecorderService:
 
     def _handle(self, key: str, payload: bytes, now_ns: int, filed_ns: int) -> None:
         """File one message received at ``now_ns`` (its MCAP log time) at ``filed_ns``."""
-        received = classify(key, payload, now_ns)
+        received = classify(key, payload, now_ns, self._sensor_ranges)
         self.recorder.write(received)
         if received.station != OTHER_STATION:
             is_sample = received.schema_name == _SAMPLE
             sample_time_ns = (
                 received.publish_time_ns if is_sample and received.message is not None else None
             )
-            self.health.written(received.station, filed_ns, sample_time_ns, is_sample)
+            self.health.written(
+                received.station, filed_ns, sample_time_ns, is_sample, not received.decodable
+            )
             if received.schema_name == _BUS_STATS and received.message is not None:
                 bus = received.message
                 self.health.bus_stats(received.station, bus.samples, bus.started_ns)
@@ -263,7 +271,10 @@ class RecorderService:
 
     def _wear_replier(self, station: str) -> Callable[[zenoh.Query], None]:
         def reply(query: zenoh.Query) -> None:
-            self._reply_wear(station, query)
+            # finalized on leaving (the querier's get ends now), not when the Query is freed:
+            # an error's traceback, kept by a log record, would keep it until its timeout
+            with query:
+                self._reply_wear(station, query)
 
         return reply
 

@@ -8,9 +8,9 @@ may declare subscribers, queryables and liveliness tokens under
 ``boltwatch/**`` and receive what is published there; only
 
 - ``<st>-acquisition`` may put ``boltwatch/<st>/samples``, ``tool``, ``bus``
-  and the predictor's keys ``events``, ``intensity``, ``decision``, ``runs``
-  (it hosts the station's predictor: ``[predictor] placement = "edge"``, the
-  default),
+  and the predictor's keys ``events``, ``intensity``, ``decision``, ``runs``,
+  ``predictor`` (its stats) (it hosts the station's predictor:
+  ``[predictor] placement = "edge"``, the default),
 - ``<st>-predictor`` may put the predictor's keys (a line predictor,
   ``boltwatch serve predictor`` for a station with ``placement = "line"``),
 - ``line-recorder`` may put ``boltwatch/<st>/recorder`` and ``wear/**``.
@@ -35,7 +35,7 @@ from typing import Any
 from shared import keys
 
 ACQUISITION_TOPICS = (keys.SAMPLES, keys.TOOL, keys.BUS)
-PREDICTOR_TOPICS = (keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS)
+PREDICTOR_TOPICS = (keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS, keys.PREDICTOR)
 RECORDER_TOPICS = (keys.RECORDER, keys.WEAR, f"{keys.WEAR}/**")
 LINE_OBSERVERS = ("line-recorder", "line-viewer", "line-monitor")
 

@@ -2,14 +2,17 @@
 
 Run on demand (not collected by pytest)::
 
-    .venv/bin/python tests/benchmarks/bench_line_decode.py [--repeats 7]
+    git worktree add /tmp/before 9ac095d     # the code to compare with
+    .venv/bin/python tests/benchmarks/bench_line_decode.py --before /tmp/before [--repeats 7]
 
-- predictor: ``codec.decode(Sample, payload)`` (JSON -> dict -> ``Sample(**d)``,
-  no type check) against ``codec.decoder(Sample)`` (every field's JSON type
-  checked, the dataclass built positionally, ``json.loads`` without the
-  encoding sniffing);
-- recorder: :func:`classify` as it was (``codec.decode`` for every topic)
-  against the current one (the checking decoder for flat types);
+- predictor: ``codec.decoder(Sample)`` of the ``--before`` checkout (its
+  ``shared/codec.py``; at 9ac095d: every field's JSON type checked, no
+  bounds) against this one (types, every field's bounds, payload size and
+  nesting); without ``--before``, ``codec.decode`` of this checkout (the
+  general decoder) stands in;
+- recorder: :func:`classify` of a sample as at 9ac095d (the ``--before``
+  decoder, no time window, no sensor range) against the current one (the
+  bounded decoder, the time window and the station's sensor range);
 - predictor, per stick-slip event: ``codec.encode`` of a StickSlipEvent and
   an Intensity as it was (``dataclasses.is_dataclass`` on every field, a
   ``json.dumps`` encoder per call) against the current one.
@@ -22,11 +25,13 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import importlib.util
 import json
 import statistics
 import sys
 import time
-from collections.abc import Callable
+import typing
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -44,10 +49,11 @@ from services.recorder.incoming import (  # noqa: E402
 from shared import codec, keys  # noqa: E402
 from shared.errors import InputError  # noqa: E402
 from shared.messages import Intensity, Prediction, Sample, StickSlipEvent  # noqa: E402
+from shared.sensor_range import SensorRange  # noqa: E402
 
 CALLS = 100_000
 PAYLOAD = (
-    b'{"station":"st12","run_id":1712345678001,"sequence":512,"time_ns":1712345678123456789,'
+    b'{"station":"st12","run_id":1712345678,"sequence":512,"time_ns":1712345678123456789,'
     b'"torque_nm":123.45678912345,"angle_deg":45.678912345678,"force_n":30123.456789012}'
 )
 KEY = "boltwatch/st12/samples"
@@ -79,8 +85,14 @@ def encode_as_before(message: Any) -> bytes:
     return json.dumps(to_dict_as_before(message), separators=(",", ":")).encode()
 
 
-def classify_as_before(key: str, payload: bytes, log_time_ns: int) -> Received:
-    """classify() before this change: codec.decode of every recorded type."""
+def classify_as_before(
+    key: str,
+    payload: bytes,
+    log_time_ns: int,
+    sensor_ranges: Mapping[str, SensorRange] | None = None,
+) -> Received:
+    """classify() two changes ago: codec.decode of every recorded type, no time window
+    (bench_line_inbox.py's ``recorder-classify-before``)."""
     try:
         station, topic = keys.split_key(key)
     except ValueError:
@@ -97,6 +109,24 @@ def classify_as_before(key: str, payload: bytes, log_time_ns: int) -> Received:
     return Received(key, station, schema_name, message, payload, log_time_ns, publish_time_ns)
 
 
+def classify_sample_with(
+    decode_sample: Callable[[bytes], Any],
+) -> Callable[[str, bytes, int], Received]:
+    """classify() of a sample as at 9ac095d, with ``decode_sample`` (no window, no range)."""
+
+    def classify_sample(key: str, payload: bytes, log_time_ns: int) -> Received:
+        station, topic = keys.split_key(key)
+        try:
+            message = decode_sample(payload)
+        except InputError:
+            return Received(key, station, TOPIC_TYPES[topic], None, payload, log_time_ns, 0)
+        return Received(
+            key, station, TOPIC_TYPES[topic], message, payload, log_time_ns, message.time_ns
+        )
+
+    return classify_sample
+
+
 def us_per_call(call: Callable[[], object], repeats: int) -> float:
     times = []
     for _ in range(repeats):
@@ -107,22 +137,40 @@ def us_per_call(call: Callable[[], object], repeats: int) -> float:
     return statistics.median(times)
 
 
+def decoder_of_checkout(checkout: Path) -> Callable[[bytes], Any]:
+    """``codec.decoder(Sample)`` of another checkout's ``shared/codec.py`` (loaded under
+    another module name; what it imports comes from this checkout)."""
+    spec = importlib.util.spec_from_file_location("codec_before", checkout / "shared/codec.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return typing.cast(Callable[[bytes], Any], module.decoder(Sample))
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--repeats", type=int, default=7)
+    parser.add_argument("--before", type=Path, help="a checkout of the code to compare with")
     args = parser.parse_args(argv)
     decode_sample = codec.decoder(Sample)
-    assert decode_sample(PAYLOAD) == codec.decode(Sample, PAYLOAD)
-    assert classify(KEY, PAYLOAD, 1) == classify_as_before(KEY, PAYLOAD, 1)
+    decode_before: Callable[[bytes], Any] = (
+        decoder_of_checkout(args.before)
+        if args.before is not None
+        else lambda payload: codec.decode(Sample, payload)
+    )
+    log_time_ns = 1712345678123456789 + 1_000_000
+    classify_before = classify_sample_with(decode_before)
+    assert decode_sample(PAYLOAD) == decode_before(PAYLOAD)
+    assert classify(KEY, PAYLOAD, log_time_ns) == classify_before(KEY, PAYLOAD, log_time_ns)
     assert codec.encode(EVENT) == encode_as_before(EVENT)
     pairs = {
         "predictor: decode a Sample": (
-            lambda: codec.decode(Sample, PAYLOAD),
+            lambda: decode_before(PAYLOAD),
             lambda: decode_sample(PAYLOAD),
         ),
         "recorder: classify a Sample": (
-            lambda: classify_as_before(KEY, PAYLOAD, 1),
-            lambda: classify(KEY, PAYLOAD, 1),
+            lambda: classify_before(KEY, PAYLOAD, log_time_ns),
+            lambda: classify(KEY, PAYLOAD, log_time_ns),
         ),
         "predictor: encode a StickSlipEvent and its Intensity": (
             lambda: (encode_as_before(EVENT), encode_as_before(INTENSITY)),

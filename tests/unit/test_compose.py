@@ -144,7 +144,7 @@ def test_dockerfile_installs_the_package_and_runs_the_cli() -> None:
 # -- docker-compose.tls.yml over docker-compose.yml: mutual TLS, one identity per container --
 
 TLS_TEXT = TLS_FILE.read_text()
-PREDICTOR_PUTS = {keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS}
+PREDICTOR_PUTS = {keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS, keys.PREDICTOR}
 ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), per station
     # the acquisition hosts the station's predictor (placement "edge") and publishes for it
     "acquisition": {keys.SAMPLES, keys.TOOL, keys.BUS} | PREDICTOR_PUTS,

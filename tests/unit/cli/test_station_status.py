@@ -11,6 +11,7 @@ from shared import keys
 from shared.codec import encode
 from shared.messages import (
     BusStats,
+    PredictorStats,
     RecorderStats,
     RunSummary,
     Sample,
@@ -350,3 +351,31 @@ def test_summaries_the_wear_ledger_refused_show() -> None:
     text = format_report(report)
     assert "0 write errors, 2 run summaries refused by the wear ledger, " in text
     assert to_json(report)["stations"]["st1"]["recorder"]["refused_summaries"] == 2
+
+
+def test_what_each_service_refused_is_shown() -> None:
+    """Bad decisions (BusStats), the predictor's bad payloads and samples (PredictorStats),
+    the recorder's refused payloads (RecorderStats): counted where they were refused."""
+    collector = StatusCollector()
+    feed(collector, keys.BUS, bus(T0, samples=10, bad_decisions=4))
+    feed(collector, keys.RECORDER, recorder_stats(T0, bad_payloads=17))
+    stats = PredictorStats("st1", T0, T0 - 60 * S, 5, 2, 1, 0, 0)
+    feed(collector, keys.PREDICTOR, stats, at_ns=T0 - S)
+
+    report = collector.report("e", 2.0, T0)
+    (status,) = report.stations
+
+    assert status.bus is not None and status.bus.bad_decisions == 4
+    assert status.recorder is not None and status.recorder.bad_payloads == 17
+    assert status.predictor is not None
+    assert (status.predictor.bad_payloads, status.predictor.bad_samples) == (5, 2)
+    text = format_report(report)
+    assert "0 late decisions, 4 bad decisions" in text
+    assert "predictor     5 bad payloads, 2 bad samples, 1 samples without a run, " in text
+    assert "0 unfinished runs (1.0 s ago)" in text
+    assert "17 bad payloads" in text
+    assert to_json(report)["stations"]["st1"]["predictor"]["bad_samples"] == 2
+    quiet = StatusCollector()
+    feed(quiet, keys.BUS, bus(T0, samples=1))
+    text = format_report(quiet.report("e", 2.0, T0))
+    assert "predictor     - (no predictor stats in the window" in text

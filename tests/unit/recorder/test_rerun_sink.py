@@ -19,7 +19,10 @@ from typing import Any
 
 import pytest
 from rerun.chunk import RrdReader
-from test_recording import run_messages  # type: ignore[import-not-found]  # sibling test module
+from test_recording import (  # type: ignore[import-not-found]  # sibling test module
+    T0_NS,
+    run_messages,
+)
 
 from services.cli.station_supervisor import stop_process
 from services.recorder import rerun_blueprint as bp
@@ -64,8 +67,10 @@ def station(tmp_path: Path) -> LoadedStation:
 
 
 def received(run_id: int, items: list[tuple[str, Any]], t0_ns: int = 0) -> list[Received]:
+    """The run's messages as received from ``T0_NS + t0_ns`` on, one a millisecond (messages
+    ahead of their arrival by more than a few minutes would be refused)."""
     return [
-        classify(keys.station_key("st1", topic), encode(message), t0_ns + n * 1_000_000)
+        classify(keys.station_key("st1", topic), encode(message), T0_NS + t0_ns + n * 1_000_000)
         for n, (topic, message) in enumerate(items)
     ]
 
@@ -138,15 +143,15 @@ def test_a_failing_rerun_sink_leaves_the_mcap_file_whole(
     loaded = station(tmp_path)
     limits = FileLimits(1_000_000_000, 1 << 30, 3600 * 1_000_000_000)
     # The run's .rrd path is taken by a directory: Rerun cannot create the file.
-    day = loaded.recordings_folder / "st1" / "1970-01-01"
-    (day / "st1_run1_000000.rrd").mkdir(parents=True)
+    day = loaded.recordings_folder / "st1" / "2023-11-14"  # T0_NS is 2023-11-14T22:13:20Z
+    (day / "st1_run1_221320.rrd").mkdir(parents=True)
     recorder = Recorder(loaded.recordings_folder, limits, FileMetadata(loaded), RerunOptions())
     items = received(1, run_messages(1, 300))
     for item in items:
         recorder.write(item)
     (mcap,) = recorder.close()
 
-    assert mcap == day / "st1_run1_000000.mcap"
+    assert mcap == day / "st1_run1_221320.mcap"
     assert recorder.messages == len(items)
     assert any("Rerun" in record.getMessage() for record in caplog.records)
     from mcap.reader import make_reader

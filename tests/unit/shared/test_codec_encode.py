@@ -14,6 +14,7 @@ import math
 import pytest
 
 from shared import codec
+from shared.errors import InputError
 from shared.messages import Intensity, Prediction, Sample, StickSlipEvent
 
 EVENT = StickSlipEvent(
@@ -38,10 +39,17 @@ def test_encode_is_json_dumps_of_asdict(message: object) -> None:
     assert codec.decode(type(message), codec.encode(message)) == message
 
 
-def test_nan_is_written_as_json_nan_and_read_back() -> None:
+def test_nan_is_written_as_json_nan_and_read_back_where_a_value_may_be_nan() -> None:
+    """A sample's measured values may be anything the bus said (the predictor judges them);
+    a figure such as an intensity must be finite: the decoder refuses a NaN one."""
+    sample = Sample("st1", 1, 2, 3, math.nan, 5.0, math.inf)
+    assert b'"torque_nm":NaN' in codec.encode(sample)
+    decoded = codec.decode(Sample, codec.encode(sample))
+    assert math.isnan(decoded.torque_nm) and decoded.force_n == math.inf
     message = Intensity("st1", 5, 1, math.nan, 1.2)
     assert b'"event_intensity":NaN' in codec.encode(message)
-    assert math.isnan(codec.decode(Intensity, codec.encode(message)).event_intensity)
+    with pytest.raises(InputError, match="event_intensity is nan, expected a finite number"):
+        codec.decode(Intensity, codec.encode(message))
 
 
 def test_to_dict_nests_predictions() -> None:
