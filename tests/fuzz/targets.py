@@ -318,7 +318,20 @@ class RecorderTarget(_Target):
         ]
         good.append(("tool", ToolState(self.station, self.run_id, 3, 1, "done", now + 20)))
         summary = template(keys.RUNS, self.station, now + 20, self.run_id)
-        good.append((keys.RUNS, replace(summary, tool_id=TOOL_ID, process_intensity=1.5)))
+        good.append(  # a summary the wear ledger takes: within what its run can carry
+            (
+                keys.RUNS,
+                replace(
+                    summary,
+                    tool_id=TOOL_ID,
+                    process_intensity=1.5,
+                    events=5,
+                    samples=20,
+                    started_ns=now,
+                    ended_ns=now + 1_000_000_000,
+                ),
+            )
+        )
         for channel, message in good:
             self.send(channel, encode(message))
         wait_until(lambda: self.recorded() == self.sent, "the good run recorded", WAIT_S)
