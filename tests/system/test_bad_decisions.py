@@ -51,7 +51,7 @@ class Station:
 @pytest.fixture
 def station(tmp_path: Path) -> Iterator[Station]:
     port = free_tcp_port()
-    path = write_station(tmp_path, zenoh_port=port)
+    path = write_station(tmp_path, zenoh_port=port, placement="line")  # decisions from zenoh
     config = load_station(path)
     endpoint = f"tcp/127.0.0.1:{port}"
     log = tmp_path / "acquisition.log"
