@@ -132,6 +132,8 @@ class WearWatch:
         if now_ns < self._check_at_ns:
             return
         self._check_at_ns = now_ns + CHECK_INTERVAL_NS
+        if self._ledger is None and not self._pending and not self._ledger_file.exists():
+            return  # no ledger yet and nothing to count: made by the first summary
         self._write(now_ns, count_errors=False)
         if self.last_ledger_error is not None and now_ns >= self._remind_at_ns:
             self._remind_at_ns = now_ns + REMINDER_INTERVAL_NS
