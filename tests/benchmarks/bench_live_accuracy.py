@@ -44,9 +44,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import math
-import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import threading
@@ -91,11 +89,11 @@ from tests.benchmarks.bench_predictor_accuracy import (  # noqa: E402
     stats,
     torque_error,
 )
+from tests.benchmarks.bench_stop_path import serve_from, wait_alive  # noqa: E402
 from tests.benchmarks.joint_files import joint_toml  # noqa: E402
 from tests.system.station_files import write_station  # noqa: E402
 
 STATION = "st1"
-START_TIMEOUT_S = 30.0
 #: the contract DBC's ranges: the drawn programs' limits are held inside them
 MAX_TORQUE_NM = 8000.0
 MAX_ANGLE_DEG = 80_000.0
@@ -169,29 +167,6 @@ class Heard:
             elif topic == keys.RUNS:
                 summary = decode(RunSummary, sample.payload.to_bytes())
                 self.summaries[summary.run_id] = summary
-
-
-def serve(args: list[str], log: Path) -> subprocess.Popen[bytes]:
-    with log.open("ab") as out:
-        return subprocess.Popen(
-            [sys.executable, "-m", "services.cli", "serve", *args],
-            cwd=REPO,
-            env={**os.environ, "PYTHONPATH": str(REPO)},
-            stdout=out,
-            stderr=subprocess.STDOUT,
-        )
-
-
-def wait_alive(session: zenoh.Session, folder: Path) -> None:
-    deadline = time.monotonic() + START_TIMEOUT_S
-    missing = {"recorder", "acquisition", "predictor"}
-    while missing:
-        for reply in session.liveliness().get(keys.health_key(STATION, "*")):
-            if reply.ok is not None:
-                missing.discard(str(reply.ok.key_expr).rsplit("/", 1)[-1])
-        if time.monotonic() > deadline:
-            raise SystemExit(f"not alive after {START_TIMEOUT_S:.0f} s: {missing} (logs {folder})")
-        time.sleep(0.1)
 
 
 def tighten_live(
@@ -307,7 +282,7 @@ def measure(args: argparse.Namespace, joints: list[Joint], folder: Path) -> int:
     station_file = write_files(folder, joints, args.placement, args.torque_only)
     station = load_station(station_file)
     endpoint = station.config.zenoh.connect[0]
-    processes = [serve(["router", "--listen", endpoint], folder / "router.log")]
+    processes = [serve_from(REPO, ["router", "--listen", endpoint], folder / "router.log")]
     heard = Heard()
     started = time.monotonic()
     try:
@@ -315,12 +290,14 @@ def measure(args: argparse.Namespace, joints: list[Joint], folder: Path) -> int:
         for name in names:
             extra = ["--no-rerun"] if name == "recorder" else []
             processes.append(
-                serve([name, "--config", str(station_file), *extra], folder / f"{name}.log")
+                serve_from(
+                    REPO, [name, "--config", str(station_file), *extra], folder / f"{name}.log"
+                )
             )
         with zenoh.open(zenoh_config("client", [endpoint])) as session:
             subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard.on_sample)
             try:
-                wait_alive(session, folder)
+                wait_alive(session, STATION, [folder])
                 live_runs = tighten_live(station_file, joints, heard, folder, args.torque_only)
             finally:
                 subscriber.undeclare()
