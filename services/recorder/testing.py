@@ -16,6 +16,8 @@ from typing import Any
 import zenoh
 
 from services.recorder.service import RecorderService
+from shared import keys
+from shared.codec import encode
 from shared.config import LoadedStation
 from shared.zenoh_session import open_session
 
@@ -43,6 +45,23 @@ def has_subscribers(publisher: zenoh.Publisher) -> bool:
     """
     status: Any = publisher.matching_status
     return bool(getattr(status, "matching", status))
+
+
+def publish(session: zenoh.Session, items: Sequence[tuple[str, Any]], station: str = "st1") -> int:
+    """Put every ``(topic, message)`` on ``boltwatch/<station>/<topic>`` in order, once a
+    subscriber matches each topic, none dropped (BLOCK); a bytes message goes as it is."""
+    publishers = {
+        topic: session.declare_publisher(
+            keys.station_key(station, topic), congestion_control=zenoh.CongestionControl.BLOCK
+        )
+        for topic in {topic for topic, _ in items}
+    }
+    wait_until(lambda: all(has_subscribers(p) for p in publishers.values()), "the recorder")
+    for topic, message in items:
+        publishers[topic].put(message if isinstance(message, bytes) else encode(message))
+    for publisher in publishers.values():
+        publisher.undeclare()
+    return len(items)
 
 
 class RunningRecorder:

@@ -147,7 +147,7 @@ class LiveStation:
         self.can = CanWatch(self.loaded)
         endpoint = self.loaded.config.zenoh.connect[0]
         self.supervisor.start("router", ["--listen", endpoint])
-        self.session = self._open_session(endpoint)
+        self.session = open_client(endpoint)
         self._subscriber = self.session.declare_subscriber(
             keys.station_key(STATION, "*"), self.heard.on_sample
         )
@@ -223,16 +223,6 @@ class LiveStation:
                 return run.run_id
         return None
 
-    def _open_session(self, endpoint: str) -> zenoh.Session:
-        deadline = time.monotonic() + START_TIMEOUT_S
-        while True:
-            try:
-                return open_from(zenoh_config("client", [endpoint], connect_timeout_ms=500))
-            except TransportError:
-                if time.monotonic() > deadline:
-                    raise
-                time.sleep(0.1)
-
     def close(self) -> None:
         """Stop the rig first, the recorder last (so its files are complete), then the rest."""
         with contextlib.suppress(zenoh.ZError):
@@ -247,6 +237,18 @@ class LiveStation:
         ]
         self.supervisor.stop_all([*order, "router"])
         self.can.close()
+
+
+def open_client(endpoint: str) -> zenoh.Session:
+    """A client session to the router at ``endpoint``, retried while the router starts."""
+    deadline = time.monotonic() + START_TIMEOUT_S
+    while True:
+        try:
+            return open_from(zenoh_config("client", [endpoint], connect_timeout_ms=500))
+        except TransportError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.1)
 
 
 @contextlib.contextmanager

@@ -17,14 +17,12 @@ import time
 from pathlib import Path
 
 import pytest
-import zenoh
 
 from shared import keys
 from shared.codec import encode
-from shared.errors import TransportError
 from shared.messages import RunSummary
-from shared.zenoh_session import open_from, zenoh_config
 from tests.paths import REPO
+from tests.system.live_station import open_client
 from tests.system.station_files import write_station
 from tests.system.test_station_up import UP_TIMEOUT_S, read_recordings, start_up, wait_for_first_run
 
@@ -41,17 +39,6 @@ def forged(run_id: int, intensity: float) -> bytes:
             intensity, 1700, now - 1_700_000_000, now,
         )
     )  # fmt: skip
-
-
-def open_client(endpoint: str) -> zenoh.Session:
-    deadline = time.monotonic() + 30
-    while True:
-        try:
-            return open_from(zenoh_config("client", [endpoint], connect_timeout_ms=500))
-        except TransportError:
-            if time.monotonic() > deadline:
-                raise
-            time.sleep(0.2)
 
 
 def test_a_forged_summary_is_neither_a_run_of_up_nor_wear_in_the_ledger(tmp_path: Path) -> None:

@@ -26,11 +26,11 @@ import pytest
 import zenoh
 
 from services.cli.main import main
-from services.recorder.testing import RunningRecorder, has_subscribers, wait_until
+from services.recorder.testing import RunningRecorder, publish, wait_until
 from services.recorder.wear_bound import CONTRACT_LIMITS
 from services.recorder.wear_ledger import WearLedger
 from shared import keys
-from shared.codec import decode, encode
+from shared.codec import decode
 from shared.config import LoadedStation
 from shared.messages import RecorderStats, RunSummary, Sample, ToolState
 from shared.zenoh_session import zenoh_config
@@ -55,18 +55,6 @@ def run_messages(run_id: int) -> list[tuple[str, Any]]:
         0.5 * run_id, SAMPLES, t, end,
     )  # fmt: skip
     return [*out, ("runs", summary)]
-
-
-def publish(session: zenoh.Session, items: list[tuple[str, Any]]) -> None:
-    publishers = {
-        topic: session.declare_publisher(keys.station_key("st1", topic))
-        for topic in {topic for topic, _ in items}
-    }
-    wait_until(lambda: all(has_subscribers(p) for p in publishers.values()), "the recorder")
-    for topic, message in items:
-        publishers[topic].put(encode(message))
-    for publisher in publishers.values():
-        publisher.undeclare()
 
 
 def healthy_ledger(path: Path, runs: int = 3) -> None:

@@ -22,12 +22,12 @@ from services.recorder.mcap_sink import RAW_ENCODING, RAW_REASON
 from services.recorder.service import RecorderService
 from services.recorder.testing import (
     RunningRecorder,
-    has_subscribers,
+    publish,
     wait_until,
     write_station_file,
 )
 from shared import keys
-from shared.codec import encode, json_schema
+from shared.codec import json_schema
 from shared.config import LoadedStation, load_station
 from shared.messages import (
     Intensity,
@@ -119,19 +119,6 @@ def run_messages(run_id: int, samples: int) -> list[tuple[str, Any]]:
         )
     )
     return out
-
-
-def publish(session: zenoh.Session, items: list[tuple[str, Any]]) -> int:
-    publishers = {
-        topic: session.declare_publisher(keys.station_key("st1", topic))
-        for topic in {topic for topic, _ in items}
-    }
-    wait_until(lambda: all(has_subscribers(p) for p in publishers.values()), "the recorder")
-    for topic, message in items:
-        publishers[topic].put(message if isinstance(message, bytes) else encode(message))
-    for publisher in publishers.values():
-        publisher.undeclare()
-    return len(items)
 
 
 def recorded_files(loaded: LoadedStation) -> list[Path]:
@@ -245,7 +232,7 @@ def test_one_recorder_serves_several_station_files(
         sent = 0
         for name, tool_id in (("st1", 7), ("st2", 8), ("st3", 9)):
             items = [(topic, at_station(m, name, tool_id)) for topic, m in run_messages(5, 20)]
-            sent += publish_at(client, name, items)
+            sent += publish(client, items, station=name)
         wait_until(lambda: service.recorder.messages == sent, "every message recorded")
         per_station = len(run_messages(5, 20))
         wait_until(
@@ -307,19 +294,6 @@ def serving(service: RecorderService, session: zenoh.Session) -> Iterator[Record
         session.close()
 
 
-def publish_at(session: zenoh.Session, station: str, items: list[tuple[str, Any]]) -> int:
-    publishers = {
-        topic: session.declare_publisher(keys.station_key(station, topic))
-        for topic in {topic for topic, _ in items}
-    }
-    wait_until(lambda: all(has_subscribers(p) for p in publishers.values()), "the recorder")
-    for topic, message in items:
-        publishers[topic].put(encode(message))
-    for publisher in publishers.values():
-        publisher.undeclare()
-    return len(items)
-
-
 def test_a_view_only_recorder_takes_none_of_the_line_recorders_duties(
     tmp_path: Path, endpoint: str
 ) -> None:
@@ -339,7 +313,7 @@ def test_a_view_only_recorder_takes_none_of_the_line_recorders_duties(
         assert [str(r.ok.key_expr) for r in tokens if r.ok is not None] == [
             "boltwatch/st1/health/viewer"
         ]
-        sent = publish_at(client, "st1", run_messages(5, 20))
+        sent = publish(client, run_messages(5, 20))
         wait_until(lambda: service.recorder.messages == sent, "every message recorded")
         time.sleep(2.5)  # two RecorderStats periods: a line recorder would have published
         assert stats == []

@@ -21,7 +21,7 @@ from mcap.reader import make_reader
 from test_recording import recorded_files  # type: ignore[import-not-found]
 
 from services.recorder.mcap_sink import RAW_ENCODING
-from services.recorder.testing import RunningRecorder, has_subscribers, wait_until
+from services.recorder.testing import RunningRecorder, publish, wait_until
 from shared import keys
 from shared.codec import encode
 from shared.config import LoadedStation
@@ -47,22 +47,6 @@ def live_run(t0_ns: int, samples: int) -> tuple[list[tuple[str, Any]], list[tupl
     rest = [("tool", ToolState("st1", RUN, 7, 1, "done", end_ns)), ("runs", summary)]
     half = samples // 2
     return start + rows[:half], rows[half:] + rest
-
-
-def publish(session: zenoh.Session, items: list[tuple[str, Any]]) -> int:
-    """Put every item on ``boltwatch/st1/<topic>``, in order, none dropped (BLOCK)."""
-    publishers = {
-        topic: session.declare_publisher(
-            keys.station_key("st1", topic), congestion_control=zenoh.CongestionControl.BLOCK
-        )
-        for topic in {topic for topic, _ in items}
-    }
-    wait_until(lambda: all(has_subscribers(p) for p in publishers.values()), "the recorder")
-    for topic, message in items:
-        publishers[topic].put(message if isinstance(message, bytes) else encode(message))
-    for publisher in publishers.values():
-        publisher.undeclare()
-    return len(items)
 
 
 def hostile(t0_ns: int) -> list[tuple[str, bytes]]:
