@@ -6,4 +6,7 @@
   to StopCommands, every fault counted), :mod:`.frame_decoder` (one frame against
   the DBC), :mod:`.pairing` (the two sensor frames of a sample, by Counter)
 - :mod:`.zenoh_outlet` (samples, run states and bus counters onto zenoh)
+- :mod:`.decider` (what may decide on the CAN thread, for the station's predictor
+  placed at the edge; the acquisition never imports the predictor, ``serve`` hands
+  it in)
 """

@@ -1,11 +1,14 @@
 """The ``boltwatch`` command line: the one place that knows every service.
 
-- :mod:`.main` (entry point), :mod:`.commands` (one module per subcommand),
-  :mod:`.command_options` (options several commands share)
+- :mod:`.main` (entry point; ``__main__`` for ``python -m services.cli``),
+  :mod:`.commands` (one module per subcommand), :mod:`.command_options` (options
+  several commands share), :mod:`.error_lines` (an OSError as one line naming the
+  path)
 - ``boltwatch up``: :mod:`.station_run`, :mod:`.station_supervisor`, :mod:`.run_table`,
   :mod:`.run_tally` (which summaries count: runs seen starting, once)
 - ``boltwatch status``: :mod:`.station_status`, :mod:`.station_status_text`
 - ``boltwatch import``: :mod:`.import_destination` (recordings or trace CSVs),
   :mod:`.controller_replay` (the predictor over an imported run: here, because
   the recorder may not import the predictor)
+- ``boltwatch predict``: :mod:`.predict_settings` (its options, or a station's program)
 """

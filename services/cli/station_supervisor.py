@@ -5,7 +5,9 @@ its own session (so a terminal Ctrl-C reaches only the supervisor, which then
 stops the services in order: the tool first, the recorder last, so that the
 recording holds everything). Each service logs to its own file. Processes
 that can stop at the same time (the rigs of a line, its acquisitions) are
-stopped as a group: signalled together, then waited for.
+stopped as a group: signalled together, then waited for. Should the supervisor
+itself be killed outright, each service gets SIGTERM from the kernel
+(:mod:`shared.supervisor_link`) and stops as it would on Ctrl-C.
 """
 
 from __future__ import annotations
@@ -20,6 +22,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from shared.supervisor_link import supervisor_environment
 
 LOG = logging.getLogger(__name__)
 
@@ -115,7 +119,7 @@ class StationSupervisor:
                 stdout=log,
                 stderr=subprocess.STDOUT,
                 start_new_session=True,
-                env={**os.environ, "PYTHONUNBUFFERED": "1"},
+                env={**os.environ, "PYTHONUNBUFFERED": "1", **supervisor_environment()},
             )
         managed = ManagedProcess(name, process, log_path)
         self.processes.append(managed)

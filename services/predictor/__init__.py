@@ -5,6 +5,10 @@
   :mod:`.served_station` (one station's configuration), :mod:`.active_run`
   (one run's core and summary), :mod:`.run_messages` (core outputs as messages,
   live and replayed alike), :mod:`.station_counts` (what it could not use, per
-  station: PredictorStats)
+  station: PredictorStats), :mod:`.station_runs` (one station's runs: states and
+  samples in, messages out, for both placements), :mod:`.station_refusal` (one
+  predictor per station)
+- :mod:`.edge_predictor`: the station's predictor on its acquisition's CAN thread
+  (``[predictor] placement = "edge"``, the default)
 - :mod:`.trace_replay`: the core over an offline trace (``boltwatch predict``)
 """

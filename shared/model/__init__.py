@@ -12,6 +12,9 @@ Model time t starts at the untwisted, unloaded joint (φ_m = φ̇_m · t); see
     characteristic_constants  K1-K3 and their bands                    eqs. 31-39
     resonance                 natural frequency of the extension       eq. 40
     joint_model               all of it for one joint and speed, over t
+
+and around it: ``envelope_check`` (measured events against the envelopes, Figs.
+13-15), ``report`` (what ``boltwatch model`` prints), ``figures`` (its plot).
 """
 
 from shared.model.characteristic_constants import (

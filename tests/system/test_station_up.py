@@ -182,3 +182,28 @@ def test_ctrl_c_stops_every_process_cleanly(tmp_path: Path) -> None:
     for path in (tmp_path / "recordings").rglob("*.mcap"):
         with path.open("rb") as handle:
             assert make_reader(handle).get_summary() is not None, path
+
+
+def test_services_stop_cleanly_when_up_is_killed_outright(tmp_path: Path) -> None:
+    """SIGKILL to ``up`` (out-of-memory killer, a crash): no orphan keeps the bus and the
+    ports, and the recorder still closes its files."""
+    up = start_up(write_station(tmp_path), runs=100)
+    try:
+        wait_for_first_run(up)
+        services_pids = list(services_of(up).values())
+        assert len(services_pids) == 4
+    finally:
+        up.kill()
+        up.communicate(timeout=60)
+    deadline = time.monotonic() + 60
+    while (alive := [pid for pid in services_pids if is_running(pid)]) and (
+        time.monotonic() < deadline
+    ):
+        time.sleep(0.1)
+    kill_all(alive)
+    assert alive == []
+    recordings = list((tmp_path / "recordings").rglob("*.mcap"))
+    assert recordings
+    for path in recordings:
+        with path.open("rb") as handle:
+            assert make_reader(handle).get_summary() is not None, path

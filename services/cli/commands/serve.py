@@ -64,8 +64,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from shared.logging_setup import setup_logging
+    from shared.supervisor_link import follow_supervisor
 
     setup_logging(args.service, args.log_level)
+    follow_supervisor()  # started by boltwatch up: stop when it dies
     service = importlib.import_module(f"{args.service_package}.service")
     if args.service == "acquisition":  # the station's predictor may decide in it (edge)
         from services.predictor.edge_predictor import EdgePredictor
