@@ -11,7 +11,8 @@ simulated stations from one station file (:func:`derive_stations`):
   (i = 0..N-1), so each station has its own simulated bus;
 - ``station.tool_id`` = base + i, ``rig.seed`` = base + i (unset stays unset:
   a fresh seed per process);
-- the rest (router, joint, DBC, programs, predictor, recorder folder) is the
+- the rest (router and its TLS files, joint, DBC, programs and their joints,
+  predictor, recorder folder) is the
   base file's, with relative paths made absolute because the derived files
   live elsewhere (in the run's log folder).
 """
@@ -23,7 +24,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from shared.config.loading import read_toml
+from shared.config.loading import read_toml, resolve_relative
 from shared.config.station import LoadedStation, load_station
 from shared.config.toml_writer import dumps
 from shared.errors import ConfigError
@@ -148,4 +149,16 @@ def _derived_document(
     if config.rig.seed is not None:
         document["rig"] = {**raw.get("rig", {}), "seed": config.rig.seed + index}
     document["recorder"] = {**raw["recorder"], "folder": str(base.recordings_folder.resolve())}
+    tls = {
+        key: str(path.resolve())
+        for key in ("tls_root_ca", "tls_cert", "tls_key")
+        if (path := getattr(config.zenoh, key)) is not None  # resolved when loaded
+    }
+    document["zenoh"] = {**raw["zenoh"], **tls}
+    document["programs"] = [
+        {**program, "joint": str(resolve_relative(Path(program["joint"]), base.path))}
+        if "joint" in program
+        else program
+        for program in raw["programs"]
+    ]
     return document

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 import tomllib
 from pathlib import Path
 
@@ -10,7 +11,7 @@ import pytest
 from shared.config import derive_stations, derived_ids, load_line, load_station
 from shared.config.toml_writer import dumps
 from shared.errors import ConfigError
-from tests.paths import STATION_FILE
+from tests.paths import CONFIG, STATION_FILE
 from tests.system.station_files import write_station
 
 
@@ -97,3 +98,26 @@ def test_toml_writer_round_trips_a_station_file() -> None:
 def _port(path: Path) -> str:
     text = path.read_text()
     return text.split("tcp/127.0.0.1:")[1].split('"')[0]
+
+
+def test_derived_stations_keep_every_relative_path_of_the_base(tmp_path: Path) -> None:
+    """The derived files live in another folder: a program's own joint and the TLS files,
+    relative to the base station file, must still name the same files."""
+    base_folder = tmp_path / "base"
+    shutil.copytree(CONFIG, base_folder)
+    (base_folder / "security" / "ca.pem").write_text("not parsed at load")
+    base_file = base_folder / "station.toml"
+    text = base_file.read_text()
+    text = text.replace(
+        "motor_speed_rad_s = 1.0",
+        'motor_speed_rad_s = 1.0\njoint = "joints/paper-section-3-4.toml"',
+    )
+    text = text.replace("[zenoh]\n", '[zenoh]\ntls_root_ca = "security/ca.pem"\n')
+    text = text.replace("tcp/127.0.0.1:7447", "tls/127.0.0.1:7447")
+    base_file.write_text(text)
+    base = load_station(base_file)
+    assert base.config.zenoh.tls_root_ca == base_folder / "security" / "ca.pem"
+    for path in derive_stations(base_file, 2, tmp_path / "derived"):
+        derived = load_station(path)
+        assert derived.config.zenoh == base.config.zenoh
+        assert derived.joint_of(2) == base.joint_of(2) != base.joint
