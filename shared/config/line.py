@@ -12,9 +12,8 @@ simulated stations from one station file (:func:`derive_stations`):
 - ``station.tool_id`` = base + i, ``rig.seed`` = base + i (unset stays unset:
   a fresh seed per process);
 - the rest (router and its TLS files, joint, DBC, programs and their joints,
-  predictor, recorder folder) is the
-  base file's, with relative paths made absolute because the derived files
-  live elsewhere (in the run's log folder).
+  predictor, recorder folder) is the base file's, with relative paths made
+  absolute because the derived files live elsewhere (in the run's log folder).
 """
 
 from __future__ import annotations
