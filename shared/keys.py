@@ -1,44 +1,15 @@
-"""Zenoh key expressions of boltwatch, in one place.
+"""Zenoh key expressions of boltwatch: where a station's keys live.
 
-Every station lives under ``boltwatch/<station>/``:
-
-=========================  ===========================  =================================
-key                        publisher                    payload (see :mod:`shared.messages`)
-=========================  ===========================  =================================
-``samples``                acquisition                  :class:`Sample`, one per 1 kHz sample
-``tool``                   acquisition                  :class:`ToolState`, on every change
-``bus``                    acquisition                  :class:`BusStats`, once a second
-``events``                 predictor                    :class:`StickSlipEvent`
-``intensity``              predictor                    :class:`Intensity`
-``decision``               predictor                    :class:`StopDecision`
-``runs``                   predictor                    :class:`RunSummary`, one per run
-``recorder``               recorder                     :class:`RecorderStats`, once a second
-``predictor``              predictor                    :class:`PredictorStats`, once a second
-``controller``             import (a controller bridge) :class:`ControllerResult`, one per run
-``wear``                   recorder (queryable)         wear ledger rows
-``health/<service>``       every service (liveliness)   -
-=========================  ===========================  =================================
-
-``tool``, ``bus``, ``recorder``, ``predictor`` and ``controller`` are additions to DESIGN.md's list:
-services need run boundaries, bus fault counters, recorder and predictor health, and a plant needs
-its tool controllers' own results (OK/NOK, each step's values); none of those is a sample
-or a run summary.
+Every station lives under ``boltwatch/<station>/``: its channels
+(``boltwatch/<station>/<topic>``, the table of :mod:`shared.channels`), the
+liveliness token of each service (``health/<service>``) and the recorder's
+queryable of the wear ledger (``wear``).
 """
 
 from __future__ import annotations
 
 ROOT = "boltwatch"
 
-SAMPLES = "samples"
-TOOL = "tool"
-BUS = "bus"
-EVENTS = "events"
-INTENSITY = "intensity"
-DECISION = "decision"
-RUNS = "runs"
-RECORDER = "recorder"
-PREDICTOR = "predictor"
-CONTROLLER = "controller"
 WEAR = "wear"
 HEALTH = "health"
 

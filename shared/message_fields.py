@@ -40,8 +40,13 @@ from __future__ import annotations
 
 import re
 import sys
+from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
+
+import annotated_types
+from pydantic import ConfigDict
+from pydantic.types import AllowInfNan, StringConstraints
 
 if TYPE_CHECKING:
     from shared.can_database import StationDatabase
@@ -55,20 +60,36 @@ STATION_ID = re.compile(r"[A-Za-z0-9_-]{1,64}")
 
 
 @dataclass(frozen=True, slots=True)
-class NumberRange:
-    """Inclusive range of an integer or a number; ``nan_ok``: NaN and infinities pass too."""
+class NumberRange(annotated_types.GroupedMetadata):
+    """Inclusive range of an integer or a number; ``nan_ok``: NaN and infinities pass too.
+
+    The codec's validator (pydantic) reads it as the constraints it yields.
+    """
 
     low: float
     high: float
     nan_ok: bool = False
 
+    def __iter__(self) -> Iterator[Any]:
+        # nan_ok: a NaN, an infinity, or an integer beyond any float fails these two, and
+        # the codec's closer look (MessageShape) takes the first two and refuses the third
+        if self.nan_ok:
+            yield AllowInfNan(True)
+        yield annotated_types.Ge(self.low)
+        yield annotated_types.Le(self.high)
+
 
 @dataclass(frozen=True, slots=True)
-class TextRange:
+class TextRange(annotated_types.GroupedMetadata):
     """At most ``max_chars`` characters; with ``pattern``, the whole text matches it."""
 
     max_chars: int
     pattern: re.Pattern[str] | None = None
+
+    def __iter__(self) -> Iterator[Any]:
+        yield annotated_types.MaxLen(self.max_chars)
+        if self.pattern is not None:
+            yield StringConstraints(pattern=f"^{self.pattern.pattern}$")
 
 
 #: integer nanoseconds since the Unix epoch
@@ -85,6 +106,20 @@ StationId = Annotated[str, TextRange(64, STATION_ID)]
 DEFAULT_INT = NumberRange(INT64_MIN, INT64_MAX)
 DEFAULT_FLOAT = NumberRange(-FLOAT_MAX, FLOAT_MAX)
 DEFAULT_TEXT = TextRange(MAX_TEXT_CHARS)
+#: an integer with no bound of its own: what 64 signed bits hold
+Int64 = Annotated[int, DEFAULT_INT]
+
+#: How every message is read and written (``__pydantic_config__`` of each message type):
+#: exactly the JSON types of its schema (no string for a number), no unknown field,
+#: figures finite unless a field says ``nan_ok`` (written as JSON's ``NaN`` and
+#: ``Infinity``, as Python's json module reads them), texts of at most MAX_TEXT_CHARS.
+WIRE_CONFIG = ConfigDict(
+    strict=True,
+    extra="forbid",
+    allow_inf_nan=False,
+    ser_json_inf_nan="constants",
+    str_max_length=MAX_TEXT_CHARS,
+)
 
 
 def can_id_bounds(database: StationDatabase) -> dict[str, tuple[int, int]]:

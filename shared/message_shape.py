@@ -6,8 +6,8 @@ for a list of nested messages, the shape of the items. :meth:`~MessageShape.chec
 checks a list of field values field by field, converts what JSON Schema
 allows (``1.0`` for an integer, ``1`` for a number) and raises
 :class:`~shared.errors.InputError` naming the first field that is wrong;
-:mod:`shared.codec` calls it for nested messages and whenever its fast
-checks of a flat message find something to look at.
+:mod:`shared.codec` calls it for a payload its validator (pydantic) refused, to take
+what JSON Schema allows and to say what is wrong in an operator's words.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from __future__ import annotations
 import dataclasses
 import types
 import typing
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import Any, Generic, TypeVar
 
 from shared.errors import InputError
@@ -29,8 +29,6 @@ from shared.message_fields import (
 
 MessageT = TypeVar("MessageT")
 
-#: station ids remembered per message type as matching their pattern
-MATCHED_KEPT = 1024
 #: the longest value quoted in an error (a refused payload may hold 64 KiB of text)
 QUOTED_CHARS = 60
 
@@ -87,8 +85,6 @@ class MessageShape(Generic[MessageT]):
         self.texts: dict[int, TextRange] = {}
         self.enums: dict[int, frozenset[Any]] = {}
         self.nested: dict[int, MessageShape[Any]] = {}
-        #: values of patterned fields (station ids) already checked: a handful on a line
-        self.matched: set[str] = set()
         for index, name in enumerate(self.names):
             self._derive(index, hints[name], narrower.get(name))
 
@@ -130,73 +126,6 @@ class MessageShape(Generic[MessageT]):
             if type(None) in allowed:
                 self.enums[index] |= {None}
         self.allowed.append(frozenset(allowed))
-
-    @property
-    def is_flat(self) -> bool:
-        return not self.nested
-
-    def fast_check(self) -> Callable[..., bool]:
-        """``check(*values)``: True when every value is of its field's usual type and in bounds.
-
-        Generated once per shape (as :mod:`dataclasses` generates ``__init__``):
-        one expression of ``type(v) is T`` and chained comparisons per field,
-        about a quarter of a microsecond for a sample. False (or a TypeError)
-        says nothing more than "look closer": :meth:`checked` then converts
-        what may be converted and names what is refused. A number field takes
-        only a float here (an integer is converted by :meth:`checked`); NaN,
-        infinities and integers for a number field, and station ids not seen
-        before (:attr:`matched`, filled by the caller), go there too.
-        """
-        constants: dict[str, Any] = {"_type": type, "_len": len}
-        terms = []
-        for index in range(len(self.names)):
-            terms.append(self._fast_term(index, f"v{index}", constants))
-        arguments = ", ".join(f"v{index}" for index in range(len(self.names)))
-        defaults = ", ".join(f"{name}={name}" for name in constants)
-        source = (
-            f"def check({arguments}, *, {defaults}):\n"
-            f"    return ({' and '.join(terms) or 'True'})\n"
-        )
-        namespace: dict[str, Any] = dict(constants)
-        exec(compile(source, f"<fast check of {self.type_name}>", "exec"), namespace)
-        return typing.cast(Callable[..., bool], namespace["check"])
-
-    def _fast_term(self, index: int, name: str, constants: dict[str, Any]) -> str:
-        """The check of one field's value ``name`` (constants go into ``constants``)."""
-        allowed = self.allowed[index]
-        optional = type(None) in allowed
-        enum = self.enums.get(index)
-        if enum is not None:
-            constants[f"_enum{index}"] = enum
-            return f"{name} in _enum{index}"
-        kinds = sorted(
-            (t for t in allowed - {type(None)} if not (t is int and float in allowed)),
-            key=lambda t: t.__name__,
-        )
-        parts = []
-        for kind in kinds:
-            constants[f"_{kind.__name__}"] = kind
-            parts.append(f"_type({name}) is _{kind.__name__}")
-        term = " or ".join(parts) or "False"
-        number = self.numbers.get(index)
-        if number is not None and not number.nan_ok:
-            constants[f"_low{index}"], constants[f"_high{index}"] = number.low, number.high
-            term = f"({term}) and _low{index} <= {name} <= _high{index}"
-        text = self.texts.get(index)
-        if text is not None:
-            constants[f"_max{index}"] = text.max_chars
-            term = f"({term}) and _len({name}) <= _max{index}"
-            if text.pattern is not None:
-                constants[f"_matched{index}"] = self.matched
-                term = f"{term} and {name} in _matched{index}"
-        return f"({name} is None or ({term}))" if optional else f"({term})"
-
-    def remember_matches(self, values: list[Any]) -> None:
-        """Keep the values of patterned fields (checked) for :meth:`fast_check`."""
-        if len(self.matched) < MATCHED_KEPT:
-            for index, text in self.texts.items():
-                if text.pattern is not None and isinstance(values[index], str):
-                    self.matched.add(values[index])
 
     def error(self, text: str) -> InputError:
         return InputError(f"not a valid {self.type_name} message: {text}")

@@ -8,7 +8,9 @@ code of ours). Times are integer nanoseconds since the Unix epoch (``*_ns``)
 or float seconds since the start of the run (``*_s``); units are in names.
 Every field is bounded (times, ids and counts from 0, station ids a key
 chunk, figures finite, texts of limited length): the aliases of
-:mod:`shared.message_fields` say how, and the decoders refuse the rest.
+:mod:`shared.message_fields` say how, and the decoder refuses the rest
+(``__pydantic_config__``: :data:`~shared.message_fields.WIRE_CONFIG`). Which
+channel carries which message, who puts it and how: :mod:`shared.channels`.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import Literal
 
-from shared.message_fields import Count, Id, Measured, StationId, TimeNs
+from shared.message_fields import WIRE_CONFIG, Count, Id, Int64, Measured, StationId, TimeNs
 
 ToolStateName = Literal["idle", "running", "done", "aborted"]
 StopReasonName = Literal[
@@ -60,6 +62,8 @@ class StopReason(IntEnum):
 class Sample:
     """One 1 kHz sample: a ToolSensors frame paired with its JointSensors frame."""
 
+    __pydantic_config__ = WIRE_CONFIG
+
     station: StationId
     run_id: Id
     sequence: Count  # sample index within the run (the 16-bit CAN Counter, unrolled)
@@ -77,6 +81,8 @@ class Sample:
 class ToolState:
     """The tool's run state (CAN ToolStatus), published when it changes."""
 
+    __pydantic_config__ = WIRE_CONFIG
+
     station: StationId
     run_id: Id
     tool_id: Id
@@ -91,6 +97,8 @@ class ToolState:
 @dataclass(frozen=True, slots=True)
 class BusStats:
     """Counters of the acquisition since it started; faults are counted, never fatal."""
+
+    __pydantic_config__ = WIRE_CONFIG
 
     station: StationId
     time_ns: TimeNs
@@ -118,6 +126,8 @@ class BusStats:
 class Prediction:
     """A predicted stick-slip event, ``horizon`` events ahead (1 = the next)."""
 
+    __pydantic_config__ = WIRE_CONFIG
+
     horizon: Count
     time_s: float
     peak_torque_nm: float
@@ -127,6 +137,8 @@ class Prediction:
 @dataclass(frozen=True, slots=True)
 class StickSlipEvent:
     """One detected stick-slip event j with its figures (paper Fig. 3, eqs. 31-33, 66-68)."""
+
+    __pydantic_config__ = WIRE_CONFIG
 
     station: StationId
     run_id: Id
@@ -152,6 +164,8 @@ class StickSlipEvent:
 class Intensity:
     """Vibration intensity: of the last event and of the process so far (eqs. 67, 68)."""
 
+    __pydantic_config__ = WIRE_CONFIG
+
     station: StationId
     run_id: Id
     time_ns: TimeNs
@@ -162,6 +176,8 @@ class Intensity:
 @dataclass(frozen=True, slots=True)
 class StopDecision:
     """The predictor's decision to stop the tool now, with its reason."""
+
+    __pydantic_config__ = WIRE_CONFIG
 
     station: StationId
     run_id: Id
@@ -182,6 +198,8 @@ class StopDecision:
 @dataclass(frozen=True, slots=True)
 class RunSummary:
     """One tightening run, start to end, as the predictor saw it."""
+
+    __pydantic_config__ = WIRE_CONFIG
 
     station: StationId
     run_id: Id
@@ -210,6 +228,8 @@ class RunSummary:
 class RecorderStats:
     """The recorder's view of one station, once a second: is it keeping up and writing?"""
 
+    __pydantic_config__ = WIRE_CONFIG
+
     station: StationId
     time_ns: TimeNs
     messages: Count  # messages of this station written since the recorder started
@@ -231,6 +251,8 @@ class RecorderStats:
 @dataclass(frozen=True, slots=True)
 class PredictorStats:
     """The predictor's counts for one served station since it started, once a second."""
+
+    __pydantic_config__ = WIRE_CONFIG
 
     station: StationId
     time_ns: TimeNs
@@ -255,6 +277,8 @@ class ControllerFunction:
     ``torque_unit``, angle in degrees, time in seconds.
     """
 
+    __pydantic_config__ = WIRE_CONFIG
+
     name: str  # as the controller names it, e.g. "TF Torque", "MFs TorqueMax"
     nominal: float | None  # ``nom``; None when the controller gave none
     actual: float | None  # ``act``
@@ -263,6 +287,8 @@ class ControllerFunction:
 @dataclass(frozen=True, slots=True)
 class ControllerStep:
     """One step of a controller's tightening program and how it went."""
+
+    __pydantic_config__ = WIRE_CONFIG
 
     name: str  # e.g. "Finding", "Thread forming", "Tightening 1.4"
     result: str  # "OK" or "NOK" as the controller wrote it ("" when it wrote none)
@@ -280,6 +306,8 @@ class ControllerResult:
     controller's, ``-1`` where it keeps no batch, None where the file had none.
     """
 
+    __pydantic_config__ = WIRE_CONFIG
+
     station: StationId
     run_id: Id
     tool_id: Id
@@ -291,30 +319,27 @@ class ControllerResult:
     torque_unit: str
     # trailing samples of the last step's graph that are the tool unloading (``torsion release``)
     torsion_release_samples: Count | None
-    batch_number: int | None
-    batch_ok: int | None
-    batch_nok: int | None
-    batch_max_ok: int | None
-    batch_max_nok: int | None
-    batch_canceled: int | None
-    batch_direction_ok: int | None
-    batch_direction_nok: int | None
+    batch_number: Int64 | None
+    batch_ok: Int64 | None
+    batch_nok: Int64 | None
+    batch_max_ok: Int64 | None
+    batch_max_nok: Int64 | None
+    batch_canceled: Int64 | None
+    batch_direction_ok: Int64 | None
+    batch_direction_nok: Int64 | None
     steps: list[ControllerStep] = field(default_factory=list)
 
 
-#: Registry name of each message type: MCAP schema names and documentation.
-MESSAGE_TYPES: dict[str, type] = {
-    f"boltwatch.{cls.__name__}": cls
-    for cls in (
-        Sample,
-        ToolState,
-        BusStats,
-        StickSlipEvent,
-        Intensity,
-        StopDecision,
-        RunSummary,
-        RecorderStats,
-        PredictorStats,
-        ControllerResult,
-    )
-}
+@dataclass(frozen=True, slots=True)
+class WearAlert:
+    """A tool has taken its service threshold of vibration intensity since its last service."""
+
+    __pydantic_config__ = WIRE_CONFIG
+
+    station: StationId
+    tool_id: Id
+    time_ns: TimeNs
+    intensity_since_service: float  # Σ I_process of the runs since the last service (eq. 69)
+    threshold: float
+    runs_since_service: Count
+    last_service_ns: TimeNs | None

@@ -4,7 +4,7 @@ The acquisition's CAN thread is the station's stop path: between two frames
 it may not wait on anything, and a zenoh ``put`` with blocking congestion
 control waits whenever the link to the router is congested (and it always
 costs an encode and a call into zenoh). So the CAN thread only appends
-``(topic, message)`` to a queue (:meth:`QueuedPublisher.publish`, a fraction
+``message`` to a queue (:meth:`QueuedPublisher.publish`, a fraction
 of a microsecond); this publisher's thread encodes and puts, in order. One
 queue per station keeps the order of everything the station publishes: a
 run's ``done`` never overtakes its last samples, its events never overtake
@@ -13,7 +13,7 @@ the samples they were found in.
 The queue holds at most :data:`CAPACITY` messages (about 50 s of a station at
 1 kHz): a router that takes nothing for that long loses the overflow,
 counted (:attr:`QueuedPublisher.dropped`), instead of the station's memory.
-Each topic gets its publisher once, with its QoS (:data:`PublisherQos`).
+Each channel gets its publisher once, with its options (:mod:`shared.channels`).
 """
 
 from __future__ import annotations
@@ -21,42 +21,18 @@ from __future__ import annotations
 import logging
 import queue
 import threading
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Callable
 from typing import Any
 
 import zenoh
 
-from shared import keys
+from shared import channels
 from shared.codec import encode
 
 LOG = logging.getLogger(__name__)
 
 CAPACITY = 50_000
 
-
-@dataclass(frozen=True, slots=True)
-class PublisherQos:
-    """How one topic is published (zenoh's options)."""
-
-    priority: zenoh.Priority = field(default_factory=lambda: zenoh.Priority.DATA)
-    express: bool = False  # no batching: latency-critical
-    congestion_control: zenoh.CongestionControl = field(
-        default_factory=lambda: zenoh.CongestionControl.BLOCK
-    )
-
-
-#: a station's topics and their QoS: samples and run states share one priority, so a
-#: run's ``done`` never overtakes its samples; a decision is REAL_TIME
-STATION_QOS: Mapping[str, PublisherQos] = {
-    keys.SAMPLES: PublisherQos(express=True),
-    keys.TOOL: PublisherQos(express=True),
-    keys.BUS: PublisherQos(),
-    keys.DECISION: PublisherQos(priority=zenoh.Priority.REAL_TIME, express=True),
-    keys.EVENTS: PublisherQos(),
-    keys.INTENSITY: PublisherQos(),
-    keys.RUNS: PublisherQos(),
-}
 
 _STOP = object()
 
@@ -68,12 +44,10 @@ class QueuedPublisher:
         self,
         session: zenoh.Session,
         station_id: str,
-        qos: Mapping[str, PublisherQos] = STATION_QOS,
         capacity: int = CAPACITY,
     ) -> None:
         self._session = session
         self._station_id = station_id
-        self._qos = qos
         self._capacity = capacity
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._publishers: dict[str, zenoh.Publisher] = {}
@@ -82,14 +56,15 @@ class QueuedPublisher:
         self._thread = threading.Thread(target=self._run, name=f"publish-{station_id}", daemon=True)
         self._thread.start()
 
-    def publish(self, topic: str, message: object) -> None:
-        """Queue ``message`` for ``boltwatch/<station>/<topic>``; never waits."""
+    def publish(self, message: object) -> None:
+        """Queue ``message`` for its channel (:mod:`shared.channels`) of the station; never
+        waits. KeyError for a message no channel carries."""
         if self._queue.qsize() >= self._capacity:
             self.dropped += 1
             if self.dropped in (1, 100) or self.dropped % 10_000 == 0:
                 LOG.error("zenoh takes nothing: %d messages dropped so far", self.dropped)
             return
-        self._queue.put((topic, message))
+        self._queue.put((channels.of_message(message), message))
 
     def call(self, function: Callable[[], None]) -> None:
         """Run ``function`` on the publishing thread, after what is queued before it."""
@@ -111,23 +86,17 @@ class QueuedPublisher:
             if callable(item):
                 item()
                 continue
-            topic, message = item
+            channel, message = item
             try:
-                self._publisher(topic).put(encode(message))
+                self._publisher(channel).put(encode(message))
             except Exception as err:  # a closing session, a message that does not encode
                 self.failed += 1  # counted, and the thread goes on: one message, not all
                 if self.failed in (1, 100) or self.failed % 10_000 == 0:
-                    LOG.error("%s not published (#%d): %s", topic, self.failed, err)
+                    LOG.error("%s not published (#%d): %s", channel.topic, self.failed, err)
 
-    def _publisher(self, topic: str) -> zenoh.Publisher:
-        publisher = self._publishers.get(topic)
+    def _publisher(self, channel: channels.Channel[Any]) -> zenoh.Publisher:
+        publisher = self._publishers.get(channel.topic)
         if publisher is None:
-            qos = self._qos.get(topic, PublisherQos())
-            publisher = self._session.declare_publisher(
-                keys.station_key(self._station_id, topic),
-                priority=qos.priority,
-                express=qos.express,
-                congestion_control=qos.congestion_control,
-            )
-            self._publishers[topic] = publisher
+            publisher = channel.declare_publisher(self._session, self._station_id)
+            self._publishers[channel.topic] = publisher
         return publisher

@@ -63,7 +63,11 @@ identity() {
 }
 
 identity router router
-PYTHONPATH="$repo${PYTHONPATH:+:$PYTHONPATH}" "${PYTHON:-python3}" -m services.router.access_control \
+# the generator reads the channel table (shared/channels.py), which needs the project's
+# packages: the checkout's .venv (make run makes it) unless PYTHON names another
+python=${PYTHON:-python3}
+[ -n "${PYTHON:-}" ] || [ ! -x "$repo/.venv/bin/python" ] || python="$repo/.venv/bin/python"
+PYTHONPATH="$repo${PYTHONPATH:+:$PYTHONPATH}" "$python" -m services.router.access_control \
     "${stations[@]}" >"$out/router/acl.json5.new"
 mv "$out/router/acl.json5.new" "$out/router/acl.json5"
 chmod 644 "$out/router/acl.json5"

@@ -42,6 +42,4 @@ class StationDecider(Decider, Protocol):
 
 #: (session, the station, a publish that never waits) -> the station's decider; the CLI
 #: passes the predictor's EdgePredictor (services never import each other)
-DeciderFactory = Callable[
-    [zenoh.Session, LoadedStation, Callable[[str, object], None]], StationDecider
-]
+DeciderFactory = Callable[[zenoh.Session, LoadedStation, Callable[[object], None]], StationDecider]

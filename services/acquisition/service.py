@@ -32,7 +32,7 @@ import zenoh
 from services.acquisition.acquisition import Acquisition
 from services.acquisition.decider import DeciderFactory
 from services.acquisition.zenoh_outlet import ZenohOutlet
-from shared import keys
+from shared import channels, keys
 from shared.can_bus import open_bus
 from shared.can_database import StationDatabase
 from shared.config import load_station
@@ -49,7 +49,7 @@ POLL_TIMEOUT_S = 0.05  # the stop flag is checked at least this often
 
 def subscribe_decisions(session: zenoh.Session, acquisition: Acquisition) -> zenoh.Subscriber[None]:
     """``boltwatch/<st>/decision`` into :meth:`Acquisition.decision`, in zenoh's callback."""
-    key = keys.station_key(acquisition.station_id, keys.DECISION)
+    key = channels.DECISION.key(acquisition.station_id)
 
     def on_decision(sample: zenoh.Sample) -> None:
         acquisition.decision(sample.payload.to_bytes(), key)

@@ -17,7 +17,6 @@ import logging
 
 import zenoh
 
-from shared import keys
 from shared.messages import BusStats, Sample, ToolState
 from shared.queued_publisher import QueuedPublisher
 from shared.zenoh_session import RouterLink
@@ -39,13 +38,13 @@ class ZenohOutlet:
     def sample(self, sample: Sample) -> None:
         if not self.link.connected:
             self.unsent_samples += 1
-        self._publish(keys.SAMPLES, sample)
+        self._publish(sample)
 
     def tool_state(self, state: ToolState) -> None:
-        self._publish(keys.TOOL, state)
+        self._publish(state)
 
     def bus_stats(self, stats: BusStats) -> None:
-        self._publish(keys.BUS, stats)
+        self._publish(stats)
 
     def _link_changed(self, connected: bool, outage_s: float) -> None:
         if connected:

@@ -35,7 +35,7 @@ from services.predictor.core import CoreEvent, PredictorCore, PredictorSettings
 from services.predictor.run_messages import decision_message, event_messages
 from services.recorder.controller_import import PredictorReplay, run_end_ns
 from services.recorder.controller_run import ControllerRun
-from shared import keys
+from shared import channels
 from shared.messages import RunSummary
 
 
@@ -60,12 +60,15 @@ def replay_run(station: str, run: ControllerRun) -> PredictorReplay:
         for output in core.update(time_s, torque_nm, math.nan, angle_deg):
             if isinstance(output, CoreEvent):
                 event, intensity = event_messages(station, run.run_id, started_ns, output, time_ns)
-                outputs += [(index, keys.EVENTS, event), (index, keys.INTENSITY, intensity)]
+                outputs += [
+                    (index, channels.EVENTS.topic, event),
+                    (index, channels.INTENSITY.topic, intensity),
+                ]
             else:
                 decision = decision_message(
                     station, run.run_id, output, time_ns, torque_nm, time_ns, advisory=True
                 )
-                outputs.append((index, keys.DECISION, decision))
+                outputs.append((index, channels.DECISION.topic, decision))
     return PredictorReplay(outputs, _summary(station, run, core))
 
 

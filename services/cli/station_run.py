@@ -23,7 +23,7 @@ import zenoh
 from services.cli import run_table
 from services.cli.run_tally import RunTally
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
-from shared import keys
+from shared import channels, keys
 from shared.codec import decode
 from shared.config import LoadedStation, Program
 from shared.errors import BoltwatchError, TransportError
@@ -104,7 +104,11 @@ class StationRun:
             self._session.declare_subscriber(
                 keys.station_key("*", topic), zenoh.handlers.FifoChannel(10000)
             )
-            for topic in (keys.TOOL, keys.RUNS, keys.BUS)  # a run's start before its summary
+            for topic in (
+                channels.TOOL.topic,
+                channels.RUNS.topic,
+                channels.BUS.topic,
+            )  # a run's start before its summary
         ]
         self.supervisor.start("recorder")
         if self.line_predicted:
@@ -217,13 +221,13 @@ class StationRun:
             if station_id not in self.summaries:
                 continue  # another station on the same router: not ours to report
             try:
-                if topic == keys.TOOL:
+                if topic == channels.TOOL.topic:
                     self.tally.tool_state(station_id, decode(ToolState, sample.payload.to_bytes()))
-                elif topic == keys.RUNS:
+                elif topic == channels.RUNS.topic:
                     summary = decode(RunSummary, sample.payload.to_bytes())
                     if self.tally.summary(station_id, summary):
                         print(run_table.row(summary, self.line), flush=True)
-                elif topic == keys.BUS:
+                elif topic == channels.BUS.topic:
                     self.bus_stats[station_id] = decode(BusStats, sample.payload.to_bytes())
             except BoltwatchError as err:
                 LOG.warning("unreadable %s message: %s", topic, err)

@@ -37,7 +37,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-from shared import keys
+from shared import channels, keys
 from shared.codec import decode
 from shared.errors import InputError
 from shared.messages import (
@@ -204,26 +204,26 @@ class StatusCollector:
             return
         seen = self._station(station)
         try:
-            if topic == keys.SAMPLES:
+            if topic == channels.SAMPLES.topic:
                 # 1 kHz: count only; the latest is decoded once, at report time.
                 seen.samples += 1
                 seen.last_sample_payload = payload
-            elif topic == keys.BUS:
+            elif topic == channels.BUS.topic:
                 stats = decode(BusStats, payload)
                 if seen.first_bus is None:
                     seen.first_bus = stats
                 seen.bus = stats
                 seen.bus_received_ns = received_ns
-            elif topic == keys.TOOL:
+            elif topic == channels.TOOL.topic:
                 seen.tool = decode(ToolState, payload)
-            elif topic == keys.DECISION:
+            elif topic == channels.DECISION.topic:
                 seen.decision = decode(StopDecision, payload)
-            elif topic == keys.RUNS:
+            elif topic == channels.RUNS.topic:
                 seen.summary = decode(RunSummary, payload)
-            elif topic == keys.RECORDER:
+            elif topic == channels.RECORDER.topic:
                 seen.recorder = decode(RecorderStats, payload)
                 seen.recorder_received_ns = received_ns
-            elif topic == keys.PREDICTOR:
+            elif topic == channels.PREDICTOR.topic:
                 seen.predictor = decode(PredictorStats, payload)
                 seen.predictor_received_ns = received_ns
         except InputError:

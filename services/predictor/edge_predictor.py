@@ -37,12 +37,12 @@ from services.predictor.station_refusal import refuse_stations_served_elsewhere
 from services.predictor.station_runs import StationRuns
 from shared import keys
 from shared.config import LoadedStation
-from shared.messages import Intensity, Sample, StopDecision, ToolState
+from shared.messages import Sample, StopDecision, ToolState
 
 LOG = logging.getLogger(__name__)
 
-#: (topic, message) -> None, never waiting: the station's queued publisher
-Publish = Callable[[str, object], None]
+#: message -> None (on its channel), never waiting: the station's queued publisher
+Publish = Callable[[object], None]
 #: how often the station's PredictorStats goes out
 STATS_PERIOD_S = 1.0
 
@@ -70,18 +70,14 @@ class EdgePredictor:
     def on_tool_state(self, state: ToolState) -> None:
         summary = self._runs.on_tool(state)
         if summary is not None:
-            self._publish(keys.RUNS, summary)
+            self._publish(summary)
 
     def on_sample(self, sample: Sample) -> StopDecision | None:
         decision = None
         for message in self._runs.on_sample(sample, time.time_ns()):
             if isinstance(message, StopDecision):  # the acquisition sends and logs the stop
                 decision = message
-                self._publish(keys.DECISION, message)
-            elif isinstance(message, Intensity):
-                self._publish(keys.INTENSITY, message)
-            else:
-                self._publish(keys.EVENTS, message)
+            self._publish(message)
         return decision
 
     @property
@@ -90,7 +86,7 @@ class EdgePredictor:
 
     def _publish_stats(self) -> None:
         while not self._closed.wait(STATS_PERIOD_S):
-            self._publish(keys.PREDICTOR, self._runs.counts.stats(time.time_ns(), self._started_ns))
+            self._publish(self._runs.counts.stats(time.time_ns(), self._started_ns))
 
     def close(self) -> None:
         self._closed.set()

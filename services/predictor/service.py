@@ -38,7 +38,7 @@ from services.predictor.station_counts import StationCounts
 from services.predictor.station_inbox import Inbox, InboxFactory, StationInbox
 from services.predictor.station_refusal import refuse_stations_served_elsewhere
 from services.predictor.station_runs import StationRuns
-from shared import codec, keys
+from shared import channels, codec, keys
 from shared.config import LoadedStation, load_line
 from shared.config.line import stations_by_id
 from shared.errors import InputError
@@ -126,9 +126,7 @@ class PredictorService:
             for runs in self._runs.values():
                 stats = runs.counts.stats(now_ns, self.started_ns)
                 try:
-                    self._session.put(
-                        keys.station_key(stats.station, keys.PREDICTOR), codec.encode(stats)
-                    )
+                    self._session.put(channels.PREDICTOR.key(stats.station), codec.encode(stats))
                 except zenoh.ZError as err:  # the session is closing
                     LOG.debug("predictor stats of %s not published: %s", stats.station, err)
 
@@ -139,11 +137,11 @@ class PredictorService:
             return
         served = runs.served
         try:
-            if topic == keys.SAMPLES:
+            if topic == channels.SAMPLES.topic:
                 sample = served.decode_sample(payload)
                 if self._belongs(sample.station, station_id, topic):
                     self._on_sample(runs, sample)
-            elif topic == keys.TOOL:
+            elif topic == channels.TOOL.topic:
                 state = served.decode_tool_state(payload)
                 if self._belongs(state.station, station_id, topic):
                     self._on_tool(runs, state)
@@ -176,7 +174,7 @@ class PredictorService:
     def _on_tool(self, runs: StationRuns, state: ToolState) -> None:
         summary = runs.on_tool(state)
         if summary is not None:
-            self._publish(state.station, keys.RUNS, summary)
+            self._publish(state.station, channels.RUNS.topic, summary)
 
     def _on_sample(self, runs: StationRuns, sample: Sample) -> None:
         for message in runs.on_sample(sample, time.time_ns()):
@@ -209,19 +207,19 @@ class PredictorService:
 
     def _send(self, station: str, message: Outgoing) -> None:
         if isinstance(message, StopDecision):
-            self._publish(station, keys.DECISION, message)
+            self._publish(station, channels.DECISION.topic, message)
             LOG.info(
                 "%s run %s: stop (%s) %s", station, message.run_id, message.reason, message.detail
             )
         elif isinstance(message, Intensity):
-            self._publish(station, keys.INTENSITY, message)
+            self._publish(station, channels.INTENSITY.topic, message)
         else:
-            self._publish(station, keys.EVENTS, message)
+            self._publish(station, channels.EVENTS.topic, message)
 
     def _publish(self, station: str, topic: str, message: object) -> None:
         publisher = self._publishers.get((station, topic))
         if publisher is None:
-            if topic == keys.DECISION:
+            if topic == channels.DECISION.topic:
                 publisher = self._session.declare_publisher(
                     keys.station_key(station, topic),
                     priority=zenoh.Priority.REAL_TIME,

@@ -39,7 +39,7 @@ from typing import Protocol
 
 import zenoh
 
-from shared import keys
+from shared import channels, keys
 from shared.receive_threads import keep_thread_state
 
 #: (served station id, topic, payload) -> None; called one message at a time
@@ -71,7 +71,7 @@ class StationInbox:
         session: zenoh.Session,
         station_ids: Iterable[str],
         handle: Handler,
-        topics: tuple[str, ...] = (keys.SAMPLES, keys.TOOL),
+        topics: tuple[str, ...] = (channels.SAMPLES.topic, channels.TOOL.topic),
     ) -> None:
         self._handle = handle
         self._lock = threading.Lock()

@@ -56,7 +56,7 @@ from services.recorder.mcap_sink import McapSink
 from services.recorder.recorder import describe_os_error
 from services.recorder.run_files import file_path
 from services.recorder.wear_bound import CONTRACT_LIMITS, RunLimits
-from shared import keys
+from shared import channels, keys
 from shared.codec import encode
 from shared.errors import BoltwatchError, InputError
 from shared.messages import RunSummary, Sample, ToolState
@@ -111,12 +111,12 @@ def controller_messages(
     started_ns = run.started_ns
     outputs = replay.outputs if replay is not None else []
     next_output = 0
-    yield keys.TOOL, _state(station, run, "running", started_ns), started_ns
+    yield channels.TOOL.topic, _state(station, run, "running", started_ns), started_ns
     for sequence, (time_ns, time_s, torque, angle) in enumerate(
         zip(run.times_ns, run.run_time_s, run.torque_nm, run.angle_deg, strict=True)
     ):
         sample = Sample(station, run.run_id, sequence, time_ns, torque, angle, None, time_s)
-        yield keys.SAMPLES, sample, time_ns
+        yield channels.SAMPLES.topic, sample, time_ns
         while next_output < len(outputs) and outputs[next_output][0] <= sequence:
             _, topic, message = outputs[next_output]
             yield topic, message, time_ns
@@ -124,10 +124,10 @@ def controller_messages(
     end_ns = run_end_ns(run)
     for _, topic, message in outputs[next_output:]:
         yield topic, message, end_ns
-    yield keys.TOOL, _state(station, run, "done", end_ns), end_ns
-    yield keys.CONTROLLER, run.result(station, end_ns), end_ns
+    yield channels.TOOL.topic, _state(station, run, "done", end_ns), end_ns
+    yield channels.CONTROLLER.topic, run.result(station, end_ns), end_ns
     if replay is not None:
-        yield keys.RUNS, replay.summary, end_ns
+        yield channels.RUNS.topic, replay.summary, end_ns
 
 
 def controller_limits(run: ControllerRun) -> RunLimits:

@@ -1,10 +1,8 @@
 """What the recorder receives: one zenoh sample, classified and (when it is ours) decoded.
 
-A key ``boltwatch/<station>/<topic>`` whose topic names a message type (see
-:data:`TOPIC_TYPES`) is decoded with :mod:`shared.codec` (the checking
-:func:`~shared.codec.decoder` for flat types: samples at 1 kHz per station
-are most of what a line's recorder does); anything else is kept as raw
-bytes. Nothing is dropped here: a payload that is refused is marked
+A key ``boltwatch/<station>/<topic>`` whose topic is a channel
+(:mod:`shared.channels`) is decoded with :mod:`shared.codec`; anything else
+is kept as raw bytes. Nothing is dropped here: a payload that is refused is marked
 ``decodable=False`` (with the reason in ``problem``) and still recorded, byte
 for byte, on its key's raw channel, with its arrival as its publish time.
 Refused are payloads the decoder refuses (bad JSON, too large or nested too
@@ -26,12 +24,11 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any, NamedTuple
 
-from services.recorder.wear_watch import ALERT_TOPIC, WearAlert
-from shared import keys
-from shared.codec import decode, decoder
+from shared import channels, keys
+from shared.codec import decoder
 from shared.errors import InputError
 from shared.message_fields import STATION_ID
-from shared.messages import MESSAGE_TYPES, Sample
+from shared.messages import Sample
 from shared.sensor_range import CONTRACT_RANGE, SensorRange
 
 #: how far ahead of its arrival a message's own time may be: the clocks of two hosts of
@@ -39,36 +36,10 @@ from shared.sensor_range import CONTRACT_RANGE, SensorRange
 MAX_AHEAD_S = 300
 _MAX_AHEAD_NS = MAX_AHEAD_S * 1_000_000_000
 
-#: Registry name -> message type of everything recorded schema'd: the shared
-#: messages and the recorder's own wear alert.
-RECORDED_TYPES: dict[str, type] = {**MESSAGE_TYPES, "boltwatch.WearAlert": WearAlert}
-
-#: zenoh topic (key below the station) -> registry name of its message type
-TOPIC_TYPES: dict[str, str] = {
-    keys.SAMPLES: "boltwatch.Sample",
-    keys.TOOL: "boltwatch.ToolState",
-    keys.BUS: "boltwatch.BusStats",
-    keys.EVENTS: "boltwatch.StickSlipEvent",
-    keys.INTENSITY: "boltwatch.Intensity",
-    keys.DECISION: "boltwatch.StopDecision",
-    keys.RUNS: "boltwatch.RunSummary",
-    keys.RECORDER: "boltwatch.RecorderStats",
-    keys.PREDICTOR: "boltwatch.PredictorStats",
-    keys.CONTROLLER: "boltwatch.ControllerResult",
-    ALERT_TOPIC: "boltwatch.WearAlert",
-}
-
-
-def _decoder_of(message_type: type) -> Callable[[bytes], Any]:
-    try:
-        return decoder(message_type)
-    except TypeError:  # nested dataclasses or lists: the general decoder
-        return lambda payload: decode(message_type, payload)
-
-
-#: zenoh topic -> (registry name, decoder) of its message type
+#: zenoh topic -> (registry name, decoder) of its message type: every channel
 _TOPIC_DECODERS: dict[str, tuple[str, Callable[[bytes], Any]]] = {
-    topic: (name, _decoder_of(RECORDED_TYPES[name])) for topic, name in TOPIC_TYPES.items()
+    channel.topic: (channel.schema_name, decoder(channel.message_type))
+    for channel in channels.CHANNELS
 }
 
 #: Station folder of keys outside ``boltwatch/<station>/...``.

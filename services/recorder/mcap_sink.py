@@ -34,8 +34,9 @@ from typing import BinaryIO
 from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 
-from services.recorder.incoming import RECORDED_TYPES, Received
+from services.recorder.incoming import Received
 from services.recorder.recording_reader import RecordingScan
+from shared import channels
 from shared.codec import json_schema
 from shared.errors import InputError
 
@@ -221,7 +222,7 @@ class McapSink:
     def _schema_id(self, schema_name: str) -> int:
         schema_id = self._schemas.get(schema_name)
         if schema_id is None:
-            schema = json_schema(RECORDED_TYPES[schema_name])
+            schema = json_schema(channels.SCHEMA_TYPES[schema_name])
             schema_id = self._writer.register_schema(
                 name=schema_name,
                 encoding=SchemaEncoding.JSONSchema,

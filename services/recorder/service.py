@@ -47,13 +47,13 @@ from services.recorder.recorder_health import RecorderHealth
 from services.recorder.run_files import FileLimits
 from services.recorder.wear_bound import StationLimits
 from services.recorder.wear_ledger import WearLedger, ledger_path
-from services.recorder.wear_watch import ALERT_TOPIC, WearAlert, WearWatch
-from shared import keys
+from services.recorder.wear_watch import WearWatch
+from shared import channels, keys
 from shared.codec import encode
 from shared.config import LoadedStation, load_line
 from shared.errors import ConfigError
 from shared.message_fields import MAX_TEXT_CHARS
-from shared.messages import RecorderStats
+from shared.messages import RecorderStats, WearAlert
 from shared.service_runtime import ServiceRunner
 from shared.zenoh_session import open_session
 
@@ -247,7 +247,7 @@ class RecorderService:
         for stats in self.stats(now_ns):
             try:
                 self._session.put(
-                    keys.station_key(stats.station, keys.RECORDER),
+                    channels.RECORDER.key(stats.station),
                     encode(stats),
                     allowed_destination=zenoh.Locality.REMOTE,
                 )
@@ -258,7 +258,7 @@ class RecorderService:
         """Put the alert for the line and record it here: a put this session also heard
         would come back through the inbox on this very thread, which waits when the
         inbox is full, for room only this thread makes."""
-        key = keys.station_key(alert.station, ALERT_TOPIC)
+        key = channels.WEAR_ALERT.key(alert.station)
         payload = encode(alert)
         self._session.put(
             key,

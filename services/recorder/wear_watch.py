@@ -36,39 +36,23 @@ import logging
 import sqlite3
 from collections import Counter, deque
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 from services.recorder.wear_bound import RefusedSummaryError, RunLimits, refusal
 from services.recorder.wear_ledger import ToolWear, WearLedger
 from services.recorder.wear_ledger_file import BrokenLedgerError
 from services.recorder.wear_waiting import load_waiting, save_waiting, waiting_path
-from shared import keys
 from shared.errors import InputError
-from shared.messages import RunSummary
+from shared.messages import RunSummary, WearAlert
 
 LOG = logging.getLogger(__name__)
 
-ALERT_TOPIC = f"{keys.WEAR}/alert"
 PENDING_LIMIT = 100_000  # summaries kept while the ledger cannot be written (days of runs)
 #: How often the ledger file is looked at (and waiting summaries tried) with no summary.
 CHECK_INTERVAL_NS = 2_000_000_000
 REMINDER_INTERVAL_NS = 30_000_000_000
 #: At most one log line per this long about refused summaries.
 LOG_INTERVAL_NS = 10_000_000_000
-
-
-@dataclass(frozen=True, slots=True)
-class WearAlert:
-    """A tool has taken its service threshold of vibration intensity since its last service."""
-
-    station: str
-    tool_id: int
-    time_ns: int
-    intensity_since_service: float  # Σ I_process of the runs since the last service (eq. 69)
-    threshold: float
-    runs_since_service: int
-    last_service_ns: int | None
 
 
 class WearWatch:

@@ -32,11 +32,16 @@ import json
 import sys
 from typing import Any
 
-from shared import keys
+from shared import channels, keys
 
-ACQUISITION_TOPICS = (keys.SAMPLES, keys.TOOL, keys.BUS)
-PREDICTOR_TOPICS = (keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS, keys.PREDICTOR)
-RECORDER_TOPICS = (keys.RECORDER, keys.WEAR, f"{keys.WEAR}/**")
+ACQUISITION_TOPICS = channels.topics_of("acquisition")
+PREDICTOR_TOPICS = channels.topics_of("predictor")
+#: its channels below ``wear/**`` (the alert) and the wear ledger's queryable
+RECORDER_TOPICS = (
+    *(topic for topic in channels.topics_of("recorder") if not topic.startswith(keys.WEAR)),
+    keys.WEAR,
+    f"{keys.WEAR}/**",
+)
 LINE_OBSERVERS = ("line-recorder", "line-viewer", "line-monitor")
 
 _DECLARATIONS = [

@@ -45,7 +45,7 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
 from services.cli.station_supervisor import stop_process  # noqa: E402
-from shared import keys  # noqa: E402
+from shared import channels, keys  # noqa: E402
 from shared.can_database import StationDatabase  # noqa: E402
 from shared.codec import decode, encode  # noqa: E402
 from shared.config import derive_stations, load_station  # noqa: E402
@@ -84,11 +84,11 @@ def generate(endpoint: str, station_ids: list[str], seconds: float) -> int:
         # generator (ticks behind schedule) instead of losing samples in the router
         cc = zenoh.CongestionControl.BLOCK
         samples = {
-            s: session.declare_publisher(keys.station_key(s, keys.SAMPLES), congestion_control=cc)
+            s: session.declare_publisher(channels.SAMPLES.key(s), congestion_control=cc)
             for s in station_ids
         }
         tools = {
-            s: session.declare_publisher(keys.station_key(s, keys.TOOL), congestion_control=cc)
+            s: session.declare_publisher(channels.TOOL.key(s), congestion_control=cc)
             for s in station_ids
         }
         time.sleep(1.0)  # let the router learn the subscribers
@@ -220,8 +220,8 @@ def bench(stations: int, runs: int, rerun: bool, folder: Path) -> dict[str, obje
         ):
             subscribers = [
                 session.declare_subscriber(keys.station_key(REAL_STATION, "*"), heard.on_sample),
-                session.declare_subscriber(keys.station_key("*", keys.RUNS), line.on_summary),
-                session.declare_subscriber(keys.station_key("*", keys.RECORDER), line.on_recorder),
+                session.declare_subscriber(channels.RUNS.key("*"), line.on_summary),
+                session.declare_subscriber(channels.RECORDER.key("*"), line.on_recorder),
             ]
             expected = {
                 (s, svc) for s in [REAL_STATION, *synthetic] for svc in ("recorder", "predictor")

@@ -41,12 +41,10 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
 
 from services.recorder.incoming import (  # noqa: E402
     OTHER_STATION,
-    RECORDED_TYPES,
-    TOPIC_TYPES,
     Received,
     classify,
 )
-from shared import codec, keys  # noqa: E402
+from shared import channels, codec, keys  # noqa: E402
 from shared.errors import InputError  # noqa: E402
 from shared.messages import Intensity, Prediction, Sample, StickSlipEvent  # noqa: E402
 from shared.sensor_range import SensorRange  # noqa: E402
@@ -97,11 +95,12 @@ def classify_as_before(
         station, topic = keys.split_key(key)
     except ValueError:
         return Received(key, OTHER_STATION, None, None, payload, log_time_ns, log_time_ns)
-    schema_name = TOPIC_TYPES.get(topic)
-    if schema_name is None:
+    channel = channels.by_topic(topic)
+    if channel is None:
         return Received(key, station, None, None, payload, log_time_ns, log_time_ns)
+    schema_name = channel.schema_name
     try:
-        message: Any = codec.decode(RECORDED_TYPES[schema_name], payload)
+        message: Any = codec.decode(channel.message_type, payload)
     except InputError:
         return Received(key, station, schema_name, None, payload, log_time_ns, log_time_ns)
     own_time = getattr(message, "time_ns", getattr(message, "ended_ns", None))
@@ -115,13 +114,21 @@ def classify_sample_with(
     """classify() of a sample as at 9ac095d, with ``decode_sample`` (no window, no range)."""
 
     def classify_sample(key: str, payload: bytes, log_time_ns: int) -> Received:
-        station, topic = keys.split_key(key)
+        station, _topic = keys.split_key(key)
         try:
             message = decode_sample(payload)
         except InputError:
-            return Received(key, station, TOPIC_TYPES[topic], None, payload, log_time_ns, 0)
+            return Received(
+                key, station, channels.SAMPLES.schema_name, None, payload, log_time_ns, 0
+            )
         return Received(
-            key, station, TOPIC_TYPES[topic], message, payload, log_time_ns, message.time_ns
+            key,
+            station,
+            channels.SAMPLES.schema_name,
+            message,
+            payload,
+            log_time_ns,
+            message.time_ns,
         )
 
     return classify_sample

@@ -60,7 +60,7 @@ from services.cli.station_supervisor import stop_process  # noqa: E402
 from services.predictor.service import PredictorService  # noqa: E402
 from services.predictor.station_inbox import Handler, Inbox, StationInbox  # noqa: E402
 from services.recorder.recording_reader import RecordingScan  # noqa: E402
-from shared import keys  # noqa: E402
+from shared import channels, keys  # noqa: E402
 from shared.codec import decode  # noqa: E402
 from shared.config import derive_stations, load_line  # noqa: E402
 from shared.messages import RunSummary  # noqa: E402
@@ -71,7 +71,7 @@ from tests.benchmarks.line_station_runs import SHORT_PROGRAM  # noqa: E402
 from tests.system.station_files import free_tcp_port, serve, write_station  # noqa: E402
 from tests.unit.predictor.synthetic import staircase  # noqa: E402
 
-TOPICS = (keys.SAMPLES, keys.TOOL)
+TOPICS = (channels.SAMPLES.topic, channels.TOOL.topic)
 WAKE = b""
 
 
@@ -206,7 +206,7 @@ def consumer_command(variant: str, paths: list[Path], before_repo: Path | None) 
 
 def recorded_samples(recordings: Path) -> int:
     """Sample messages in every MCAP file under ``recordings``."""
-    suffix = f"/{keys.SAMPLES}"
+    suffix = f"/{channels.SAMPLES.topic}"
     return sum(
         sum(1 for _ in RecordingScan(path).messages(suffix))
         for path in sorted(recordings.rglob("*.mcap"))
@@ -263,7 +263,7 @@ def one_run(
         processes.append(predictor)
         with zenoh.open(zenoh_config("client", [endpoint])) as session:
             runs = session.declare_subscriber(
-                keys.station_key("*", keys.RUNS),
+                channels.RUNS.key("*"),
                 on_summary,
             )
             service = "recorder" if variant in RECORDER_VARIANTS else "predictor"

@@ -66,7 +66,7 @@ from services.predictor.trace_replay import replay  # noqa: E402
 from services.recorder.trace_export import export_trace  # noqa: E402
 from services.rig.frames import RigFrames  # noqa: E402
 from services.rig.realtime import RealtimeRig, ToolIdentity  # noqa: E402
-from shared import keys  # noqa: E402
+from shared import channels, keys  # noqa: E402
 from shared.can_bus import open_bus  # noqa: E402
 from shared.can_database import StationDatabase  # noqa: E402
 from shared.codec import decode  # noqa: E402
@@ -161,10 +161,10 @@ class Heard:
     def on_sample(self, sample: zenoh.Sample) -> None:
         topic = str(sample.key_expr).rsplit("/", 1)[-1]
         with self.lock:
-            if topic == keys.DECISION:
+            if topic == channels.DECISION.topic:
                 decision = decode(StopDecision, sample.payload.to_bytes())
                 self.decisions.setdefault(decision.run_id, decision)
-            elif topic == keys.RUNS:
+            elif topic == channels.RUNS.topic:
                 summary = decode(RunSummary, sample.payload.to_bytes())
                 self.summaries[summary.run_id] = summary
 

@@ -56,7 +56,7 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
 from services.cli.station_supervisor import stop_process  # noqa: E402
-from shared import keys  # noqa: E402
+from shared import channels, keys  # noqa: E402
 from shared.can_database import StationDatabase  # noqa: E402
 from shared.codec import decode  # noqa: E402
 from shared.config import LoadedStation, derive_stations, load_station  # noqa: E402
@@ -106,10 +106,10 @@ class Heard:
         topic = str(sample.key_expr).rsplit("/", 1)[-1]
         payload = sample.payload.to_bytes()
         with self.lock:
-            if topic == keys.DECISION:
+            if topic == channels.DECISION.topic:
                 decision = decode(StopDecision, payload)
                 self.decisions.setdefault((decision.station, decision.run_id), decision)
-            elif topic == keys.RUNS:
+            elif topic == channels.RUNS.topic:
                 summary = decode(RunSummary, payload)
                 self.summaries[(summary.station, summary.run_id)] = summary
 

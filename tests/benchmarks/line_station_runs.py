@@ -17,7 +17,7 @@ from pathlib import Path
 
 import zenoh
 
-from shared import keys
+from shared import channels
 from shared.codec import decode
 from shared.messages import RunSummary, StickSlipEvent, StopDecision
 from tests.system.can_injector import HeardStop
@@ -44,13 +44,13 @@ class Heard:
         topic = str(sample.key_expr).rsplit("/", 1)[-1]
         payload = sample.payload.to_bytes()
         with self.lock:
-            if topic == keys.DECISION:
+            if topic == channels.DECISION.topic:
                 decision = decode(StopDecision, payload)
                 self.decisions.setdefault(decision.run_id, decision)
-            elif topic == keys.EVENTS:
+            elif topic == channels.EVENTS.topic:
                 event = decode(StickSlipEvent, payload)
                 self.events.setdefault(event.run_id, []).append(event)
-            elif topic == keys.RUNS:
+            elif topic == channels.RUNS.topic:
                 summary = decode(RunSummary, payload)
                 self.summaries[summary.run_id] = summary
 

@@ -21,7 +21,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from shared import keys
+from shared import channels
 from shared.sensor_range import CONTRACT_RANGE
 from tests.fuzz.payloads import as_json, dumps
 
@@ -59,20 +59,24 @@ def _acquisition_extra(_topic: str, message: Any) -> list[bytes]:
 def _predictor_refuses(topic: str, field: str, value: Any) -> bool:
     if field == "station":
         return value != "pt1"
-    if field in CAN_IDS and (topic == keys.TOOL or field == "run_id"):
+    if field in CAN_IDS and (topic == channels.TOOL.topic or field == "run_id"):
         return not 0 <= value <= CAN_IDS[field]
     return False
 
 
 def _predictor_extra(topic: str, message: Any) -> list[bytes]:
     fields = as_json(message)
-    wider = {"run_id": 2**32} if topic == keys.SAMPLES else {"tool_id": 2**16, "program_id": 256}
+    wider = (
+        {"run_id": 2**32}
+        if topic == channels.SAMPLES.topic
+        else {"tool_id": 2**16, "program_id": 256}
+    )
     others = [dumps({**fields, name: value}) for name, value in wider.items()]
     return [dumps({**fields, "station": "pt2"}), *others]
 
 
 def _publish_time_field(topic: str) -> str:
-    return "ended_ns" if topic == keys.RUNS else "time_ns"
+    return "ended_ns" if topic == channels.RUNS.topic else "time_ns"
 
 
 def _recorder_refuses(topic: str, field: str, value: Any) -> bool:
@@ -80,7 +84,7 @@ def _recorder_refuses(topic: str, field: str, value: Any) -> bool:
         return value != "st1"
     if field == _publish_time_field(topic):  # WearAlert's time_ns may be negative by contract
         return bool(value < 0 or value > time.time_ns() + AHEAD_NS)
-    if topic == keys.SAMPLES and field in MEASURED and value is not None:
+    if topic == channels.SAMPLES.topic and field in MEASURED and value is not None:
         low, high = MEASURED[field]
         return math.isnan(value) or not low <= value <= high
     return False
@@ -90,7 +94,7 @@ def _recorder_extra(topic: str, message: Any) -> list[bytes]:
     fields = as_json(message)
     ahead = {_publish_time_field(topic): time.time_ns() + HOUR_NS}
     extra = [dumps({**fields, **ahead}), dumps({**fields, "station": "st2"})]
-    if topic == keys.SAMPLES:
+    if topic == channels.SAMPLES.topic:
         extra += [dumps({**fields, "torque_nm": 1e6}), dumps({**fields, "force_n": -1e12})]
     return extra
 

@@ -43,7 +43,7 @@ from services.recorder.testing import (
     wait_until,
     write_station_file,
 )
-from shared import keys
+from shared import channels, keys
 from shared.can_database import StationDatabase
 from shared.codec import decode, encode
 from shared.config import load_line, load_station
@@ -136,7 +136,7 @@ class _Outlet:
 
 
 class AcquisitionTarget(_Target):
-    channels = (keys.DECISION,)
+    channels = (channels.DECISION.topic,)
 
     def __init__(self) -> None:
         super().__init__()
@@ -182,7 +182,7 @@ class AcquisitionTarget(_Target):
         now = time.time_ns()
         good = StopDecision(self.station, self.run_id, now, 0.5, "plateau_closest", "", 1.0,
                             None, None, now)  # fmt: skip
-        self.send(keys.DECISION, encode(good))
+        self.send(channels.DECISION.topic, encode(good))
         deadline = time.monotonic() + WAIT_S
         while time.monotonic() < deadline:
             frame = self.tool.recv(0.1)
@@ -203,7 +203,7 @@ class AcquisitionTarget(_Target):
 
 class PredictorTarget(_Target):
     station = "pt1"
-    channels = (keys.SAMPLES, keys.TOOL)
+    channels = (channels.SAMPLES.topic, channels.TOOL.topic)
 
     def __init__(self, folder: Path) -> None:
         super().__init__()
@@ -225,16 +225,16 @@ class PredictorTarget(_Target):
         """A whole good run is still decided (plateau_closest, as without the fuzz)."""
         self.run_id += 1
         decisions = self.feeding.declare_subscriber(
-            keys.station_key(self.station, keys.DECISION), zenoh.handlers.FifoChannel(100)
+            channels.DECISION.key(self.station), zenoh.handlers.FifoChannel(100)
         )
         try:
-            self.send(keys.TOOL, encode(self._state("running", START_NS)))
+            self.send(channels.TOOL.topic, encode(self._state("running", START_NS)))
             for i, row in enumerate(staircase(torque_noise_nm=0.2, force_noise_n=30.0).rows()):
                 t, torque, force, angle = row
                 sample = Sample(self.station, self.run_id, i, START_NS + round(t * 1e9), torque,
                                 angle, force)  # fmt: skip
-                self.send(keys.SAMPLES, encode(sample))
-            self.send(keys.TOOL, encode(self._state("done", START_NS + 2_000_000_000)))
+                self.send(channels.SAMPLES.topic, encode(sample))
+            self.send(channels.TOOL.topic, encode(self._state("done", START_NS + 2_000_000_000)))
             deadline = time.monotonic() + WAIT_S
             heard = decisions.try_recv()
             while heard is None and time.monotonic() < deadline:
@@ -260,8 +260,21 @@ class PredictorTarget(_Target):
 class RecorderTarget(_Target):
     #: every key the recorder decodes
     channels = (
-        *(keys.SAMPLES, keys.TOOL, keys.BUS, keys.EVENTS, keys.INTENSITY, keys.DECISION),
-        *(keys.RUNS, keys.RECORDER, keys.PREDICTOR, keys.CONTROLLER, "wear/alert"),
+        *(
+            channels.SAMPLES.topic,
+            channels.TOOL.topic,
+            channels.BUS.topic,
+            channels.EVENTS.topic,
+            channels.INTENSITY.topic,
+            channels.DECISION.topic,
+        ),
+        *(
+            channels.RUNS.topic,
+            channels.RECORDER.topic,
+            channels.PREDICTOR.topic,
+            channels.CONTROLLER.topic,
+            "wear/alert",
+        ),
     )
 
     def __init__(self, folder: Path) -> None:  # no served session: the recorder opens its own
@@ -317,10 +330,10 @@ class RecorderTarget(_Target):
             for n in range(20)
         ]
         good.append(("tool", ToolState(self.station, self.run_id, 3, 1, "done", now + 20)))
-        summary = template(keys.RUNS, self.station, now + 20, self.run_id)
+        summary = template(channels.RUNS.topic, self.station, now + 20, self.run_id)
         good.append(  # a summary the wear ledger takes: within what its run can carry
             (
-                keys.RUNS,
+                channels.RUNS.topic,
                 replace(
                     summary,
                     tool_id=TOOL_ID,

@@ -27,7 +27,7 @@ import zenoh
 
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
 from services.recorder.recording_reader import RecordingScan
-from shared import keys
+from shared import channels, keys
 from shared.can_bus import open_bus
 from shared.can_database import StationDatabase
 from shared.codec import decode
@@ -118,9 +118,9 @@ class Heard:
         topic = str(sample.key_expr).rsplit("/", 1)[-1]
         payload = sample.payload.to_bytes()
         with self.lock:
-            if topic == keys.RUNS:
+            if topic == channels.RUNS.topic:
                 self.summaries.append(decode(RunSummary, payload))
-            elif topic == keys.DECISION:
+            elif topic == channels.DECISION.topic:
                 decision = decode(StopDecision, payload)
                 self.decisions[decision.run_id].append(decision)
 

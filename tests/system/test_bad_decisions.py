@@ -24,7 +24,7 @@ import zenoh
 
 from services.cli.station_supervisor import stop_process
 from services.recorder.testing import wait_until
-from shared import keys
+from shared import channels, keys
 from shared.can_database import StationDatabase
 from shared.codec import decode, encode
 from shared.config import load_station
@@ -101,9 +101,9 @@ def test_bad_decisions_are_counted_never_stop_and_a_good_one_still_does(
     def heard(sample: zenoh.Sample) -> None:
         topic = str(sample.key_expr).rsplit("/", 1)[-1]
         with lock:
-            if topic == keys.BUS:
+            if topic == channels.BUS.topic:
                 stats.append(decode(BusStats, sample.payload.to_bytes()))
-            elif topic == keys.TOOL:
+            elif topic == channels.TOOL.topic:
                 states.append(decode(ToolState, sample.payload.to_bytes()))
 
     def seen(condition: object) -> bool:
@@ -118,7 +118,7 @@ def test_bad_decisions_are_counted_never_stop_and_a_good_one_still_does(
     ):
         subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard)
         decisions = session.declare_publisher(
-            keys.station_key(STATION, keys.DECISION),
+            channels.DECISION.key(STATION),
             congestion_control=zenoh.CongestionControl.BLOCK,
         )
         try:

@@ -27,7 +27,7 @@ import zenoh
 
 from services.cli.station_supervisor import stop_process
 from services.recorder.testing import wait_until
-from shared import keys
+from shared import channels, keys
 from shared.can_database import StationDatabase
 from shared.codec import decode, encode
 from shared.config import load_station
@@ -63,11 +63,11 @@ class Heard:
         topic = str(sample.key_expr).rsplit("/", 1)[-1]
         payload = sample.payload.to_bytes()
         with self.lock:
-            if topic == keys.SAMPLES:
+            if topic == channels.SAMPLES.topic:
                 self.samples.append(decode(Sample, payload))
-            elif topic == keys.TOOL:
+            elif topic == channels.TOOL.topic:
                 self.states.append(decode(ToolState, payload))
-            elif topic == keys.BUS:
+            elif topic == channels.BUS.topic:
                 self.stats.append(decode(BusStats, payload))
 
     def wait(self, what: str, done: Callable[[], object], timeout_s: float) -> None:
@@ -285,7 +285,7 @@ def test_bad_can_traffic_is_counted_and_never_stops_the_tool(station: Station) -
         CanInjector(station.can, station.database) as bus,
     ):
         subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard.on_sample)
-        decisions = session.declare_publisher(keys.station_key(STATION, keys.DECISION))
+        decisions = session.declare_publisher(channels.DECISION.key(STATION))
         try:
             heard.wait("the acquisition's first BusStats", lambda: bool(heard.stats), 20.0)
 

@@ -34,7 +34,7 @@ import zenoh
 
 from services.cli.station_supervisor import stop_process
 from services.recorder.testing import has_subscribers
-from shared import keys
+from shared import channels, keys
 from shared.codec import decode
 from shared.config import load_station
 from shared.errors import BoltwatchError
@@ -62,9 +62,9 @@ TLS_STATIONS = "/etc/boltwatch/compose/tls"
 HEALTHY_WITHIN_S = 60.0
 NOT_ALIVE = 1  # `boltwatch health`: 1 not alive (yet), 2 router unreachable or bad file
 HEARD_WITHIN_S = 60.0
-DECISION = keys.station_key("st1", keys.DECISION)
-SAMPLES = keys.station_key("st1", keys.SAMPLES)
-RUNS = keys.station_key("st1", keys.RUNS)
+DECISION = channels.DECISION.key("st1")
+SAMPLES = channels.SAMPLES.key("st1")
+RUNS = channels.RUNS.key("st1")
 
 
 class ComposeLine:
@@ -228,7 +228,7 @@ def test_data_flows_and_only_st1s_acquisition_may_decide_for_st1(line: ComposeLi
         monitor = line.session("recorder", identity="line-monitor")
         sessions.append(monitor)
         subscriber = monitor.declare_subscriber(keys.station_key("st1", "*"), on_sample)
-        recorder = keys.station_key("st1", keys.RECORDER)
+        recorder = channels.RECORDER.key("st1")
         # The acquisition's and the recorder's own certificates may put their keys.
         wait_for("st1's samples and recorder stats", lambda h: SAMPLES in h and recorder in h)
         # The predictor in acquisition-st1 decided, stopped the tool, summed the run up.
@@ -237,9 +237,9 @@ def test_data_flows_and_only_st1s_acquisition_may_decide_for_st1(line: ComposeLi
         impostor = line.session("acquisition-st1", identity="st2-acquisition")
         legit = line.session("acquisition-st1")
         sessions += [impostor, legit]
-        decisions = monitor.declare_subscriber(keys.station_key("*", keys.DECISION), on_sample)
+        decisions = monitor.declare_subscriber(channels.DECISION.key("*"), on_sample)
         publisher = legit.declare_publisher(DECISION)
-        own_key = keys.station_key("st2", keys.DECISION)  # what st2's acquisition may decide
+        own_key = channels.DECISION.key("st2")  # what st2's acquisition may decide
         own = impostor.declare_publisher(own_key)
         deadline = time.monotonic() + HEARD_WITHIN_S
         while not (has_subscribers(publisher) and has_subscribers(own)):

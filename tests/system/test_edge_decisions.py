@@ -16,7 +16,7 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
-from shared import keys
+from shared import channels, keys
 from shared.can_database import StationDatabase
 from shared.codec import encode
 from shared.config import load_station
@@ -49,7 +49,7 @@ def test_a_decision_from_the_network_never_stops_an_edge_station(tmp_path: Path)
             while not any(r.ok is not None for r in session.liveliness().get(token)):
                 assert time.monotonic() < deadline, (tmp_path / "acquisition.log").read_text()
                 time.sleep(0.1)
-            decisions = session.declare_publisher(keys.station_key("st1", keys.DECISION))
+            decisions = session.declare_publisher(channels.DECISION.key("st1"))
             bus.tool_status(RUN, ToolRunState.RUNNING)
             pacer = Pacer()
             for counter in range(300):  # a run far below its target and limits: no decision

@@ -26,7 +26,7 @@ from services.recorder.testing import (
     wait_until,
     write_station_file,
 )
-from shared import keys
+from shared import channels
 from shared.codec import encode
 from shared.messages import Sample, ToolState
 from shared.zenoh_session import zenoh_config
@@ -86,8 +86,8 @@ def session(recorder_process: RecorderProcess) -> Iterator[zenoh.Session]:
 
 def publish_run(session: zenoh.Session, run_id: int, duration_s: float) -> int:
     """ToolState running, then samples at ~RATE_HZ for ``duration_s``; the sample count."""
-    tool = session.declare_publisher(keys.station_key("st1", keys.TOOL))
-    samples = session.declare_publisher(keys.station_key("st1", keys.SAMPLES))
+    tool = session.declare_publisher(channels.TOOL.key("st1"))
+    samples = session.declare_publisher(channels.SAMPLES.key("st1"))
     publishers = (tool, samples)
     wait_until(lambda: all(has_subscribers(p) for p in publishers), "the recorder")
     tool.put(encode(ToolState("st1", run_id, 7, 1, "running", time.time_ns())))

@@ -33,7 +33,7 @@ import zenoh
 from services.cli.station_supervisor import stop_process
 from services.recorder.recording_reader import RecordingScan
 from services.recorder.testing import wait_until
-from shared import keys
+from shared import channels, keys
 from shared.codec import decode
 from shared.messages import BusStats, RecorderStats, RunSummary, Sample
 from shared.zenoh_session import zenoh_config
@@ -62,11 +62,11 @@ class Heard:
     def on_sample(self, sample: zenoh.Sample) -> None:
         topic = str(sample.key_expr).rsplit("/", 1)[-1]
         with self.lock:
-            if topic == keys.RUNS:
+            if topic == channels.RUNS.topic:
                 self.summaries.append(decode(RunSummary, sample.payload.to_bytes()))
-            elif topic == keys.BUS:
+            elif topic == channels.BUS.topic:
                 self.stats.append(decode(BusStats, sample.payload.to_bytes()))
-            elif topic == keys.RECORDER:
+            elif topic == channels.RECORDER.topic:
                 self.recorder.append(decode(RecorderStats, sample.payload.to_bytes()))
 
     def wait(self, what: str, done: Callable[[], object], timeout_s: float) -> None:

@@ -24,7 +24,7 @@ import zenoh
 from services.cli.station_supervisor import stop_process
 from services.recorder.testing import has_subscribers
 from services.router.access_control import line_access_control
-from shared import keys
+from shared import channels
 from shared.config.station import ZenohSection
 from shared.errors import TransportError
 from shared.zenoh_session import open_session
@@ -36,8 +36,8 @@ pytestmark = [
     pytest.mark.skipif(shutil.which("openssl") is None, reason="needs the openssl CLI"),
 ]
 
-DECISION = keys.station_key("st1", keys.DECISION)
-OTHER_DECISION = keys.station_key("st2", keys.DECISION)
+DECISION = channels.DECISION.key("st1")
+OTHER_DECISION = channels.DECISION.key("st2")
 NAMES = ("st1-predictor", "st1-acquisition", "st2-acquisition", "line-recorder", "rogue")
 OPEN_TIMEOUT_S = 20.0
 REFUSED_TIMEOUT_S = 2.0
@@ -108,7 +108,7 @@ def test_only_the_stations_acquisition_and_predictor_may_put_its_decision(
     try:
         monitor = open_session(line.section("line-recorder"))
         sessions.append(monitor)
-        subscriber = monitor.declare_subscriber(keys.station_key("*", keys.DECISION), on_decision)
+        subscriber = monitor.declare_subscriber(channels.DECISION.key("*"), on_decision)
         for name in ("rogue", "st2-acquisition", "st1-acquisition", "st1-predictor"):
             sessions.append(open_session(line.section(name)))
         rogue, other_station, acquisition, predictor = sessions[1:]

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from services.cli.station_supervisor import stop_process
-from shared import keys
+from shared import channels, keys
 from shared.codec import encode
 from shared.errors import TransportError
 from shared.messages import BusStats, RunSummary, Sample, StopDecision, ToolState
@@ -101,12 +101,14 @@ class FakeStation:
         sequence = 0
         while not self.stop.is_set():
             now = time.time_ns()
-            self._put(keys.SAMPLES, Sample(STATION, 12, sequence, now, 150.0, 40.0, 42000.0))
+            self._put(
+                channels.SAMPLES.topic, Sample(STATION, 12, sequence, now, 150.0, 40.0, 42000.0)
+            )
             if sequence % 40 == 0:  # five times a second (the real ones: on change, 1 Hz)
-                self._put(keys.TOOL, ToolState(STATION, 12, 7, 1, "running", now))
-                self._put(keys.BUS, bus_stats(now, samples=sequence))
-                self._put(keys.DECISION, decision(now))
-                self._put(keys.RUNS, run_summary(now))
+                self._put(channels.TOOL.topic, ToolState(STATION, 12, 7, 1, "running", now))
+                self._put(channels.BUS.topic, bus_stats(now, samples=sequence))
+                self._put(channels.DECISION.topic, decision(now))
+                self._put(channels.RUNS.topic, run_summary(now))
             sequence += 1
             time.sleep(PUBLISH_PERIOD_S)
 

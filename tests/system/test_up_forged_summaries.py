@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from shared import keys
+from shared import channels
 from shared.codec import encode
 from shared.messages import RunSummary
 from tests.paths import REPO
@@ -52,7 +52,7 @@ def test_a_forged_summary_is_neither_a_run_of_up_nor_wear_in_the_ledger(tmp_path
         first_run_id = int(first.split()[0])
         session = open_client(endpoint)
         try:
-            runs = session.declare_publisher(keys.station_key("st1", keys.RUNS))
+            runs = session.declare_publisher(channels.RUNS.key("st1"))
             runs.put(forged(4242, 1e15))  # a run that never ran
             runs.put(forged(4243, 5e5))  # never ran either, however plausible
             runs.put(forged(first_run_id, 9e5))  # a run that ran, summarised again

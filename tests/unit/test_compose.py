@@ -22,7 +22,7 @@ import yaml
 from services.cli.main import build_parser
 from services.router.access_control import line_access_control
 from services.router.service import router_config
-from shared import keys
+from shared import channels, keys
 from shared.config import load_line, load_station
 from shared.config.loading import resolve_relative
 from tests.access_rules import put_keys_granted
@@ -144,12 +144,19 @@ def test_dockerfile_installs_the_package_and_runs_the_cli() -> None:
 # -- docker-compose.tls.yml over docker-compose.yml: mutual TLS, one identity per container --
 
 TLS_TEXT = TLS_FILE.read_text()
-PREDICTOR_PUTS = {keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS, keys.PREDICTOR}
+PREDICTOR_PUTS = {
+    channels.EVENTS.topic,
+    channels.INTENSITY.topic,
+    channels.DECISION.topic,
+    channels.RUNS.topic,
+    channels.PREDICTOR.topic,
+}
 ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), per station
     # the acquisition hosts the station's predictor (placement "edge") and publishes for it
-    "acquisition": {keys.SAMPLES, keys.TOOL, keys.BUS} | PREDICTOR_PUTS,
+    "acquisition": {channels.SAMPLES.topic, channels.TOOL.topic, channels.BUS.topic}
+    | PREDICTOR_PUTS,
     "predictor": PREDICTOR_PUTS,
-    "recorder": {keys.RECORDER, keys.WEAR, f"{keys.WEAR}/**"},
+    "recorder": {channels.RECORDER.topic, keys.WEAR, f"{keys.WEAR}/**"},
 }
 needs_openssl = pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl")
 

@@ -7,7 +7,7 @@ from typing import Any
 
 from services.cli.station_status import LastRun, StatusCollector, to_json
 from services.cli.station_status_text import format_report
-from shared import keys
+from shared import channels, keys
 from shared.codec import encode
 from shared.messages import (
     BusStats,
@@ -99,9 +99,9 @@ def test_services_from_liveliness_tokens_known_ones_always_listed() -> None:
 def test_sample_rate_from_samples_and_from_bus_stats_deltas() -> None:
     collector = StatusCollector()
     for sequence in range(1500):
-        feed(collector, keys.SAMPLES, sample(4, sequence))
-    feed(collector, keys.BUS, bus(T0, samples=10_000))
-    feed(collector, keys.BUS, bus(T0 + 2 * S, samples=12_000))
+        feed(collector, channels.SAMPLES.topic, sample(4, sequence))
+    feed(collector, channels.BUS.topic, bus(T0, samples=10_000))
+    feed(collector, channels.BUS.topic, bus(T0 + 2 * S, samples=12_000))
 
     (status,) = collector.report("e", 1.5, T0 + 2 * S).stations
 
@@ -111,18 +111,18 @@ def test_sample_rate_from_samples_and_from_bus_stats_deltas() -> None:
 
 def test_bus_rate_unknown_with_one_bus_stats_or_a_restarted_acquisition() -> None:
     one = StatusCollector()
-    feed(one, keys.BUS, bus(T0, samples=10))
+    feed(one, channels.BUS.topic, bus(T0, samples=10))
     assert one.report("e", 2.0, T0).stations[0].bus_samples_per_s is None
 
     restarted = StatusCollector()
-    feed(restarted, keys.BUS, bus(T0, samples=5000))
-    feed(restarted, keys.BUS, bus(T0 + S, samples=20))
+    feed(restarted, channels.BUS.topic, bus(T0, samples=5000))
+    feed(restarted, channels.BUS.topic, bus(T0 + S, samples=20))
     assert restarted.report("e", 2.0, T0).stations[0].bus_samples_per_s is None
 
 
 def test_faults_come_from_the_latest_bus_stats() -> None:
     collector = StatusCollector()
-    feed(collector, keys.BUS, bus(T0, samples=100, counter_gaps=1, missed_samples=2))
+    feed(collector, channels.BUS.topic, bus(T0, samples=100, counter_gaps=1, missed_samples=2))
     latest = bus(
         T0 + S,
         samples=1100,
@@ -135,7 +135,7 @@ def test_faults_come_from_the_latest_bus_stats() -> None:
         unknown_ids=50,
         receive_errors=1,
     )
-    feed(collector, keys.BUS, latest, at_ns=T0 + S)
+    feed(collector, channels.BUS.topic, latest, at_ns=T0 + S)
 
     (status,) = collector.report("e", 2.0, T0 + 2 * S).stations
 
@@ -148,16 +148,16 @@ def test_faults_come_from_the_latest_bus_stats() -> None:
 
 def test_last_run_prefers_tool_state_then_samples_then_summary() -> None:
     collector = StatusCollector()
-    feed(collector, keys.RUNS, summary(3))
+    feed(collector, channels.RUNS.topic, summary(3))
     assert collector.report("e", 2.0, T0).stations[0].last_run == _run(3, "done", 7, 1, "runs")
 
-    feed(collector, keys.SAMPLES, sample(4, 0))
-    feed(collector, keys.SAMPLES, sample(4, 1))
+    feed(collector, channels.SAMPLES.topic, sample(4, 0))
+    feed(collector, channels.SAMPLES.topic, sample(4, 1))
     assert collector.report("e", 2.0, T0).stations[0].last_run == _run(
         4, "running", None, None, "samples"
     )
 
-    feed(collector, keys.TOOL, ToolState("st1", 4, 7, 2, "running", T0))
+    feed(collector, channels.TOOL.topic, ToolState("st1", 4, 7, 2, "running", T0))
     assert collector.report("e", 2.0, T0).stations[0].last_run == _run(4, "running", 7, 2, "tool")
 
 
@@ -170,8 +170,8 @@ def test_last_decision_and_summary_with_their_ages() -> None:
     decision = StopDecision(
         "st1", 3, T0, 2.4, "plateau_closest", "next plateau farther", 190.0, 55800.0, 57100.0, T0
     )
-    feed(collector, keys.DECISION, decision)
-    feed(collector, keys.RUNS, summary(3, ended_ns=T0 + S // 2))
+    feed(collector, channels.DECISION.topic, decision)
+    feed(collector, channels.RUNS.topic, summary(3, ended_ns=T0 + S // 2))
 
     (status,) = collector.report("e", 2.0, T0 + 3 * S).stations
 
@@ -188,7 +188,7 @@ def test_torque_only_summary_reports_torque() -> None:
     collector = StatusCollector()
     feed(
         collector,
-        keys.RUNS,
+        channels.RUNS.topic,
         summary(5, target_force_n=None, reached_force_n=None, stop_reason=None),
     )
     (status,) = collector.report("e", 2.0, T0).stations
@@ -215,8 +215,8 @@ def test_unreadable_messages_are_counted_not_fatal() -> None:
 def test_json_is_one_object_keyed_by_station() -> None:
     collector = StatusCollector()
     collector.alive(keys.health_key("st1", "acquisition"))
-    feed(collector, keys.BUS, bus(T0, samples=10, missed_samples=1))
-    feed(collector, keys.TOOL, ToolState("st1", 4, 7, 1, "running", T0))
+    feed(collector, channels.BUS.topic, bus(T0, samples=10, missed_samples=1))
+    feed(collector, channels.TOOL.topic, ToolState("st1", 4, 7, 1, "running", T0))
 
     data = json.loads(json.dumps(to_json(collector.report("tcp/h:1", 2.0, T0))))
 
@@ -238,14 +238,14 @@ def test_table_reads_per_station() -> None:
     collector = StatusCollector()
     collector.alive(keys.health_key("st1", "acquisition"))
     for sequence in range(2000):
-        feed(collector, keys.SAMPLES, sample(4, sequence))
-    feed(collector, keys.BUS, bus(T0, samples=0))
+        feed(collector, channels.SAMPLES.topic, sample(4, sequence))
+    feed(collector, channels.BUS.topic, bus(T0, samples=0))
     feed(
         collector,
-        keys.BUS,
+        channels.BUS.topic,
         bus(T0 + S, samples=1000, counter_gaps=2, missed_samples=3, late_decisions=1),
     )
-    feed(collector, keys.RUNS, summary(3))
+    feed(collector, channels.RUNS.topic, summary(3))
 
     text = format_report(collector.report("tcp/127.0.0.1:7447", 2.0, T0 + S))
 
@@ -282,8 +282,8 @@ def recorder_stats(time_ns: int, **changes: Any) -> RecorderStats:
 
 def test_recorder_lag_and_health_come_from_the_latest_recorder_stats() -> None:
     collector = StatusCollector()
-    feed(collector, keys.RECORDER, recorder_stats(T0, lag_p50_ms=9.0), at_ns=T0)
-    feed(collector, keys.RECORDER, recorder_stats(T0 + S), at_ns=T0 + S)
+    feed(collector, channels.RECORDER.topic, recorder_stats(T0, lag_p50_ms=9.0), at_ns=T0)
+    feed(collector, channels.RECORDER.topic, recorder_stats(T0 + S), at_ns=T0 + S)
 
     report = collector.report("e", 2.0, T0 + 2 * S)
     (status,) = report.stations
@@ -308,7 +308,7 @@ def test_a_recorder_that_cannot_write_says_so_and_why() -> None:
         recording=False,
         missing_samples=42,
     )
-    feed(collector, keys.RECORDER, failing)
+    feed(collector, channels.RECORDER.topic, failing)
     collector.message("boltwatch/st1/recorder", b"{broken", T0)
 
     report = collector.report("e", 2.0, T0)
@@ -331,7 +331,7 @@ def test_a_broken_wear_ledger_and_refused_summaries_show_while_recording_goes_on
         T0, last_error=broken, write_errors=1, refused_summaries=2, waiting_summaries=3
     )
     collector = StatusCollector()
-    feed(collector, keys.RECORDER, stats)
+    feed(collector, channels.RECORDER.topic, stats)
 
     report = collector.report("e", 2.0, T0)
     (status,) = report.stations
@@ -346,7 +346,7 @@ def test_a_broken_wear_ledger_and_refused_summaries_show_while_recording_goes_on
 
 def test_summaries_the_wear_ledger_refused_show() -> None:
     collector = StatusCollector()
-    feed(collector, keys.RECORDER, recorder_stats(T0, refused_summaries=2))
+    feed(collector, channels.RECORDER.topic, recorder_stats(T0, refused_summaries=2))
     report = collector.report("e", 2.0, T0)
     text = format_report(report)
     assert "0 write errors, 2 run summaries refused by the wear ledger, " in text
@@ -357,10 +357,10 @@ def test_what_each_service_refused_is_shown() -> None:
     """Bad decisions (BusStats), the predictor's bad payloads and samples (PredictorStats),
     the recorder's refused payloads (RecorderStats): counted where they were refused."""
     collector = StatusCollector()
-    feed(collector, keys.BUS, bus(T0, samples=10, bad_decisions=4))
-    feed(collector, keys.RECORDER, recorder_stats(T0, bad_payloads=17))
+    feed(collector, channels.BUS.topic, bus(T0, samples=10, bad_decisions=4))
+    feed(collector, channels.RECORDER.topic, recorder_stats(T0, bad_payloads=17))
     stats = PredictorStats("st1", T0, T0 - 60 * S, 5, 2, 1, 0, 0)
-    feed(collector, keys.PREDICTOR, stats, at_ns=T0 - S)
+    feed(collector, channels.PREDICTOR.topic, stats, at_ns=T0 - S)
 
     report = collector.report("e", 2.0, T0)
     (status,) = report.stations
@@ -376,6 +376,6 @@ def test_what_each_service_refused_is_shown() -> None:
     assert "17 bad payloads" in text
     assert to_json(report)["stations"]["st1"]["predictor"]["bad_samples"] == 2
     quiet = StatusCollector()
-    feed(quiet, keys.BUS, bus(T0, samples=1))
+    feed(quiet, channels.BUS.topic, bus(T0, samples=1))
     text = format_report(quiet.report("e", 2.0, T0))
     assert "predictor     - (no predictor stats in the window" in text

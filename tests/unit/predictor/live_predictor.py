@@ -14,7 +14,7 @@ from typing import Any
 
 import zenoh
 
-from shared import codec, keys
+from shared import channels, codec, keys
 from shared.messages import Sample, StopReasonName, ToolState
 
 REPO = Path(__file__).resolve().parents[3]
@@ -76,8 +76,8 @@ class StationFeed:
 
     def __init__(self, session: zenoh.Session, station_id: str, wait: bool = True) -> None:
         self.station_id = station_id
-        self.tool = session.declare_publisher(keys.station_key(station_id, keys.TOOL))
-        self.samples = session.declare_publisher(keys.station_key(station_id, keys.SAMPLES))
+        self.tool = session.declare_publisher(channels.TOOL.key(station_id))
+        self.samples = session.declare_publisher(channels.SAMPLES.key(station_id))
         if wait:  # the predictor's subscribers must be known before the first put
             for publisher in (self.tool, self.samples):
                 wait_for_subscriber(publisher)

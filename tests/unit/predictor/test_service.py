@@ -13,7 +13,7 @@ import pytest
 import zenoh
 
 from services.predictor.service import PredictorService
-from shared import codec, keys
+from shared import channels, codec, keys
 from shared.config import LoadedStation
 from shared.errors import ConfigError
 from shared.messages import (
@@ -95,7 +95,12 @@ def test_one_service_predicts_each_station_with_its_own_configuration(
             feed.close()
     check_run(by_key, "pt1", trace)
     check_run(by_key, "pt2", trace, acted=False)
-    predictor_topics = (keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS)
+    predictor_topics = (
+        channels.EVENTS.topic,
+        channels.INTENSITY.topic,
+        channels.DECISION.topic,
+        channels.RUNS.topic,
+    )
     assert not [key for key in by_key if key.startswith("pt3/") and key[4:] in predictor_topics]
     assert service.dropped_samples == 1
     assert service.bad_payloads == 0
@@ -157,7 +162,7 @@ def test_a_run_id_counts_once_however_its_state_flips(
     with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
         wait_for_token(session, keys.health_key("pt1", "predictor"))
         summaries = session.declare_subscriber(
-            keys.station_key("pt1", keys.RUNS), zenoh.handlers.FifoChannel(100)
+            channels.RUNS.key("pt1"), zenoh.handlers.FifoChannel(100)
         )
         feed = StationFeed(session, "pt1")
         for flip in range(5):

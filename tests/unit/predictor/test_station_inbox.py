@@ -14,7 +14,7 @@ import zenoh
 
 from services.predictor.station_inbox import StationInbox
 from services.recorder.testing import free_port, wait_until
-from shared import keys
+from shared import channels, keys
 from shared.zenoh_session import zenoh_config
 
 Handled = list[tuple[str, str, bytes]]
@@ -24,7 +24,7 @@ REPO = Path(__file__).resolve().parents[3]
 def publishers(session: zenoh.Session, station_id: str) -> dict[str, zenoh.Publisher]:
     found = {
         topic: session.declare_publisher(keys.station_key(station_id, topic))
-        for topic in (keys.SAMPLES, keys.TOOL)
+        for topic in (channels.SAMPLES.topic, channels.TOOL.topic)
     }
     for publisher in found.values():
         wait_until(lambda p=publisher: bool(p.matching_status.matching), "the inbox")  # type: ignore[misc]
@@ -39,11 +39,11 @@ def test_only_served_stations_arrive_in_publication_order(
     inbox = StationInbox(served, ["a1", "a2"], lambda *message: handled.append(message))
     try:
         feeds = {s: publishers(feeding, s) for s in ("a1", "a2")}
-        unserved = feeding.declare_publisher(keys.station_key("a3", keys.SAMPLES))
+        unserved = feeding.declare_publisher(channels.SAMPLES.key("a3"))
         expected: Handled = []
         for i in range(200):
             for station_id, topics in feeds.items():
-                topic = keys.TOOL if i % 50 == 0 else keys.SAMPLES
+                topic = channels.TOOL.topic if i % 50 == 0 else channels.SAMPLES.topic
                 topics[topic].put(f"{station_id}-{i}".encode())
                 expected.append((station_id, topic, f"{station_id}-{i}".encode()))
             unserved.put(b"never")
@@ -80,7 +80,7 @@ def test_a_handler_error_ends_serve_with_it_and_later_messages_are_counted(
     worker = threading.Thread(target=serve, daemon=True)
     worker.start()
     try:
-        samples = publishers(feeding, "a1")[keys.SAMPLES]
+        samples = publishers(feeding, "a1")[channels.SAMPLES.topic]
         samples.put(b"good")
         samples.put(b"bad")
         samples.put(b"after")
@@ -132,7 +132,7 @@ def calls_seen_before(keep_thread_states: bool) -> list[int]:
     ):
         inbox = inbox_type(served, ["a1"], handle)
         try:
-            samples = publishers(feeding, "a1")[keys.SAMPLES]
+            samples = publishers(feeding, "a1")[channels.SAMPLES.topic]
             for _ in range(50):
                 samples.put(b"x")
                 time.sleep(0.002)  # one callback at a time
@@ -177,7 +177,7 @@ def test_close_waits_for_the_callback_in_progress(
         finished.append(time.monotonic())
 
     inbox = StationInbox(served, ["a1"], slow)
-    publishers(feeding, "a1")[keys.SAMPLES].put(b"x")
+    publishers(feeding, "a1")[channels.SAMPLES.topic].put(b"x")
     assert started.wait(10.0)
     inbox.close()
     closed_at = time.monotonic()

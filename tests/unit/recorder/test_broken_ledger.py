@@ -29,7 +29,7 @@ from services.cli.main import main
 from services.recorder.testing import RunningRecorder, publish, wait_until
 from services.recorder.wear_bound import CONTRACT_LIMITS
 from services.recorder.wear_ledger import WearLedger
-from shared import keys
+from shared import channels
 from shared.codec import decode
 from shared.config import LoadedStation
 from shared.messages import RecorderStats, RunSummary, Sample, ToolState
@@ -202,7 +202,7 @@ def test_the_recorder_records_on_and_counts_the_waiting_runs_once_reset(
     stats: list[RecorderStats] = []
     try:
         subscriber = session.declare_subscriber(
-            keys.station_key("st1", keys.RECORDER),
+            channels.RECORDER.key("st1"),
             lambda sample: stats.append(decode(RecorderStats, sample.payload.to_bytes())),
         )
         wear = recorder.service.wear

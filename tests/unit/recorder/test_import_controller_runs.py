@@ -23,8 +23,8 @@ from mcap.reader import make_reader
 
 from services.cli.main import main
 from services.recorder.controller_run import read_controller_run
+from shared.channels import SCHEMA_TYPES
 from shared.codec import json_schema
-from shared.messages import MESSAGE_TYPES
 from shared.trace import read_trace
 from tests.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 
@@ -85,7 +85,7 @@ def test_every_real_run_imports_as_a_live_recording(
             for topic, channel in channels.items():  # every channel schema'd, as live
                 schema = schemas[channel.schema_id]
                 assert channel.message_encoding == "json"
-                assert json.loads(schema.data) == json_schema(MESSAGE_TYPES[schema.name]), topic
+                assert json.loads(schema.data) == json_schema(SCHEMA_TYPES[schema.name]), topic
             assert {"boltwatch/cs351/samples", "boltwatch/cs351/tool"} <= set(channels)
             samples = [
                 (message, json.loads(message.data))  # json alone, no code of ours

@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 
 from services.recorder.incoming import OTHER_STATION, classify
-from shared import keys
+from shared import channels
 from shared.codec import encode, to_dict
 from shared.messages import RunSummary, Sample, StickSlipEvent, ToolState
 
@@ -19,7 +19,7 @@ SAMPLE = Sample("st4", 9, 33, T_NS + 5, 80.0, 12.5, None)
 
 
 def test_a_sample_is_filed_by_station_run_sequence_and_its_own_time() -> None:
-    received = classify(keys.station_key("st4", keys.SAMPLES), encode(SAMPLE), T_NS + 99)
+    received = classify(channels.SAMPLES.key("st4"), encode(SAMPLE), T_NS + 99)
     assert received.station == "st4" and received.schema_name == "boltwatch.Sample"
     assert received.message == SAMPLE and received.decodable
     assert (received.run_id, received.sequence) == (9, 33)
@@ -30,7 +30,7 @@ def test_a_sample_is_filed_by_station_run_sequence_and_its_own_time() -> None:
 def test_a_sample_breaking_its_schema_is_kept_raw() -> None:
     for change in ({"sequence": "33"}, {"torque_nm": None}, {"extra": 1}):
         payload = json.dumps({**to_dict(SAMPLE), **change}).encode()
-        received = classify(keys.station_key("st4", keys.SAMPLES), payload, T_NS)
+        received = classify(channels.SAMPLES.key("st4"), payload, T_NS)
         assert received.schema_name == "boltwatch.Sample"
         assert received.message is None and not received.decodable
         assert received.payload == payload and received.publish_time_ns == T_NS
@@ -39,19 +39,19 @@ def test_a_sample_breaking_its_schema_is_kept_raw() -> None:
 
 def test_run_start_summary_and_nested_events() -> None:
     running = classify(
-        keys.station_key("st4", keys.TOOL),
+        channels.TOOL.key("st4"),
         encode(ToolState("st4", 9, 1, 2, "running", T_NS + 1)),
         T_NS,
     )
     assert running.run_started and running.publish_time_ns == T_NS + 1
     summary = RunSummary("st4", 9, 1, 2, "done", None, 9.0, None, 8.0, -1.0, 0, None, 0.0, 5, 6, 7)
-    filed = classify(keys.station_key("st4", keys.RUNS), encode(summary), T_NS)
+    filed = classify(channels.RUNS.key("st4"), encode(summary), T_NS)
     assert filed.message == summary and filed.publish_time_ns == 7  # ended_ns
     event = StickSlipEvent(
         "st4", 9, 1, T_NS + 3, 0.1, 50.0, None, None, None, None, None, None, None, None,
         None, None, 0.0, [],
     )  # fmt: skip
-    nested = classify(keys.station_key("st4", keys.EVENTS), encode(event), T_NS)
+    nested = classify(channels.EVENTS.key("st4"), encode(event), T_NS)
     assert nested.message == event and nested.run_id == 9
 
 

@@ -9,7 +9,7 @@ import zenoh
 
 from services.recorder.line_inbox import LineInbox, Message
 from services.recorder.testing import has_subscribers, wait_until
-from shared import keys
+from shared import channels, keys
 
 
 def blocking_publisher(session: zenoh.Session, key: str) -> zenoh.Publisher:
@@ -35,8 +35,8 @@ def test_every_message_is_kept_in_order_with_its_key_and_receive_time(
     served, feeding = sessions
     inbox = LineInbox(served, keys.EVERYTHING)
     try:
-        samples = blocking_publisher(feeding, keys.station_key("a1", keys.SAMPLES))
-        tool = blocking_publisher(feeding, keys.station_key("a2", keys.TOOL))
+        samples = blocking_publisher(feeding, channels.SAMPLES.key("a1"))
+        tool = blocking_publisher(feeding, channels.TOOL.key("a2"))
         for i in range(500):
             (tool if i % 100 == 0 else samples).put(str(i).encode())
         taken = take_until(inbox, 500)
@@ -56,7 +56,7 @@ def test_a_full_inbox_holds_the_publisher_back_and_loses_nothing(
     inbox = LineInbox(served, keys.EVERYTHING, max_pending=10)
     published = threading.Event()
     try:
-        samples = blocking_publisher(feeding, keys.station_key("a1", keys.SAMPLES))
+        samples = blocking_publisher(feeding, channels.SAMPLES.key("a1"))
 
         def publish() -> None:
             for i in range(300):
@@ -79,7 +79,7 @@ def test_close_keeps_what_came_before_for_a_last_take(
 ) -> None:
     served, feeding = sessions
     inbox = LineInbox(served, keys.EVERYTHING)
-    samples = blocking_publisher(feeding, keys.station_key("a1", keys.SAMPLES))
+    samples = blocking_publisher(feeding, channels.SAMPLES.key("a1"))
     for i in range(20):
         samples.put(str(i).encode())
     wait_until(lambda: len(inbox._pending) == 20, "20 pending")
@@ -112,7 +112,7 @@ def test_close_wakes_a_receive_thread_waiting_for_room_and_counts_its_message(
 ) -> None:
     served, feeding = sessions
     inbox = LineInbox(served, keys.EVERYTHING, max_pending=10)
-    samples = blocking_publisher(feeding, keys.station_key("a1", keys.SAMPLES))
+    samples = blocking_publisher(feeding, channels.SAMPLES.key("a1"))
     publisher_thread = threading.Thread(
         target=lambda: [samples.put(str(i).encode()) for i in range(300)], daemon=True
     )

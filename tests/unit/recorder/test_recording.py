@@ -26,7 +26,7 @@ from services.recorder.testing import (
     wait_until,
     write_station_file,
 )
-from shared import keys
+from shared import channels, keys
 from shared.codec import json_schema
 from shared.config import LoadedStation, load_station
 from shared.messages import (
@@ -221,7 +221,7 @@ def test_one_recorder_serves_several_station_files(
     stats: list[dict[str, Any]] = []
     with serving(service, session), zenoh.open(zenoh_config("peer", connect=[endpoint])) as client:
         watcher = client.declare_subscriber(
-            keys.station_key("*", keys.RECORDER),
+            channels.RECORDER.key("*"),
             lambda sample: stats.append(json.loads(sample.payload.to_bytes())),
         )
         tokens = client.liveliness().get(keys.health_key("*", "recorder"), timeout=10)
@@ -307,7 +307,7 @@ def test_a_view_only_recorder_takes_none_of_the_line_recorders_duties(
     stats: list[bytes] = []
     with serving(service, session), zenoh.open(zenoh_config("peer", connect=[endpoint])) as client:
         watcher = client.declare_subscriber(
-            keys.station_key("*", keys.RECORDER), lambda sample: stats.append(b"")
+            channels.RECORDER.key("*"), lambda sample: stats.append(b"")
         )
         tokens = client.liveliness().get(keys.health_key("st1", "*"), timeout=10)
         assert [str(r.ok.key_expr) for r in tokens if r.ok is not None] == [

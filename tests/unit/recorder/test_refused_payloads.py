@@ -22,7 +22,7 @@ from test_recording import recorded_files  # type: ignore[import-not-found]
 
 from services.recorder.mcap_sink import RAW_ENCODING
 from services.recorder.testing import RunningRecorder, publish, wait_until
-from shared import keys
+from shared import channels, keys
 from shared.codec import encode
 from shared.config import LoadedStation
 from shared.messages import RunSummary, Sample, StopDecision, ToolState
@@ -90,7 +90,7 @@ def test_times_no_recording_can_hold_and_deep_nesting_are_recorded_raw_and_count
         with lock:
             stats.append(json.loads(sample.payload.to_bytes()))
 
-    watcher = publisher_session.declare_subscriber(keys.station_key("st1", keys.RECORDER), heard)
+    watcher = publisher_session.declare_subscriber(channels.RECORDER.key("st1"), heard)
     t0_ns = time.time_ns()
     first, rest = live_run(t0_ns, 200)
     bad = hostile(t0_ns)

@@ -15,7 +15,7 @@ from services.recorder.testing import (
     wait_until,
     write_station_file,
 )
-from shared import keys
+from shared import channels, keys
 from shared.codec import encode
 from shared.config import LoadedStation, load_station
 from shared.messages import RunSummary, ToolState
@@ -53,8 +53,8 @@ def test_summaries_count_once_and_a_due_tool_raises_an_alert(
     subscriber = publisher_session.declare_subscriber(
         alert_key, lambda sample: alerts.append(json.loads(sample.payload.to_bytes()))
     )
-    tool = publisher_session.declare_publisher(keys.station_key("st1", keys.TOOL))
-    runs = publisher_session.declare_publisher(keys.station_key("st1", keys.RUNS))
+    tool = publisher_session.declare_publisher(channels.TOOL.key("st1"))
+    runs = publisher_session.declare_publisher(channels.RUNS.key("st1"))
     wait_until(lambda: has_subscribers(runs) and has_subscribers(tool), "the recorder")
     tool.put(encode(ToolState("st1", 1, 7, 1, "running", T0_NS)))
     runs.put(summary(1, 1.5))
@@ -122,10 +122,10 @@ def test_summaries_beyond_their_bound_are_refused_counted_and_said_in_recorder_s
 
     stats: list[RecorderStats] = []
     subscriber = publisher_session.declare_subscriber(
-        keys.station_key("st1", keys.RECORDER),
+        channels.RECORDER.key("st1"),
         lambda sample: stats.append(decode(RecorderStats, sample.payload.to_bytes())),
     )
-    runs = publisher_session.declare_publisher(keys.station_key("st1", keys.RUNS))
+    runs = publisher_session.declare_publisher(channels.RUNS.key("st1"))
     wait_until(lambda: has_subscribers(runs), "the recorder")
     for run_id, intensity in ((1, 1.5), (2, -2e9), (3, 9e11), (4, 1e15), (5, 2.5)):
         runs.put(summary(run_id, intensity))

@@ -11,7 +11,7 @@ from services.router.access_control import (
     PREDICTOR_TOPICS,
     line_access_control,
 )
-from shared import keys
+from shared import channels, keys
 from tests.access_rules import common_names, put_keys_granted
 from tests.paths import CONFIG
 
@@ -41,7 +41,7 @@ def test_a_line_predictor_may_put_only_the_predictors_keys(station: str) -> None
 @pytest.mark.parametrize("station", STATIONS)
 def test_no_other_identity_may_put_a_stations_decision(station: str) -> None:
     acl = line_access_control(STATIONS)
-    decision = keys.station_key(station, keys.DECISION)
+    decision = channels.DECISION.key(station)
     deciders = {name for name in common_names(acl) if decision in put_keys_granted(acl, name)}
     assert deciders == {f"{station}-acquisition", f"{station}-predictor"}
     assert not any(decision in put_keys_granted(acl, n) for n in ("rogue", "router"))

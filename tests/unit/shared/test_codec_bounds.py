@@ -17,10 +17,10 @@ import jsonschema
 import pytest
 
 from shared import codec
+from shared.channels import CHANNELS, SCHEMA_TYPES
 from shared.errors import InputError
 from shared.message_fields import MAX_TEXT_CHARS
 from shared.messages import (
-    MESSAGE_TYPES,
     ControllerResult,
     RunSummary,
     Sample,
@@ -31,18 +31,7 @@ from shared.messages import (
 from tests.fuzz.payloads import refused_values, template
 
 NOW_NS = time.time_ns()
-TOPICS = {  # a topic of each registered message type
-    "boltwatch.Sample": "samples",
-    "boltwatch.ToolState": "tool",
-    "boltwatch.BusStats": "bus",
-    "boltwatch.StickSlipEvent": "events",
-    "boltwatch.Intensity": "intensity",
-    "boltwatch.StopDecision": "decision",
-    "boltwatch.RunSummary": "runs",
-    "boltwatch.RecorderStats": "recorder",
-    "boltwatch.PredictorStats": "predictor",
-    "boltwatch.ControllerResult": "controller",
-}
+TOPICS = {channel.schema_name: channel.topic for channel in CHANNELS}  # a topic of each type
 
 
 def payload_with(message: object, **changes: object) -> bytes:
@@ -50,12 +39,12 @@ def payload_with(message: object, **changes: object) -> bytes:
 
 
 def test_every_registered_type_has_an_example_here() -> None:
-    assert set(TOPICS) == set(MESSAGE_TYPES)
+    assert set(TOPICS) == set(SCHEMA_TYPES)
 
 
 @pytest.mark.parametrize("name", sorted(TOPICS))
 def test_every_field_refuses_what_its_bounds_refuse_naming_it(name: str) -> None:
-    message_type = MESSAGE_TYPES[name]
+    message_type = SCHEMA_TYPES[name]
     message = template(TOPICS[name], "st1", NOW_NS)
     assert codec.decode(message_type, codec.encode(message)) == message
     decoders: list[Callable[[bytes], object]] = [lambda p: codec.decode(message_type, p)]
@@ -163,9 +152,9 @@ def test_a_narrower_decoder_takes_ids_only_as_wide_as_a_can_signal() -> None:
     assert codec.decoder(ToolState)(payload_with(state, run_id=2**40)).run_id == 2**40
 
 
-@pytest.mark.parametrize("name", sorted(MESSAGE_TYPES))
+@pytest.mark.parametrize("name", sorted(SCHEMA_TYPES))
 def test_schemas_state_the_bounds_and_stay_what_foxglove_decodes(name: str) -> None:
-    schema = codec.json_schema(MESSAGE_TYPES[name])
+    schema = codec.json_schema(SCHEMA_TYPES[name])
     jsonschema.Draft202012Validator.check_schema(schema)
     assert schema["type"] == "object"  # Foxglove needs an object at the root
     properties = schema["properties"]

@@ -10,12 +10,12 @@ from typing import Any
 import jsonschema
 import pytest
 
-from shared import keys
+from shared import channels, keys
 from shared.can_database import CONTRACT, StationDatabase
+from shared.channels import SCHEMA_TYPES
 from shared.codec import decode, encode, json_schema
 from shared.errors import CanDatabaseError, InputError
 from shared.messages import (
-    MESSAGE_TYPES,
     BusStats,
     ControllerFunction,
     ControllerResult,
@@ -114,7 +114,7 @@ def test_round_trip_and_schema_validates_the_payload(message: Any) -> None:
 
 
 def test_every_message_type_has_a_registered_schema() -> None:
-    for name, message_type in MESSAGE_TYPES.items():
+    for name, message_type in SCHEMA_TYPES.items():
         assert json_schema(message_type)["title"] == name
 
 
@@ -152,7 +152,7 @@ def test_dbc_missing_a_contract_message_is_an_error(tmp_path: Path) -> None:
 
 
 def test_keys() -> None:
-    assert keys.station_key("st1", keys.SAMPLES) == "boltwatch/st1/samples"
+    assert channels.SAMPLES.key("st1") == "boltwatch/st1/samples"
     assert keys.split_key("boltwatch/st1/health/predictor") == ("st1", "health/predictor")
     with pytest.raises(ValueError, match="not a boltwatch station key"):
         keys.split_key("other/st1/samples")
