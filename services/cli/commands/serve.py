@@ -11,20 +11,26 @@ serves every station named.
 from __future__ import annotations
 
 import argparse
-import importlib
+from collections.abc import Callable
+from types import ModuleType
 
+from services.acquisition import arguments as acquisition_arguments
 from services.cli.command_options import add_station_file_option
+from services.predictor import arguments as predictor_arguments
+from services.recorder import arguments as recorder_arguments
+from services.rig import arguments as rig_arguments
+from services.router import arguments as router_arguments
 
 NAME = "serve"
 HELP = "run one long-running service (rig, acquisition, predictor, recorder, router)"
 
-#: service name -> package that implements it
-SERVICES = {
-    "rig": "services.rig",
-    "acquisition": "services.acquisition",
-    "predictor": "services.predictor",
-    "recorder": "services.recorder",
-    "router": "services.router",
+#: service name -> its arguments module (light: no heavy imports, so ``--help`` is fast)
+SERVICES: dict[str, ModuleType] = {
+    "rig": rig_arguments,
+    "acquisition": acquisition_arguments,
+    "predictor": predictor_arguments,
+    "recorder": recorder_arguments,
+    "router": router_arguments,
 }
 
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR")
@@ -43,7 +49,7 @@ SERVICE_HELP = {
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     services = parser.add_subparsers(dest="service", metavar="SERVICE", required=True)
-    for name, package in SERVICES.items():
+    for name, arguments in SERVICES.items():
         sub = services.add_parser(name, help=SERVICE_HELP[name], description=SERVICE_HELP[name])
         if name in MULTI_STATION:
             add_station_file_option(
@@ -58,8 +64,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
             default=None,
             help="DEBUG, INFO (default), WARNING, ERROR",
         )
-        sub.set_defaults(service_package=package, command_label=f"{NAME} {name}")
-        importlib.import_module(f"{package}.arguments").add_arguments(sub)
+        sub.set_defaults(command_label=f"{NAME} {name}")
+        arguments.add_arguments(sub)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -68,9 +74,28 @@ def run(args: argparse.Namespace) -> int:
 
     setup_logging(args.service, args.log_level)
     follow_supervisor()  # started by boltwatch up: stop when it dies
-    service = importlib.import_module(f"{args.service_package}.service")
-    if args.service == "acquisition":  # the station's predictor may decide in it (edge)
+    return _service_main(args.service)(args)
+
+
+def _service_main(service: str) -> Callable[[argparse.Namespace], int]:
+    """The ``main`` of a service, imported only when that service runs (each is heavy)."""
+    if service == "rig":
+        from services.rig.service import main as rig_main
+
+        return rig_main
+    if service == "acquisition":  # the station's predictor may decide in it (edge)
+        from services.acquisition.service import main as acquisition_main
         from services.predictor.edge_predictor import EdgePredictor
 
-        return int(service.main(args, decider_factory=EdgePredictor))
-    return int(service.main(args))
+        return lambda args: acquisition_main(args, decider_factory=EdgePredictor)
+    if service == "predictor":
+        from services.predictor.service import main as predictor_main
+
+        return predictor_main
+    if service == "recorder":
+        from services.recorder.service import main as recorder_main
+
+        return recorder_main
+    from services.router.service import main as router_main
+
+    return router_main
