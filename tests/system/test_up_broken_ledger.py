@@ -58,6 +58,10 @@ def test_a_ledger_overwritten_under_up_is_reported_and_replaced_and_no_run_is_lo
     up = start_up(write_station(tmp_path), runs=RUNS)
     try:
         output = wait_for_first_run(up)
+        deadline = time.monotonic() + 30  # up prints a run as the recorder files it: a race
+        while not ledger.exists():
+            assert time.monotonic() < deadline, "no wear ledger 30 s after the first run"
+            time.sleep(0.05)
         with ledger.open("r+b") as handle:  # the recorder has it open
             handle.write(os.urandom(64 * 1024))
         output += "".join(read_rows(up, 1))
