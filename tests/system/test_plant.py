@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -92,10 +93,10 @@ def run_plant(hosts: Hosts, folder: Path) -> None:
         assert folders == [f"st{line}"], folders
 
 
-def _settled_status(plant: Plant) -> dict[str, object]:
+def _settled_status(plant: Plant) -> dict[str, Any]:
     """Status on line 1 once both recorders report every sample of their station recorded
     (the last BusStats counts the samples the acquisition published)."""
-    status: dict[str, object] = {}
+    status: dict[str, Any] = {}
     for _attempt in range(10):
         status = plant.status(1)
         recorders = [
