@@ -99,9 +99,12 @@ def line_access_control(
     for router, its_stations in (peers or {}).items():
         subjects.append({"id": router, "cert_common_names": [router]})
         everyone.append(router)
-        topics = ACQUISITION_TOPICS + PREDICTOR_TOPICS + RECORDER_TOPICS
         rule_id = f"{router}-forwards"
-        forwarded = [keys.station_key(st, topic) for st in its_stations for topic in topics]
+        forwarded = [
+            keys.station_key(st, topic)
+            for st in its_stations
+            for topic in (*ACQUISITION_TOPICS, *PREDICTOR_TOPICS, *RECORDER_TOPICS)
+        ]
         rules.append(_rule(rule_id, ["put"], ["ingress"], forwarded))
         policies.append({"id": rule_id, "rules": [rule_id], "subjects": [router]})
     policies.insert(
