@@ -9,6 +9,9 @@
 # st1-acquisition, st1-predictor, line-recorder, ...). The router's
 # certificate names localhost and 127.0.0.1; add the names services use to
 # reach it with ROUTER_SAN="DNS:router.plant.local,IP:10.0.0.5".
+# A plant of several lines shares one CA: ROUTER_NAME=line2-router makes
+# line2-router.pem + .key instead of router.pem (its common name is what the
+# other lines' access control names with --peer; README, "A plant of several lines").
 # An existing CA in OUT_DIR is reused, so services can be added later.
 # Needs the openssl CLI (1.1.1 or 3.x). Keys are EC P-256, certificates last
 # DAYS days (default 825). Private keys are written 0600 and never committed.
@@ -22,6 +25,11 @@ out=$1
 shift
 days=${DAYS:-825}
 router_san="DNS:localhost,IP:127.0.0.1${ROUTER_SAN:+,$ROUTER_SAN}"
+router_name=${ROUTER_NAME:-router}
+if [[ ! $router_name =~ ^[A-Za-z0-9._-]+$ ]]; then
+    echo "$0: ROUTER_NAME=$router_name: a certificate name is letters, digits, '.', '_' or '-'" >&2
+    exit 2
+fi
 mkdir -p "$out"
 umask 077
 
@@ -49,7 +57,7 @@ sign() {
 
 common="basicConstraints=critical,CA:FALSE
 keyUsage=critical,digitalSignature"
-sign router "$common
+sign "$router_name" "$common
 extendedKeyUsage=serverAuth,clientAuth
 subjectAltName=$router_san"
 for name in "$@"; do
@@ -61,4 +69,4 @@ for name in "$@"; do
 extendedKeyUsage=clientAuth"
 done
 chmod 644 "$out/ca.pem"
-echo "certificates in $out: ca.pem router.pem $(printf '%s.pem ' "$@")"
+echo "certificates in $out: ca.pem $router_name.pem $(printf '%s.pem ' "$@")"

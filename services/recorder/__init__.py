@@ -12,7 +12,8 @@ Files, one concept each:
   whole, a broken one recognised and moved aside), :mod:`.wear_watch`
   (summaries in, alerts out, a failing or broken ledger waited out),
   :mod:`.wear_waiting` (runs still waiting when the recorder stops),
-  :mod:`.wear_reset` (``boltwatch wear reset``), :mod:`.wear_table`
+  :mod:`.wear_reset` (``boltwatch wear reset``), :mod:`.wear_table`,
+  :mod:`.wear_plant` (every line's ledger merged: ``boltwatch wear --plant``)
 - reading back: :mod:`.recording_reader`, :mod:`.json_decoder`,
   :mod:`.trace_export`, :mod:`.recovery`, :mod:`.rrd_recovery`, and the
   post-mortem :mod:`.run_plot`, :mod:`.post_mortem_run`,

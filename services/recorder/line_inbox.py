@@ -1,6 +1,7 @@
 """The recorder's inbox: everything on the line, taken on zenoh's receive thread, filed in batches.
 
-One subscriber on the whole line whose callback runs on zenoh's receive
+One subscriber per key expression (the recorder's: one per station it
+serves, ``boltwatch/<st>/**``) whose callback runs on zenoh's receive
 thread (``indirect=False``) and only appends ``(key, payload, receive time)``
 to a pending list. The recorder's worker takes the whole list at once
 (:meth:`LineInbox.take`, every few milliseconds) and files it: one
@@ -22,6 +23,7 @@ from __future__ import annotations
 import contextlib
 import threading
 import time
+from collections.abc import Sequence
 
 import zenoh
 
@@ -35,9 +37,14 @@ MAX_PENDING = 100_000
 
 
 class LineInbox:
-    """A callback subscriber on ``key_expr`` that keeps what it receives for :meth:`take`."""
+    """Callback subscribers on ``key_exprs`` that keep what they receive for :meth:`take`."""
 
-    def __init__(self, session: zenoh.Session, key_expr: str, max_pending: int = MAX_PENDING):
+    def __init__(
+        self,
+        session: zenoh.Session,
+        key_exprs: str | Sequence[str],
+        max_pending: int = MAX_PENDING,
+    ):
         self._max_pending = max_pending
         self._pending: list[Message] = []
         self._lock = threading.Lock()
@@ -48,9 +55,13 @@ class LineInbox:
         self.after_close = 0
         #: times the receive thread waited because MAX_PENDING messages were waiting
         self.full_waits = 0
-        self._subscriber = session.declare_subscriber(
-            key_expr, zenoh.handlers.Callback(self._deliver, indirect=False)
-        )
+        wanted = [key_exprs] if isinstance(key_exprs, str) else list(key_exprs)
+        self._subscribers = [
+            session.declare_subscriber(
+                key_expr, zenoh.handlers.Callback(self._deliver, indirect=False)
+            )
+            for key_expr in wanted
+        ]
 
     def _deliver(self, sample: zenoh.Sample) -> None:
         keep_thread_state()
@@ -93,5 +104,6 @@ class LineInbox:
                 return
             self._closed = True
             self._room.notify_all()
-        with contextlib.suppress(zenoh.ZError):  # the session is already closed
-            self._subscriber.undeclare()
+        for subscriber in self._subscribers:
+            with contextlib.suppress(zenoh.ZError):  # the session is already closed
+                subscriber.undeclare()

@@ -1,7 +1,8 @@
-"""``boltwatch serve recorder``: everything on ``boltwatch/**`` into MCAP files.
+"""``boltwatch serve recorder``: everything of its stations into MCAP files.
 
-One zenoh session, one subscriber on :data:`shared.keys.EVERYTHING`
-(:class:`~services.recorder.line_inbox.LineInbox`: its callback keeps each
+One zenoh session, one subscriber per station it serves on
+``boltwatch/<st>/**`` (:class:`~services.recorder.line_inbox.LineInbox`: its
+callback keeps each
 message, the service's worker thread files them in batches every
 :data:`TAKE_INTERVAL_S`). The worker also flushes files every half flush
 interval, even when the line is quiet, and once a second publishes
@@ -12,8 +13,10 @@ finished, so it is readable without recovery.
 One process serves several stations (``--config A.toml B.toml``): each
 served station gets its metadata from its own file, its own ``wear``
 queryable and its own health token; they share the recordings folder and
-the ``[recorder]`` settings (an error when the files disagree). Messages of
-a station with no file are recorded too, with minimal metadata. No payload
+the ``[recorder]`` settings (an error when the files disagree). A station
+with no file is not its station: in a plant each line's recorder records its
+own line's stations, and the subscription never asks the router for the
+others (no other line's sample crosses to this line for it). No payload
 stops it: what it refuses (:mod:`services.recorder.incoming`) is recorded
 raw and counted in the station's ``RecorderStats.bad_payloads``.
 
@@ -32,6 +35,7 @@ import argparse
 import contextlib
 import json
 import logging
+import socket
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -127,6 +131,8 @@ class RecorderService:
         self.recorder = Recorder(first.recordings_folder, limits_of(first), metadata, rerun)
         self.health = RecorderHealth(self.station_ids)
         self._ledger_file = ledger_path(first.recordings_folder)
+        #: with the ledger's path, which ledger a wear reply comes from (a plant has several)
+        self._host = socket.gethostname()
         self.view_only = view_only
         self.wear: WearWatch | None = None
         if not view_only:
@@ -136,7 +142,7 @@ class RecorderService:
                 self._publish_alert,
                 StationLimits(stations).of,
             )
-        self._inbox = LineInbox(session, keys.EVERYTHING)
+        self._inbox = LineInbox(session, [station_keys(station) for station in self.station_ids])
         self._queryables = [
             session.declare_queryable(
                 keys.station_key(station, keys.WEAR), self._wear_replier(station)
@@ -149,10 +155,9 @@ class RecorderService:
             liveliness.declare_token(keys.health_key(station, role)) for station in self.station_ids
         ]
         LOG.info(
-            "recording %s into %s (station files: %s)",
-            keys.EVERYTHING,
+            "recording %s into %s (its station files)",
+            ", ".join(station_keys(station) for station in self.station_ids),
             first.recordings_folder,
-            ", ".join(self.station_ids),
         )
 
     def wake(self) -> None:
@@ -287,8 +292,21 @@ class RecorderService:
             LOG.warning("wear query of %s failed: %s", station, err)
             query.reply_err(str(err).encode())
             return
-        reply = {"station": station, "ledger": str(self._ledger_file), "tools": tools}
-        query.reply(query.key_expr, json.dumps(reply).encode())
+        reply = {
+            "station": station,
+            "ledger": str(self._ledger_file),
+            "host": self._host,
+            "tools": tools,
+        }
+        # on the station's own key, never the query's: a plant-wide get of
+        # boltwatch/*/wear would otherwise see every recorder's reply under one key,
+        # and zenoh's default consolidation keeps one of them
+        query.reply(keys.station_key(station, keys.WEAR), json.dumps(reply).encode())
+
+
+def station_keys(station: str) -> str:
+    """Everything of one station: ``boltwatch/<st>/**``."""
+    return keys.station_key(station, "**")
 
 
 def rerun_options(write_files: bool, live_url: str | None) -> RerunOptions | None:

@@ -15,7 +15,11 @@ may declare subscribers, queryables and liveliness tokens under
   ``boltwatch serve predictor`` for a station with ``placement = "line"``),
 - ``line-recorder`` may put ``boltwatch/<st>/recorder`` and ``wear/**``.
 
-No one else may put a station's decision.
+No one else may put a station's decision; in a plant of several lines the
+router of another line (``--peer NAME=ST,...``: the common name of that
+router's certificate and its line's stations) may put what its own line's
+services may put for its own stations (it forwards them; its own access
+control checked them on the way in), nothing for this line's stations.
 
 Anyone else (another common name, a certificate for another station) gets
 nothing through the router. The router enforces it on what enters it
@@ -23,13 +27,17 @@ nothing through the router. The router enforces it on what enters it
 common name is the verified certificate's.
 
 ``python -m services.router.access_control st1 st2 > acl.json5`` writes the
-section for a line (config/security/access_control.json5 is the one for st1).
+section for a line (config/security/access_control.json5 is the one for st1);
+``... st1 st2 --peer line2-router=st3,st4`` for line 1 of a plant whose line 2
+(router ``line2-router``) serves st3 and st4.
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from shared import channels, keys
@@ -60,8 +68,11 @@ def station_subjects(station: str) -> dict[str, str]:
     return {role: f"{station}-{role}" for role in ("acquisition", "predictor", "rig")}
 
 
-def line_access_control(stations: list[str]) -> dict[str, Any]:
-    """The ``access_control`` section of the router for ``stations``."""
+def line_access_control(
+    stations: list[str], peers: Mapping[str, Sequence[str]] | None = None
+) -> dict[str, Any]:
+    """The ``access_control`` section of the router for ``stations``; ``peers``: the
+    routers of the plant's other lines (certificate common name -> their stations)."""
     rules: list[dict[str, Any]] = [
         _rule("line-declarations", _DECLARATIONS, ["ingress", "egress"], [keys.EVERYTHING]),
         _rule("line-delivery", ["put", "delete"], ["egress"], [keys.EVERYTHING]),
@@ -90,6 +101,17 @@ def line_access_control(stations: list[str]) -> dict[str, Any]:
                 _rule(rule_id, ["put"], ["ingress"], [keys.station_key(station, t) for t in topics])
             )
             policies.append({"id": rule_id, "rules": [rule_id], "subjects": [names[role]]})
+    for router, its_stations in (peers or {}).items():
+        subjects.append({"id": router, "cert_common_names": [router]})
+        everyone.append(router)
+        rule_id = f"{router}-forwards"
+        forwarded = [
+            keys.station_key(st, topic)
+            for st in its_stations
+            for topic in (*ACQUISITION_TOPICS, *PREDICTOR_TOPICS, *RECORDER_TOPICS)
+        ]
+        rules.append(_rule(rule_id, ["put"], ["ingress"], forwarded))
+        policies.append({"id": rule_id, "rules": [rule_id], "subjects": [router]})
     policies.insert(
         0, {"id": "line", "rules": ["line-declarations", "line-delivery"], "subjects": everyone}
     )
@@ -115,11 +137,26 @@ def _rule(
 
 
 def main(argv: list[str]) -> int:
-    if not argv:
-        print("usage: python -m services.router.access_control STATION...", file=sys.stderr)
-        return 2
+    parser = argparse.ArgumentParser(prog="python -m services.router.access_control")
+    parser.add_argument("stations", nargs="+", metavar="STATION", help="this line's stations")
+    parser.add_argument(
+        "--peer",
+        action="append",
+        default=[],
+        metavar="ROUTER=ST,...",
+        help="another line's router (its certificate's common name) and that line's stations",
+    )
+    args = parser.parse_args(argv)
+    peers: dict[str, list[str]] = {}
+    for peer in args.peer:
+        router, _, stations = peer.partition("=")
+        named = [station for station in stations.split(",") if station]
+        if not router or not named or set(named) & set(args.stations):
+            parser.error(f"--peer {peer}: expected ROUTER=ST,... naming the other line's stations")
+        peers[router] = named
     header = "// zenoh access_control of the line, made by services/router/access_control.py\n"
-    sys.stdout.write(header + json.dumps(line_access_control(argv), indent=2) + "\n")
+    acl = line_access_control(args.stations, peers)
+    sys.stdout.write(header + json.dumps(acl, indent=2) + "\n")
     return 0
 
 

@@ -4,6 +4,12 @@ Stations connect to it as clients (``[zenoh] mode = "client"``). In a plant
 the official ``eclipse/zenoh`` router image does the same job (see
 docker-compose.yml); this one needs nothing but the Python wheel.
 
+With ``--connect`` it meshes with another line's router (a plant of several
+lines): the two routers route every declaration, put, query and liveliness
+token between their lines, so ``boltwatch status`` and ``boltwatch wear``
+answer for the whole plant from any line. A peer router that is not there
+yet is retried for ever (every ``RECONNECT_PERIOD_MAX_MS`` at most).
+
 With ``--tls-*`` it takes only TLS connections from services whose
 certificate the line's CA signed (mutual TLS); with ``--access-control`` it
 enforces zenoh's access control, e.g. only a station's predictor may put
@@ -53,8 +59,9 @@ def exposure_warning(endpoints: list[str]) -> str | None:
 def router_config(args: argparse.Namespace) -> zenoh.Config:
     """The router's zenoh.Config; bad TLS or access-control options are ConfigErrors."""
     endpoints = args.listen or [DEFAULT_LISTEN]
-    tls = _tls_files(args, endpoints)
-    config = zenoh_config("router", listen=endpoints, tls=tls)
+    peers = getattr(args, "connect", None) or []
+    tls = _tls_files(args, [*endpoints, *peers])
+    config = zenoh_config("router", connect=peers, listen=endpoints, tls=tls)
     if args.access_control is not None:
         _insert_access_control(config, args.access_control)
     return config
@@ -112,6 +119,8 @@ def main(args: argparse.Namespace) -> int:
     endpoints = args.listen or [DEFAULT_LISTEN]
     with open_from(config):
         LOG.info("zenoh router listening on %s", ", ".join(endpoints))
+        if peers := getattr(args, "connect", None):
+            LOG.info("meshed with the routers of other lines at %s", ", ".join(peers))
         warning = exposure_warning(endpoints)
         if warning is not None:
             LOG.warning("UNPROTECTED LINE: %s", warning)

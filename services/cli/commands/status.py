@@ -28,7 +28,6 @@ HELP = (
     "decision, recorder lag and health"
 )
 
-CONNECT_TIMEOUT_MS = 2000
 LIVELINESS_TIMEOUT_S = 2.0
 
 
@@ -69,17 +68,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from services.cli.router_client import router_client
     from services.cli.station_status import to_json
     from services.cli.station_status_text import format_report
-    from shared.zenoh_session import zenoh_config
 
-    if args.connect is not None:
-        endpoint, config = (
-            args.connect,
-            zenoh_config("client", [args.connect], connect_timeout_ms=CONNECT_TIMEOUT_MS),
-        )
-    else:
-        endpoint, config = _router_of(args.config or DEFAULT_STATION_FILE)
+    endpoint, config = router_client(args.config or DEFAULT_STATION_FILE, args.connect)
     report = _watch(endpoint, config, args.listen_s)
     if args.json:
         print(json.dumps(to_json(report), indent=2))
@@ -88,44 +81,16 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _router_of(config: Path) -> tuple[str, zenoh.Config]:
-    """The router endpoint of a station file and a client config that reaches it as the
-    file's services do (its TLS files included)."""
-    from shared.config import load_station
-    from shared.errors import ConfigError
-    from shared.zenoh_session import client_config
-
-    section = load_station(config).config.zenoh
-    if not section.connect:
-        raise ConfigError(
-            f"{config}: zenoh.connect is empty (a peer that only listens); "
-            "give the router with --connect ENDPOINT"
-        )
-    endpoint = section.connect[0]
-    return endpoint, client_config(section, CONNECT_TIMEOUT_MS, [endpoint])
-
-
 def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport:
     """Listen on ``endpoint`` for ``listen_s`` seconds; the StatusReport of what came."""
     import threading
     import time
 
-    import zenoh
-
+    from services.cli.router_client import open_client
     from services.cli.station_status import StatusCollector
     from shared import keys
-    from shared.errors import TransportError
-    from shared.zenoh_session import zenoh_reason
 
-    try:
-        session = zenoh.open(config)
-    except zenoh.ZError as err:
-        reason = zenoh_reason(err)
-        raise TransportError(
-            f"cannot reach the zenoh router at {endpoint} within "
-            f"{CONNECT_TIMEOUT_MS / 1000:.0f} s ({reason}); is 'boltwatch serve router' "
-            "running there?"
-        ) from err
+    session = open_client(endpoint, config)
 
     collector = StatusCollector()
     lock = threading.Lock()

@@ -5,6 +5,13 @@
     boltwatch wear [--recordings DIR] [--station ST]      the table, one line per tool
     boltwatch wear service TOOL --note TEXT               record a service of TOOL
     boltwatch wear reset [--recordings DIR]               a broken ledger moved aside, a new one
+    boltwatch wear --plant [--config FILE | --connect EP]  every line's ledger, over zenoh
+
+``--plant`` asks every recorder of the plant (``boltwatch/*/wear`` through the
+router of the station file, or ``--connect``; the routers of a plant's lines
+are meshed) and merges their replies (:mod:`services.recorder.wear_plant`). A
+recorder that replies with an error is named on stderr, what the others said
+is printed, and the exit status is 2.
 
 A broken ledger (empty, not SQLite, another schema, corrupt) is one line
 naming the file, what is wrong and the reset command, exit status 2.
@@ -16,7 +23,7 @@ import argparse
 from pathlib import Path
 
 from services.cli.command_options import add_recordings_folder_options, recordings_folder
-from shared.option_types import int_in
+from shared.option_types import int_in, seconds
 
 NAME = "wear"
 HELP = "show the wear ledger per tool, record a tool's service, or replace a broken ledger"
@@ -55,6 +62,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="only the tools that ran at station ST (their totals still count every station)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    plant = parser.add_argument_group("the whole plant (every line's recorder, over zenoh)")
+    plant.add_argument(
+        "--plant",
+        action="store_true",
+        help="ask every line's recorder (boltwatch/*/wear) through the router of --config's "
+        "station file, with its TLS files, and merge their ledgers",
+    )
+    plant.add_argument(
+        "--connect",
+        default=None,
+        metavar="ENDPOINT",
+        help="the router to ask, e.g. tcp/10.0.1.5:7447 (implies --plant; plain tcp)",
+    )
+    plant.add_argument(
+        "--timeout-s",
+        type=seconds,
+        default=5.0,
+        metavar="S",
+        help="how long to wait for the recorders' replies (default 5)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -65,6 +92,8 @@ def run(args: argparse.Namespace) -> int:
     from services.recorder.wear_table import format_table
     from shared.errors import InputError
 
+    if args.plant or args.connect is not None:
+        return _plant(args)
     path = ledger_path(recordings_folder(args))
     if args.action == "reset":
         return _reset(args, path)
@@ -102,3 +131,57 @@ def _reset(args: argparse.Namespace, path: Path) -> int:
         "kept waiting into it within seconds"
     )
     return 0
+
+
+def _plant(args: argparse.Namespace) -> int:
+    """The merged ledgers of every line's recorder; 2 when one replied with an error."""
+    import json
+    import sys
+
+    from services.cli.router_client import open_client, router_client
+    from services.recorder.wear_plant import WearReply, merge, parse_reply
+    from services.recorder.wear_table import format_table
+    from shared import keys
+    from shared.errors import InputError
+
+    if args.action is not None:
+        raise InputError(
+            f"wear {args.action} works on one ledger file (--recordings), not --plant: "
+            "run it on the line server whose recorder keeps the tool's runs"
+        )
+    endpoint, config = router_client(args.config, args.connect)
+    replies: list[WearReply] = []
+    failed: list[str] = []
+    with open_client(endpoint, config) as session:
+        import zenoh
+
+        for reply in session.get(
+            keys.station_key("*", keys.WEAR),
+            target=zenoh.QueryTarget.ALL,
+            consolidation=zenoh.ConsolidationMode.NONE,
+            timeout=args.timeout_s,
+        ):
+            if reply.ok is not None:
+                where = str(reply.ok.key_expr)
+                try:
+                    replies.append(parse_reply(reply.ok.payload.to_bytes()))
+                except InputError as err:
+                    failed.append(f"{where}: {err}")
+            elif reply.err is not None:
+                reason = reply.err.payload.to_bytes().decode(errors="replace")
+                failed.append(f"a recorder could not read its ledger: {reason}")
+    if not replies and not failed:
+        raise InputError(
+            f"no recorder answered a wear query through {endpoint} within {args.timeout_s:g} s"
+        )
+    tools = merge(replies, args.station)
+    if args.json:
+        print(json.dumps([tool.to_dict() for tool in tools], indent=2))
+    else:
+        print(format_table(tools, args.station))
+        ledgers = sorted({reply.ledger for reply in replies})
+        stations = sorted({reply.station for reply in replies})
+        print(f"{len(ledgers)} ledgers answered for stations {', '.join(stations) or '-'}")
+    for line in failed:
+        print(f"boltwatch wear: {line}", file=sys.stderr)
+    return 2 if failed else 0

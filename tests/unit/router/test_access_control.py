@@ -53,3 +53,30 @@ def test_the_shipped_access_control_is_the_one_made_for_st1() -> None:
     header, body = text.split("\n", 1)
     assert header.startswith("//")
     assert json.loads(body) == line_access_control(["st1"])
+
+
+def test_another_lines_router_may_forward_its_own_stations_only() -> None:
+    """A plant: line 1's router takes from line 2's router what line 2's services may put
+    for line 2's stations (samples, decisions, recorder stats, wear alerts), nothing for st1."""
+    acl = line_access_control(["st1"], {"line2-router": ["st2", "st3"]})
+    granted = put_keys_granted(acl, "line2-router")
+    assert channels.SAMPLES.key("st2") in granted
+    assert channels.DECISION.key("st3") in granted
+    assert keys.station_key("st3", f"{keys.WEAR}/**") in granted
+    assert not any(key.startswith("boltwatch/st1/") for key in granted)
+    line = next(policy for policy in acl["policies"] if policy["id"] == "line")
+    assert "line2-router" in line["subjects"]  # declarations, queries, replies, delivery
+    decision = channels.DECISION.key("st1")
+    deciders = {name for name in common_names(acl) if decision in put_keys_granted(acl, name)}
+    assert deciders == {"st1-acquisition", "st1-predictor"}
+
+
+def test_a_peer_naming_this_lines_station_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    from services.router.access_control import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main(["st1", "--peer", "line2-router=st1"])
+    assert exit_info.value.code == 2
+    assert "--peer line2-router=st1" in capsys.readouterr().err
+    assert main(["st1", "--peer", "line2-router=st2"]) == 0
+    assert '"line2-router-forwards"' in capsys.readouterr().out

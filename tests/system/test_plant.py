@@ -1,0 +1,110 @@
+"""A plant of two lines: meshed routers, a recorder per line, status and wear from any line.
+
+Each line server runs its router, its recorder for its own station, and the
+station (acquisition with its edge predictor, simulated rig); line 2's router
+connects to line 1's. Checked: each recorder's MCAP holds its own station
+only (the other line's samples never reach it, nor are they counted as bad
+payloads); ``boltwatch status`` on line 1 shows line 2's station with its
+services and its recorder's health; ``boltwatch wear --plant`` on line 1 (and
+on line 2) merges both ledgers for the tool that worked on both lines.
+
+Once on this host's loopback (two router ports: runs anywhere) and once with
+each line server in its own network namespace, the two joined by a veth pair
+(skipped, with the reason, where namespaces cannot be made).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.system.netns_line import unavailable_reason
+from tests.system.plant import (
+    LINES,
+    TOOL_ID,
+    Hosts,
+    LoopbackPlant,
+    NamespacePlant,
+    Plant,
+    recorded_topics,
+)
+
+pytestmark = pytest.mark.system
+
+RUNS = 2
+WHY_NO_NAMESPACES = unavailable_reason()
+
+
+@pytest.fixture
+def namespaces() -> Iterator[NamespacePlant]:
+    if WHY_NO_NAMESPACES is not None:
+        pytest.skip(WHY_NO_NAMESPACES)
+    with NamespacePlant() as hosts:
+        yield hosts
+
+
+def test_two_lines_on_loopback(tmp_path: Path) -> None:
+    run_plant(LoopbackPlant(), tmp_path)
+
+
+def test_two_lines_in_network_namespaces(namespaces: NamespacePlant, tmp_path: Path) -> None:
+    run_plant(namespaces, tmp_path)
+
+
+def run_plant(hosts: Hosts, folder: Path) -> None:
+    plant = Plant(hosts, folder)
+    try:
+        plant.start_lines()
+        plant.wait_until_up()
+        for rig in plant.start_rigs(RUNS):
+            assert rig.wait(60) == 0, f"a rig failed; see {plant.logs}"
+        status = _settled_status(plant)
+        wear = {line: plant.wear(line) for line in LINES}
+    finally:
+        plant.stop()
+
+    # status on line 1: line 2's station, its services, its recorder (line 2's) healthy
+    assert sorted(status) == ["st1", "st2"], status
+    for line in LINES:
+        station = status[f"st{line}"]
+        assert all(station["services"][s] for s in ("acquisition", "predictor", "recorder"))
+        recorder = station["recorder"]
+        assert recorder is not None, station
+        assert recorder["recording"] and recorder["bad_payloads"] == 0, recorder
+        assert recorder["missing_samples"] == 0, recorder
+    # wear from either line: the tool's runs on both lines, from both ledgers
+    for line in LINES:
+        (tool,) = wear[line]
+        assert tool["tool_id"] == TOOL_ID
+        assert tool["stations"] == ["st1", "st2"], tool
+        assert tool["runs"] == 2 * RUNS, tool
+        assert {run["station"] for run in tool["worst_runs"]} <= {"st1", "st2"}
+    # each line's recordings: its own station only, every topic of it
+    for line in LINES:
+        topics = recorded_topics(plant.recordings(line))
+        own = f"boltwatch/st{line}/"
+        assert topics and all(topic.startswith(own) for topic in topics), sorted(topics)
+        for topic in ("samples", "runs", "tool", "bus", "decision"):
+            assert topics.get(own + topic, 0) > 0, (own + topic, sorted(topics))
+        folders = sorted(path.name for path in plant.recordings(line).iterdir() if path.is_dir())
+        assert folders == [f"st{line}"], folders
+
+
+def _settled_status(plant: Plant) -> dict[str, Any]:
+    """Status on line 1 once both recorders report every sample of their station recorded
+    (the last BusStats counts the samples the acquisition published)."""
+    status: dict[str, Any] = {}
+    for _attempt in range(10):
+        status = plant.status(1)
+        recorders = [
+            station.get("recorder") for station in status.values() if isinstance(station, dict)
+        ]
+        if len(recorders) == len(LINES) and all(
+            isinstance(r, dict) and r["missing_samples"] == 0 and r["messages"] > 0
+            for r in recorders
+        ):
+            return status
+    return status
