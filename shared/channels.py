@@ -91,11 +91,11 @@ class Channel(Generic[MessageT]):
     message_type: type[MessageT]
     publisher: str
     qos: Qos = field(default_factory=Qos)
+    #: the registry name of its message type (``boltwatch.<Type>``): MCAP schema names
+    schema_name: str = field(init=False)
 
-    @property
-    def schema_name(self) -> str:
-        """The registry name of its message type: MCAP schema names, documentation."""
-        return f"boltwatch.{self.message_type.__name__}"
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "schema_name", f"boltwatch.{self.message_type.__name__}")
 
     def key(self, station: str) -> str:
         """``boltwatch/<station>/<topic>``."""

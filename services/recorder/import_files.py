@@ -27,14 +27,15 @@ from pathlib import Path
 from mcap.records import Message, Metadata
 
 from services.recorder.recording_reader import RecordingScan
+from shared import channels
 from shared.codec import decode
 from shared.errors import InputError
 from shared.messages import RunSummary
 
 TEMPORARY_MARK = ".importing"
 CONTROLLER_RECORD = "controller"
-_SAMPLE_SCHEMA = "boltwatch.Sample"
-_SUMMARY_SCHEMA = "boltwatch.RunSummary"
+_SAMPLE_SCHEMA = channels.SAMPLES.schema_name
+_SUMMARY_SCHEMA = channels.RUNS.schema_name
 _TEMPORARY = re.compile(r"^\.(?P<stem>.+)\.(?P<pid>\d+)" + re.escape(TEMPORARY_MARK) + r"\.\w+$")
 
 

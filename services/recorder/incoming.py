@@ -73,7 +73,7 @@ class Received(NamedTuple):
     @property
     def sequence(self) -> int | None:
         """Sample.sequence for samples; None for every other message."""
-        if self.schema_name == "boltwatch.Sample" and self.message is not None:
+        if self.schema_name == channels.SAMPLES.schema_name and self.message is not None:
             return int(self.message.sequence)
         return None
 
@@ -81,7 +81,7 @@ class Received(NamedTuple):
     def run_started(self) -> bool:
         """True for ToolState(state="running"), the start of a run."""
         return (
-            self.schema_name == "boltwatch.ToolState"
+            self.schema_name == channels.TOOL.schema_name
             and getattr(self.message, "state", None) == "running"
         )
 
@@ -142,7 +142,7 @@ def _time_problem(own_time_ns: int, arrival_ns: int) -> str:
     return f"its time is {ahead_s:.0f} s ahead of its arrival (at most {MAX_AHEAD_S} s)"
 
 
-_SAMPLE = "boltwatch.Sample"
+_SAMPLE = channels.SAMPLES.schema_name
 
 
 def _check_measured(sample: Sample, sensors: SensorRange) -> None:

@@ -27,6 +27,7 @@ from mcap.records import Message, Metadata
 
 from services.recorder.recording_reader import RecordingScan
 from services.recorder.trace_export import SAMPLE_SCHEMA
+from shared import channels
 from shared.codec import decode
 from shared.config.joint import JointConfig
 from shared.errors import InputError
@@ -35,8 +36,8 @@ from shared.model import JointConstants, JointModel
 
 LOG = logging.getLogger(__name__)
 
-EVENT_SCHEMA = "boltwatch.StickSlipEvent"
-DECISION_SCHEMA = "boltwatch.StopDecision"
+EVENT_SCHEMA = channels.EVENTS.schema_name
+DECISION_SCHEMA = channels.DECISION.schema_name
 
 
 @dataclass(frozen=True, slots=True)

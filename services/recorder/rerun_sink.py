@@ -33,6 +33,7 @@ import rerun as rr
 from services.recorder import rerun_blueprint as bp
 from services.recorder.incoming import Received
 from services.recorder.rerun_streams import borrow_stream, ensure_layout_file, return_stream
+from shared import channels
 
 LOG = logging.getLogger(__name__)
 
@@ -132,7 +133,7 @@ class RerunSink:
         if self.failed or message is None:
             return
         try:
-            if received.schema_name == "boltwatch.Sample":
+            if received.schema_name == channels.SAMPLES.schema_name:
                 time_ns = message.time_ns
                 self._torque.times_ns.append(time_ns)
                 self._torque.values.append(message.torque_nm)
@@ -142,15 +143,15 @@ class RerunSink:
                 self._pending_samples += 1
                 if self._pending_samples >= self._batch_samples:
                     self._send_samples()
-            elif received.schema_name == "boltwatch.StickSlipEvent":
+            elif received.schema_name == channels.EVENTS.schema_name:
                 self._event(message)
-            elif received.schema_name == "boltwatch.StopDecision":
+            elif received.schema_name == channels.DECISION.schema_name:
                 self._decision(message)
-            elif received.schema_name == "boltwatch.RunSummary":
+            elif received.schema_name == channels.RUNS.schema_name:
                 self._summary(message)
-            elif received.schema_name == "boltwatch.ControllerResult":
+            elif received.schema_name == channels.CONTROLLER.schema_name:
                 self._controller(message)
-            elif received.schema_name == "boltwatch.ToolState":
+            elif received.schema_name == channels.TOOL.schema_name:
                 self._text(
                     message.time_ns,
                     f"tool {message.state} (tool {message.tool_id}, program {message.program_id})",

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING
 from services.recorder.file_metadata import FileMetadata
 from services.recorder.incoming import Received
 from services.recorder.mcap_sink import McapSink
+from shared import channels
 
 if TYPE_CHECKING:  # rerun is imported only when .rrd files are wanted
     from services.recorder.rerun_sink import RerunOptions, RerunSink
@@ -141,7 +142,7 @@ class StationFiles:
             companion.write(received)
         if (
             sink is self.current
-            and received.schema_name == "boltwatch.ToolState"
+            and received.schema_name == channels.TOOL.schema_name
             and received.message
         ):
             self._run_ended = received.message.state in _ENDED_STATES  # a refused one is raw

@@ -73,8 +73,8 @@ STATS_PERIOD_S = 1.0
 TAKE_INTERVAL_S = 0.005
 #: health role of a ``--view-only`` recorder (a live view, not the line's recorder)
 VIEWER = "viewer"
-_BUS_STATS = "boltwatch.BusStats"
-_SAMPLE = "boltwatch.Sample"
+_BUS_STATS = channels.BUS.schema_name
+_SAMPLE = channels.SAMPLES.schema_name
 
 
 def limits_of(loaded: LoadedStation) -> FileLimits:
@@ -242,7 +242,7 @@ class RecorderService:
                 self.health.bus_stats(received.station, bus.samples, bus.started_ns)
         if (
             self.wear is not None
-            and received.schema_name == "boltwatch.RunSummary"
+            and received.schema_name == channels.RUNS.schema_name
             and received.message is not None
         ):
             self.wear.on_summary(received.message, now_ns)

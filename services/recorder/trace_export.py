@@ -20,10 +20,11 @@ from pathlib import Path
 from typing import Any
 
 from services.recorder.recording_reader import RecordingScan
+from shared import channels
 from shared.errors import InputError
 from shared.trace import write_trace
 
-SAMPLE_SCHEMA = "boltwatch.Sample"
+SAMPLE_SCHEMA = channels.SAMPLES.schema_name
 
 
 @dataclass(frozen=True, slots=True)
