@@ -6,6 +6,9 @@ Every station lives under ``boltwatch/<station>/``:
 key                        publisher                    payload (see :mod:`shared.messages`)
 =========================  ===========================  =================================
 ``samples``                acquisition                  :class:`Sample`, one per 1 kHz sample
+                                                        (placement line: the line predictor's)
+``sample_batches``         acquisition                  :class:`SampleBatch`, every 10 ms
+                                                        (placement edge: what the line records)
 ``tool``                   acquisition                  :class:`ToolState`, on every change
 ``bus``                    acquisition                  :class:`BusStats`, once a second
 ``events``                 predictor                    :class:`StickSlipEvent`
@@ -19,6 +22,10 @@ key                        publisher                    payload (see :mod:`share
 ``health/<service>``       every service (liveliness)   -
 =========================  ===========================  =================================
 
+A station's samples go toward the line once, on one of the two channels: one message per sample
+where a line predictor decides on them (``[predictor] placement = "line"``), in batches otherwise
+(the decision is taken on the station; the line only records them).
+
 ``tool``, ``bus``, ``recorder``, ``predictor`` and ``controller`` are additions to DESIGN.md's list:
 services need run boundaries, bus fault counters, recorder and predictor health, and a plant needs
 its tool controllers' own results (OK/NOK, each step's values); none of those is a sample
@@ -30,6 +37,7 @@ from __future__ import annotations
 ROOT = "boltwatch"
 
 SAMPLES = "samples"
+SAMPLE_BATCHES = "sample_batches"
 TOOL = "tool"
 BUS = "bus"
 EVENTS = "events"

@@ -14,6 +14,13 @@ The queue holds at most :data:`CAPACITY` messages (about 50 s of a station at
 1 kHz): a router that takes nothing for that long loses the overflow,
 counted (:attr:`QueuedPublisher.dropped`), instead of the station's memory.
 Each topic gets its publisher once, with its QoS (:data:`PublisherQos`).
+
+With ``batch_samples`` (an edge station: nobody on the line decides on its
+samples), what is published on ``samples`` goes out in batches on
+``sample_batches`` instead (:mod:`shared.sample_batching`): the thread keeps
+the batch in progress, publishes it when due and before any other message,
+so the order above holds for batches too. Each sample goes toward the line
+once, on one of the two channels.
 """
 
 from __future__ import annotations
@@ -21,6 +28,7 @@ from __future__ import annotations
 import logging
 import queue
 import threading
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -29,6 +37,7 @@ import zenoh
 
 from shared import keys
 from shared.codec import encode
+from shared.sample_batching import SampleBatching
 
 LOG = logging.getLogger(__name__)
 
@@ -50,6 +59,7 @@ class PublisherQos:
 #: run's ``done`` never overtakes its samples; a decision is REAL_TIME
 STATION_QOS: Mapping[str, PublisherQos] = {
     keys.SAMPLES: PublisherQos(express=True),
+    keys.SAMPLE_BATCHES: PublisherQos(express=True),
     keys.TOOL: PublisherQos(express=True),
     keys.BUS: PublisherQos(),
     keys.DECISION: PublisherQos(priority=zenoh.Priority.REAL_TIME, express=True),
@@ -70,13 +80,16 @@ class QueuedPublisher:
         station_id: str,
         qos: Mapping[str, PublisherQos] = STATION_QOS,
         capacity: int = CAPACITY,
+        batch_samples: bool = False,
     ) -> None:
+        """``batch_samples``: samples go out in batches on ``sample_batches``, not one by one."""
         self._session = session
         self._station_id = station_id
         self._qos = qos
         self._capacity = capacity
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._publishers: dict[str, zenoh.Publisher] = {}
+        self._batching = SampleBatching(station_id) if batch_samples else None
         self.dropped = 0  # messages the full queue could not take
         self.failed = 0  # puts zenoh refused (a closing session)
         self._thread = threading.Thread(target=self._run, name=f"publish-{station_id}", daemon=True)
@@ -104,20 +117,39 @@ class QueuedPublisher:
         self._publishers.clear()
 
     def _run(self) -> None:
+        batching = self._batching
         while True:
-            item = self._queue.get()
+            wait_s = None if batching is None else batching.wait_s(time.monotonic())
+            try:
+                item = self._queue.get(timeout=wait_s)
+            except queue.Empty:  # the batch in progress is due and nothing else came
+                self._send_batch()
+                continue
+            if batching is not None:
+                if type(item) is tuple and item[0] == keys.SAMPLES:
+                    for batch in batching.add(item[1], time.monotonic()):
+                        self._put(keys.SAMPLE_BATCHES, batch)
+                    continue
+                self._send_batch()  # nothing overtakes the samples queued before it
             if item is _STOP:
                 return
             if callable(item):
                 item()
                 continue
-            topic, message = item
-            try:
-                self._publisher(topic).put(encode(message))
-            except Exception as err:  # a closing session, a message that does not encode
-                self.failed += 1  # counted, and the thread goes on: one message, not all
-                if self.failed in (1, 100) or self.failed % 10_000 == 0:
-                    LOG.error("%s not published (#%d): %s", topic, self.failed, err)
+            self._put(*item)
+
+    def _send_batch(self) -> None:
+        batch = None if self._batching is None else self._batching.take()
+        if batch is not None:
+            self._put(keys.SAMPLE_BATCHES, batch)
+
+    def _put(self, topic: str, message: object) -> None:
+        try:
+            self._publisher(topic).put(encode(message))
+        except Exception as err:  # a closing session, a message that does not encode
+            self.failed += 1  # counted, and the thread goes on: one message, not all
+            if self.failed in (1, 100) or self.failed % 10_000 == 0:
+                LOG.error("%s not published (#%d): %s", topic, self.failed, err)
 
     def _publisher(self, topic: str) -> zenoh.Publisher:
         publisher = self._publishers.get(topic)

@@ -34,7 +34,7 @@ from typing import Any
 
 from shared import keys
 
-ACQUISITION_TOPICS = (keys.SAMPLES, keys.TOOL, keys.BUS)
+ACQUISITION_TOPICS = (keys.SAMPLES, keys.SAMPLE_BATCHES, keys.TOOL, keys.BUS)
 PREDICTOR_TOPICS = (keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS, keys.PREDICTOR)
 RECORDER_TOPICS = (keys.RECORDER, keys.WEAR, f"{keys.WEAR}/**")
 LINE_OBSERVERS = ("line-recorder", "line-viewer", "line-monitor")

@@ -260,7 +260,8 @@ class PredictorTarget(_Target):
 class RecorderTarget(_Target):
     #: every key the recorder decodes
     channels = (
-        *(keys.SAMPLES, keys.TOOL, keys.BUS, keys.EVENTS, keys.INTENSITY, keys.DECISION),
+        *(keys.SAMPLES, keys.SAMPLE_BATCHES, keys.TOOL, keys.BUS, keys.EVENTS, keys.INTENSITY),
+        keys.DECISION,
         *(keys.RUNS, keys.RECORDER, keys.PREDICTOR, keys.CONTROLLER, "wear/alert"),
     )
 
@@ -279,6 +280,8 @@ class RecorderTarget(_Target):
         super().send(channel, payload, refuse)
         if refuse:  # kept to find it in the raw channel later
             self.refused_payloads.append((keys.station_key(self.station, channel), payload))
+        elif channel == keys.SAMPLE_BATCHES:  # written as the samples it holds
+            self.sent += len(json.loads(payload)["samples"]) - 1
 
     def refused(self) -> int:
         return self.running.service.recorder.refused[self.station]
