@@ -13,6 +13,7 @@ refuses (recorded raw, byte for byte, and counted as a bad payload).
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import json
 import time
@@ -112,7 +113,8 @@ def test_batches_are_recorded_exactly_as_samples_that_came_alone(
 
 
 def bus(station: str, published: int, started_ns: int) -> BusStats:
-    return BusStats(station, time.time_ns(), 0, published, *[0] * 11, started_ns=started_ns)
+    stats = BusStats(station, time.time_ns(), 0, published, *[0] * 11)
+    return dataclasses.replace(stats, started_ns=started_ns)
 
 
 def stats_of(recorder: RunningRecorder, station: str) -> RecorderStats:
