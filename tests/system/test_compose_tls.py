@@ -63,7 +63,7 @@ HEALTHY_WITHIN_S = 60.0
 NOT_ALIVE = 1  # `boltwatch health`: 1 not alive (yet), 2 router unreachable or bad file
 HEARD_WITHIN_S = 60.0
 DECISION = keys.station_key("st1", keys.DECISION)
-SAMPLES = keys.station_key("st1", keys.SAMPLES)
+SAMPLES = keys.station_key("st1", keys.SAMPLE_BATCHES)  # an edge station: its samples in batches
 RUNS = keys.station_key("st1", keys.RUNS)
 
 

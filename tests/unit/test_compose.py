@@ -147,7 +147,7 @@ TLS_TEXT = TLS_FILE.read_text()
 PREDICTOR_PUTS = {keys.EVENTS, keys.INTENSITY, keys.DECISION, keys.RUNS, keys.PREDICTOR}
 ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), per station
     # the acquisition hosts the station's predictor (placement "edge") and publishes for it
-    "acquisition": {keys.SAMPLES, keys.TOOL, keys.BUS} | PREDICTOR_PUTS,
+    "acquisition": {keys.SAMPLES, keys.SAMPLE_BATCHES, keys.TOOL, keys.BUS} | PREDICTOR_PUTS,
     "predictor": PREDICTOR_PUTS,
     "recorder": {keys.RECORDER, keys.WEAR, f"{keys.WEAR}/**"},
 }
