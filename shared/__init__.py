@@ -12,7 +12,8 @@ codecs, zenoh and CAN helpers, and the paper's analytical model.
 - CAN: :mod:`.can_bus` (open the bus), :mod:`.can_database` (the DBC, checked),
   :mod:`.sensor_range` (what the sensors can measure)
 - zenoh: :mod:`.zenoh_session` (sessions, the router link), :mod:`.queued_publisher`
-  (publish without waiting), :mod:`.receive_threads` (cheap callbacks)
+  (publish without waiting), :mod:`.sample_batching` (an edge station's samples in
+  batches toward the line), :mod:`.receive_threads` (cheap callbacks)
 - a service's life: :mod:`.service_runtime` (start, signals, stop),
   :mod:`.supervisor_link` (stop when ``boltwatch up`` dies), :mod:`.realtime`
   (SCHED_FIFO for the stop path), :mod:`.logging_setup`, :mod:`.log_limit` (one

@@ -13,7 +13,10 @@ channel: its message type in :mod:`shared.messages`, its row below.
 =================  ====================  ===========================================
 topic              publisher             message, when
 =================  ====================  ===========================================
-``samples``        acquisition           :class:`Sample`, one per 1 kHz sample
+``samples``        acquisition           :class:`Sample`, one per 1 kHz sample (placement
+                                         line: what the line's predictor decides on)
+``sample_batches`` acquisition           :class:`SampleBatch`, every 10 ms (placement
+                                         edge: what the line records)
 ``tool``           acquisition           :class:`ToolState`, on every change
 ``bus``            acquisition           :class:`BusStats`, once a second
 ``events``         predictor             :class:`StickSlipEvent`, one per event
@@ -25,6 +28,11 @@ topic              publisher             message, when
 ``wear/alert``     recorder              :class:`WearAlert`, when a tool is due
 ``controller``     import (a bridge)     :class:`ControllerResult`, one per run
 =================  ====================  ===========================================
+
+A station's samples go toward the line once, on one of the two sample
+channels: one message per sample where a line predictor decides on them
+(``[predictor] placement = "line"``), in batches otherwise (the decision is
+taken on the station; the line only records them).
 
 Not channels: ``health/<service>`` (liveliness tokens) and ``wear`` (the
 recorder's queryable of the wear ledger), in :mod:`shared.keys`.
@@ -52,6 +60,7 @@ from shared.messages import (
     RecorderStats,
     RunSummary,
     Sample,
+    SampleBatch,
     StickSlipEvent,
     StopDecision,
     ToolState,
@@ -107,6 +116,7 @@ class Channel(Generic[MessageT]):
 
 
 SAMPLES = Channel("samples", Sample, "acquisition", Qos(express=True))
+SAMPLE_BATCHES = Channel("sample_batches", SampleBatch, "acquisition", Qos(express=True))
 TOOL = Channel("tool", ToolState, "acquisition", Qos(express=True))
 BUS = Channel("bus", BusStats, "acquisition")
 EVENTS = Channel("events", StickSlipEvent, "predictor")
@@ -123,6 +133,7 @@ CONTROLLER = Channel("controller", ControllerResult, "import")
 #: every channel, in the order of the table above
 CHANNELS: tuple[Channel[Any], ...] = (
     SAMPLES,
+    SAMPLE_BATCHES,
     TOOL,
     BUS,
     EVENTS,

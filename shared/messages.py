@@ -78,6 +78,27 @@ class Sample:
 
 
 @dataclass(frozen=True, slots=True)
+class SampleBatch:
+    """A station's samples of the last few milliseconds, in order: what the line records.
+
+    The acquisition of an edge station sends its samples toward the line in
+    batches (:data:`shared.channels.SAMPLE_BATCHES`, one every
+    :data:`shared.sample_batching.BATCH_PERIOD_S` at most, at most
+    :data:`shared.sample_batching.MAX_BATCH_SAMPLES` samples, never two runs): one
+    zenoh message per batch instead of one per sample. Every sample names the
+    batch's station. The recorder writes each sample as its own MCAP message on
+    ``boltwatch/<station>/samples``, as if it had come alone. Bounded by the
+    payload's size (64 KiB: about 400 samples).
+    """
+
+    __pydantic_config__ = WIRE_CONFIG
+
+    station: StationId
+    time_ns: TimeNs  # when the station's publisher sent it
+    samples: list[Sample]
+
+
+@dataclass(frozen=True, slots=True)
 class ToolState:
     """The tool's run state (CAN ToolStatus), published when it changes."""
 

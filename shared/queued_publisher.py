@@ -14,6 +14,13 @@ The queue holds at most :data:`CAPACITY` messages (about 50 s of a station at
 1 kHz): a router that takes nothing for that long loses the overflow,
 counted (:attr:`QueuedPublisher.dropped`), instead of the station's memory.
 Each channel gets its publisher once, with its options (:mod:`shared.channels`).
+
+With ``batch_samples`` (an edge station: nobody on the line decides on its
+samples), samples go out in batches on ``sample_batches`` instead
+(:mod:`shared.sample_batching`): the thread keeps the batch in progress,
+publishes it when due and before any other message, so the order above
+holds for batches too. Each sample goes toward the line once, on one of the
+two channels.
 """
 
 from __future__ import annotations
@@ -21,6 +28,7 @@ from __future__ import annotations
 import logging
 import queue
 import threading
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -28,6 +36,8 @@ import zenoh
 
 from shared import channels
 from shared.codec import encode
+from shared.messages import Sample
+from shared.sample_batching import SampleBatching
 
 LOG = logging.getLogger(__name__)
 
@@ -45,12 +55,15 @@ class QueuedPublisher:
         session: zenoh.Session,
         station_id: str,
         capacity: int = CAPACITY,
+        batch_samples: bool = False,
     ) -> None:
+        """``batch_samples``: samples go out in batches on ``sample_batches``, not one by one."""
         self._session = session
         self._station_id = station_id
         self._capacity = capacity
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._publishers: dict[str, zenoh.Publisher] = {}
+        self._batching = SampleBatching(station_id) if batch_samples else None
         self.dropped = 0  # messages the full queue could not take
         self.failed = 0  # puts zenoh refused (a closing session)
         self._thread = threading.Thread(target=self._run, name=f"publish-{station_id}", daemon=True)
@@ -79,20 +92,39 @@ class QueuedPublisher:
         self._publishers.clear()
 
     def _run(self) -> None:
+        batching = self._batching
         while True:
-            item = self._queue.get()
+            wait_s = None if batching is None else batching.wait_s(time.monotonic())
+            try:
+                item = self._queue.get(timeout=wait_s)
+            except queue.Empty:  # the batch in progress is due and nothing else came
+                self._send_batch()
+                continue
+            if batching is not None:
+                if type(item) is tuple and type(item[1]) is Sample:
+                    for batch in batching.add(item[1], time.monotonic()):
+                        self._put(channels.SAMPLE_BATCHES, batch)
+                    continue
+                self._send_batch()  # nothing overtakes the samples queued before it
             if item is _STOP:
                 return
             if callable(item):
                 item()
                 continue
-            channel, message = item
-            try:
-                self._publisher(channel).put(encode(message))
-            except Exception as err:  # a closing session, a message that does not encode
-                self.failed += 1  # counted, and the thread goes on: one message, not all
-                if self.failed in (1, 100) or self.failed % 10_000 == 0:
-                    LOG.error("%s not published (#%d): %s", channel.topic, self.failed, err)
+            self._put(*item)
+
+    def _send_batch(self) -> None:
+        batch = None if self._batching is None else self._batching.take()
+        if batch is not None:
+            self._put(channels.SAMPLE_BATCHES, batch)
+
+    def _put(self, channel: channels.Channel[Any], message: object) -> None:
+        try:
+            self._publisher(channel).put(encode(message))
+        except Exception as err:  # a closing session, a message that does not encode
+            self.failed += 1  # counted, and the thread goes on: one message, not all
+            if self.failed in (1, 100) or self.failed % 10_000 == 0:
+                LOG.error("%s not published (#%d): %s", channel.topic, self.failed, err)
 
     def _publisher(self, channel: channels.Channel[Any]) -> zenoh.Publisher:
         publisher = self._publishers.get(channel.topic)

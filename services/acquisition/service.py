@@ -70,7 +70,7 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
     with contextlib.ExitStack() as resources:
         bus = resources.enter_context(open_bus(station.config.can))
         session = resources.enter_context(open_session(station.config.zenoh))
-        publisher = QueuedPublisher(session, station_id)
+        publisher = QueuedPublisher(session, station_id, batch_samples=edge)
         resources.callback(publisher.close)
         outlet = ZenohOutlet(session, publisher)
         resources.callback(outlet.close)

@@ -2,7 +2,9 @@
 
 Through the station's :class:`~shared.queued_publisher.QueuedPublisher`:
 the CAN thread only queues (it is the stop path), a thread of the
-publisher's own encodes and puts, in order.
+publisher's own encodes and puts, in order. An edge station's publisher
+sends the samples in batches on ``sample_batches`` (the line only records
+them); a line-placed station's one message per sample on ``samples``.
 
 While the session has no router (it restarts, the network is cut) zenoh has
 nowhere to send a sample: it is lost. The outlet counts those samples

@@ -10,7 +10,9 @@ printed by :mod:`services.cli.station_status_text` (for a person) or
 Per station:
 
 - services alive: the liveliness tokens ``boltwatch/<st>/health/<service>``;
-- sample rate: Sample messages received per second over the window, and, when
+- sample rate: samples received per second over the window (one per Sample
+  message of a line-placed station, every sample of an edge station's
+  SampleBatch), and, when
   two or more BusStats arrived, the acquisition's own count (``samples``
   delta over ``time_ns`` delta) -- the second tells a slow link from a slow bus;
 - bus faults: from the latest BusStats (counters since the acquisition started);
@@ -38,7 +40,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from shared import channels, keys
-from shared.codec import decode
+from shared.codec import decode, encode
 from shared.errors import InputError
 from shared.messages import (
     BusStats,
@@ -46,6 +48,7 @@ from shared.messages import (
     RecorderStats,
     RunSummary,
     Sample,
+    SampleBatch,
     StopDecision,
     ToolState,
 )
@@ -208,6 +211,11 @@ class StatusCollector:
                 # 1 kHz: count only; the latest is decoded once, at report time.
                 seen.samples += 1
                 seen.last_sample_payload = payload
+            elif topic == channels.SAMPLE_BATCHES.topic:  # an edge station's, 100 a second
+                batch = decode(SampleBatch, payload)
+                if batch.samples:
+                    seen.samples += len(batch.samples)
+                    seen.last_sample_payload = encode(batch.samples[-1])
             elif topic == channels.BUS.topic:
                 stats = decode(BusStats, payload)
                 if seen.first_bus is None:

@@ -3,7 +3,8 @@
 Files, one concept each:
 
 - live recording: :mod:`.service` (zenoh wiring), :mod:`.arguments`,
-  :mod:`.line_inbox`, :mod:`.incoming` (classify and decode), :mod:`.recorder`
+  :mod:`.line_inbox`, :mod:`.incoming` (classify and decode), :mod:`.sample_batches`
+  (a batch filed as its samples), :mod:`.recorder`
   (payloads into files, disk faults), :mod:`.run_files` (one file per run),
   :mod:`.mcap_sink`, :mod:`.file_metadata`, :mod:`.recorder_health`
 - Rerun: :mod:`.rerun_sink`, :mod:`.rerun_streams`, :mod:`.rerun_blueprint`

@@ -2,7 +2,9 @@
 
 A key ``boltwatch/<station>/<topic>`` whose topic is a channel
 (:mod:`shared.channels`) is decoded with :mod:`shared.codec`; anything else
-is kept as raw bytes. Nothing is dropped here: a payload that is refused is marked
+is kept as raw bytes. A :class:`~shared.messages.SampleBatch` is checked
+sample by sample as samples that came alone are (:mod:`.sample_batches` then
+files each sample as if it had). Nothing is dropped here: a payload that is refused is marked
 ``decodable=False`` (with the reason in ``problem``) and still recorded, byte
 for byte, on its key's raw channel, with its arrival as its publish time.
 Refused are payloads the decoder refuses (bad JSON, too large or nested too
@@ -28,7 +30,7 @@ from shared import channels, keys
 from shared.codec import decoder
 from shared.errors import InputError
 from shared.message_fields import STATION_ID
-from shared.messages import Sample
+from shared.messages import Sample, SampleBatch
 from shared.sensor_range import CONTRACT_RANGE, SensorRange
 
 #: how far ahead of its arrival a message's own time may be: the clocks of two hosts of
@@ -123,6 +125,9 @@ def classify(
         if schema_name == _SAMPLE:
             sensors = CONTRACT_RANGE if sensor_ranges is None else sensor_ranges.get(station)
             _check_measured(message, sensors or CONTRACT_RANGE)
+        elif schema_name == _BATCH:
+            sensors = CONTRACT_RANGE if sensor_ranges is None else sensor_ranges.get(station)
+            _check_batch(message, log_time_ns, sensors or CONTRACT_RANGE)
     except InputError as err:
         return Received(
             key, station, schema_name, None, payload, log_time_ns, log_time_ns, str(err)
@@ -143,6 +148,22 @@ def _time_problem(own_time_ns: int, arrival_ns: int) -> str:
 
 
 _SAMPLE = channels.SAMPLES.schema_name
+_BATCH = channels.SAMPLE_BATCHES.schema_name
+
+
+def _check_batch(batch: SampleBatch, arrival_ns: int, sensors: SensorRange) -> None:
+    """Each sample of a batch as :func:`classify` checks a sample that came alone: one bad
+    sample refuses the batch (recorded raw, byte for byte, on its own channel)."""
+    latest_ns = arrival_ns + _MAX_AHEAD_NS
+    for index, sample in enumerate(batch.samples):
+        try:
+            if sample.station != batch.station:
+                raise InputError(f"it names station {sample.station!r}, in a batch of its own")
+            if not 0 <= sample.time_ns <= latest_ns:
+                raise InputError(_time_problem(sample.time_ns, arrival_ns))
+            _check_measured(sample, sensors)
+        except InputError as err:
+            raise InputError(f"samples[{index}]: {err}") from None
 
 
 def _check_measured(sample: Sample, sensors: SensorRange) -> None:

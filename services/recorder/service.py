@@ -44,11 +44,12 @@ from typing import TYPE_CHECKING
 import zenoh
 
 from services.recorder.file_metadata import FileMetadata
-from services.recorder.incoming import OTHER_STATION, classify
+from services.recorder.incoming import OTHER_STATION, Received, classify
 from services.recorder.line_inbox import LineInbox, Message
 from services.recorder.recorder import Recorder
 from services.recorder.recorder_health import RecorderHealth
 from services.recorder.run_files import FileLimits
+from services.recorder.sample_batches import BatchSamples
 from services.recorder.wear_bound import StationLimits
 from services.recorder.wear_ledger import WearLedger, ledger_path
 from services.recorder.wear_watch import WearWatch
@@ -75,6 +76,7 @@ TAKE_INTERVAL_S = 0.005
 VIEWER = "viewer"
 _BUS_STATS = channels.BUS.schema_name
 _SAMPLE = channels.SAMPLES.schema_name
+_BATCH = channels.SAMPLE_BATCHES.schema_name
 
 
 def limits_of(loaded: LoadedStation) -> FileLimits:
@@ -130,6 +132,7 @@ class RecorderService:
         self._sensor_ranges = {station.station_id: station.sensor_range for station in stations}
         self.recorder = Recorder(first.recordings_folder, limits_of(first), metadata, rerun)
         self.health = RecorderHealth(self.station_ids)
+        self._batches = BatchSamples()
         self._ledger_file = ledger_path(first.recordings_folder)
         #: with the ledger's path, which ledger a wear reply comes from (a plant has several)
         self._host = socket.gethostname()
@@ -228,6 +231,9 @@ class RecorderService:
     def _handle(self, key: str, payload: bytes, now_ns: int, filed_ns: int) -> None:
         """File one message received at ``now_ns`` (its MCAP log time) at ``filed_ns``."""
         received = classify(key, payload, now_ns, self._sensor_ranges)
+        if received.schema_name == _BATCH and received.message is not None:
+            self._file_batch(received, filed_ns)
+            return
         self.recorder.write(received)
         if received.station != OTHER_STATION:
             is_sample = received.schema_name == _SAMPLE
@@ -246,6 +252,14 @@ class RecorderService:
             and received.message is not None
         ):
             self.wear.on_summary(received.message, now_ns)
+
+    def _file_batch(self, batch: Received, filed_ns: int) -> None:
+        """Each sample of a batch, as a sample that came alone (a refused batch is filed raw
+        by :meth:`_handle`: its samples are not received, so they count as missing)."""
+        write, written, station = self.recorder.write, self.health.written, batch.station
+        for sample in self._batches.samples(batch):
+            write(sample)
+            written(station, filed_ns, sample.publish_time_ns, True, False)
 
     def _publish_stats(self, now_ns: int) -> None:
         """Put each station's RecorderStats for everyone but this recorder (not recorded)."""

@@ -67,8 +67,9 @@ def publish(session: zenoh.Session, items: Sequence[tuple[str, Any]], station: s
 class RunningRecorder:
     """A RecorderService working in a thread of this process, as ServiceRunner runs it."""
 
-    def __init__(self, loaded: LoadedStation) -> None:
-        self.session = open_session(loaded.config.zenoh)
+    def __init__(self, loaded: LoadedStation | Sequence[LoadedStation]) -> None:
+        first = loaded if isinstance(loaded, LoadedStation) else loaded[0]
+        self.session = open_session(first.config.zenoh)
         self.service = RecorderService(loaded, self.session)
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self.service.work, args=(self.stop,))

@@ -1,30 +1,38 @@
-"""A line on one predictor and one recorder: how many 1 kHz stations, at what stop latency.
+"""A line server for N stations: router + recorder (MCAP and Rerun) against N edge stations.
 
 Run on demand (not collected by pytest)::
 
-    .venv/bin/python tests/benchmarks/bench_line.py --stations 1 10 25 50 [--runs 10]
+    .venv/bin/python tests/benchmarks/bench_line.py --stations 50 100 [--runs 20]
 
-Per N: one router, ONE ``serve predictor`` and ONE ``serve recorder``
-process serving N station files (derived with ``shared.config.derive_stations``,
-as ``boltwatch up --stations N`` does). Station st1 is real: its rig and
-acquisition run on a udp_multicast bus and the stop path is measured as in
-``bench_stop_path.py`` (CAN receive time of the deciding sample in the
-acquisition -> StopCommand heard on the CAN bus, kernel timestamps). The
-other N-1 stations are a load generator (a separate process, stated: the
-2-core machine cannot also run N-1 rigs and acquisitions) publishing
-synthetic 1 kHz ``Sample`` streams (the predictor tests' stick-slip
-staircase, 1 s runs, ToolState running/done around each) straight on zenoh.
+Per N: one router and ONE ``serve recorder`` (MCAP and Rerun ``.rrd``;
+``--no-rerun``: MCAP only) serving N + 1 station files (derived as ``boltwatch
+up --stations`` derives them). Station st1 is real, with its stop path: its rig
+and its acquisition with the edge predictor (placement edge) on a
+udp_multicast CAN bus; the stop path is measured as in ``bench_stop_path.py``
+(the deciding sample's CAN receive time -> the StopCommand heard on the bus).
+The N other stations are one generator process publishing exactly what an edge
+station publishes toward the line, at its rates, pre-encoded so the generator
+stays cheap: a ``SampleBatch`` of 10 samples every 10 ms (1 s runs, 0.2 s
+apart), ``ToolState`` running/done around each run, a stick-slip event and its
+intensity every 25 ms, a decision and a summary per run, ``BusStats`` (with
+its count of published samples: the recorder's loss count) and
+``PredictorStats`` once a second. ``--per-sample`` publishes each sample as its
+own message instead (the wire before batches; with ``--repo`` a checkout of
+an older commit runs the line and st1, for a side-by-side comparison).
 
-"Keeps up" is read from the line's own outputs: the predictor's RunSummary
-of every synthetic run must count all its samples, and its lag (summary
-received minus the run's ``done``) stays small; the recorder's RecorderStats
-lag (receive minus acquisition time of samples) stays small. The recorder
-runs with ``--no-rerun`` (MCAP only) unless ``--rerun``.
+Printed per N: recorder CPU µs per sample (all its CPU over the load, per
+sample it recorded) and stations per recorder core, recorder lag p50 (median
+of the per-second p50s of ``RecorderStats``) and p99 (of the per-second
+maxima: an upper bound), samples missing (``RecorderStats.missing_samples``,
+end to end), and st1's stop path p50/p90/p99. Exit status 1 when a sample is
+missing or a goal is missed: recorder <= 10 µs per sample; at N = 50 lag p99
+<= 1 s and the stop path p90 <= 2 ms (README, the edge stop path).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import re
 import signal
@@ -49,81 +57,159 @@ from shared import channels, keys  # noqa: E402
 from shared.can_database import StationDatabase  # noqa: E402
 from shared.codec import decode, encode  # noqa: E402
 from shared.config import derive_stations, load_station  # noqa: E402
-from shared.messages import RecorderStats, RunSummary, ToolState  # noqa: E402
+from shared.messages import BusStats, RecorderStats  # noqa: E402
 from shared.zenoh_session import zenoh_config  # noqa: E402
-from tests.benchmarks.line_station_runs import (  # noqa: E402
-    SHORT_PROGRAM,
-    Heard,
-    figures,
-    tighten,
-)
+from tests.benchmarks.bench_stop_path import serve_from  # noqa: E402
+from tests.benchmarks.line_station_runs import SHORT_PROGRAM, Heard, figures, tighten  # noqa: E402
+from tests.fuzz.payloads import template  # noqa: E402
 from tests.system.can_injector import StopListener  # noqa: E402
-from tests.system.station_files import free_tcp_port, serve, write_station  # noqa: E402
+from tests.system.station_files import free_tcp_port, write_station  # noqa: E402
 from tests.unit.predictor.synthetic import staircase  # noqa: E402
 
 REAL_STATION = "st1"
-START_TIMEOUT_S = 90.0
-RUN_TIMEOUT_S = 20.0
-SYNTHETIC_PROGRAM = 1
-GENERATOR_PAUSE_S = 0.2  # between synthetic runs
+START_TIMEOUT_S = 120.0
+RUN_SAMPLES = 1000  # 1 s runs at 1 kHz
+BATCH_SAMPLES = 10  # every 10 ms
+RUN_PAUSE_TICKS = 200  # 0.2 s between runs
+EVENT_EVERY_TICKS = 25
+RUN_MARK = 987_654_321  # stands for the run id in pre-encoded messages
+GOAL_US_PER_SAMPLE = 10.0
+GOAL_LAG_P99_MS = 1000.0
+GOAL_STOP_P90_MS = 2.0
+#: what an edge station publishes toward the line (and ``samples``, with --per-sample)
+STATION_CHANNELS = tuple(
+    channel for channel in channels.CHANNELS if channel.publisher in ("acquisition", "predictor")
+)
+#: the real station on the edge (the default placement), the short program
+EDGE_PROGRAM = {k: v for k, v in SHORT_PROGRAM.items() if k != "[predictor]\n"}
 
 
-# -- the load generator (a child process: python bench_line.py --generate ...) ---------------
+# -- the generator (a child process: python bench_line.py --generate ...) --------------------
 
 
-def generate(endpoint: str, station_ids: list[str], seconds: float) -> int:
-    """Publish 1 kHz synthetic runs for ``station_ids`` for ``seconds`` or until SIGTERM
-    (the current run is finished first, so every run the predictor sees is complete)."""
+def run_templated(message: object) -> str:
+    """The JSON of ``message`` (whose run id is RUN_MARK) with ``%d`` for the run id."""
+    return encode(message).decode().replace("%", "%%").replace(str(RUN_MARK), "%d")
+
+
+def sample_texts(station: str, rows: list[tuple[float, float, float]]) -> list[str]:
+    """Each sample of a run as JSON with ``%d`` for its run id, then its time."""
+    return [
+        f'{{"station":"{station}","run_id":%d,"sequence":{n},"time_ns":%d,"torque_nm":{tq!r},'
+        f'"angle_deg":{angle!r},"force_n":{force!r},"time_s":{n / 1e3!r}}}'
+        for n, (tq, angle, force) in enumerate(rows)
+    ]
+
+
+class Station:
+    """One synthetic edge station's publishers and pre-encoded messages."""
+
+    def __init__(self, session: zenoh.Session, station: str, rows: list, per_sample: bool) -> None:
+        self.put = {  # as the station's publisher: each channel's options (BLOCK: never lossy)
+            channel.topic: channel.declare_publisher(session, station).put
+            for channel in STATION_CHANNELS
+        }
+        self.station = station
+        self.per_sample = per_sample
+        texts = sample_texts(station, rows)
+        self.samples = texts
+        self.batches = [
+            f'{{"station":"{station}","time_ns":%d,"samples":[' + ",".join(texts[i : i + 10]) + "]}"
+            for i in range(0, len(texts), BATCH_SAMPLES)
+        ]
+        now = time.time_ns()
+        made = {topic: template(topic, station, now, RUN_MARK) for topic in ("events", "intensity")}
+        summary = dataclasses.replace(
+            template("runs", station, now, RUN_MARK), process_intensity=1.5, events=3, samples=1000
+        )
+        self.events = run_templated(made["events"]).encode()
+        self.intensity = run_templated(made["intensity"]).encode()
+        self.decision = run_templated(template("decision", station, now, RUN_MARK)).encode()
+        self.summary = run_templated(summary).encode()
+        self.predictor = encode(template("predictor", station, now))
+        self.published = 0
+        self.started_ns = now
+
+    def tool(self, run_id: int, state: str, now_ns: int) -> None:
+        self.put[channels.TOOL.topic](
+            f'{{"station":"{self.station}","run_id":{run_id},"tool_id":1,"program_id":1,'
+            f'"state":"{state}","time_ns":{now_ns}}}'
+        )
+
+    def bus(self, now_ns: int) -> None:
+        stats = BusStats(self.station, now_ns, 0, self.published, *[0] * 11)
+        self.put[channels.BUS.topic](encode(dataclasses.replace(stats, started_ns=self.started_ns)))
+
+
+def batch_ids(run_id: int, newest_ns: int) -> list[int]:
+    """(run id, time) of each sample of a batch whose newest sample is ``newest_ns``."""
+    ids: list[int] = []
+    for k in range(BATCH_SAMPLES - 1, -1, -1):
+        ids += (run_id, newest_ns - k * 1_000_000)
+    return ids
+
+
+def generate(endpoint: str, station_ids: list[str], seconds: float, per_sample: bool) -> int:
+    """Publish the stations' runs for ``seconds`` or until SIGTERM (the run in progress is
+    finished first), then each station's last BusStats."""
     stopped = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stopped.set())
     trace = staircase(torque_noise_nm=0.2, force_noise_n=30.0, duration_s=1.0)
-    rows = [(tq, a, f) for _t, tq, f, a in trace.rows()]
-    published = behind_ticks = 0
+    rows = [(tq, a, f) for _t, tq, f, a in trace.rows()][:RUN_SAMPLES]
+    behind = 0
     with zenoh.open(zenoh_config("client", [endpoint])) as session:
-        # BLOCK as the acquisition's publishers: a line that cannot keep up slows the
-        # generator (ticks behind schedule) instead of losing samples in the router
-        cc = zenoh.CongestionControl.BLOCK
-        samples = {
-            s: session.declare_publisher(channels.SAMPLES.key(s), congestion_control=cc)
-            for s in station_ids
-        }
-        tools = {
-            s: session.declare_publisher(channels.TOOL.key(s), congestion_control=cc)
-            for s in station_ids
-        }
-        time.sleep(1.0)  # let the router learn the subscribers
+        stations = [Station(session, s, rows, per_sample) for s in station_ids]
+        time.sleep(1.0)  # the router learns the subscribers
         end = time.monotonic() + seconds
         run_id = int(time.time()) * 1000
+        tick = 0
+        next_tick = time.perf_counter()
         while time.monotonic() < end and not stopped.is_set():
             run_id += 1
-            start_ns = time.time_ns()
-            for station_id in station_ids:
-                tools[station_id].put(
-                    encode(ToolState(station_id, run_id, 1, SYNTHETIC_PROGRAM, "running", start_ns))
-                )
-            next_tick = time.perf_counter()
-            for sequence, (torque, angle, force) in enumerate(rows):
+            now_ns = time.time_ns()
+            for station in stations:
+                station.tool(run_id, "running", now_ns)
+            for n in range(len(rows)):
                 now_ns = time.time_ns()
-                for station_id in station_ids:
-                    samples[station_id].put(
-                        f'{{"station":"{station_id}","run_id":{run_id},"sequence":{sequence},'
-                        f'"time_ns":{now_ns},"torque_nm":{torque},"angle_deg":{angle},'
-                        f'"force_n":{force}}}'
-                    )
-                published += len(station_ids)
+                for station in stations:
+                    if per_sample:
+                        station.put[channels.SAMPLES.topic](station.samples[n] % (run_id, now_ns))
+                        station.published += 1
+                    elif n % BATCH_SAMPLES == BATCH_SAMPLES - 1:
+                        first = n - BATCH_SAMPLES + 1
+                        times = [
+                            x
+                            for k in range(BATCH_SAMPLES)
+                            for x in (run_id, now_ns - (9 - k) * 1_000_000)
+                        ]
+                        station.put[channels.SAMPLE_BATCHES.topic](
+                            station.batches[first // BATCH_SAMPLES] % (now_ns, *times)
+                        )
+                        station.published += BATCH_SAMPLES
+                    if n % EVENT_EVERY_TICKS == 0:
+                        station.put[channels.EVENTS.topic](station.events % run_id)
+                        station.put[channels.INTENSITY.topic](station.intensity % run_id)
+                    if tick % 1000 == 0:
+                        station.bus(now_ns)
+                        station.put[channels.PREDICTOR.topic](station.predictor)
+                tick += 1
                 next_tick += 1e-3
                 delay = next_tick - time.perf_counter()
                 if delay > 0:
                     time.sleep(delay)
                 else:
-                    behind_ticks += 1
-            done_ns = time.time_ns()
-            for station_id in station_ids:
-                tools[station_id].put(
-                    encode(ToolState(station_id, run_id, 1, SYNTHETIC_PROGRAM, "done", done_ns))
-                )
-            time.sleep(GENERATOR_PAUSE_S)
-    print(f"generator: {published} samples, {behind_ticks} ticks behind schedule", flush=True)
+                    behind += 1
+            now_ns = time.time_ns()
+            for station in stations:
+                station.put[channels.DECISION.topic](station.decision % run_id)
+                station.tool(run_id, "done", now_ns)
+                station.put[channels.RUNS.topic](station.summary % run_id)
+            time.sleep(RUN_PAUSE_TICKS / 1e3)
+            next_tick = time.perf_counter()
+        for station in stations:
+            station.bus(time.time_ns())
+    published = sum(s.published for s in stations)
+    print(f"generator: {published} samples, {behind} ticks behind schedule", flush=True)
     return 0
 
 
@@ -131,41 +217,31 @@ def generate(endpoint: str, station_ids: list[str], seconds: float) -> int:
 
 
 @dataclass
-class LineHeard:
-    """What the benchmark hears from the synthetic stations: summaries and recorder stats."""
+class RecorderHeard:
+    """The recorder's RecorderStats of every station, as published once a second."""
 
-    summary_lag_ms: list[float] = field(default_factory=list)
-    incomplete_runs: int = 0
-    runs: int = 0
-    recorder_lag_p50_ms: list[float] = field(default_factory=list)
-    recorder_lag_max_ms: list[float] = field(default_factory=list)
+    lag_p50_ms: list[float] = field(default_factory=list)
+    lag_max_ms: list[float] = field(default_factory=list)
+    missing: dict[str, int] = field(default_factory=dict)
+    bad_payloads: dict[str, int] = field(default_factory=dict)
+    listening: bool = False
     lock: threading.Lock = field(default_factory=threading.Lock)
-    expected_samples: int = 0
 
-    def on_summary(self, sample: zenoh.Sample) -> None:
-        summary = decode(RunSummary, sample.payload.to_bytes())
-        if summary.station == REAL_STATION:
-            return
-        with self.lock:
-            self.runs += 1
-            self.summary_lag_ms.append((time.time_ns() - summary.ended_ns) / 1e6)
-            if summary.samples != self.expected_samples:
-                self.incomplete_runs += 1
-
-    def on_recorder(self, sample: zenoh.Sample) -> None:
+    def on_stats(self, sample: zenoh.Sample) -> None:
         stats = decode(RecorderStats, sample.payload.to_bytes())
         with self.lock:
+            self.missing[stats.station] = stats.missing_samples
+            self.bad_payloads[stats.station] = stats.bad_payloads
+            if not self.listening:
+                return
             if stats.lag_p50_ms is not None:
-                self.recorder_lag_p50_ms.append(stats.lag_p50_ms)
+                self.lag_p50_ms.append(stats.lag_p50_ms)
             if stats.lag_max_ms is not None:
-                self.recorder_lag_max_ms.append(stats.lag_max_ms)
+                self.lag_max_ms.append(stats.lag_max_ms)
 
 
 def wait_alive(
-    session: zenoh.Session,
-    expected: set[tuple[str, str]],
-    processes: list[subprocess.Popen[bytes]],
-    folder: Path,
+    session: zenoh.Session, expected: set[tuple[str, str]], processes: list, folder: Path
 ) -> None:
     deadline = time.monotonic() + START_TIMEOUT_S
     missing = set(expected)
@@ -178,9 +254,7 @@ def wait_alive(
                 station_id, tail = keys.split_key(str(reply.ok.key_expr))
                 missing.discard((station_id, tail.rsplit("/", 1)[-1]))
         if time.monotonic() > deadline:
-            raise SystemExit(
-                f"not alive after {START_TIMEOUT_S:.0f} s: {sorted(missing)[:5]} ({folder})"
-            )
+            raise SystemExit(f"not alive after {START_TIMEOUT_S:.0f} s: {sorted(missing)[:5]}")
         time.sleep(0.2)
 
 
@@ -190,71 +264,57 @@ def cpu_s(process: subprocess.Popen[bytes]) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
-def percentiles(values: list[float]) -> str:
-    if not values:
-        return "-"
-    p50, p99 = np.percentile(values, [50, 99])
-    return f"p50 {p50:.2f} ms, p99 {p99:.2f} ms, max {max(values):.2f} ms (n={len(values)})"
-
-
-def bench(stations: int, runs: int, rerun: bool, folder: Path) -> dict[str, object]:
+def bench(
+    stations: int, runs: int, rerun: bool, per_sample: bool, repo: Path, folder: Path
+) -> dict[str, object]:
     port = free_tcp_port()
-    base = write_station(folder, zenoh_port=port, replacements=SHORT_PROGRAM)
-    paths = derive_stations(base, stations, folder / "stations")
+    base = write_station(folder, zenoh_port=port, replacements=EDGE_PROGRAM)
+    paths = derive_stations(base, stations + 1, folder / "stations")
     real = load_station(paths[0])
     endpoint = f"tcp/127.0.0.1:{port}"
     processes: list[subprocess.Popen[bytes]] = []
-    heard = Heard()
-    line = LineHeard(expected_samples=len(staircase(duration_s=1.0).rows()))
+    heard, line = Heard(), RecorderHeard()
     synthetic = [p.stem for p in paths[1:]]
     files = [str(p) for p in paths]
     try:
-        processes.append(serve(["router", "--listen", endpoint], folder / "router.log"))
+        processes.append(serve_from(repo, ["router", "--listen", endpoint], folder / "router.log"))
         recorder_args = ["recorder", "--config", *files] + ([] if rerun else ["--no-rerun"])
-        processes.append(serve(recorder_args, folder / "recorder.log"))
-        processes.append(serve(["predictor", "--config", *files], folder / "predictor.log"))
-        processes.append(serve(["acquisition", "--config", str(paths[0])], folder / "acq.log"))
+        recorder = serve_from(repo, recorder_args, folder / "recorder.log")
+        processes.append(recorder)
+        acquisition_args = ["acquisition", "--config", str(paths[0])]
+        processes.append(serve_from(repo, acquisition_args, folder / "acquisition.log"))
         with (
             zenoh.open(zenoh_config("client", [endpoint])) as session,
             StopListener(real.config.can, StationDatabase(real.dbc_path)) as listener,
         ):
             subscribers = [
                 session.declare_subscriber(keys.station_key(REAL_STATION, "*"), heard.on_sample),
-                session.declare_subscriber(channels.RUNS.key("*"), line.on_summary),
-                session.declare_subscriber(channels.RECORDER.key("*"), line.on_recorder),
+                session.declare_subscriber(channels.RECORDER.key("*"), line.on_stats),
             ]
-            expected = {
-                (s, svc) for s in [REAL_STATION, *synthetic] for svc in ("recorder", "predictor")
-            }
-            wait_alive(session, expected | {(REAL_STATION, "acquisition")}, processes, folder)
-            generator = None
-            line_processes = {"predictor": processes[2], "recorder": processes[1]}
-            cpu_before = {name: cpu_s(p) for name, p in line_processes.items()}
-            if synthetic:
-                with (folder / "generator.log").open("wb") as out:
-                    generator = subprocess.Popen(
-                        [
-                            sys.executable,
-                            __file__,
-                            "--generate",
-                            endpoint,
-                            "--seconds",
-                            str(runs * 20.0),
-                            *synthetic,
-                        ],
-                        cwd=REPO,
-                        stdout=out,
-                        stderr=subprocess.STDOUT,
-                    )
-                processes.append(generator)
-                time.sleep(2.0)  # the load is on before the measured runs
+            expected = {(s, "recorder") for s in [REAL_STATION, *synthetic]}
+            expected |= {(REAL_STATION, "acquisition"), (REAL_STATION, "predictor")}
+            wait_alive(session, expected, processes, folder)
+            cpu_before = cpu_s(recorder)
+            with (folder / "generator.log").open("wb") as out:
+                generator = subprocess.Popen(
+                    [sys.executable, __file__, "--generate", endpoint, "--seconds", "3600"]
+                    + (["--per-sample"] if per_sample else [])
+                    + synthetic,
+                    cwd=REPO,
+                    stdout=out,
+                    stderr=subprocess.STDOUT,
+                )
+            processes.append(generator)
+            time.sleep(3.0)  # the load is on before the measured runs
+            with line.lock:
+                line.listening = True
             rig_args = ["rig", "--config", str(paths[0]), "--runs", str(runs), "--program", "1"]
-            log = folder / "rig.log"
-            _, elapsed_s = tighten(rig_args, log, runs, heard, processes, RUN_TIMEOUT_S)
-            if generator is not None:
-                stop_process(generator, grace_s=10.0)
-                time.sleep(1.5)  # the last summaries and recorder stats
-            cpu_used = {name: cpu_s(p) - cpu_before[name] for name, p in line_processes.items()}
+            _, elapsed_s = tighten(rig_args, folder / "rig.log", runs, heard, processes)
+            with line.lock:
+                line.listening = False
+            stop_process(generator, grace_s=10.0)
+            time.sleep(3.0)  # the last batches filed, the last BusStats counted and reported
+            cpu_used = cpu_s(recorder) - cpu_before
             for subscriber in subscribers:
                 subscriber.undeclare()
             stops = listener.heard
@@ -263,59 +323,89 @@ def bench(stations: int, runs: int, rerun: bool, folder: Path) -> dict[str, obje
             stop_process(process, grace_s=10.0)
     with heard.lock:
         rows, notes = figures(heard, stops)
+        real_samples = sum(s.samples for s in heard.summaries.values())
     stop_ms = [r.stop_path_ms for r in rows]
-    generator_note = (folder / "generator.log").read_text().strip() if synthetic else "-"
+    generator_note = (folder / "generator.log").read_text().strip()
     published = re.search(r"generator: (\d+) samples", generator_note)
-    load_samples = int(published.group(1)) if published else 0
-    cpu_per_sample: dict[str, float | None] = {}
-    for name, used in cpu_used.items():
-        us = used / load_samples * 1e6 if load_samples else None
-        cpu_per_sample[f"{name}_cpu_us_per_sample"] = round(us, 1) if us else None
-        # one core's second over one station's 1000 samples a second
-        cpu_per_sample[f"{name}_stations_per_core"] = round(1e3 / us) if us else None
+    samples = (int(published.group(1)) if published else 0) + real_samples
+    us = cpu_used / samples * 1e6 if samples else float("nan")
     with line.lock:
-        result: dict[str, object] = {
-            "stations": stations,
-            "stop_path": percentiles(stop_ms),
-            "stop_p50_ms": float(np.percentile(stop_ms, 50)) if stop_ms else None,
-            "stop_p99_ms": float(np.percentile(stop_ms, 99)) if stop_ms else None,
-            "measured_runs": f"{len(rows)} of {runs} ({elapsed_s:.0f} s)",
-            "synthetic_runs": line.runs,
-            "incomplete_synthetic_runs": line.incomplete_runs,
-            "predictor_summary_lag": percentiles(line.summary_lag_ms),
-            "recorder_lag_p50_median_ms": (
-                statistics.median(line.recorder_lag_p50_ms) if line.recorder_lag_p50_ms else None
-            ),
-            "recorder_lag_max_ms": max(line.recorder_lag_max_ms, default=None),
-            "generator": generator_note,
-            **cpu_per_sample,
-            "notes": notes,
-        }
-    return result
+        missing = sum(line.missing.values())
+        lag_p50 = statistics.median(line.lag_p50_ms) if line.lag_p50_ms else float("nan")
+        lag_p99 = float(np.percentile(line.lag_max_ms, 99)) if line.lag_max_ms else float("nan")
+        reported = len(line.missing)
+        bad = sum(line.bad_payloads.values())
+    p50, p90, p99 = np.percentile(stop_ms, [50, 90, 99]) if stop_ms else [float("nan")] * 3
+    return {
+        "stations": stations,
+        "recorder_cpu_us_per_sample": round(us, 2),
+        "stations_per_recorder_core": round(1e3 / us) if samples else None,
+        "recorder_lag_p50_ms": round(lag_p50, 1),
+        "recorder_lag_p99_ms": round(lag_p99, 1),
+        "samples_missing": missing,
+        "stations_reported": reported,
+        "bad_payloads": bad,
+        "stop_path_p50_ms": round(float(p50), 3),
+        "stop_path_p90_ms": round(float(p90), 3),
+        "stop_path_p99_ms": round(float(p99), 3),
+        "stop_path_max_ms": round(max(stop_ms), 3) if stop_ms else None,
+        "real_station_runs": f"{len(rows)} stops of {runs} runs ({elapsed_s:.0f} s)",
+        "samples_recorded": samples,
+        "generator": generator_note,
+        "notes": notes,
+    }
+
+
+def goals_missed(result: dict[str, object]) -> list[str]:
+    """What the result misses (nothing lost anywhere; the per-sample cost; N = 50's)."""
+    missed = []
+    if result["samples_missing"] != 0:
+        missed.append(f"{result['samples_missing']} samples missing")
+    if result["stations_reported"] != int(str(result["stations"])) + 1:
+        missed.append(f"RecorderStats of {result['stations_reported']} stations only")
+    us = float(str(result["recorder_cpu_us_per_sample"]))
+    if not us <= GOAL_US_PER_SAMPLE:
+        missed.append(f"recorder {us} µs per sample (goal <= {GOAL_US_PER_SAMPLE})")
+    if result["stations"] == 50:
+        lag = float(str(result["recorder_lag_p99_ms"]))
+        if not lag <= GOAL_LAG_P99_MS:
+            missed.append(f"recorder lag p99 {lag} ms (goal <= {GOAL_LAG_P99_MS})")
+        p90 = float(str(result["stop_path_p90_ms"]))
+        if not p90 <= GOAL_STOP_P90_MS:
+            missed.append(f"stop path p90 {p90} ms (goal <= {GOAL_STOP_P90_MS})")
+    return missed
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--stations", type=int, nargs="+", default=[1, 10, 25, 50])
-    parser.add_argument("--runs", type=int, default=10, help="measured runs of st1 per N")
-    parser.add_argument("--rerun", action="store_true", help="recorder writes .rrd too")
+    parser.add_argument("--stations", type=int, nargs="+", default=[50, 100])
+    parser.add_argument("--runs", type=int, default=20, help="measured runs of st1 per N")
+    parser.add_argument("--no-rerun", action="store_true", help="the recorder writes MCAP only")
+    parser.add_argument("--per-sample", action="store_true", help="one message per sample")
+    parser.add_argument("--repo", type=Path, default=REPO, help="checkout that runs the line")
     parser.add_argument("--keep", type=Path, default=None, help="keep files and logs here")
     parser.add_argument("--generate", default=None, help=argparse.SUPPRESS)
     parser.add_argument("--seconds", type=float, default=0.0, help=argparse.SUPPRESS)
     parser.add_argument("ids", nargs="*", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.generate:
-        return generate(args.generate, args.ids, args.seconds)
+        return generate(args.generate, args.ids, args.seconds, args.per_sample)
+    failed = False
     for count in args.stations:
         with tempfile.TemporaryDirectory(prefix=f"bench-line-{count}-") as tmp:
             folder = args.keep / f"n{count}" if args.keep else Path(tmp)
             folder.mkdir(parents=True, exist_ok=True)
-            result = bench(count, args.runs, args.rerun, folder)
-        print(f"N={count}:")
+            result = bench(
+                count, args.runs, not args.no_rerun, args.per_sample, args.repo.resolve(), folder
+            )
+        missed = goals_missed(result)
+        failed = failed or bool(missed)
+        print(f"N={count} (+ st1 real):")
         for key, value in result.items():
             print(f"  {key}: {value}")
+        print(f"  goals: {'MISSED: ' + '; '.join(missed) if missed else 'met'}")
         sys.stdout.flush()
-    return 0
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

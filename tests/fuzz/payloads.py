@@ -52,6 +52,7 @@ from shared.messages import (
     RecorderStats,
     RunSummary,
     Sample,
+    SampleBatch,
     StickSlipEvent,
     StopDecision,
     ToolState,
@@ -65,6 +66,14 @@ def template(topic: str, station: str, now_ns: int, run_id: int = 1) -> Any:
     """A valid message of ``topic`` (a key below ``boltwatch/<station>/``), stamped ``now_ns``."""
     made: dict[str, Callable[[], Any]] = {
         "samples": lambda: Sample(station, run_id, 5, now_ns, 10.0, 1.0, 20_000.0),
+        "sample_batches": lambda: SampleBatch(
+            station,
+            now_ns,
+            [
+                Sample(station, run_id, n, now_ns - 1_000_000 * (2 - n), 10.0, 1.0, 2e4)
+                for n in range(3)
+            ],
+        ),
         "tool": lambda: ToolState(station, run_id, 3, 1, "done", now_ns),
         "bus": lambda: BusStats(station, now_ns, 10, 5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0),
         "events": lambda: StickSlipEvent(

@@ -96,6 +96,14 @@ def _recorder_extra(topic: str, message: Any) -> list[bytes]:
     extra = [dumps({**fields, **ahead}), dumps({**fields, "station": "st2"})]
     if topic == channels.SAMPLES.topic:
         extra += [dumps({**fields, "torque_nm": 1e6}), dumps({**fields, "force_n": -1e12})]
+    if topic == channels.SAMPLE_BATCHES.topic:  # one sample the recorder refuses refuses the batch
+        *good, last = fields["samples"]
+        for change in (
+            {"torque_nm": 1e6},
+            {"station": "st2"},
+            {"time_ns": time.time_ns() + HOUR_NS},
+        ):
+            extra.append(dumps({**fields, "samples": [*good, {**last, **change}]}))
     return extra
 
 

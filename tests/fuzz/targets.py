@@ -45,6 +45,7 @@ from services.recorder.testing import (
 )
 from shared import channels, keys
 from shared.can_database import StationDatabase
+from shared.channels import CHANNELS
 from shared.codec import decode, encode
 from shared.config import load_line, load_station
 from shared.messages import BusStats, Sample, StopDecision, ToolState
@@ -259,23 +260,7 @@ class PredictorTarget(_Target):
 
 class RecorderTarget(_Target):
     #: every key the recorder decodes
-    channels = (
-        *(
-            channels.SAMPLES.topic,
-            channels.TOOL.topic,
-            channels.BUS.topic,
-            channels.EVENTS.topic,
-            channels.INTENSITY.topic,
-            channels.DECISION.topic,
-        ),
-        *(
-            channels.RUNS.topic,
-            channels.RECORDER.topic,
-            channels.PREDICTOR.topic,
-            channels.CONTROLLER.topic,
-            "wear/alert",
-        ),
-    )
+    channels = tuple(channel.topic for channel in CHANNELS)
 
     def __init__(self, folder: Path) -> None:  # no served session: the recorder opens its own
         self.endpoint = f"tcp/127.0.0.1:{free_port()}"
@@ -292,6 +277,8 @@ class RecorderTarget(_Target):
         super().send(channel, payload, refuse)
         if refuse:  # kept to find it in the raw channel later
             self.refused_payloads.append((keys.station_key(self.station, channel), payload))
+        elif channel == channels.SAMPLE_BATCHES.topic:  # written as the samples it holds
+            self.sent += len(json.loads(payload)["samples"]) - 1
 
     def refused(self) -> int:
         return self.running.service.recorder.refused[self.station]

@@ -63,7 +63,7 @@ HEALTHY_WITHIN_S = 60.0
 NOT_ALIVE = 1  # `boltwatch health`: 1 not alive (yet), 2 router unreachable or bad file
 HEARD_WITHIN_S = 60.0
 DECISION = channels.DECISION.key("st1")
-SAMPLES = channels.SAMPLES.key("st1")
+SAMPLES = channels.SAMPLE_BATCHES.key("st1")  # an edge station: its samples in batches
 RUNS = channels.RUNS.key("st1")
 
 

@@ -153,8 +153,7 @@ PREDICTOR_PUTS = {
 }
 ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), per station
     # the acquisition hosts the station's predictor (placement "edge") and publishes for it
-    "acquisition": {channels.SAMPLES.topic, channels.TOOL.topic, channels.BUS.topic}
-    | PREDICTOR_PUTS,
+    "acquisition": set(channels.topics_of("acquisition")) | PREDICTOR_PUTS,
     "predictor": PREDICTOR_PUTS,
     "recorder": {channels.RECORDER.topic, keys.WEAR, f"{keys.WEAR}/**"},
 }

@@ -1,0 +1,74 @@
+"""Samples toward the line in batches: the batch in progress on a station's publisher thread.
+
+An edge station decides on its own box (the predictor runs on the
+acquisition's CAN thread), so the line needs its samples only to record
+them: one zenoh message per sample would cost the router and the recorder a
+message's price a thousand times a second per station. The station's
+:class:`~shared.queued_publisher.QueuedPublisher` therefore gathers its
+samples into a :class:`~shared.messages.SampleBatch` and publishes it on
+:data:`shared.channels.SAMPLE_BATCHES` when the oldest sample in it is
+:data:`BATCH_PERIOD_S` old, when it holds :data:`MAX_BATCH_SAMPLES`, when a
+sample of another run comes, and before anything else the station publishes
+(a run's ``done``, its bus counters, the predictor's events and decisions), so
+the order of everything a station publishes is kept: a batch never overtakes
+the tool state before it, an event never overtakes the samples it was found in.
+
+Clock: ``now_s`` is :func:`time.monotonic` of the publisher thread.
+"""
+
+from __future__ import annotations
+
+import time
+
+from shared.messages import Sample, SampleBatch
+
+#: the longest a sample waits for its batch, seconds (100 batches a second at 1 kHz)
+BATCH_PERIOD_S = 0.010
+#: the most samples in one batch (a burst after a stall); about 7 KB, far below 64 KiB
+MAX_BATCH_SAMPLES = 50
+
+
+class SampleBatching:
+    """The samples of one station waiting for their batch, oldest first."""
+
+    def __init__(
+        self,
+        station: str,
+        period_s: float = BATCH_PERIOD_S,
+        max_samples: int = MAX_BATCH_SAMPLES,
+    ) -> None:
+        self._station = station
+        self._period_s = period_s
+        self._max_samples = max_samples
+        self._samples: list[Sample] = []
+        self._due_s = 0.0  # when the batch in progress must go (monotonic seconds)
+
+    def add(self, sample: Sample, now_s: float) -> list[SampleBatch]:
+        """Append ``sample``; the batches that are ready now (none, one, or two when a new
+        run starts in a batch that is also due), oldest first."""
+        ready: list[SampleBatch] = []
+        samples = self._samples
+        if samples and samples[-1].run_id != sample.run_id:
+            ready.append(self._take())
+            samples = self._samples
+        if not samples:
+            self._due_s = now_s + self._period_s
+        samples.append(sample)
+        if len(samples) >= self._max_samples or now_s >= self._due_s:
+            ready.append(self._take())
+        return ready
+
+    def take(self) -> SampleBatch | None:
+        """The batch in progress (None when no sample waits); the next one starts empty."""
+        return self._take() if self._samples else None
+
+    def wait_s(self, now_s: float) -> float | None:
+        """Seconds until the batch in progress is due (0 when overdue); None when empty."""
+        if not self._samples:
+            return None
+        return max(0.0, self._due_s - now_s)
+
+    def _take(self) -> SampleBatch:
+        batch = SampleBatch(self._station, time.time_ns(), self._samples)
+        self._samples = []
+        return batch
