@@ -328,11 +328,13 @@ def rerun_options(write_files: bool, live_url: str | None) -> RerunOptions | Non
     if not write_files and live_url is None:
         return None
     try:
-        from services.recorder.rerun_sink import RerunOptions
+        from services.recorder.rerun_sink import LIVE_BATCH_SAMPLES, RerunOptions
     except ImportError:
         LOG.exception("Rerun is unusable; recording MCAP only")
         return None
-    return RerunOptions(live_url=live_url, write_files=write_files)
+    if live_url is None:
+        return RerunOptions(write_files=write_files)
+    return RerunOptions(LIVE_BATCH_SAMPLES, live_url, write_files)
 
 
 def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
