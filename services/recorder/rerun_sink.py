@@ -38,7 +38,6 @@ from shared.run_clock import RunClock
 LOG = logging.getLogger(__name__)
 
 DEFAULT_GRPC_PORT = 9876
-DEFAULT_WEB_PORT = 9090
 
 
 @dataclass(frozen=True, slots=True)
