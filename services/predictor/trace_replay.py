@@ -2,7 +2,7 @@
 
 The same :class:`~services.predictor.core.PredictorCore` as the live service,
 sample by sample; the outputs become JSON-ready dicts (the
-``boltwatch predict`` contract in DESIGN.md).
+``boltwatch predict`` contract in docs/design.md).
 """
 
 from __future__ import annotations

@@ -49,7 +49,7 @@ from shared.messages import RunSummary
 from shared.run_clock import RunClock
 from shared.sensor_range import CONTRACT_RANGE, SensorRange
 
-#: The contract's sample rate (DESIGN, CAN): ToolSensors at 1 kHz while running.
+#: The contract's sample rate (docs/design.md, "CAN"): ToolSensors at 1 kHz while running.
 SAMPLE_RATE_HZ = 1000.0
 #: The highest stick-slip frequency a run sampled at SAMPLE_RATE_HZ can show (a peak
 #: and a trough sample per period).

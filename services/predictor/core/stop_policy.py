@@ -12,7 +12,7 @@ On every sample (O(1)):
 Once per stick-slip event j (after its slip, on the new plateau):
 
 3. :class:`~.stop_rules.intensity_rule.IntensityRule`: intensity_limit, eq. 70;
-4. :class:`~.stop_rules.constant_bands.ConstantBands`: constant_out_of_band,
+4. :class:`~.stop_rules.constant_band_rule.ConstantBandRule`: constant_out_of_band,
    eq. 71 (the model's band, then the running means);
 5. :class:`~.stop_rules.plateau_rule.PlateauRule`: plateau_closest, eqs. 64/65.
 
@@ -29,7 +29,7 @@ import math
 from services.predictor.core.model_bands import BandVerdict
 from services.predictor.core.outputs import CoreDecision
 from services.predictor.core.settings import PredictorSettings
-from services.predictor.core.stop_rules.constant_bands import ConstantBands
+from services.predictor.core.stop_rules.constant_band_rule import ConstantBandRule
 from services.predictor.core.stop_rules.hard_limits import HardLimits
 from services.predictor.core.stop_rules.intensity_rule import IntensityRule
 from services.predictor.core.stop_rules.plateau_rule import PlateauRule
@@ -46,7 +46,7 @@ class StopPolicy:
         self.limits = HardLimits(settings)
         self.target = TargetRule(settings)
         self.intensity = IntensityRule(settings.max_process_intensity)
-        self.constant_bands = ConstantBands(settings.constant_band, settings.constant_window)
+        self.constant_bands = ConstantBandRule(settings.constant_band, settings.constant_window)
         self.plateau = PlateauRule(self.target.target_force_n, self.target.target_torque_nm)
 
     def plan_halt(

@@ -1,4 +1,4 @@
-"""constant_out_of_band, eq. 71: the friction constants K1-K3 leave their band (per event).
+"""constant_out_of_band, eq. 71: the characteristic constants K1-K3 leave their band (per event).
 
 Two bands, the model's first:
 
@@ -17,7 +17,7 @@ from services.predictor.core.model_bands import BandVerdict
 from services.predictor.core.stop_rules.stop import Stop
 
 
-class ConstantBands:
+class ConstantBandRule:
     """Eq. 71 against the model's band and against each constant's running mean."""
 
     __slots__ = ("_band", "_history", "_window")
