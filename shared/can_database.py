@@ -1,6 +1,6 @@
 """The station's CAN database (``config/can/station.dbc``), checked against the contract.
 
-Message and signal names are the contract of DESIGN.md; ids, layout and
+Message and signal names are the contract of docs/design.md; ids, layout and
 scaling live in the DBC. :class:`StationDatabase` looks every contract message
 up once, so a DBC that lacks one fails at start-up with its file named,
 and the hot path encodes and decodes through prepared cantools messages.
@@ -16,7 +16,7 @@ import cantools.database
 
 from shared.errors import CanDatabaseError
 
-#: Contract messages and the signals each must carry (DESIGN.md, "CAN").
+#: Contract messages and the signals each must carry (docs/design.md, "CAN").
 CONTRACT: dict[str, tuple[str, ...]] = {
     "ToolSensors": ("Torque", "Angle", "Counter"),
     "JointSensors": ("Force", "Counter"),

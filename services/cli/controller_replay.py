@@ -31,12 +31,13 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from services.predictor.core import CoreEvent, PredictorCore, PredictorSettings
+from services.predictor.core import EventFigures, PredictorCore, PredictorSettings
 from services.predictor.run_messages import decision_message, event_messages
 from services.recorder.controller_import import PredictorReplay, run_end_ns
 from services.recorder.controller_run import ControllerRun
 from shared import channels
 from shared.messages import RunSummary
+from shared.run_clock import RunClock
 
 
 def target_torque_nm(run: ControllerRun) -> float | None:
@@ -53,13 +54,13 @@ def replay_settings(run: ControllerRun) -> PredictorSettings:
 def replay_run(station: str, run: ControllerRun) -> PredictorReplay:
     """Feed every sample of ``run`` to a new core; its outputs as messages, and the summary."""
     core = PredictorCore(replay_settings(run))
-    started_ns = run.started_ns
+    clock = RunClock(run.started_ns)
     outputs: list[tuple[int, str, Any]] = []
     samples = zip(run.run_time_s, run.times_ns, run.torque_nm, run.angle_deg, strict=True)
     for index, (time_s, time_ns, torque_nm, angle_deg) in enumerate(samples):
         for output in core.update(time_s, torque_nm, math.nan, angle_deg):
-            if isinstance(output, CoreEvent):
-                event, intensity = event_messages(station, run.run_id, started_ns, output, time_ns)
+            if isinstance(output, EventFigures):
+                event, intensity = event_messages(station, run.run_id, clock, output, time_ns)
                 outputs += [
                     (index, channels.EVENTS.topic, event),
                     (index, channels.INTENSITY.topic, intensity),

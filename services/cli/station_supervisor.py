@@ -152,11 +152,3 @@ class StationSupervisor:
                 remaining.remove(managed)
         for managed in remaining:
             self.stop(managed)
-
-    def wait_any_exit(self, timeout_s: float) -> None:
-        """Sleep up to ``timeout_s``, returning early if any process ends."""
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            if any(p.exit_code() is not None for p in self.processes):
-                return
-            time.sleep(0.02)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from services.predictor.core import CoreDecision, CoreEvent, PredictorCore, PredictorSettings
+from services.predictor.core import CoreDecision, EventFigures, PredictorCore, PredictorSettings
 from services.predictor.run_messages import decision_message, event_messages
 from shared.config import Program
 from shared.messages import (
@@ -21,6 +21,7 @@ from shared.messages import (
     StopDecision,
     ToolState,
 )
+from shared.run_clock import RunClock
 
 Outgoing = StickSlipEvent | Intensity | StopDecision
 
@@ -34,6 +35,7 @@ class ActiveRun:
         self.settings = settings
         self.core = PredictorCore(settings)
         self.started_ns = state.time_ns
+        self.clock = RunClock(state.time_ns)
         self.samples = 0
         self.last: Sample | None = None  # the last sample whose torque was a measurement
         self.decision: StopDecision | None = None
@@ -43,7 +45,7 @@ class ActiveRun:
         """The sample's run time: on the tool's own clock when it has one (no receive jitter)."""
         if sample.time_s is not None:
             return sample.time_s
-        return (sample.time_ns - self.started_ns) / 1e9
+        return self.clock.seconds(sample.time_ns)
 
     def on_sample(self, sample: Sample, wall_ns: int) -> list[Outgoing]:
         """Feed one sample; the messages to publish because of it."""
@@ -56,17 +58,15 @@ class ActiveRun:
             return []
         messages: list[Outgoing] = []
         for output in outputs:
-            if isinstance(output, CoreEvent):
+            if isinstance(output, EventFigures):
                 messages.extend(self._event_messages(output, sample))
             else:
                 messages.append(self._decision_message(output, sample, wall_ns))
         return messages
 
-    def _event_messages(self, event: CoreEvent, sample: Sample) -> list[Outgoing]:
+    def _event_messages(self, event: EventFigures, sample: Sample) -> list[Outgoing]:
         state = self.state
-        return list(
-            event_messages(state.station, state.run_id, self.started_ns, event, sample.time_ns)
-        )
+        return list(event_messages(state.station, state.run_id, self.clock, event, sample.time_ns))
 
     def _decision_message(
         self, decision: CoreDecision, sample: Sample, wall_ns: int

@@ -2,43 +2,53 @@
 
 One place for the conversion, so a live run (:class:`~services.predictor.active_run.ActiveRun`)
 and a replayed one (``boltwatch import``) publish the same fields the same way.
-Times: ``time_ns`` of an event is the run start + its peak's run time; the
-intensity and the decision carry the time of the sample that produced them.
+Times: ``time_ns`` of an event is its peak's run time on the run's clock
+(:class:`~shared.run_clock.RunClock`); the intensity and the decision carry
+the time of the sample that produced them.
 """
 
 from __future__ import annotations
 
 import math
 
-from services.predictor.core import CoreDecision, CoreEvent
+from services.predictor.core import CoreDecision, EventFigures
 from shared.messages import Intensity, StickSlipEvent, StopDecision
+from shared.run_clock import RunClock
+
+
+def stick_slip_event(
+    station: str, run_id: int, clock: RunClock, event: EventFigures
+) -> StickSlipEvent:
+    """Event j as the wire message: its figures (all but the core's own
+    ``current_force_n`` and ``detected_at_s``), the station, the run and the peak's ``time_ns``."""
+    return StickSlipEvent(
+        station=station,
+        run_id=run_id,
+        index=event.index,
+        time_ns=clock.ns(event.time_s),
+        time_s=event.time_s,
+        peak_torque_nm=event.peak_torque_nm,
+        min_torque_nm=event.min_torque_nm,
+        torque_drop_nm=event.torque_drop_nm,
+        plateau_force_n=event.plateau_force_n,
+        force_step_n=event.force_step_n,
+        period_s=event.period_s,
+        f_ss_hz=event.f_ss_hz,
+        k1=event.k1,
+        k2=event.k2,
+        k3=event.k3,
+        intensity=event.intensity,
+        process_intensity=event.process_intensity,
+        predictions=list(event.predictions),
+    )
 
 
 def event_messages(
-    station: str, run_id: int, started_ns: int, event: CoreEvent, sample_time_ns: int
+    station: str, run_id: int, clock: RunClock, event: EventFigures, sample_time_ns: int
 ) -> tuple[StickSlipEvent, Intensity]:
     """Event j and the intensity update it brings, confirmed at the sample of ``sample_time_ns``."""
     return (
-        StickSlipEvent(
-            station=station,
-            run_id=run_id,
-            index=event.index,
-            time_ns=started_ns + round(event.time_s * 1e9),
-            time_s=event.time_s,
-            peak_torque_nm=event.peak_torque_nm,
-            min_torque_nm=event.min_torque_nm,
-            torque_drop_nm=event.torque_drop_nm,
-            plateau_force_n=event.plateau_force_n,
-            force_step_n=event.force_step_n,
-            period_s=event.period_s,
-            f_ss_hz=event.f_ss_hz,
-            k1=event.k1,
-            k2=event.k2,
-            k3=event.k3,
-            intensity=event.intensity,
-            process_intensity=event.process_intensity,
-            predictions=list(event.predictions),
-        ),
+        stick_slip_event(station, run_id, clock, event),
         Intensity(
             station=station,
             run_id=run_id,

@@ -2,7 +2,7 @@
 
 The same :class:`~services.predictor.core.PredictorCore` as the live service,
 sample by sample; the outputs become JSON-ready dicts (the
-``boltwatch predict`` contract in DESIGN.md).
+``boltwatch predict`` contract in docs/design.md).
 """
 
 from __future__ import annotations
@@ -12,11 +12,11 @@ import math
 from collections.abc import Iterator
 from typing import Any
 
-from services.predictor.core import CoreDecision, CoreEvent, PredictorCore
+from services.predictor.core import CoreDecision, EventFigures, PredictorCore
 from shared.trace import Trace
 
 
-def replay(core: PredictorCore, trace: Trace) -> Iterator[CoreEvent | CoreDecision]:
+def replay(core: PredictorCore, trace: Trace) -> Iterator[EventFigures | CoreDecision]:
     """Feed every sample of ``trace`` to ``core``; yield the outputs in order."""
     columns = zip(
         trace.time_s.tolist(),
@@ -32,10 +32,10 @@ def replay(core: PredictorCore, trace: Trace) -> Iterator[CoreEvent | CoreDecisi
             yield from outputs
 
 
-def output_record(output: CoreEvent | CoreDecision) -> dict[str, Any]:
+def output_record(output: EventFigures | CoreDecision) -> dict[str, Any]:
     """The JSON Lines object of one output: ``{"type": "event"|"stop", "time_s": ..., ...}``."""
     fields = dataclasses.asdict(output)
-    if isinstance(output, CoreEvent):
+    if isinstance(output, EventFigures):
         record: dict[str, Any] = {"type": "event"}
     else:
         record = {"type": "stop"}

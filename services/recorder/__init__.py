@@ -15,10 +15,10 @@ Files, one concept each:
   :mod:`.wear_waiting` (runs still waiting when the recorder stops),
   :mod:`.wear_reset` (``boltwatch wear reset``), :mod:`.wear_table`,
   :mod:`.wear_plant` (every line's ledger merged: ``boltwatch wear --plant``)
-- reading back: :mod:`.recording_reader`, :mod:`.json_decoder`,
-  :mod:`.trace_export`, :mod:`.recovery`, :mod:`.rrd_recovery`, and the
-  post-mortem :mod:`.run_plot`, :mod:`.post_mortem_run`,
-  :mod:`.post_mortem_panels`, :mod:`.post_mortem_errors`
+- reading back: :mod:`.recording_reader`, :mod:`.trace_export`,
+  :mod:`.recovery`, :mod:`.rrd_recovery`, and the post-mortem
+  :mod:`.run_plot`, :mod:`.post_mortem_run`, :mod:`.post_mortem_panels`,
+  :mod:`.post_mortem_errors`
 - controller runs (``boltwatch import``): :mod:`.controller_run` (the JSON),
   :mod:`.controller_steps` (the controller's result), :mod:`.controller_timing`
   (its clock), :mod:`.controller_import` (into recordings),

@@ -36,6 +36,7 @@ from services.recorder.controller_steps import (
 from services.recorder.controller_timing import check_date, check_times
 from shared.errors import InputError
 from shared.messages import ControllerResult, ControllerStep
+from shared.run_clock import RunClock
 
 STEPS_KEY = "tightening steps"
 TIME_KEY, TORQUE_KEY, ANGLE_KEY = "time values", "torque values", "angle values"
@@ -86,12 +87,12 @@ class ControllerRun:
     @property
     def times_ns(self) -> list[int]:
         """Each sample's time: ``date`` + its time value, in integer nanoseconds."""
-        return [self.date_ns + round(t * 1e9) for t in self.time_s]
+        return RunClock(self.date_ns).ns_of(self.time_s)
 
     @property
     def started_ns(self) -> int:
         """The run starts at its first sample (``ToolState`` running, the file's name)."""
-        return self.date_ns + round(self.time_s[0] * 1e9)
+        return RunClock(self.date_ns).ns(self.time_s[0])
 
     @property
     def run_time_s(self) -> list[float]:

@@ -24,6 +24,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from shared.errors import InputError
+from shared.run_clock import RunClock
 
 #: The last nanosecond a signed 64-bit ``time_ns`` holds (2262-04-11 23:47:16.854775807 UTC).
 LAST_TIME_NS = 2**63 - 1
@@ -76,7 +77,7 @@ def _out_of_range(path: Path, date_ns: int, key: str, time_s: float) -> None:
         raise InputError(
             f"{path}: {key}: {time_s!r} s is before the run's 'date' (times count from it)"
         )
-    if date_ns + round(time_s * 1e9) >= LAST_TIME_NS:
+    if RunClock(date_ns).ns(time_s) >= LAST_TIME_NS:
         date = datetime.fromtimestamp(date_ns / 1e9, UTC)
         raise InputError(
             f"{path}: {key}: {time_s!r} s after 'date' {date:%Y-%m-%d %H:%M:%S} is past "

@@ -33,6 +33,7 @@ from shared.config.joint import JointConfig
 from shared.errors import InputError
 from shared.messages import Sample, StickSlipEvent, StopDecision
 from shared.model import JointConstants, JointModel
+from shared.run_clock import RunClock
 
 LOG = logging.getLogger(__name__)
 
@@ -74,7 +75,7 @@ class RecordedRun:
 
     def run_time_s(self, time_ns: int) -> float:
         """Seconds since the run's first sample."""
-        return (time_ns - self.t0_ns) / 1e9
+        return RunClock(self.t0_ns).seconds(time_ns)
 
     @property
     def has_force(self) -> bool:

@@ -38,6 +38,7 @@ from services.recorder import rerun_blueprint as bp
 from services.recorder.incoming import Received
 from services.recorder.rerun_streams import borrow_stream, ensure_layout_file, return_stream
 from shared import channels
+from shared.run_clock import RunClock
 
 LOG = logging.getLogger(__name__)
 
@@ -46,7 +47,6 @@ DEFAULT_GRPC_PORT = 9876
 FILE_BATCH_SAMPLES = 2000
 #: samples per column batch with a live viewer: 0.25 s at 1 kHz
 LIVE_BATCH_SAMPLES = 250
-DEFAULT_WEB_PORT = 9090
 
 
 @dataclass(frozen=True, slots=True)
@@ -104,6 +104,7 @@ class RerunSink:
         self.samples = 0  # samples sent to Rerun so far
         self.failed = False
         self._run_started_ns = run_started_ns
+        self._clock = RunClock(run_started_ns)
         self._batch_samples = max(1, options.batch_samples)
         self._pending_samples = 0
         self._closed = False
@@ -195,7 +196,8 @@ class RerunSink:
         LOG.info("closed %s: %d samples%s", self.path, self.samples, " (FAILED)" * self.failed)
 
     def _event(self, event: Any) -> None:
-        t_ns = self._run_started_ns + round(event.time_s * 1e9)
+        clock = self._clock
+        t_ns = clock.ns(event.time_s)
         series = self._series
         series[bp.PEAKS].add(t_ns, event.peak_torque_nm)
         series[bp.PLATEAUS].add(t_ns, event.plateau_force_n)
@@ -205,12 +207,12 @@ class RerunSink:
         series[bp.EVENT_INTENSITY].add(t_ns, event.intensity)
         series[bp.PROCESS_INTENSITY].add(t_ns, event.process_intensity)
         for prediction in event.predictions:
-            p_ns = self._run_started_ns + round(prediction.time_s * 1e9)
+            p_ns = clock.ns(prediction.time_s)
             series[bp.PREDICTED_PEAKS].add(p_ns, prediction.peak_torque_nm)
             series[bp.PREDICTED_PLATEAUS].add(p_ns, prediction.plateau_force_n)
 
     def _decision(self, decision: Any) -> None:
-        t_ns = self._run_started_ns + round(decision.time_s * 1e9)
+        t_ns = self._clock.ns(decision.time_s)
         self._series[bp.TORQUE_STOP].add(t_ns, decision.torque_nm)
         self._series[bp.FORCE_STOP].add(t_ns, decision.force_n)
         stop = "STOP (replayed, not acted on)" if decision.advisory else "STOP"

@@ -98,9 +98,3 @@ def draw_run(source: Path, target: Path, run_id: int | None = None) -> RecordedR
     with naming(target):
         figure.savefig(target, format="png")
     return run
-
-
-def plot_run(source: Path, target: Path, run_id: int | None = None) -> tuple[int, int]:
-    """Draw the run into ``target`` (PNG); (samples, events) drawn."""
-    run = draw_run(source, target, run_id)
-    return len(run.samples), len(run.events)

@@ -22,6 +22,7 @@ from typing import Any
 from services.recorder.recording_reader import RecordingScan
 from shared import channels
 from shared.errors import InputError
+from shared.run_clock import RunClock
 from shared.trace import write_trace
 
 SAMPLE_SCHEMA = channels.SAMPLES.schema_name
@@ -83,5 +84,5 @@ def run_times_s(samples: list[dict[str, Any]]) -> list[float]:
     if all(sample.get("time_s") is not None for sample in samples):
         t0_s = samples[0]["time_s"]
         return [sample["time_s"] - t0_s for sample in samples]
-    t0_ns = samples[0]["time_ns"]
-    return [(sample["time_ns"] - t0_ns) / 1e9 for sample in samples]
+    clock = RunClock(samples[0]["time_ns"])
+    return clock.seconds_of(sample["time_ns"] for sample in samples)

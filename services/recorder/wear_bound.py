@@ -46,9 +46,10 @@ from dataclasses import dataclass
 from shared.config import LoadedStation
 from shared.errors import InputError
 from shared.messages import RunSummary
+from shared.run_clock import RunClock
 from shared.sensor_range import CONTRACT_RANGE, SensorRange
 
-#: The contract's sample rate (DESIGN, CAN): ToolSensors at 1 kHz while running.
+#: The contract's sample rate (docs/design.md, "CAN"): ToolSensors at 1 kHz while running.
 SAMPLE_RATE_HZ = 1000.0
 #: The highest stick-slip frequency a run sampled at SAMPLE_RATE_HZ can show (a peak
 #: and a trough sample per period).
@@ -123,7 +124,7 @@ def refusal(summary: RunSummary, limits: RunLimits) -> str | None:
             f"{summary.events} events in {summary.samples} samples: an event needs a peak "
             "and a trough sample"
         )
-    duration_s = (summary.ended_ns - summary.started_ns) / 1e9
+    duration_s = RunClock(summary.started_ns).seconds(summary.ended_ns)
     if summary.samples > samples_in(duration_s):
         return (
             f"{summary.samples} samples in {duration_s:.6g} s: more than "

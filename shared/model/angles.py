@@ -61,8 +61,3 @@ def twist_at_stick_rad(motor_angle_rad: Value, gamma_stick: float) -> Value:
 def twist_at_slip_rad(motor_angle_rad: Value, gamma_slip: float) -> Value:
     """φ_0,slip = φ_m − φ_b,max = φ_m · (1 − γ_slip), twist left after a slip (eq. 20)."""
     return motor_angle_rad * (1.0 - gamma_slip)
-
-
-def as_array(value: float | NDArray[np.float64]) -> NDArray[np.float64]:
-    """``value`` as a float64 array (a 0-d array for a float)."""
-    return np.asarray(value, dtype=np.float64)

@@ -45,7 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
-from services.predictor.core import CoreEvent, PredictorCore, PredictorSettings
+from services.predictor.core import EventFigures, PredictorCore, PredictorSettings
 from services.predictor.core.extremum_tracker import NOISE_FACTOR
 from shared.config import RigSection
 
@@ -109,7 +109,7 @@ def observe(window: int, joint: Joint) -> tuple[list[TrueSlip], int, int]:
             stick_torque = sim.true_torque_nm
         slipping = sim.slipping
         for output in core.update(m.time_s, m.torque_nm, math.nan, m.angle_deg):
-            if isinstance(output, CoreEvent):
+            if isinstance(output, EventFigures):
                 peaks.append(round(output.time_s * 1000.0) - 1)
         if sim.true_force_n > 1.5 * target:
             break

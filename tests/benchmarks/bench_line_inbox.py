@@ -15,24 +15,25 @@ variants run in turns within one round, so a busy machine hurts them alike.
 
 - ``callback``: :class:`StationInbox`, the service's own: each subscriber's
   callback runs on zenoh's receive thread and handles the message there.
-- ``queue``: the former inbox: callbacks put into one ``queue.Queue``, one
-  worker thread gets and handles (a thread hand-over per message).
 - ``fifo-threads``: one ``FifoChannel`` subscriber per station and topic,
   one thread each blocking in ``recv()``, handling under one lock.
 - ``callback-unpinned``: ``callback`` without keeping the receive threads'
   Python thread states (CPython makes and frees one per callback).
 - ``callback-rx1``: ``callback`` with zenoh's receive pool at one thread
   (``ZENOH_RUNTIME``), so callbacks never pass the GIL between two threads.
-- ``recorder`` / ``recorder-classify-before``: the real recorder process
-  (``--no-rerun``) instead of the predictor, with ``classify`` as it is or as
-  it was (``codec.decode`` for every message); "runs" are not its output, the
-  samples in its MCAP files are (``recorded``, printed beside ``published``:
-compare them).
+- ``recorder``: the real recorder process (``--no-rerun``) instead of the
+  predictor; "runs" are not its output, the samples in its MCAP files are
+  (``recorded``, printed beside ``published``: compare them).
 - ``recorder-at-before``: ``serve recorder --no-rerun`` of another checkout
   (``--before-repo``, e.g. ``git worktree add /tmp/before c7ff33d``), run
   side by side with the current one.
 - ``indirect``: like ``callback`` with ``indirect=True`` (zenoh runs each
   subscriber's callbacks on a thread of its own).
+
+The README's figures for the former inbox (one ``queue.Queue`` and a worker
+thread) and for the recorder's ``classify`` as it was were taken with copies
+of that code, since removed: compare with another checkout
+(``recorder-at-before``) instead.
 """
 
 from __future__ import annotations
@@ -40,7 +41,6 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import queue
 import statistics
 import subprocess
 import sys
@@ -73,44 +73,6 @@ from tests.unit.predictor.synthetic import staircase  # noqa: E402
 
 TOPICS = (channels.SAMPLES.topic, channels.TOOL.topic)
 WAKE = b""
-
-
-class QueuedInbox:
-    """The former inbox: callbacks fill one bounded queue, one worker thread drains it."""
-
-    def __init__(self, session: zenoh.Session, station_ids: Sequence[str], handle: Handler):
-        self._handle = handle
-        self._queue: queue.Queue[tuple[str, str, bytes] | None] = queue.Queue(10_000)
-        self._subscribers = [
-            session.declare_subscriber(
-                keys.station_key(s, t),
-                zenoh.handlers.Callback(self._deliver_to(s, t), indirect=False),
-            )
-            for s in station_ids
-            for t in TOPICS
-        ]
-
-    def _deliver_to(self, station_id: str, topic: str) -> Callable[[zenoh.Sample], None]:
-        put = self._queue.put
-
-        def deliver(sample: zenoh.Sample) -> None:
-            put((station_id, topic, sample.payload.to_bytes()))
-
-        return deliver
-
-    def serve(self, stop: threading.Event) -> None:
-        get, handle = self._queue.get, self._handle
-        while not stop.is_set():
-            item = get()
-            if item is not None:
-                handle(*item)
-
-    def wake(self) -> None:
-        self._queue.put(None)
-
-    def close(self) -> None:
-        for subscriber in self._subscribers:
-            subscriber.undeclare()
 
 
 class FifoThreadsInbox:
@@ -181,7 +143,6 @@ VARIANTS: dict[str, Callable[[zenoh.Session, Sequence[str], Handler], Inbox]] = 
     "callback": StationInbox,
     "callback-unpinned": UnpinnedInbox,
     "callback-rx1": StationInbox,
-    "queue": QueuedInbox,
     "fifo-threads": FifoThreadsInbox,
     "indirect": IndirectInbox,
 }
@@ -189,9 +150,8 @@ VARIANTS: dict[str, Callable[[zenoh.Session, Sequence[str], Handler], Inbox]] = 
 RUNTIMES = {"callback-rx1": "(rx: (worker_threads: 1))"}
 
 
-#: recorder variants: the real ``serve recorder --no-rerun``, classify() as it is or as
-#: before, or another checkout's recorder
-RECORDER_VARIANTS = ("recorder", "recorder-classify-before", "recorder-at-before")
+#: recorder variants: the real ``serve recorder --no-rerun`` of this checkout or of another
+RECORDER_VARIANTS = ("recorder", "recorder-at-before")
 
 
 def consumer_command(variant: str, paths: list[Path], before_repo: Path | None) -> list[str]:
@@ -216,11 +176,6 @@ def recorded_samples(recordings: Path) -> int:
 def consume(variant: str, files: list[str]) -> int:
     """The process of one variant (a child: bench_line_inbox.py --consume ...)."""
     if variant in RECORDER_VARIANTS:
-        if variant == "recorder-classify-before":
-            from services.recorder import service as recorder_service
-            from tests.benchmarks.bench_line_decode import classify_as_before
-
-            recorder_service.classify = classify_as_before
         from services.cli.main import main as boltwatch
 
         return boltwatch(["serve", "recorder", "--no-rerun", "--config", *files])
@@ -313,7 +268,7 @@ def main(argv: list[str] | None = None) -> int:
         nargs="+",
         default=list(VARIANTS),
         choices=[*VARIANTS, *RECORDER_VARIANTS],
-        help="predictor inboxes (default: all) or the recorder's classify, before/after",
+        help="predictor inboxes (default: all) or the recorder, this checkout's or another's",
     )
     parser.add_argument(
         "--before-repo", type=Path, default=None, help="the checkout of recorder-at-before"

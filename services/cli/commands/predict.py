@@ -1,7 +1,7 @@
 """``boltwatch predict TRACE.csv --target-force N``: the predictor over a recorded trace.
 
 Runs the same predictor core as the live service, sample by sample, and
-prints JSON Lines on stdout (contract in DESIGN.md): one
+prints JSON Lines on stdout (contract in docs/design.md): one
 ``{"type": "event", "time_s": ...}`` per stick-slip event with its figures
 and predictions, one ``{"type": "stop", "time_s": ..., "reason": ...}`` per
 stop decision (``time_s`` is the sample at which it was decided).

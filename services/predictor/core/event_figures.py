@@ -20,6 +20,12 @@ negative and subtract wear. The magnitude wears the tool alike, so
 
 t is the time since the run's first sample; φ̇_m is the program's motor
 speed when known, else measured from the angle between the two peaks.
+
+:class:`EventFigures` is the one type for event j: the core reports it,
+``boltwatch predict`` prints it and :mod:`services.predictor.run_messages`
+turns it into the wire message :class:`~shared.messages.StickSlipEvent`
+(every field but ``current_force_n`` and ``detected_at_s``, which serve the
+stop rules and the tests, plus the station, the run and ``time_ns``).
 """
 
 from __future__ import annotations
@@ -27,17 +33,30 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from shared.messages import Prediction
+
 
 @dataclass(frozen=True, slots=True)
-class Figures:
-    torque_drop_nm: float
-    force_step_n: float | None
-    period_s: float | None
-    f_ss_hz: float | None
-    k1: float | None
-    k2: float | None
-    k3: float | None
-    intensity: float | None
+class EventFigures:
+    """Stick-slip event j and its figures (paper Fig. 3); None where not yet defined."""
+
+    index: int  # j, from 1
+    time_s: float  # t_j of the torque peak (run time)
+    peak_torque_nm: float  # T_max,j (eq. 48)
+    min_torque_nm: float  # T_min,j after the slip (eq. 50)
+    torque_drop_nm: float  # ΔT_j = T_max,j - T_min,j
+    plateau_force_n: float | None  # F_j: the plateau the peak sits on (before slip j)
+    force_step_n: float | None  # ΔF_j = F_j - F_{j-1}
+    period_s: float | None  # Δt_j = t_j - t_{j-1}
+    f_ss_hz: float | None  # 1 / Δt_j
+    k1: float | None  # eq. 31
+    k2: float | None  # eq. 32
+    k3: float | None  # eq. 33
+    intensity: float | None  # I_j, eq. 67
+    process_intensity: float  # I_process, eq. 68
+    current_force_n: float | None  # plateau after slip j, measured when the event was confirmed
+    detected_at_s: float  # time of the sample at which the event was confirmed
+    predictions: list[Prediction]  # the next events as predicted at event j (eqs. 52-56)
 
 
 def torque_mean_nm(peak_torque_nm: float, min_torque_nm: float) -> float:
@@ -50,8 +69,16 @@ def event_intensity(torque_drop_nm: float, mean_torque_nm: float, f_ss_hz: float
     return torque_drop_nm * abs(mean_torque_nm) * f_ss_hz
 
 
+def event_period_s(time_s: float, previous_time_s: float | None) -> float | None:
+    """Δt_j = t_j - t_(j-1); None for the first event or a peak not after the previous one."""
+    if previous_time_s is not None and time_s > previous_time_s:
+        return time_s - previous_time_s
+    return None
+
+
 def compute_figures(
     *,
+    index: int,
     time_since_start_s: float,
     peak_torque_nm: float,
     min_torque_nm: float,
@@ -60,14 +87,19 @@ def compute_figures(
     previous_plateau_n: float | None,
     time_s: float,
     motor_speed_rad_s: float | None,
-) -> Figures:
-    """All figures of one event; None where the previous event or the force is missing."""
+    process_intensity_before: float = 0.0,
+    current_force_n: float | None = None,
+    detected_at_s: float | None = None,
+    predictions: list[Prediction] | None = None,
+) -> EventFigures:
+    """All figures of event j; None where the previous event or the force is missing.
+
+    ``process_intensity_before``: I_process up to event j-1; ``detected_at_s``
+    defaults to the peak's time.
+    """
     drop = peak_torque_nm - min_torque_nm
-    period = None
-    f_ss = None
-    if previous_time_s is not None and time_s > previous_time_s:
-        period = time_s - previous_time_s
-        f_ss = 1.0 / period
+    period = event_period_s(time_s, previous_time_s)
+    f_ss = 1.0 / period if period is not None else None
     step = None
     if plateau_force_n is not None and previous_plateau_n is not None:
         step = plateau_force_n - previous_plateau_n
@@ -86,4 +118,25 @@ def compute_figures(
         if f_ss is not None
         else None
     )
-    return Figures(drop, step, period, f_ss, k1, k2, k3, intensity)
+    process_intensity = process_intensity_before
+    if intensity is not None:
+        process_intensity += intensity  # eq. 68, from j = 2
+    return EventFigures(
+        index=index,
+        time_s=time_s,
+        peak_torque_nm=peak_torque_nm,
+        min_torque_nm=min_torque_nm,
+        torque_drop_nm=drop,
+        plateau_force_n=plateau_force_n,
+        force_step_n=step,
+        period_s=period,
+        f_ss_hz=f_ss,
+        k1=k1,
+        k2=k2,
+        k3=k3,
+        intensity=intensity,
+        process_intensity=process_intensity,
+        current_force_n=current_force_n,
+        detected_at_s=time_s if detected_at_s is None else detected_at_s,
+        predictions=[] if predictions is None else predictions,
+    )

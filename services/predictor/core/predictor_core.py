@@ -5,7 +5,7 @@
     core = PredictorCore(settings)
     for t, torque, force, angle in samples:          # force NaN when there is none
         for output in core.update(t, torque, force, angle):
-            ...                                     # CoreEvent or CoreDecision
+            ...                                     # EventFigures or CoreDecision
 
 Per sample the work is O(1): the input guard, the window's running
 inclination sum (eqs. 46, 47), a noise estimate, a running force sum and the
@@ -17,11 +17,11 @@ stop rules (eqs. 64, 65, 70, 71).
 
 from __future__ import annotations
 
-import itertools
 import logging
 import math
 
-from services.predictor.core.event_figures import compute_figures
+from services.predictor.core.event_figures import EventFigures, compute_figures, event_period_s
+from services.predictor.core.event_history import EventHistory
 from services.predictor.core.extremum_tracker import ExtremumTracker, Slip
 from services.predictor.core.force_history import ForceHistory
 from services.predictor.core.halt_planner import HaltPlanner
@@ -37,7 +37,7 @@ from services.predictor.core.input_guard import (
 )
 from services.predictor.core.model_bands import BandVerdict, ModelBandCheck
 from services.predictor.core.motor_motion import MotorMotion
-from services.predictor.core.outputs import CoreDecision, CoreEvent
+from services.predictor.core.outputs import CoreDecision
 from services.predictor.core.regression import predict_events
 from services.predictor.core.scoring import PredictionScores
 from services.predictor.core.screw_plateaus import ScrewPlateaus
@@ -47,14 +47,17 @@ from shared.messages import Prediction
 
 LOG = logging.getLogger(__name__)
 
-HISTORY = 10  # events kept for the fits (the fits use at most 8)
 FIRST_PLATEAU_SAMPLES = 20  # stick samples looked at for the first event's plateau
 
-STAIRCASE_EVENTS = 3  # rising peaks in a row before torque peaks may decide (eq. 64)
+#: eq. 64 on torque peaks needs regular stick-slip: this many youngest peaks rising one
+#: after the other (or, with plateaus from the screw angle, this many events). Wiggles of a
+#: joint without stick-slip (thread forming, noise) also make events now and then; their
+#: predicted peaks are no ground to stop on.
+STAIRCASE_EVENTS = 3
 PLAN_PERIODS = 1.5  # a torque halt plan holds this many predicted periods after its peak
 MAX_STEP_FRACTION = 0.25  # a predicted step larger than this share of the value: no decision
 
-CoreOutput = CoreEvent | CoreDecision
+CoreOutput = EventFigures | CoreDecision
 
 
 class PredictorCore:
@@ -85,12 +88,7 @@ class PredictorCore:
         self._count = 0
         self._start_time_s = math.nan
         self._start_angle_deg = math.nan
-        self._previous_trough_index = -1
-        self._times: list[float] = []
-        self._periods: list[float] = []
-        self._peaks: list[float] = []
-        self._plateaus: list[float] = []
-        self._previous_angle_deg = math.nan
+        self.history = EventHistory()
         self.events = 0
         self.process_intensity = 0.0
 
@@ -161,25 +159,43 @@ class PredictorCore:
 
     def _on_slip(self, slip: Slip, now_s: float, torque_nm: float) -> list[CoreOutput]:
         settings = self.settings
+        history = self.history
         peak, trough = slip.peak, slip.trough
         self.events += 1
         j = self.events
-        previous_time = self._times[-1] if self._times else None
-        previous_plateau = self._plateaus[-1] if self._plateaus else None
+        previous_time = history.newest_time_s
+        previous_plateau = history.newest_plateau_n
+        previous_peak = history.newest_peak_nm
         plateau: float | None = None
         force_now: float | None = None
         if settings.has_force:
-            trough_before = self._previous_trough_index
+            trough_before = history.trough_index
             if trough_before < 0:
                 trough_before = max(-1, peak.index - FIRST_PLATEAU_SAMPLES)
             plateau = self._forces.plateau_before(trough_before, peak.index)
             force_now = self._forces.plateau_after(trough.index)
         speed = settings.motor_speed_rad_s
         if speed is None and previous_time is not None and peak.time_s > previous_time:
-            speed = math.radians(peak.angle_deg - self._previous_angle_deg) / (
+            speed = math.radians(peak.angle_deg - history.peak_angle_deg) / (
                 peak.time_s - previous_time
             )
-        figures = compute_figures(
+        history.add(
+            peak.time_s,
+            event_period_s(peak.time_s, previous_time),
+            peak.torque_nm,
+            plateau,
+            trough.index,
+            peak.angle_deg,
+        )
+        predictions = predict_events(
+            peak.time_s,
+            history.periods_s,
+            history.peaks_nm,
+            history.plateaus_n,
+            settings.plateau_method,
+        )
+        event = compute_figures(
+            index=j,
             time_since_start_s=peak.time_s - self._start_time_s,
             peak_torque_nm=peak.torque_nm,
             min_torque_nm=trough.torque_nm,
@@ -188,44 +204,22 @@ class PredictorCore:
             previous_plateau_n=previous_plateau,
             time_s=peak.time_s,
             motor_speed_rad_s=speed,
-        )
-        if figures.intensity is not None:
-            self.process_intensity += figures.intensity  # eq. 68, from j = 2
-        self.scores.score(
-            j,
-            peak.time_s,
-            figures.period_s,
-            peak.torque_nm,
-            plateau,
-            self._peaks[-1] if self._peaks else None,
-            figures.force_step_n,
-        )
-        self._remember(peak.time_s, figures.period_s, peak.torque_nm, plateau)
-        self._previous_trough_index = trough.index
-        self._previous_angle_deg = peak.angle_deg
-        predictions = predict_events(
-            peak.time_s, self._periods, self._peaks, self._plateaus, settings.plateau_method
-        )
-        self.scores.remember(j, predictions)
-        event = CoreEvent(
-            index=j,
-            time_s=peak.time_s,
-            peak_torque_nm=peak.torque_nm,
-            min_torque_nm=trough.torque_nm,
-            torque_drop_nm=figures.torque_drop_nm,
-            plateau_force_n=plateau,
-            force_step_n=figures.force_step_n,
-            period_s=figures.period_s,
-            f_ss_hz=figures.f_ss_hz,
-            k1=figures.k1,
-            k2=figures.k2,
-            k3=figures.k3,
-            intensity=figures.intensity,
-            process_intensity=self.process_intensity,
+            process_intensity_before=self.process_intensity,
             current_force_n=force_now,
             detected_at_s=now_s,
             predictions=predictions,
         )
+        self.process_intensity = event.process_intensity
+        self.scores.score(
+            j,
+            peak.time_s,
+            event.period_s,
+            peak.torque_nm,
+            plateau,
+            previous_peak,
+            event.force_step_n,
+        )
+        self.scores.remember(j, predictions)
         out: list[CoreOutput] = [event]
         if self._halt_planner is not None and self.policy.decision is None:
             halt = self._halt_planner.on_event(
@@ -245,9 +239,9 @@ class PredictorCore:
         if self.model_bands is not None:
             verdict = self.model_bands.on_event(
                 peak.torque_nm,
-                figures.torque_drop_nm,
-                figures.period_s,
-                figures.force_step_n,
+                event.torque_drop_nm,
+                event.period_s,
+                event.force_step_n,
                 speed,
                 self._tracker.noise_d2_nm,
             )
@@ -262,7 +256,7 @@ class PredictorCore:
             plateau,
             force_now,
             predictions,
-            (figures.k1, figures.k2, figures.k3),
+            (event.k1, event.k2, event.k3),
             by_angle,
             verdict,
         )
@@ -301,11 +295,11 @@ class PredictorCore:
         peak_now = peak_next = None
         if not self.settings.torque_plateau_rule:
             pass
-        elif by_angle is not None and self._is_staircase(rising=False):
+        elif by_angle is not None and self.history.has(STAIRCASE_EVENTS):
             now, after = by_angle
             if after - now <= MAX_STEP_FRACTION * now:
                 peak_now, peak_next = now, after
-        elif len(predictions) >= 2 and self._is_staircase():
+        elif len(predictions) >= 2 and self.history.peaks_rise(STAIRCASE_EVENTS):
             now, after = predictions[0].peak_torque_nm, predictions[1].peak_torque_nm
             if 0.0 < after - now <= MAX_STEP_FRACTION * abs(now):
                 peak_now, peak_next = now, after
@@ -320,27 +314,3 @@ class PredictorCore:
             constants,
             verdict,
         )
-
-    def _is_staircase(self, rising: bool = True) -> bool:
-        """Regular stick-slip: the youngest STAIRCASE_EVENTS peaks rise one after the other.
-
-        Wiggles of a joint without stick-slip (thread forming, noise) also make
-        events now and then; their predicted peaks are no ground to stop on.
-        """
-        peaks = self._peaks[-STAIRCASE_EVENTS:]
-        if len(peaks) < STAIRCASE_EVENTS:
-            return False
-        return not rising or all(b > a for a, b in itertools.pairwise(peaks))
-
-    def _remember(
-        self, time_s: float, period_s: float | None, peak_nm: float, plateau_n: float | None
-    ) -> None:
-        self._times.append(time_s)
-        if period_s is not None:
-            self._periods.append(period_s)
-        self._peaks.append(peak_nm)
-        if plateau_n is not None:
-            self._plateaus.append(plateau_n)
-        for history in (self._times, self._periods, self._peaks, self._plateaus):
-            if len(history) > HISTORY:
-                del history[0]

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from services.predictor.core import CoreDecision, CoreEvent, PredictorCore, PredictorSettings
+from services.predictor.core import CoreDecision, EventFigures, PredictorCore, PredictorSettings
 from tests.unit.predictor.synthetic import SyntheticTrace, smooth_ramp, staircase
 
 
@@ -19,8 +19,8 @@ def decisions(outputs: list[object]) -> list[CoreDecision]:
     return [o for o in outputs if isinstance(o, CoreDecision)]
 
 
-def events(outputs: list[object]) -> list[CoreEvent]:
-    return [o for o in outputs if isinstance(o, CoreEvent)]
+def events(outputs: list[object]) -> list[EventFigures]:
+    return [o for o in outputs if isinstance(o, EventFigures)]
 
 
 def closest_plateau(trace: SyntheticTrace, target: float) -> float:

@@ -73,6 +73,7 @@ def test_running_sum_matches_a_fresh_sum_after_many_samples() -> None:
 
 def test_event_figures_eqs_31_33_66_67() -> None:
     figures = compute_figures(
+        index=2,
         time_since_start_s=0.5,
         peak_torque_nm=120.0,
         min_torque_nm=100.0,
@@ -96,6 +97,7 @@ def test_event_figures_eqs_31_33_66_67() -> None:
 
 def test_first_event_has_no_period_step_or_intensity() -> None:
     figures = compute_figures(
+        index=1,
         time_since_start_s=0.1,
         peak_torque_nm=10.0,
         min_torque_nm=8.0,

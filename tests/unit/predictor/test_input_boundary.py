@@ -18,7 +18,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from services.predictor.core import CoreDecision, CoreEvent, PredictorCore, PredictorSettings
+from services.predictor.core import CoreDecision, EventFigures, PredictorCore, PredictorSettings
 from tests.unit.predictor.synthetic import SyntheticTrace, staircase
 
 Row = tuple[float, float, float, float]  # time_s, torque_nm, force_n, angle_deg
@@ -30,10 +30,10 @@ def trace() -> SyntheticTrace:
     return staircase(torque_noise_nm=0.2, force_noise_n=30.0)
 
 
-def outcome(rows: list[Row]) -> tuple[list[CoreEvent], CoreDecision, PredictorCore]:
+def outcome(rows: list[Row]) -> tuple[list[EventFigures], CoreDecision, PredictorCore]:
     core = PredictorCore(PredictorSettings(target_force_n=TARGET_N))
     outputs = [o for row in rows for o in core.update(*row)]
-    events = [o for o in outputs if isinstance(o, CoreEvent)]
+    events = [o for o in outputs if isinstance(o, EventFigures)]
     (decision,) = [o for o in outputs if isinstance(o, CoreDecision)]
     return events, decision, core
 

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from services.predictor.core import CoreEvent, PredictorCore, PredictorSettings
+from services.predictor.core import EventFigures, PredictorCore, PredictorSettings
 from services.predictor.core.extremum_tracker import ExtremumTracker
 from services.predictor.core.motor_motion import MotorMotion
 from services.predictor.core.second_difference import SEED_SAMPLES
@@ -38,7 +38,7 @@ def event_samples(torques_nm: list[float]) -> list[int]:
     found = []
     for i, torque_nm in enumerate(torques_nm):
         for output in core.update(i * 1e-3, torque_nm, math.nan, 0.01 * i):
-            if isinstance(output, CoreEvent):
+            if isinstance(output, EventFigures):
                 found.append(i)
     return found
 

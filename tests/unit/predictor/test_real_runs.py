@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from services.predictor.core import CoreDecision, CoreEvent, PredictorCore, PredictorSettings
+from services.predictor.core import CoreDecision, EventFigures, PredictorCore, PredictorSettings
 from services.recorder.controller_run import read_controller_run
 from tests.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 
@@ -36,16 +36,16 @@ def final_torque_nominal_nm(path: Path) -> float:
     )
 
 
-def replay(path: Path, advisory: bool) -> tuple[list[CoreEvent], CoreDecision | None, float]:
+def replay(path: Path, advisory: bool) -> tuple[list[EventFigures], CoreDecision | None, float]:
     """(events, decision, time of the torque peak) of one controller run."""
     run = read_controller_run(path)
     settings = PredictorSettings(
         target_torque_nm=final_torque_nominal_nm(path), has_force=False, advisory=advisory
     )
     core = PredictorCore(settings)
-    events: list[CoreEvent] = []
+    events: list[EventFigures] = []
     for row in zip(run.time_s, run.torque_nm, [math.nan] * len(run), run.angle_deg, strict=True):
-        events += [o for o in core.update(*row) if isinstance(o, CoreEvent)]
+        events += [o for o in core.update(*row) if isinstance(o, EventFigures)]
     peak_s = run.time_s[int(np.argmax(run.torque_nm))]
     return events, core.decision, peak_s
 

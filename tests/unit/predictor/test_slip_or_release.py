@@ -14,16 +14,16 @@ import math
 import numpy as np
 import pytest
 
-from services.predictor.core import CoreEvent, PredictorCore, PredictorSettings
+from services.predictor.core import EventFigures, PredictorCore, PredictorSettings
 from tests.unit.predictor.synthetic import staircase
 
 Row = tuple[float, float, float, float]  # time_s, torque_nm, force_n, angle_deg
 DT_S = 1e-3
 
 
-def events_of(rows: list[Row], **settings: object) -> list[CoreEvent]:
+def events_of(rows: list[Row], **settings: object) -> list[EventFigures]:
     core = PredictorCore(PredictorSettings(has_force=False, **settings))  # type: ignore[arg-type]
-    return [o for row in rows for o in core.update(*row) if isinstance(o, CoreEvent)]
+    return [o for row in rows for o in core.update(*row) if isinstance(o, EventFigures)]
 
 
 def stick_slip(duration_s: float = 0.6, seed: int = 0) -> list[Row]:
@@ -104,11 +104,11 @@ def test_after_a_binding_decision_no_event_is_reported() -> None:
     rows = stick_slip()
     core = PredictorCore(PredictorSettings(has_force=False, target_torque_nm=rows[300][1]))
     outputs = [o for row in rows for o in core.update(*row)]
-    stop = next(o for o in outputs if not isinstance(o, CoreEvent))
-    assert [o for o in outputs[outputs.index(stop) :] if isinstance(o, CoreEvent)] == []
+    stop = next(o for o in outputs if not isinstance(o, EventFigures))
+    assert [o for o in outputs[outputs.index(stop) :] if isinstance(o, EventFigures)] == []
     advisory = PredictorCore(
         PredictorSettings(has_force=False, target_torque_nm=rows[300][1], advisory=True)
     )
     replayed = [o for row in rows for o in advisory.update(*row)]
-    later = replayed[replayed.index(next(o for o in replayed if not isinstance(o, CoreEvent))) :]
-    assert any(isinstance(o, CoreEvent) for o in later)  # a replay goes on reporting
+    later = replayed[replayed.index(next(o for o in replayed if not isinstance(o, EventFigures))) :]
+    assert any(isinstance(o, EventFigures) for o in later)  # a replay goes on reporting
