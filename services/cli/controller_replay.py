@@ -33,8 +33,8 @@ from typing import Any
 
 from services.predictor.core import EventFigures, PredictorCore, PredictorSettings
 from services.predictor.run_messages import decision_message, event_messages
-from services.recorder.controller_import import PredictorReplay, run_end_ns
-from services.recorder.controller_run import ControllerRun
+from services.recorder.controller_import.controller_import import PredictorReplay, run_end_ns
+from services.recorder.controller_import.controller_run import ControllerRun
 from shared import channels
 from shared.messages import RunSummary
 from shared.run_clock import RunClock

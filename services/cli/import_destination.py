@@ -17,8 +17,8 @@ from shared import folders
 from shared.errors import InputError
 
 if TYPE_CHECKING:
-    from services.recorder.controller_run import ControllerRun
-    from services.recorder.rerun_sink import RerunOptions
+    from services.recorder.controller_import.controller_run import ControllerRun
+    from services.recorder.rerun_files.rerun_sink import RerunOptions
 
 
 def make_folder(folder: Path, what: str) -> Path:
@@ -31,7 +31,7 @@ def make_folder(folder: Path, what: str) -> Path:
 
 def write_csv_whole(target: Path, rows: Iterable[tuple[float, float, float, float | None]]) -> int:
     """:func:`shared.trace.write_trace` under a temporary name, renamed when complete."""
-    from services.recorder.import_files import remove_temporary, temporary_path
+    from services.recorder.controller_import.import_files import remove_temporary, temporary_path
     from shared.trace import write_trace
 
     temporary = temporary_path(target)
@@ -56,8 +56,8 @@ class CsvWriter:
 
     def write(self, run: ControllerRun) -> bool:
         """Write the run's trace; True (a CSV is always written, over an older one)."""
-        from services.recorder.controller_import import RunNotWrittenError
-        from services.recorder.recorder import describe_os_error
+        from services.recorder.controller_import.controller_import import RunNotWrittenError
+        from services.recorder.live.recorder import describe_os_error
 
         target = self.folder / f"{run.source.stem}.csv"
         rows = zip(run.run_time_s, run.torque_nm, run.angle_deg, [None] * len(run), strict=True)
@@ -79,13 +79,13 @@ class RecordingsWriter:
     """Each run into the recordings folder, with its predictor replay and wear-ledger count."""
 
     def __init__(self, folder: Path, station: str, rerun: bool) -> None:
-        from services.recorder.wear_ledger import WearLedger, ledger_path
+        from services.recorder.wear.wear_ledger import WearLedger, ledger_path
 
         self.folder = folder
         self._station = station
         self._options: RerunOptions | None = None
         if rerun:
-            from services.recorder.rerun_sink import RerunOptions
+            from services.recorder.rerun_files.rerun_sink import RerunOptions
 
             self._options = RerunOptions()
         self._ledger = WearLedger(ledger_path(folder))
@@ -93,7 +93,7 @@ class RecordingsWriter:
     def write(self, run: ControllerRun) -> bool:
         """Import the run; True when written now, False when it was already there."""
         from services.cli.controller_replay import replay_run
-        from services.recorder.controller_import import import_run
+        from services.recorder.controller_import.controller_import import import_run
 
         replay = replay_run(self._station, run)
         imported = import_run(run, self.folder, self._station, self._options, replay, self._ledger)

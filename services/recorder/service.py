@@ -1,7 +1,7 @@
 """``boltwatch serve recorder``: everything of its stations into MCAP files.
 
 One zenoh session, one subscriber per station it serves on
-``boltwatch/<st>/**`` (:class:`~services.recorder.line_inbox.LineInbox`: its
+``boltwatch/<st>/**`` (:class:`~services.recorder.live.line_inbox.LineInbox`: its
 callback keeps each
 message, the service's worker thread files them in batches every
 :data:`TAKE_INTERVAL_S`). The worker also flushes files every half flush
@@ -17,12 +17,12 @@ the ``[recorder]`` settings (an error when the files disagree). A station
 with no file is not its station: in a plant each line's recorder records its
 own line's stations, and the subscription never asks the router for the
 others (no other line's sample crosses to this line for it). No payload
-stops it: what it refuses (:mod:`services.recorder.incoming`) is recorded
+stops it: what it refuses (:mod:`services.recorder.live.incoming`) is recorded
 raw and counted in the station's ``RecorderStats.bad_payloads``.
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
-(:class:`services.recorder.rerun_sink.RerunLive`). ``--view-only`` makes a
+(:class:`services.recorder.rerun_files.rerun_sink.RerunLive`). ``--view-only`` makes a
 second recorder a live view beside the line's one: it keeps no wear ledger,
 answers no wear query, publishes no RecorderStats and holds the health token
 ``viewer``, so nothing on the line mistakes it for the recorder. Rerun failing never stops
@@ -43,16 +43,16 @@ from typing import TYPE_CHECKING
 
 import zenoh
 
-from services.recorder.file_metadata import FileMetadata
-from services.recorder.incoming import OTHER_STATION, Received, classify
-from services.recorder.line_inbox import LineInbox, Message
-from services.recorder.recorder import Recorder
-from services.recorder.recorder_health import RecorderHealth
-from services.recorder.run_files import FileLimits
-from services.recorder.sample_batches import BatchSamples
-from services.recorder.wear_bound import StationLimits
-from services.recorder.wear_ledger import WearLedger, ledger_path
-from services.recorder.wear_watch import WearWatch
+from services.recorder.live.file_metadata import FileMetadata
+from services.recorder.live.incoming import OTHER_STATION, Received, classify
+from services.recorder.live.line_inbox import LineInbox, Message
+from services.recorder.live.recorder import Recorder
+from services.recorder.live.recorder_health import RecorderHealth
+from services.recorder.live.run_files import FileLimits
+from services.recorder.live.sample_batches import BatchSamples
+from services.recorder.wear.wear_bound import StationLimits
+from services.recorder.wear.wear_ledger import WearLedger, ledger_path
+from services.recorder.wear.wear_watch import WearWatch
 from shared import channels, keys
 from shared.codec import encode
 from shared.config import LoadedStation, load_line
@@ -63,7 +63,7 @@ from shared.service_runtime import ServiceRunner
 from shared.zenoh_session import open_session
 
 if TYPE_CHECKING:
-    from services.recorder.rerun_sink import RerunLive, RerunOptions
+    from services.recorder.rerun_files.rerun_sink import RerunLive, RerunOptions
 
 LOG = logging.getLogger(__name__)
 
@@ -328,7 +328,7 @@ def rerun_options(write_files: bool, live_url: str | None) -> RerunOptions | Non
     if not write_files and live_url is None:
         return None
     try:
-        from services.recorder.rerun_sink import LIVE_BATCH_SAMPLES, RerunOptions
+        from services.recorder.rerun_files.rerun_sink import LIVE_BATCH_SAMPLES, RerunOptions
     except ImportError:
         LOG.exception("Rerun is unusable; recording MCAP only")
         return None
@@ -343,7 +343,7 @@ def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
     if not (web or getattr(args, "rerun_serve", False)):
         return None
     try:
-        from services.recorder.rerun_sink import RerunLive
+        from services.recorder.rerun_files.rerun_sink import RerunLive
 
         return RerunLive(args.rerun_port, args.rerun_web_port if web else None)
     except Exception:

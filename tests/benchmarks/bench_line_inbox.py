@@ -59,7 +59,7 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
 from services.cli.station_supervisor import stop_process  # noqa: E402
 from services.predictor.service import PredictorService  # noqa: E402
 from services.predictor.station_inbox import Handler, Inbox, StationInbox  # noqa: E402
-from services.recorder.recording_reader import RecordingScan  # noqa: E402
+from services.recorder.mcap_files.recording_reader import RecordingScan  # noqa: E402
 from shared import channels, keys  # noqa: E402
 from shared.codec import decode  # noqa: E402
 from shared.config import derive_stations, load_line  # noqa: E402

@@ -63,7 +63,7 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
 from services.cli.station_supervisor import stop_process  # noqa: E402
 from services.predictor.core import CoreDecision, PredictorCore, PredictorSettings  # noqa: E402
 from services.predictor.trace_replay import replay  # noqa: E402
-from services.recorder.trace_export import export_trace  # noqa: E402
+from services.recorder.mcap_files.trace_export import export_trace  # noqa: E402
 from services.rig.frames import RigFrames  # noqa: E402
 from services.rig.realtime import RealtimeRig, ToolIdentity  # noqa: E402
 from shared import channels, keys  # noqa: E402

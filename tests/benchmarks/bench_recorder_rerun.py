@@ -15,15 +15,15 @@ import tempfile
 import time
 from pathlib import Path
 
-from services.recorder.file_metadata import FileMetadata
-from services.recorder.incoming import Received, classify
-from services.recorder.recorder import Recorder
-from services.recorder.rerun_sink import RerunOptions, RerunSink
-from services.recorder.run_files import FileLimits
-from services.recorder.testing import write_station_file
+from services.recorder.live.file_metadata import FileMetadata
+from services.recorder.live.incoming import Received, classify
+from services.recorder.live.recorder import Recorder
+from services.recorder.live.run_files import FileLimits
+from services.recorder.rerun_files.rerun_sink import RerunOptions, RerunSink
 from shared.codec import encode
 from shared.config import load_station
 from shared.messages import Sample, StickSlipEvent, ToolState
+from tests.live_recorder import write_station_file
 
 SAMPLES = 60_000  # one minute at 1 kHz
 RATE_HZ = 1000

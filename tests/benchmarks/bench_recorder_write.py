@@ -17,15 +17,15 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from services.recorder.file_metadata import FileMetadata
-from services.recorder.incoming import classify
-from services.recorder.mcap_sink import McapSink
-from services.recorder.recorder import Recorder
-from services.recorder.run_files import FileLimits
-from services.recorder.testing import write_station_file
+from services.recorder.live.file_metadata import FileMetadata
+from services.recorder.live.incoming import classify
+from services.recorder.live.recorder import Recorder
+from services.recorder.live.run_files import FileLimits
+from services.recorder.mcap_files.mcap_sink import McapSink
 from shared.codec import encode
 from shared.config import load_station
 from shared.messages import Sample, ToolState
+from tests.live_recorder import write_station_file
 
 SAMPLES = 60_000  # one minute at 1 kHz
 FLUSHES = SAMPLES // 1000  # the simulated receive clock flushes once a second

@@ -31,7 +31,7 @@ from typing import Any
 
 from hypothesis import strategies as st
 
-from services.recorder.wear_watch import WearAlert
+from services.recorder.wear.wear_watch import WearAlert
 from shared.codec import MAX_PAYLOAD_BYTES, to_dict
 from shared.message_fields import (
     DEFAULT_FLOAT,

@@ -35,14 +35,7 @@ from mcap.reader import make_reader
 from services.acquisition.acquisition import Acquisition
 from services.acquisition.service import subscribe_decisions
 from services.predictor.service import PredictorService
-from services.recorder.mcap_sink import RAW_ENCODING
-from services.recorder.testing import (
-    RunningRecorder,
-    free_port,
-    has_subscribers,
-    wait_until,
-    write_station_file,
-)
+from services.recorder.mcap_files.mcap_sink import RAW_ENCODING
 from shared import channels, keys
 from shared.can_database import StationDatabase
 from shared.channels import CHANNELS
@@ -51,6 +44,13 @@ from shared.config import load_line, load_station
 from shared.messages import BusStats, Sample, StopDecision, ToolState
 from shared.zenoh_session import zenoh_config
 from tests.fuzz.payloads import template
+from tests.live_recorder import (
+    RunningRecorder,
+    free_port,
+    has_subscribers,
+    wait_until,
+    write_station_file,
+)
 from tests.paths import DBC_FILE
 from tests.unit.predictor.live_predictor import PROGRAM_OF, START_NS, station_text
 from tests.unit.predictor.synthetic import staircase

@@ -26,7 +26,7 @@ import can
 import zenoh
 
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
-from services.recorder.recording_reader import RecordingScan
+from services.recorder.mcap_files.recording_reader import RecordingScan
 from shared import channels, keys
 from shared.can_bus import open_bus
 from shared.can_database import StationDatabase

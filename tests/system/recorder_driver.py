@@ -11,15 +11,15 @@ import json
 import sys
 from pathlib import Path
 
-from services.recorder.file_metadata import FileMetadata
-from services.recorder.incoming import classify
-from services.recorder.recorder import Recorder
-from services.recorder.recording_reader import RecordingScan
-from services.recorder.run_files import FileLimits
-from services.recorder.testing import write_station_file
+from services.recorder.live.file_metadata import FileMetadata
+from services.recorder.live.incoming import classify
+from services.recorder.live.recorder import Recorder
+from services.recorder.live.run_files import FileLimits
+from services.recorder.mcap_files.recording_reader import RecordingScan
 from shared.codec import encode
 from shared.config import load_station
 from shared.messages import Sample, ToolState
+from tests.live_recorder import write_station_file
 
 MS = 1_000_000
 T0_NS = 1_800_000_000 * 1_000_000_000

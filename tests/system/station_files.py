@@ -12,7 +12,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from services.recorder.testing import free_port as free_tcp_port
+from tests.live_recorder import free_port as free_tcp_port
 from tests.paths import CONFIG, REPO, STATION_FILE
 
 

@@ -23,7 +23,6 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
-from services.recorder.testing import wait_until
 from shared import channels, keys
 from shared.can_database import StationDatabase
 from shared.codec import decode, encode
@@ -31,6 +30,7 @@ from shared.config import load_station
 from shared.config.station import CanSection
 from shared.messages import BusStats, StopDecision, ToolRunState, ToolState
 from shared.zenoh_session import zenoh_config
+from tests.live_recorder import wait_until
 from tests.system.can_injector import CanInjector, StopListener
 from tests.system.station_files import free_tcp_port, serve, write_station
 

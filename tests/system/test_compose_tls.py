@@ -33,7 +33,6 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
-from services.recorder.testing import has_subscribers
 from shared import channels, keys
 from shared.codec import decode
 from shared.config import load_station
@@ -49,6 +48,7 @@ from tests.compose_layout import (
     make_compose_certs,
     split_volume,
 )
+from tests.live_recorder import has_subscribers
 from tests.paths import REPO
 from tests.system.station_files import free_tcp_port, free_udp_port, serve
 

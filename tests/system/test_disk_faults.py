@@ -20,10 +20,10 @@ from pathlib import Path
 
 import pytest
 
-from services.recorder.recorder import RETRY_INTERVAL_NS
-from services.recorder.recording_reader import RecordingScan
-from services.recorder.wear_bound import CONTRACT_LIMITS
-from services.recorder.wear_ledger import WearLedger
+from services.recorder.live.recorder import RETRY_INTERVAL_NS
+from services.recorder.mcap_files.recording_reader import RecordingScan
+from services.recorder.wear.wear_bound import CONTRACT_LIMITS
+from services.recorder.wear.wear_ledger import WearLedger
 from shared.messages import RunSummary
 from tests.paths import REPO
 from tests.system.disk_faults import fill_up, read_only, tmpfs
@@ -32,7 +32,7 @@ from tests.system.recorder_driver import RecorderDriver, recorded_messages
 
 pytestmark = pytest.mark.system
 
-RECORDER_LOG = "services.recorder.recorder"
+RECORDER_LOG = "services.recorder.live.recorder"
 
 
 def errors_logged(caplog: pytest.LogCaptureFixture, level: int) -> list[str]:

@@ -17,19 +17,19 @@ import pytest
 import zenoh
 from mcap.reader import make_reader
 
-from services.recorder.recording_reader import RecordingScan
-from services.recorder.recovery import recover
-from services.recorder.testing import (
-    REPO_ROOT,
+from services.recorder.mcap_files.recording_reader import RecordingScan
+from services.recorder.mcap_files.recovery import recover
+from shared import channels
+from shared.codec import encode
+from shared.messages import Sample, ToolState
+from shared.zenoh_session import zenoh_config
+from tests.live_recorder import (
     free_port,
     has_subscribers,
     wait_until,
     write_station_file,
 )
-from shared import channels
-from shared.codec import encode
-from shared.messages import Sample, ToolState
-from shared.zenoh_session import zenoh_config
+from tests.paths import REPO
 
 pytestmark = pytest.mark.system
 
@@ -51,7 +51,7 @@ class RecorderProcess:
         self.log = (tmp_path / "recorder.log").open("w")
         self.process = subprocess.Popen(
             [sys.executable, "-m", "services.cli", "serve", "recorder", "--config", station_file],
-            cwd=REPO_ROOT,
+            cwd=REPO,
             stdout=self.log,
             stderr=subprocess.STDOUT,
         )

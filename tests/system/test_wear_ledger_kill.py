@@ -24,8 +24,8 @@ from pathlib import Path
 
 import pytest
 
-from services.recorder.wear_bound import CONTRACT_LIMITS
-from services.recorder.wear_ledger import WearLedger
+from services.recorder.wear.wear_bound import CONTRACT_LIMITS
+from services.recorder.wear.wear_ledger import WearLedger
 from shared.messages import RunSummary
 from tests.paths import REPO
 
@@ -40,8 +40,8 @@ S_NS = 1_000_000_000
 WRITER = textwrap.dedent(
     """
     import sys
-    from services.recorder.wear_bound import CONTRACT_LIMITS
-    from services.recorder.wear_watch import WearWatch
+    from services.recorder.wear.wear_bound import CONTRACT_LIMITS
+    from services.recorder.wear.wear_watch import WearWatch
     from shared.messages import RunSummary
 
     path, first = sys.argv[1], int(sys.argv[2])

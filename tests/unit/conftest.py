@@ -7,8 +7,8 @@ from collections.abc import Iterator
 import pytest
 import zenoh
 
-from services.recorder.testing import free_port
 from shared.zenoh_session import zenoh_config
+from tests.live_recorder import free_port
 
 
 @pytest.fixture

@@ -1,7 +1,7 @@
 """``boltwatch import CONTROLLER.json...``: real controller runs into the recordings.
 
 Reads the JSON runs a Bosch Rexroth CS351 controller exports (one file per
-run, see :mod:`services.recorder.controller_run`) and writes each as a live
+run, see :mod:`services.recorder.controller_import.controller_run`) and writes each as a live
 recording would be: ``<recordings>/<station>/<YYYY-MM-DD>/<station>_run<id>_<HHMMSS>.mcap``
 (+ ``.rrd``), same channels, schemas and metadata, the controller's own
 timing kept, the controller's result on ``boltwatch/<st>/controller``, and
@@ -88,9 +88,12 @@ class Tally:
 
 def run(args: argparse.Namespace) -> int:
     from services.cli.import_destination import CsvWriter, RecordingsWriter, make_folder
-    from services.recorder.controller_import import DEFAULT_STATION, check_station_id
-    from services.recorder.controller_run import read_controller_run
-    from services.recorder.wear_bound import RefusedSummaryError
+    from services.recorder.controller_import.controller_import import (
+        DEFAULT_STATION,
+        check_station_id,
+    )
+    from services.recorder.controller_import.controller_run import read_controller_run
+    from services.recorder.wear.wear_bound import RefusedSummaryError
     from shared.errors import BoltwatchError, InputError
 
     tally = Tally(len(args.runs))

@@ -36,7 +36,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from services.recorder.run_plot import draw_run
+    from services.recorder.post_mortem.run_plot import draw_run
 
     target = args.out or args.recording.with_suffix(".png")
     check_png_target(target, "the report")

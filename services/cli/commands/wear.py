@@ -9,7 +9,7 @@
 
 ``--plant`` asks every recorder of the plant (``boltwatch/*/wear`` through the
 router of the station file, or ``--connect``; the routers of a plant's lines
-are meshed) and merges their replies (:mod:`services.recorder.wear_plant`). A
+are meshed) and merges their replies (:mod:`services.recorder.wear.wear_plant`). A
 recorder that replies with an error is named on stderr, what the others said
 is printed, and the exit status is 2.
 
@@ -88,8 +88,8 @@ def run(args: argparse.Namespace) -> int:
     import json
     import time
 
-    from services.recorder.wear_ledger import WearLedger, ledger_path
-    from services.recorder.wear_table import format_table
+    from services.recorder.wear.wear_ledger import WearLedger, ledger_path
+    from services.recorder.wear.wear_table import format_table
     from shared.errors import InputError
 
     if args.plant or args.connect is not None:
@@ -115,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _reset(args: argparse.Namespace, path: Path) -> int:
-    from services.recorder.wear_reset import reset_ledger
+    from services.recorder.wear.wear_reset import reset_ledger
     from shared.errors import InputError
 
     if args.tool is not None:
@@ -139,8 +139,8 @@ def _plant(args: argparse.Namespace) -> int:
     import sys
 
     from services.cli.router_client import open_client, router_client
-    from services.recorder.wear_plant import WearReply, merge, parse_reply
-    from services.recorder.wear_table import format_table
+    from services.recorder.wear.wear_plant import WearReply, merge, parse_reply
+    from services.recorder.wear.wear_table import format_table
     from shared import keys
     from shared.errors import InputError
 

@@ -31,8 +31,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from services.cli.main import build_parser
-from services.recorder.incoming import classify
-from services.recorder.mcap_sink import McapSink
+from services.recorder.live.incoming import classify
+from services.recorder.mcap_files.mcap_sink import McapSink
 from shared.codec import encode
 from shared.messages import Sample
 from shared.trace import write_trace
@@ -51,9 +51,8 @@ OFFLINE = frozenset(
 OUTPUT_DESTS = frozenset({"out", "plot", "csv_dir", "recordings"})
 
 #: good files by argument name (relative to the workspace). No controller run for ``import``:
-#: it is driven with bad files only. Left out, for the rewrite of ``boltwatch import`` (issue
-#: 14 item 4): a good run with ``--recordings a-file.txt/x`` (recordings under a regular
-#: file) is a ValueError traceback in services/recorder/controller_import.py (import_run).
+#: it is driven with bad files only (its good runs, and recordings under a regular file,
+#: are tests/unit/cli/test_import_replay.py and tests/unit/recorder/test_import_*.py).
 GOOD_INPUTS = {
     "config": "station.toml",
     "joint": "joint.toml",

@@ -22,8 +22,8 @@ import pytest
 from mcap.reader import make_reader
 
 from services.cli.main import main
-from services.recorder.controller_run import read_controller_run
-from services.recorder.wear_ledger import WearLedger
+from services.recorder.controller_import.controller_run import read_controller_run
+from services.recorder.wear.wear_ledger import WearLedger
 from shared.codec import json_schema
 from shared.messages import ControllerResult
 from shared.trace import read_trace

@@ -10,9 +10,9 @@ import pytest
 import zenoh
 
 from services.predictor.service import PredictorService
-from services.recorder.testing import free_port
 from shared.config import LoadedStation, load_line
 from shared.zenoh_session import zenoh_config
+from tests.live_recorder import free_port
 from tests.unit.predictor.live_predictor import PROGRAM_OF, station_text
 
 

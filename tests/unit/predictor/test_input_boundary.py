@@ -116,7 +116,11 @@ def test_an_absurd_value_never_moves_the_decision(
     assert decision.time_s == pytest.approx(clean.time_s, abs=0.0105)
     assert abs(len(events) - len(clean_events)) <= 1
     assert math.isfinite(events[-1].process_intensity)
-    assert events[-1].process_intensity == pytest.approx(clean_events[-1].process_intensity, 0.05)
+    # within 5 %, and one event's intensity: the one event more or fewer allowed above (three
+    # samples dropped at a slip's peak lose that slip: index 527, column 0, count 3, 5.4 %)
+    largest_event = max(event.intensity or 0.0 for event in clean_events)
+    clean_total = clean_events[-1].process_intensity
+    assert abs(events[-1].process_intensity - clean_total) <= 0.05 * clean_total + largest_event
 
 
 def test_a_sample_stamped_an_hour_ahead_is_one_bad_sample() -> None:

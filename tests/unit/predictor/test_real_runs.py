@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from services.predictor.core import CoreDecision, EventFigures, PredictorCore, PredictorSettings
-from services.recorder.controller_run import read_controller_run
+from services.recorder.controller_import.controller_run import read_controller_run
 from tests.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 
 #: the share of a run's process intensity that events at or after its torque peak may carry

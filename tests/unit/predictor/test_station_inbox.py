@@ -13,9 +13,9 @@ import pytest
 import zenoh
 
 from services.predictor.station_inbox import StationInbox
-from services.recorder.testing import free_port, wait_until
 from shared import channels, keys
 from shared.zenoh_session import zenoh_config
+from tests.live_recorder import free_port, wait_until
 
 Handled = list[tuple[str, str, bytes]]
 REPO = Path(__file__).resolve().parents[3]

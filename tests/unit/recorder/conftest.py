@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 import zenoh
 
-from services.recorder.testing import RunningRecorder, free_port, write_station_file
 from shared.config import LoadedStation, load_station
 from shared.zenoh_session import zenoh_config
+from tests.live_recorder import RunningRecorder, free_port, write_station_file
 
 
 @pytest.fixture

@@ -26,14 +26,14 @@ import pytest
 import zenoh
 
 from services.cli.main import main
-from services.recorder.testing import RunningRecorder, publish, wait_until
-from services.recorder.wear_bound import CONTRACT_LIMITS
-from services.recorder.wear_ledger import WearLedger
+from services.recorder.wear.wear_bound import CONTRACT_LIMITS
+from services.recorder.wear.wear_ledger import WearLedger
 from shared import channels
 from shared.codec import decode
 from shared.config import LoadedStation
 from shared.messages import RecorderStats, RunSummary, Sample, ToolState
 from shared.zenoh_session import zenoh_config
+from tests.live_recorder import RunningRecorder, publish, wait_until
 from tests.paths import REPO
 
 T0_NS = 1_700_000_000_000_000_000

@@ -12,9 +12,9 @@ import pytest
 from mcap.reader import make_reader
 
 from services.cli.main import main
-from services.recorder.incoming import classify
-from services.recorder.mcap_sink import McapSink
-from services.recorder.recording_reader import RecordingScan
+from services.recorder.live.incoming import classify
+from services.recorder.mcap_files.mcap_sink import McapSink
+from services.recorder.mcap_files.recording_reader import RecordingScan
 from shared.codec import encode
 from shared.messages import Sample, ToolState
 from shared.trace import read_trace

@@ -22,7 +22,7 @@ import pytest
 from mcap.reader import make_reader
 
 from services.cli.main import main
-from services.recorder.controller_run import read_controller_run
+from services.recorder.controller_import.controller_run import read_controller_run
 from shared.channels import SCHEMA_TYPES
 from shared.codec import json_schema
 from shared.trace import read_trace

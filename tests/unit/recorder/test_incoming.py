@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 
-from services.recorder.incoming import OTHER_STATION, classify
+from services.recorder.live.incoming import OTHER_STATION, classify
 from shared import channels
 from shared.codec import encode, to_dict
 from shared.messages import RunSummary, Sample, StickSlipEvent, ToolState

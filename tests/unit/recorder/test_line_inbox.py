@@ -7,9 +7,9 @@ import threading
 
 import zenoh
 
-from services.recorder.line_inbox import LineInbox, Message
-from services.recorder.testing import has_subscribers, wait_until
+from services.recorder.live.line_inbox import LineInbox, Message
 from shared import channels, keys
+from tests.live_recorder import has_subscribers, wait_until
 
 
 def blocking_publisher(session: zenoh.Session, key: str) -> zenoh.Publisher:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from services.recorder.recorder_health import RecorderHealth
+from services.recorder.live.recorder_health import RecorderHealth
 
 T0 = 1_700_000_000_000_000_000
 

@@ -20,15 +20,8 @@ from mcap.reader import make_reader
 from mcap.records import Schema
 from mcap.well_known import MessageEncoding
 
-from services.recorder.mcap_sink import RAW_ENCODING, RAW_REASON
+from services.recorder.mcap_files.mcap_sink import RAW_ENCODING, RAW_REASON
 from services.recorder.service import RecorderService
-from services.recorder.testing import (
-    RunningRecorder,
-    has_subscribers,
-    publish,
-    wait_until,
-    write_station_file,
-)
 from shared import channels, keys
 from shared.codec import encode, json_schema
 from shared.config import LoadedStation, load_station
@@ -41,6 +34,13 @@ from shared.messages import (
     ToolState,
 )
 from shared.zenoh_session import zenoh_config
+from tests.live_recorder import (
+    RunningRecorder,
+    has_subscribers,
+    publish,
+    wait_until,
+    write_station_file,
+)
 
 T0_NS = 1_700_000_000_000_000_000
 SAMPLES = 300

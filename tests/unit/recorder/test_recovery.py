@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from services.recorder.incoming import classify
-from services.recorder.mcap_sink import McapSink
-from services.recorder.recording_reader import RecordingScan
-from services.recorder.recovery import default_target, recover
+from services.recorder.live.incoming import classify
+from services.recorder.mcap_files.mcap_sink import McapSink
+from services.recorder.mcap_files.recording_reader import RecordingScan
+from services.recorder.mcap_files.recovery import default_target, recover
 from shared.codec import encode
 from shared.errors import InputError
 from shared.messages import Sample

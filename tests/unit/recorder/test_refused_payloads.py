@@ -20,12 +20,12 @@ import zenoh
 from mcap.reader import make_reader
 from test_recording import recorded_files  # type: ignore[import-not-found]
 
-from services.recorder.mcap_sink import RAW_ENCODING
-from services.recorder.testing import RunningRecorder, publish, wait_until
+from services.recorder.mcap_files.mcap_sink import RAW_ENCODING
 from shared import channels, keys
 from shared.codec import encode
 from shared.config import LoadedStation
 from shared.messages import RunSummary, Sample, StopDecision, ToolState
+from tests.live_recorder import RunningRecorder, publish, wait_until
 
 RUN = 7
 HOUR_NS = 3_600_000_000_000

@@ -8,9 +8,9 @@ from typing import Any
 
 from mcap.reader import make_reader
 
-from services.recorder.file_metadata import FileMetadata
-from services.recorder.incoming import classify
-from services.recorder.run_files import FileLimits, StationFiles, file_path
+from services.recorder.live.file_metadata import FileMetadata
+from services.recorder.live.incoming import classify
+from services.recorder.live.run_files import FileLimits, StationFiles, file_path
 from shared.codec import encode
 from shared.config import LoadedStation
 from shared.messages import BusStats, RunSummary, Sample, ToolState

@@ -8,13 +8,13 @@ from typing import Any
 import pytest
 
 from services.cli.main import main
-from services.recorder.file_metadata import flatten
-from services.recorder.incoming import classify
-from services.recorder.mcap_sink import McapSink
-from services.recorder.post_mortem_errors import prediction_errors
-from services.recorder.post_mortem_panels import plateau_bars
-from services.recorder.post_mortem_run import read_run
-from services.recorder.run_plot import build_figure
+from services.recorder.live.file_metadata import flatten
+from services.recorder.live.incoming import classify
+from services.recorder.mcap_files.mcap_sink import McapSink
+from services.recorder.post_mortem.post_mortem_errors import prediction_errors
+from services.recorder.post_mortem.post_mortem_panels import plateau_bars
+from services.recorder.post_mortem.post_mortem_run import read_run
+from services.recorder.post_mortem.run_plot import build_figure
 from shared.codec import encode
 from shared.config.joint import load_joint
 from shared.messages import Prediction, Sample, StickSlipEvent, StopDecision

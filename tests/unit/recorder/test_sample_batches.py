@@ -25,13 +25,13 @@ import pytest
 import zenoh
 from mcap.reader import make_reader
 
-from services.recorder.mcap_sink import RAW_ENCODING
-from services.recorder.testing import RunningRecorder, publish, wait_until, write_station_file
+from services.recorder.mcap_files.mcap_sink import RAW_ENCODING
 from shared import channels
 from shared.codec import encode
 from shared.config import LoadedStation, load_station
 from shared.messages import BusStats, RecorderStats, Sample, SampleBatch, ToolState
 from shared.queued_publisher import QueuedPublisher
+from tests.live_recorder import RunningRecorder, publish, wait_until, write_station_file
 
 RUN = 11
 SAMPLES = 400

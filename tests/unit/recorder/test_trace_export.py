@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from services.cli.main import main
-from services.recorder.incoming import classify
-from services.recorder.mcap_sink import McapSink
-from services.recorder.trace_export import export_trace
+from services.recorder.live.incoming import classify
+from services.recorder.mcap_files.mcap_sink import McapSink
+from services.recorder.mcap_files.trace_export import export_trace
 from shared.codec import encode
 from shared.errors import InputError
 from shared.messages import Sample

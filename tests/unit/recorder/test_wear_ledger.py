@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
-from services.recorder.wear_bound import CONTRACT_LIMITS as LIMITS
-from services.recorder.wear_ledger import WearLedger, ledger_path
+from services.recorder.wear.wear_bound import CONTRACT_LIMITS as LIMITS
+from services.recorder.wear.wear_ledger import WearLedger, ledger_path
 from shared.errors import InputError
 from shared.messages import RunSummary
 

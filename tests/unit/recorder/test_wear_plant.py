@@ -6,8 +6,8 @@ import json
 
 import pytest
 
-from services.recorder.wear_ledger import RunWear, ToolWear
-from services.recorder.wear_plant import WearReply, merge, parse_reply
+from services.recorder.wear.wear_ledger import RunWear, ToolWear
+from services.recorder.wear.wear_plant import WearReply, merge, parse_reply
 from shared.errors import InputError
 
 T0_NS = 1_700_000_000_000_000_000

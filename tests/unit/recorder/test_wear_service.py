@@ -9,16 +9,16 @@ import pytest
 import zenoh
 from mcap.reader import make_reader
 
-from services.recorder.testing import (
+from shared import channels, keys
+from shared.codec import encode
+from shared.config import LoadedStation, load_station
+from shared.messages import RunSummary, ToolState
+from tests.live_recorder import (
     RunningRecorder,
     has_subscribers,
     wait_until,
     write_station_file,
 )
-from shared import channels, keys
-from shared.codec import encode
-from shared.config import LoadedStation, load_station
-from shared.messages import RunSummary, ToolState
 
 T0_NS = 1_700_000_000_000_000_000
 S_NS = 1_000_000_000
@@ -91,9 +91,9 @@ def test_summaries_count_once_and_a_due_tool_raises_an_alert(
 
 def test_a_ledger_that_cannot_be_written_keeps_the_runs_until_it_can(tmp_path: Path) -> None:
     """A file where the ledger's folder should be: logged, nothing raised, counted later."""
-    from services.recorder.wear_bound import CONTRACT_LIMITS
-    from services.recorder.wear_ledger import WearLedger
-    from services.recorder.wear_watch import WearWatch
+    from services.recorder.wear.wear_bound import CONTRACT_LIMITS
+    from services.recorder.wear.wear_ledger import WearLedger
+    from services.recorder.wear.wear_watch import WearWatch
     from shared.codec import decode
 
     blocker = tmp_path / "recordings"

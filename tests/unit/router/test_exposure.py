@@ -8,8 +8,8 @@ import time
 
 import pytest
 
-from services.recorder.testing import free_port
 from services.router.service import exposure_warning
+from tests.live_recorder import free_port
 
 
 @pytest.mark.parametrize(

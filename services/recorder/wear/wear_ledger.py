@@ -36,8 +36,8 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from services.recorder.wear_bound import RefusedSummaryError, RunLimits, refusal
-from services.recorder.wear_ledger_file import (
+from services.recorder.wear.wear_bound import RefusedSummaryError, RunLimits, refusal
+from services.recorder.wear.wear_ledger_file import (
     BrokenLedgerError,
     create_ledger,
     file_problem,

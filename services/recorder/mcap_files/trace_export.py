@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from services.recorder.recording_reader import RecordingScan
+from services.recorder.mcap_files.recording_reader import RecordingScan
 from shared import channels
 from shared.errors import InputError
 from shared.run_clock import RunClock

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from datetime import UTC, datetime
 
-from services.recorder.wear_ledger import ToolWear
+from services.recorder.wear.wear_ledger import ToolWear
 
 HEADER = (
     "tool",

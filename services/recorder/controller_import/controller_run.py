@@ -9,8 +9,8 @@ run id, as in the dataset's labels), ``tool serial``, ``prg nr``, ``date``
 
 The controller's own result (each step's name, OK/NOK, nominal and actual
 values, the run's verdict, part and batch) is read too
-(:mod:`services.recorder.controller_steps`), and the clock is checked
-(:mod:`services.recorder.controller_timing`: representable, never going back).
+(:mod:`services.recorder.controller_import.controller_steps`), and the clock is checked
+(:mod:`services.recorder.controller_import.controller_timing`: representable, never going back).
 
 Anything unusable (a cut file, a wrong type, a missing field, a number that
 is not finite, a run id below 0, a clock that goes back) is one
@@ -26,14 +26,14 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from services.recorder.controller_steps import (
+from services.recorder.controller_import.controller_steps import (
     ControllerVerdict,
     read_step,
     read_verdict,
     text,
     torque_function,
 )
-from services.recorder.controller_timing import check_date, check_times
+from services.recorder.controller_import.controller_timing import check_date, check_times
 from shared.errors import InputError
 from shared.messages import ControllerResult, ControllerStep
 from shared.run_clock import RunClock

@@ -1,6 +1,8 @@
-"""Test helpers that ship with the recorder: station files on loopback, free ports.
+"""Test helpers around a live recorder: a recorder in a thread, station files on loopback,
+free ports, a publisher of runs, waiting for a condition.
 
-Used by the recorder's unit and system tests; nothing in the service imports it.
+Used by the recorder's, the predictor's and the system tests, the fuzz and the
+benchmarks; no product code imports it.
 """
 
 from __future__ import annotations
@@ -18,12 +20,9 @@ import zenoh
 from services.recorder.service import RecorderService
 from shared import keys
 from shared.codec import encode
-from shared.config import LoadedStation
+from shared.config import LoadedStation, toml_writer
 from shared.zenoh_session import open_session
-
-REPO_ROOT = Path(__file__).resolve().parents[2]
-REPO_STATION_FILE = REPO_ROOT / "config" / "station.toml"
-
+from tests.paths import STATION_FILE
 
 WAIT_S = 10.0  # upper bound on waits for zenoh; tests never assert on time
 
@@ -106,41 +105,12 @@ def write_station_file(
     ``can.dbc`` and ``station.joint`` point at the repository's files;
     ``recorder.folder`` is ``recordings``; ``recorder`` overrides recorder keys.
     """
-    with REPO_STATION_FILE.open("rb") as handle:
+    with STATION_FILE.open("rb") as handle:
         data = tomllib.load(handle)
-    base = REPO_STATION_FILE.parent
+    base = STATION_FILE.parent
     data["station"]["joint"] = str((base / data["station"]["joint"]).resolve())
     data["can"]["dbc"] = str((base / data["can"]["dbc"]).resolve())
     data["zenoh"] = {"mode": "peer", "connect": list(connect), "listen": list(listen)}
     data["recorder"] = {**data["recorder"], "folder": str(recordings), **(recorder or {})}
-    path.write_text(to_toml(data))
+    path.write_text(toml_writer.dumps(data))
     return path
-
-
-def to_toml(data: Mapping[str, Any]) -> str:
-    """TOML text of a dict of tables and arrays of tables holding plain values."""
-    lines: list[str] = []
-    for name, value in data.items():
-        if isinstance(value, Mapping):
-            lines.append(f"[{name}]")
-            lines.extend(f"{key} = {_value(item)}" for key, item in value.items())
-        elif isinstance(value, list) and value and isinstance(value[0], Mapping):
-            for table in value:
-                lines.append(f"[[{name}]]")
-                lines.extend(f"{key} = {_value(item)}" for key, item in table.items())
-        else:
-            lines.insert(0, f"{name} = {_value(value)}")
-        lines.append("")
-    return "\n".join(lines)
-
-
-def _value(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int | float):
-        return repr(value)
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(value, list):
-        return "[" + ", ".join(_value(item) for item in value) + "]"
-    raise TypeError(f"cannot write {value!r} as TOML")

@@ -19,7 +19,7 @@ came alone, and never earlier than the station's sample filed before them
 
 from __future__ import annotations
 
-from services.recorder.incoming import Received
+from services.recorder.live.incoming import Received
 from shared import channels
 from shared.codec import encode
 from shared.messages import SampleBatch
@@ -38,7 +38,7 @@ class BatchSamples:
         self._keys: dict[str, str] = {}
 
     def samples(self, received: Received) -> list[Received]:
-        """The samples of a batch :func:`~services.recorder.incoming.classify` took."""
+        """The samples of a batch :func:`~services.recorder.live.incoming.classify` took."""
         batch: SampleBatch = received.message
         samples = batch.samples
         if not samples:

@@ -34,8 +34,8 @@ from typing import BinaryIO
 from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 
-from services.recorder.incoming import Received
-from services.recorder.recording_reader import RecordingScan
+from services.recorder.live.incoming import Received
+from services.recorder.mcap_files.recording_reader import RecordingScan
 from shared import channels
 from shared.codec import json_schema
 from shared.errors import InputError

@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from services.recorder.post_mortem_errors import HORIZONS, PredictionError
-from services.recorder.post_mortem_run import ModelClock, RecordedRun
+from services.recorder.post_mortem.post_mortem_errors import HORIZONS, PredictionError
+from services.recorder.post_mortem.post_mortem_run import ModelClock, RecordedRun
 from shared.messages import StickSlipEvent, StopDecision
 from shared.model import JointModel
 from shared.model.slip_bounds import PAPER_PARTIAL_RELIEF

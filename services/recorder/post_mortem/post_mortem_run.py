@@ -25,8 +25,8 @@ from typing import Any
 
 from mcap.records import Message, Metadata
 
-from services.recorder.recording_reader import RecordingScan
-from services.recorder.trace_export import SAMPLE_SCHEMA
+from services.recorder.mcap_files.recording_reader import RecordingScan
+from services.recorder.mcap_files.trace_export import SAMPLE_SCHEMA
 from shared import channels
 from shared.codec import decode
 from shared.config.joint import JointConfig

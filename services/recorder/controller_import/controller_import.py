@@ -6,8 +6,8 @@ None, ``ToolState`` done), the controller's own result (``ControllerResult``
 on ``boltwatch/<st>/controller``) and, when given, what the predictor made of
 it (:class:`PredictorReplay`: events, intensities, the advisory decision
 after the sample that caused each, and the ``RunSummary`` at the end). They
-are written with the recorder's own :class:`~services.recorder.mcap_sink.McapSink`
-(and :class:`~services.recorder.rerun_sink.RerunSink`): same channels,
+are written with the recorder's own :class:`~services.recorder.mcap_files.mcap_sink.McapSink`
+(and :class:`~services.recorder.rerun_files.rerun_sink.RerunSink`): same channels,
 schemas, metadata records, folders and file names as a live recording, plus
 a ``controller`` metadata record with the controller's header.
 
@@ -17,7 +17,7 @@ timestamps and gaps unchanged; ``sequence`` is the sample's index in the
 run. A run is one file, whatever its times say (the live recorder's
 rotation bounds runs that never end; an imported run has its end).
 
-A run is written whole or not at all (:mod:`services.recorder.import_files`),
+A run is written whole or not at all (:mod:`services.recorder.controller_import.import_files`),
 and counted in the wear ledger (by (station, run): never twice) before its
 files get their real names, so a run in the folder is a run in the ledger.
 The recording is not written here: this package may not import the
@@ -41,9 +41,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from services.recorder.controller_run import ControllerRun
-from services.recorder.file_metadata import FileMetadata
-from services.recorder.import_files import (
+from services.recorder.controller_import.controller_run import ControllerRun
+from services.recorder.controller_import.import_files import (
     put_in_place,
     read_copy,
     remove_leftovers,
@@ -51,19 +50,20 @@ from services.recorder.import_files import (
     run_files,
     temporary_path,
 )
-from services.recorder.incoming import Received, classify
-from services.recorder.mcap_sink import McapSink
-from services.recorder.recorder import describe_os_error
-from services.recorder.run_files import file_path
-from services.recorder.wear_bound import CONTRACT_LIMITS, RunLimits
+from services.recorder.live.file_metadata import FileMetadata
+from services.recorder.live.incoming import Received, classify
+from services.recorder.live.recorder import describe_os_error
+from services.recorder.live.run_files import file_path
+from services.recorder.mcap_files.mcap_sink import McapSink
+from services.recorder.wear.wear_bound import CONTRACT_LIMITS, RunLimits
 from shared import channels, keys
 from shared.codec import encode
 from shared.errors import BoltwatchError, InputError
 from shared.messages import RunSummary, Sample, ToolState
 
 if TYPE_CHECKING:
-    from services.recorder.rerun_sink import RerunOptions, RerunSink
-    from services.recorder.wear_ledger import WearLedger
+    from services.recorder.rerun_files.rerun_sink import RerunOptions, RerunSink
+    from services.recorder.wear.wear_ledger import WearLedger
 
 STATION_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 DEFAULT_STATION = "cs351"
@@ -289,7 +289,7 @@ def _real_names(text: str, target: Path) -> str:
 
 def _open_rerun(run: ControllerRun, station: str, target: Path, options: RerunOptions) -> RerunSink:
     """The run's Rerun sink, writing the temporary ``.rrd`` beside ``target``."""
-    from services.recorder.rerun_sink import RerunSink
+    from services.recorder.rerun_files.rerun_sink import RerunSink
 
     temporary = temporary_path(target).with_suffix(".rrd")
     try:

@@ -38,10 +38,10 @@ from collections import Counter, deque
 from collections.abc import Callable
 from pathlib import Path
 
-from services.recorder.wear_bound import RefusedSummaryError, RunLimits, refusal
-from services.recorder.wear_ledger import ToolWear, WearLedger
-from services.recorder.wear_ledger_file import BrokenLedgerError
-from services.recorder.wear_waiting import load_waiting, save_waiting, waiting_path
+from services.recorder.wear.wear_bound import RefusedSummaryError, RunLimits, refusal
+from services.recorder.wear.wear_ledger import ToolWear, WearLedger
+from services.recorder.wear.wear_ledger_file import BrokenLedgerError
+from services.recorder.wear.wear_waiting import load_waiting, save_waiting, waiting_path
 from shared.errors import InputError
 from shared.messages import RunSummary, WearAlert
 

@@ -8,10 +8,10 @@ covers the samples since the previous report (about one second); a station
 that sent no samples has no lag (None), not zero.
 
 ``bad_payloads`` counts the payloads on a message key that the recorder
-refused (see :mod:`services.recorder.incoming`) and recorded raw.
+refused (see :mod:`services.recorder.live.incoming`) and recorded raw.
 
 Write health (``write_errors``, ``last_error``, ``recording``) is read from
-the :class:`~services.recorder.recorder.Recorder`'s ``write_errors``,
+the :class:`~services.recorder.live.recorder.Recorder`'s ``write_errors``,
 ``last_write_error`` and ``recording_ok`` attributes; until the Recorder
 has them (disk-fault handling lands separately) they read as healthy.
 

@@ -27,13 +27,13 @@ from collections import Counter
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from services.recorder.file_metadata import FileMetadata
-from services.recorder.incoming import Received
-from services.recorder.run_files import FileLimits, StationFiles
+from services.recorder.live.file_metadata import FileMetadata
+from services.recorder.live.incoming import Received
+from services.recorder.live.run_files import FileLimits, StationFiles
 from shared.log_limit import RateLimitedLog
 
 if TYPE_CHECKING:
-    from services.recorder.rerun_sink import RerunOptions
+    from services.recorder.rerun_files.rerun_sink import RerunOptions
 
 LOG = logging.getLogger(__name__)
 

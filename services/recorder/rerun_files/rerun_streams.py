@@ -28,7 +28,7 @@ from pathlib import Path
 
 import rerun as rr
 
-from services.recorder import rerun_blueprint as bp
+from services.recorder.rerun_files import rerun_blueprint as bp
 
 BLUEPRINT_FILE = "boltwatch.rbl"
 

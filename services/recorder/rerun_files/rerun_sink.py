@@ -2,7 +2,7 @@
 
 Each run file borrows one of its station's :class:`rerun.RecordingStream`
 (application ``boltwatch``, recording id ``<station>``; why streams are
-pooled: :mod:`services.recorder.rerun_streams`) and points it at its own
+pooled: :mod:`services.recorder.rerun_files.rerun_streams`) and points it at its own
 ``<same stem>.rrd``, with the layout once per folder in ``boltwatch.rbl``; with live viewing on it
 also streams to the process's gRPC server (:class:`RerunLive`). Samples are
 buffered in plain lists and sent with ``send_columns`` every
@@ -19,7 +19,7 @@ chunk costs about a kilobyte of schema on disk).
 MCAP is the record that matters: every Rerun call here is guarded. The first
 failure is logged with its traceback, the sink disables itself and the
 recorder goes on (:attr:`RerunSink.failed`). Entity paths and the layout are
-in :mod:`services.recorder.rerun_blueprint`.
+in :mod:`services.recorder.rerun_files.rerun_blueprint`.
 """
 
 from __future__ import annotations
@@ -34,9 +34,13 @@ from urllib.parse import quote
 import numpy as np
 import rerun as rr
 
-from services.recorder import rerun_blueprint as bp
-from services.recorder.incoming import Received
-from services.recorder.rerun_streams import borrow_stream, ensure_layout_file, return_stream
+from services.recorder.live.incoming import Received
+from services.recorder.rerun_files import rerun_blueprint as bp
+from services.recorder.rerun_files.rerun_streams import (
+    borrow_stream,
+    ensure_layout_file,
+    return_stream,
+)
 from shared import channels
 from shared.run_clock import RunClock
 

@@ -29,7 +29,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
-from services.recorder.wear_ledger import WORST_RUNS, RunWear, ToolWear
+from services.recorder.wear.wear_ledger import WORST_RUNS, RunWear, ToolWear
 from shared.errors import InputError
 
 

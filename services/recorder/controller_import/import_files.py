@@ -26,7 +26,7 @@ from pathlib import Path
 
 from mcap.records import Message, Metadata
 
-from services.recorder.recording_reader import RecordingScan
+from services.recorder.mcap_files.recording_reader import RecordingScan
 from shared import channels
 from shared.codec import decode
 from shared.errors import InputError

@@ -22,8 +22,8 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
-from services.recorder.recovery import remove_unfinished
-from services.recorder.rerun_blueprint import TORQUE
+from services.recorder.mcap_files.recovery import remove_unfinished
+from services.recorder.rerun_files.rerun_blueprint import TORQUE
 from shared.errors import InputError
 
 SAMPLES_ENTITY = f"/{TORQUE}"  # one row per recorded sample

@@ -18,7 +18,7 @@ With ``rerun`` options each run file (not the idle ones) has a companion
 file receives, is flushed and closed with it, and never stops the MCAP file.
 
 When the disk fails under a file (an :class:`OSError` out of any method),
-the owner (:class:`~services.recorder.recorder.Recorder`) calls
+the owner (:class:`~services.recorder.live.recorder.Recorder`) calls
 :meth:`StationFiles.abandon`; the next write opens a new part of the same run.
 """
 
@@ -32,13 +32,13 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from services.recorder.file_metadata import FileMetadata
-from services.recorder.incoming import Received
-from services.recorder.mcap_sink import McapSink
+from services.recorder.live.file_metadata import FileMetadata
+from services.recorder.live.incoming import Received
+from services.recorder.mcap_files.mcap_sink import McapSink
 from shared import channels
 
 if TYPE_CHECKING:  # rerun is imported only when .rrd files are wanted
-    from services.recorder.rerun_sink import RerunOptions, RerunSink
+    from services.recorder.rerun_files.rerun_sink import RerunOptions, RerunSink
 
 LOG = logging.getLogger(__name__)
 
@@ -253,7 +253,7 @@ class StationFiles:
 
     def _open_rerun(self, path: Path, run_id: int, now_ns: int, options: RerunOptions) -> None:
         try:
-            from services.recorder.rerun_sink import open_rerun_sink
+            from services.recorder.rerun_files.rerun_sink import open_rerun_sink
         except ImportError:
             LOG.exception("Rerun is unusable; recording MCAP only from now on")
             self._rerun = None

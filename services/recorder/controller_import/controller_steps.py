@@ -1,6 +1,6 @@
 """What a CS351 controller says of its own run: each step's result and values, the verdict.
 
-Read from the run's JSON (see :mod:`services.recorder.controller_run`) into
+Read from the run's JSON (see :mod:`services.recorder.controller_import.controller_run`) into
 :class:`~shared.messages.ControllerStep` values and the run-level fields of
 :class:`~shared.messages.ControllerResult`:
 

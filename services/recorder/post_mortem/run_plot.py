@@ -13,7 +13,7 @@ sample, the clock of ``Sample.time_ns``):
 With the joint (``joint`` metadata) and the motor speed (``program``) in the
 file, the analytical envelopes (Figure 10), bounds (eqs. 21-26) and K bands
 (eqs. 34-39) are drawn, at model time = run time + a shift anchored at the
-first plateau (:class:`~services.recorder.post_mortem_run.ModelClock`); the
+first plateau (:class:`~services.recorder.post_mortem.post_mortem_run.ModelClock`); the
 caption says so, and says when they are missing. matplotlib (Agg) is
 imported inside the functions: nothing at import time.
 """
@@ -23,8 +23,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from services.recorder.post_mortem_errors import prediction_errors
-from services.recorder.post_mortem_panels import (
+from services.recorder.post_mortem.post_mortem_errors import prediction_errors
+from services.recorder.post_mortem.post_mortem_panels import (
     Bounds,
     draw_constants,
     draw_error_panels,
@@ -32,7 +32,7 @@ from services.recorder.post_mortem_panels import (
     draw_force,
     draw_torque,
 )
-from services.recorder.post_mortem_run import RecordedRun, read_run
+from services.recorder.post_mortem.post_mortem_run import RecordedRun, read_run
 from shared.errors import naming
 
 if TYPE_CHECKING:

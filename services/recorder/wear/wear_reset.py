@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from services.recorder.wear_ledger import WearLedger
-from services.recorder.wear_ledger_file import (
+from services.recorder.wear.wear_ledger import WearLedger
+from services.recorder.wear.wear_ledger_file import (
     COMPANIONS,
     BrokenLedgerError,
     holder_pid,

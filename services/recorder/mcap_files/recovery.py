@@ -16,7 +16,7 @@ from pathlib import Path
 from mcap.records import Attachment, Channel, Header, Message, Metadata, Schema
 from mcap.writer import CompressionType, Writer
 
-from services.recorder.recording_reader import McapRecord, RecordingScan
+from services.recorder.mcap_files.recording_reader import McapRecord, RecordingScan
 from shared.errors import InputError, naming
 
 LOG = logging.getLogger(__name__)

@@ -1,0 +1,7 @@
+"""Rerun: an ``.rrd`` beside each run's MCAP, and the live view.
+
+- :mod:`.rerun_sink`: one run's Rerun recording, written in column batches
+- :mod:`.rerun_streams`: recording streams pooled per station (and why)
+- :mod:`.rerun_blueprint`: entity paths and the layout (``boltwatch.rbl``)
+- :mod:`.rrd_recovery`: a truncated ``.rrd`` made readable
+"""
