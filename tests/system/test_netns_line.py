@@ -197,7 +197,9 @@ def test_three_hosts_one_cut_off_for_ten_seconds(tmp_path: Path) -> None:
     # the line server sees no sample of the cut station while the others' go on
     # (any rate: the window takes in pauses between runs, and a loaded machine runs its
     # rigs slower; 93 samples/s was seen with three other suites beside it)
-    assert during_cut[f"st{CUT_STATION}"]["samples_per_s"] == 0.0, during_cut
+    # (not listed at all is nothing seen too: under load the recorder's once-a-second
+    # RecorderStats of the cut station can miss the 1.5 s window, and no token of it is left)
+    assert during_cut.get(f"st{CUT_STATION}", {}).get("samples_per_s", 0.0) == 0.0, during_cut
     for index in (1, 2):
         rate = during_cut[f"st{index}"]["samples_per_s"]
         assert isinstance(rate, float) and rate > 0.0, during_cut
