@@ -5,10 +5,11 @@ codecs, zenoh and CAN helpers, and the paper's analytical model.
 
 - :mod:`.config` (station, joint and line files), :mod:`.model` (the paper's
   analytical model), :mod:`.errors` (the exception tree)
-- contracts: :mod:`.messages` (payloads), :mod:`.keys` (zenoh key expressions),
-  :mod:`.message_fields` (every field's bounds), :mod:`.message_shape` (what a
-  decoder derives from a type), :mod:`.codec` (JSON and schemas), :mod:`.trace`
-  (the offline CSV)
+- contracts: :mod:`.channels` (every channel of a line: topic, message type,
+  schema name, QoS, publisher), :mod:`.messages` (payloads), :mod:`.keys` (zenoh
+  key expressions), :mod:`.message_fields` (every field's bounds),
+  :mod:`.codec` (JSON and schemas, pydantic), :mod:`.message_shape` (a refused
+  payload looked at field by field), :mod:`.trace` (the offline CSV)
 - CAN: :mod:`.can_bus` (open the bus), :mod:`.can_database` (the DBC, checked),
   :mod:`.sensor_range` (what the sensors can measure)
 - zenoh: :mod:`.zenoh_session` (sessions, the router link), :mod:`.queued_publisher`

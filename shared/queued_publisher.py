@@ -43,7 +43,6 @@ LOG = logging.getLogger(__name__)
 
 CAPACITY = 50_000
 
-
 _STOP = object()
 
 
