@@ -15,7 +15,9 @@ codecs, zenoh and CAN helpers, and the paper's analytical model.
 - zenoh: :mod:`.zenoh_session` (sessions, the router link), :mod:`.queued_publisher`
   (publish without waiting), :mod:`.sample_batching` (an edge station's samples in
   batches toward the line), :mod:`.receive_threads` (cheap callbacks)
-- a service's life: :mod:`.service_runtime` (start, signals, stop),
+- a service's life: :mod:`.service_skeleton` (its session, health tokens,
+  declarations and stop order in one ExitStack), :mod:`.service_runtime` (the
+  work thread, signals, exit status),
   :mod:`.supervisor_link` (stop when ``boltwatch up`` dies), :mod:`.realtime`
   (SCHED_FIFO for the stop path), :mod:`.logging_setup`, :mod:`.log_limit` (one
   line for a flood), :mod:`.folders` (make a folder or say why not)

@@ -21,7 +21,7 @@ from services.recorder.service import RecorderService
 from shared import keys
 from shared.codec import encode
 from shared.config import LoadedStation, toml_writer
-from shared.zenoh_session import open_session
+from shared.service_skeleton import ServiceSkeleton
 from tests.paths import STATION_FILE
 
 WAIT_S = 10.0  # upper bound on waits for zenoh; tests never assert on time
@@ -68,22 +68,23 @@ class RunningRecorder:
 
     def __init__(self, loaded: LoadedStation | Sequence[LoadedStation]) -> None:
         first = loaded if isinstance(loaded, LoadedStation) else loaded[0]
-        self.session = open_session(first.config.zenoh)
-        self.service = RecorderService(loaded, self.session)
+        self.skeleton = ServiceSkeleton("recorder")
+        self.session = self.skeleton.open_session(first.config.zenoh)
+        self.service = RecorderService(loaded, self.skeleton)
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self.service.work, args=(self.stop,))
         self.thread.start()
 
     def finish(self) -> None:
-        """Stop as on SIGTERM (stop flag + wake), then close; safe to call twice."""
+        """Stop as on SIGTERM (stop flag + wake), then the skeleton's stop; safe to call
+        twice."""
         if self.thread.is_alive():
             self.stop.set()
             self.service.wake()
             self.thread.join(WAIT_S)
             if self.thread.is_alive():
                 raise AssertionError("the recorder did not stop")
-        self.service.close()
-        self.session.close()
+        self.skeleton.close()
 
 
 def free_port() -> int:

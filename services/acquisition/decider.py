@@ -18,10 +18,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Protocol
 
-import zenoh
-
 from shared.config import LoadedStation
 from shared.messages import Sample, StopDecision, ToolState
+from shared.service_skeleton import ServiceSkeleton
 
 
 class Decider(Protocol):
@@ -35,11 +34,15 @@ class Decider(Protocol):
 
 
 class StationDecider(Decider, Protocol):
-    """A decider that lives as long as the acquisition's session (it holds a token)."""
+    """A decider that lives as long as the acquisition's session (its health token is
+    declared through the acquisition's skeleton)."""
 
-    def close(self) -> None: ...
+    def close(self) -> None:
+        """Stop what runs beside the CAN thread (the WORK stage of the acquisition's stop)."""
 
 
-#: (session, the station, a publish that never waits) -> the station's decider; the CLI
-#: passes the predictor's EdgePredictor (services never import each other)
-DeciderFactory = Callable[[zenoh.Session, LoadedStation, Callable[[object], None]], StationDecider]
+#: (the acquisition's skeleton, the station, a publish that never waits) -> the station's
+#: decider; the CLI passes the predictor's EdgePredictor (services never import each other)
+DeciderFactory = Callable[
+    [ServiceSkeleton, LoadedStation, Callable[[object], None]], StationDecider
+]

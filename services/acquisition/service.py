@@ -22,39 +22,39 @@ predictor's messages go through the station's queued publisher.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import logging
 import threading
 import time
+from collections.abc import Callable
 
 import zenoh
 
 from services.acquisition.acquisition import Acquisition
 from services.acquisition.decider import DeciderFactory
 from services.acquisition.zenoh_outlet import ZenohOutlet
-from shared import channels, keys
+from shared import channels
 from shared.can_bus import open_bus
 from shared.can_database import StationDatabase
 from shared.config import load_station
 from shared.errors import ConfigError
 from shared.queued_publisher import QueuedPublisher
 from shared.realtime import STOP_PATH_PRIORITY, use_realtime_priority
-from shared.service_runtime import ServiceRunner
-from shared.zenoh_session import open_session
+from shared.service_skeleton import ServiceSkeleton, Stop
 
 LOG = logging.getLogger(__name__)
 
 POLL_TIMEOUT_S = 0.05  # the stop flag is checked at least this often
 
 
-def subscribe_decisions(session: zenoh.Session, acquisition: Acquisition) -> zenoh.Subscriber[None]:
-    """``boltwatch/<st>/decision`` into :meth:`Acquisition.decision`, in zenoh's callback."""
+def decision_handler(acquisition: Acquisition) -> Callable[[zenoh.Sample], None]:
+    """The zenoh callback of ``boltwatch/<st>/decision``: into :meth:`Acquisition.decision`
+    (placement line: a decision on the line becomes a ``StopCommand``)."""
     key = channels.DECISION.key(acquisition.station_id)
 
     def on_decision(sample: zenoh.Sample) -> None:
         acquisition.decision(sample.payload.to_bytes(), key)
 
-    return session.declare_subscriber(key, on_decision)
+    return on_decision
 
 
 def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None) -> int:
@@ -67,17 +67,17 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
         )
     database = StationDatabase(station.dbc_path)
     station_id = station.station_id
-    with contextlib.ExitStack() as resources:
-        bus = resources.enter_context(open_bus(station.config.can))
-        session = resources.enter_context(open_session(station.config.zenoh))
+    with ServiceSkeleton("acquisition") as skeleton:
+        bus = skeleton.device(open_bus(station.config.can))
+        session = skeleton.open_session(station.config.zenoh)
         publisher = QueuedPublisher(session, station_id, batch_samples=edge)
-        resources.callback(publisher.close)
+        skeleton.on_stop(Stop.OUTPUT, publisher.close)
         outlet = ZenohOutlet(session, publisher)
-        resources.callback(outlet.close)
+        skeleton.on_stop(Stop.OUTPUT, outlet.close)  # the link first, then the queue's flush
         decider = None
         if edge and decider_factory is not None:
-            decider = decider_factory(session, station, publisher.publish)
-            resources.callback(decider.close)
+            decider = decider_factory(skeleton, station, publisher.publish)
+            skeleton.on_stop(Stop.WORK, decider.close)
         acquisition = Acquisition(
             station_id,
             station.config.station.has_force_sensor,
@@ -88,10 +88,8 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
             decider=decider,
         )
         if not edge:
-            decisions = subscribe_decisions(session, acquisition)
-            resources.callback(decisions.undeclare)
-        token = session.liveliness().declare_token(keys.health_key(station_id, "acquisition"))
-        resources.callback(token.undeclare)
+            skeleton.subscriber(channels.DECISION.key(station_id), decision_handler(acquisition))
+        skeleton.health_token(station_id, "acquisition")
         LOG.info(
             "acquisition of %s on %s:%s, decisions %s",
             station_id,
@@ -99,6 +97,12 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
             station.config.can.channel,
             "on this CAN thread (placement edge)" if edge else "from the line's predictor",
         )
+
+        def last_bus_stats() -> None:
+            outlet.bus_stats(acquisition.stats())
+            LOG.info("acquisition stopped: %s", acquisition.stats())
+
+        skeleton.on_stop(Stop.WORK, last_bus_stats)  # before the decider's close
 
         def work(stop: threading.Event) -> None:
             use_realtime_priority(STOP_PATH_PRIORITY, "acquisition CAN thread")
@@ -109,7 +113,4 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
                     outlet.bus_stats(acquisition.stats())
                     next_stats += args.stats_interval_s
 
-        status = ServiceRunner("acquisition", work).run()
-        outlet.bus_stats(acquisition.stats())
-        LOG.info("acquisition stopped: %s", acquisition.stats())
-    return status
+        return skeleton.run(work)

@@ -30,14 +30,12 @@ import threading
 import time
 from collections.abc import Callable
 
-import zenoh
-
 from services.predictor.served_station import ServedStation
 from services.predictor.station_refusal import refuse_stations_served_elsewhere
 from services.predictor.station_runs import StationRuns
-from shared import keys
 from shared.config import LoadedStation
 from shared.messages import Sample, StopDecision, ToolState
+from shared.service_skeleton import ServiceSkeleton
 
 LOG = logging.getLogger(__name__)
 
@@ -50,13 +48,12 @@ STATS_PERIOD_S = 1.0
 class EdgePredictor:
     """One station's runs, decided on the calling (CAN) thread."""
 
-    def __init__(self, session: zenoh.Session, station: LoadedStation, publish: Publish) -> None:
-        refuse_stations_served_elsewhere(session, [station.station_id])
+    def __init__(self, skeleton: ServiceSkeleton, station: LoadedStation, publish: Publish) -> None:
+        """``skeleton``: the acquisition's; the health token is declared through it."""
+        refuse_stations_served_elsewhere(skeleton.session, [station.station_id])
         self._runs = StationRuns(ServedStation(station))
         self._publish = publish
-        self._token = session.liveliness().declare_token(
-            keys.health_key(station.station_id, "predictor")
-        )
+        skeleton.health_token(station.station_id, "predictor")
         self._started_ns = time.time_ns()
         self._closed = threading.Event()
         self._stats = threading.Thread(
@@ -89,6 +86,6 @@ class EdgePredictor:
             self._publish(self._runs.counts.stats(time.time_ns(), self._started_ns))
 
     def close(self) -> None:
+        """Stop the stats thread (its token goes with the acquisition's, in its skeleton)."""
         self._closed.set()
         self._stats.join(timeout=5.0)
-        self._token.undeclare()

@@ -45,8 +45,7 @@ from shared.errors import InputError
 from shared.log_limit import RateLimitedLog
 from shared.messages import Intensity, Sample, StopDecision, ToolState
 from shared.receive_threads import use_one_receive_thread
-from shared.service_runtime import ServiceRunner
-from shared.zenoh_session import open_session
+from shared.service_skeleton import ServiceSkeleton, Stop
 
 LOG = logging.getLogger(__name__)
 
@@ -59,47 +58,34 @@ class PredictorService:
 
     def __init__(
         self,
-        session: zenoh.Session,
+        skeleton: ServiceSkeleton,
         stations: LoadedStation | Sequence[LoadedStation],
         inbox: InboxFactory = StationInbox,
     ) -> None:
+        """Declares through ``skeleton`` (its session, inbox, publishers, health tokens),
+        which undeclares them when it closes."""
         served = [stations] if isinstance(stations, LoadedStation) else list(stations)
-        self._session = session
+        self._skeleton = skeleton
+        self._session = skeleton.session
         self._stations = {
             station_id: ServedStation(station)
             for station_id, station in stations_by_id(served).items()
         }
-        refuse_stations_served_elsewhere(session, self._stations)
+        refuse_stations_served_elsewhere(self._session, self._stations)
         self._runs = {
             station_id: StationRuns(served) for station_id, served in self._stations.items()
         }
-        self._publishers: dict[tuple[str, str], Any] = {}
+        self._publishers: dict[tuple[str, str], zenoh.Publisher] = {}
         self.started_ns = time.time_ns()
         self._log_bad_payload = RateLimitedLog(LOG)
-        self._inbox: Inbox = inbox(session, list(self._stations), self.handle)
-        self._tokens = [
-            session.liveliness().declare_token(keys.health_key(station_id, "predictor"))
-            for station_id in self._stations
-        ]
+        self._inbox: Inbox = inbox(self._session, list(self._stations), self.handle)
+        skeleton.on_stop(Stop.INPUT, self._inbox.close)
+        for station_id in self._stations:
+            skeleton.health_token(station_id, "predictor")
 
     @property
     def station_ids(self) -> list[str]:
         return list(self._stations)
-
-    def close(self) -> None:
-        self._inbox.close()
-        for publisher in self._publishers.values():
-            publisher.undeclare()
-        self._publishers.clear()
-        for token in self._tokens:
-            token.undeclare()
-        self._tokens.clear()
-
-    def __enter__(self) -> PredictorService:
-        return self
-
-    def __exit__(self, *_exc: object) -> None:
-        self.close()
 
     def wake(self) -> None:
         """Unblock the worker's wait in :meth:`work`."""
@@ -174,7 +160,7 @@ class PredictorService:
     def _on_tool(self, runs: StationRuns, state: ToolState) -> None:
         summary = runs.on_tool(state)
         if summary is not None:
-            self._publish(state.station, channels.RUNS.topic, summary)
+            self._publish(state.station, channels.RUNS, summary)
 
     def _on_sample(self, runs: StationRuns, sample: Sample) -> None:
         for message in runs.on_sample(sample, time.time_ns()):
@@ -207,31 +193,21 @@ class PredictorService:
 
     def _send(self, station: str, message: Outgoing) -> None:
         if isinstance(message, StopDecision):
-            self._publish(station, channels.DECISION.topic, message)
+            self._publish(station, channels.DECISION, message)
             LOG.info(
                 "%s run %s: stop (%s) %s", station, message.run_id, message.reason, message.detail
             )
         elif isinstance(message, Intensity):
-            self._publish(station, channels.INTENSITY.topic, message)
+            self._publish(station, channels.INTENSITY, message)
         else:
-            self._publish(station, channels.EVENTS.topic, message)
+            self._publish(station, channels.EVENTS, message)
 
-    def _publish(self, station: str, topic: str, message: object) -> None:
-        publisher = self._publishers.get((station, topic))
-        if publisher is None:
-            if topic == channels.DECISION.topic:
-                publisher = self._session.declare_publisher(
-                    keys.station_key(station, topic),
-                    priority=zenoh.Priority.REAL_TIME,
-                    express=True,
-                    congestion_control=zenoh.CongestionControl.BLOCK,
-                )
-            else:  # BLOCK too: zenoh's default DROP lost events under load, silently
-                publisher = self._session.declare_publisher(
-                    keys.station_key(station, topic),
-                    congestion_control=zenoh.CongestionControl.BLOCK,
-                )
-            self._publishers[(station, topic)] = publisher
+    def _publish(self, station: str, channel: channels.Channel[Any], message: object) -> None:
+        publisher = self._publishers.get((station, channel.topic))
+        if publisher is None:  # the channel's options: decisions REAL_TIME and express;
+            # every channel BLOCK (zenoh's default DROP lost events under load, silently)
+            publisher = self._skeleton.publisher(channel, station)
+            self._publishers[(station, channel.topic)] = publisher
         publisher.put(codec.encode(message))
 
 
@@ -241,8 +217,7 @@ def main(args: argparse.Namespace) -> int:
     # (measured with bench_line_inbox.py, variant callback-rx1; figures in the README).
     use_one_receive_thread()
     stations = load_line(args.config)
-    with (
-        open_session(stations[0].config.zenoh) as session,
-        PredictorService(session, stations) as service,
-    ):
-        return ServiceRunner("predictor", service.work, service.wake).run()
+    with ServiceSkeleton("predictor") as skeleton:
+        skeleton.open_session(stations[0].config.zenoh)
+        service = PredictorService(skeleton, stations)
+        return skeleton.run(service.work, service.wake)

@@ -32,7 +32,6 @@ the MCAP recording: it is logged and the recorder goes on without it.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import logging
 import socket
@@ -59,8 +58,7 @@ from shared.config import LoadedStation, load_line
 from shared.errors import ConfigError
 from shared.message_fields import MAX_TEXT_CHARS
 from shared.messages import RecorderStats, WearAlert
-from shared.service_runtime import ServiceRunner
-from shared.zenoh_session import open_session
+from shared.service_skeleton import ServiceSkeleton, Stop
 
 if TYPE_CHECKING:
     from services.recorder.rerun_files.rerun_sink import RerunLive, RerunOptions
@@ -111,20 +109,22 @@ def served_stations(loaded: LoadedStation | Sequence[LoadedStation]) -> list[Loa
 
 
 class RecorderService:
-    """The recorder wired to one zenoh session (which the caller opens and closes)."""
+    """The recorder wired to the zenoh session of a :class:`ServiceSkeleton`."""
 
     def __init__(
         self,
         loaded: LoadedStation | Sequence[LoadedStation],
-        session: zenoh.Session,
+        skeleton: ServiceSkeleton,
         rerun_files: bool = True,
         rerun_live_url: str | None = None,
         view_only: bool = False,
     ) -> None:
-        """``view_only``: a live view beside the line's recorder (``--view-only``)."""
+        """``view_only``: a live view beside the line's recorder (``--view-only``). Its
+        subscriber, queryables and health tokens are declared through ``skeleton``, which
+        undeclares them when it closes."""
         stations = served_stations(loaded)
         first = stations[0]
-        self._session = session
+        session = self._session = skeleton.session
         self._tick_s = first.config.recorder.flush_interval_s / 2
         rerun = rerun_options(rerun_files, rerun_live_url)
         metadata = FileMetadata(stations)
@@ -146,17 +146,11 @@ class RecorderService:
                 StationLimits(stations).of,
             )
         self._inbox = LineInbox(session, [station_keys(station) for station in self.station_ids])
-        self._queryables = [
-            session.declare_queryable(
-                keys.station_key(station, keys.WEAR), self._wear_replier(station)
-            )
-            for station in ([] if view_only else self.station_ids)
-        ]
-        liveliness = session.liveliness()
-        role = VIEWER if view_only else "recorder"
-        self._tokens = [
-            liveliness.declare_token(keys.health_key(station, role)) for station in self.station_ids
-        ]
+        skeleton.on_stop(Stop.INPUT, self._inbox.close)
+        for station in [] if view_only else self.station_ids:
+            skeleton.queryable(keys.station_key(station, keys.WEAR), self._wear_replier(station))
+        for station in self.station_ids:
+            skeleton.health_token(station, VIEWER if view_only else "recorder")
         LOG.info(
             "recording %s into %s (its station files)",
             ", ".join(station_keys(station) for station in self.station_ids),
@@ -193,17 +187,6 @@ class RecorderService:
                 self.wear.close()
             closed = self.recorder.close()
             LOG.info("recorder stopped: %d messages, %d files", self.recorder.messages, len(closed))
-
-    def close(self) -> None:
-        """Undeclare the subscriber, queryables and health tokens; safe to call twice."""
-        self._inbox.close()
-        entities: list[zenoh.LivelinessToken | zenoh.Queryable[None]] = [
-            *self._tokens,
-            *self._queryables,
-        ]
-        for entity in entities:
-            with contextlib.suppress(zenoh.ZError):
-                entity.undeclare()
 
     def stats(self, now_ns: int) -> list[RecorderStats]:
         """RecorderStats of every station now (starts the next lag window)."""
@@ -355,22 +338,17 @@ def main(args: argparse.Namespace) -> int:
     loaded = load_line(args.config)  # serve recorder: one or more files, always a list
     served_stations(loaded)  # bad combinations fail before zenoh is opened
     loaded[0].make_recordings_folder()  # and a folder that can never be made
-    session = open_session(loaded[0].config.zenoh)
-    live = start_rerun_live(args)
-    try:
+    view_only = getattr(args, "view_only", False)
+    with ServiceSkeleton(VIEWER if view_only else "recorder") as skeleton:
+        skeleton.open_session(loaded[0].config.zenoh)
+        live = start_rerun_live(args)
+        if live is not None:
+            skeleton.on_stop(Stop.DEVICE, live.close)
         service = RecorderService(
             loaded,
-            session,
+            skeleton,
             rerun_files=not getattr(args, "no_rerun", False),
             rerun_live_url=live.url if live is not None else None,
-            view_only=getattr(args, "view_only", False),
+            view_only=view_only,
         )
-        try:
-            name = VIEWER if service.view_only else "recorder"
-            return ServiceRunner(name, service.work, service.wake).run()
-        finally:
-            service.close()
-    finally:
-        session.close()
-        if live is not None:
-            live.close()
+        return skeleton.run(service.work, service.wake)

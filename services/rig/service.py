@@ -1,8 +1,8 @@
 """``boltwatch serve rig``: the simulated tool controller and sensors on the station's CAN bus.
 
 Loads the station file once, opens the configured bus (closed on exit) and
-runs :class:`~services.rig.realtime.RealtimeRig` in a
-:class:`~shared.service_runtime.ServiceRunner` worker: ``--runs N`` exits 0
+runs :class:`~services.rig.realtime.RealtimeRig` in the work thread of its
+:class:`~shared.service_skeleton.ServiceSkeleton`: ``--runs N`` exits 0
 after N runs, otherwise it runs until SIGINT/SIGTERM (the loop looks at the
 stop flag every sample period, so no wake is needed).
 
@@ -16,7 +16,6 @@ reach the rig, so it announces nothing (and needs no zenoh: unit tests).
 from __future__ import annotations
 
 import argparse
-import contextlib
 import logging
 import threading
 import time
@@ -24,15 +23,13 @@ import time
 from services.rig.frames import RigFrames
 from services.rig.realtime import RealtimeRig, ToolIdentity
 from services.rig.selection import choose_program, choose_seed
-from shared import keys
 from shared.can_bus import open_bus
 from shared.can_database import StationDatabase
 from shared.config import load_station
 from shared.errors import ConfigError
 from shared.model.stiffness import JointConstants
 from shared.realtime import RIG_PRIORITY, use_realtime_priority
-from shared.service_runtime import ServiceRunner
-from shared.zenoh_session import open_session
+from shared.service_skeleton import ServiceSkeleton
 
 LOG = logging.getLogger(__name__)
 
@@ -61,12 +58,11 @@ def main(args: argparse.Namespace) -> int:
         seed,
         args.runs if args.runs is not None else "until stopped",
     )
-    with contextlib.ExitStack() as resources:
-        bus = resources.enter_context(open_bus(config.can))
+    with ServiceSkeleton("rig") as skeleton:
+        bus = skeleton.device(open_bus(config.can))
         if config.can.interface != "virtual":
-            session = resources.enter_context(open_session(config.zenoh))
-            token = session.liveliness().declare_token(keys.health_key(config.station.id, "rig"))
-            resources.callback(token.undeclare)
+            skeleton.open_session(config.zenoh)
+            skeleton.health_token(config.station.id, "rig")
         rig = RealtimeRig(
             bus,
             frames,
@@ -80,4 +76,4 @@ def main(args: argparse.Namespace) -> int:
             use_realtime_priority(RIG_PRIORITY, "rig")
             rig.run_many(program, first_run_id, seed, stop, runs=args.runs)
 
-        return ServiceRunner("rig", work).run()
+        return skeleton.run(work)

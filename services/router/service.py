@@ -28,8 +28,8 @@ from pathlib import Path
 import zenoh
 
 from shared.errors import ConfigError
-from shared.service_runtime import ServiceRunner
-from shared.zenoh_session import TlsFiles, open_from, zenoh_config, zenoh_reason
+from shared.service_skeleton import ServiceSkeleton
+from shared.zenoh_session import TlsFiles, zenoh_config, zenoh_reason
 
 LOG = logging.getLogger(__name__)
 
@@ -117,7 +117,8 @@ def _insert_access_control(config: zenoh.Config, path: Path) -> None:
 def main(args: argparse.Namespace) -> int:
     config = router_config(args)
     endpoints = args.listen or [DEFAULT_LISTEN]
-    with open_from(config):
+    with ServiceSkeleton("router") as skeleton:
+        skeleton.open_session_from(config)
         LOG.info("zenoh router listening on %s", ", ".join(endpoints))
         if peers := getattr(args, "connect", None):
             LOG.info("meshed with the routers of other lines at %s", ", ".join(peers))
@@ -128,6 +129,6 @@ def main(args: argparse.Namespace) -> int:
             LOG.info("access control from %s", args.access_control)
 
         def work(stop: threading.Event) -> None:
-            stop.wait()
+            stop.wait()  # the session routes on zenoh's threads
 
-        return ServiceRunner("router", work).run()
+        return skeleton.run(work)

@@ -64,8 +64,8 @@ from shared import channels, keys  # noqa: E402
 from shared.codec import decode  # noqa: E402
 from shared.config import derive_stations, load_line  # noqa: E402
 from shared.messages import RunSummary  # noqa: E402
-from shared.service_runtime import ServiceRunner  # noqa: E402
-from shared.zenoh_session import open_session, zenoh_config  # noqa: E402
+from shared.service_skeleton import ServiceSkeleton  # noqa: E402
+from shared.zenoh_session import zenoh_config  # noqa: E402
 from tests.benchmarks.bench_line import cpu_s, wait_alive  # noqa: E402
 from tests.benchmarks.line_station_runs import SHORT_PROGRAM  # noqa: E402
 from tests.system.station_files import free_tcp_port, serve, write_station  # noqa: E402
@@ -182,11 +182,10 @@ def consume(variant: str, files: list[str]) -> int:
     if variant in RUNTIMES:  # read when zenoh's runtime starts: before the first session
         os.environ["ZENOH_RUNTIME"] = RUNTIMES[variant]
     stations = load_line([Path(f) for f in files])
-    with (
-        open_session(stations[0].config.zenoh) as session,
-        PredictorService(session, stations, inbox=VARIANTS[variant]) as service,
-    ):
-        return ServiceRunner("predictor", service.work, service.wake).run()
+    with ServiceSkeleton("predictor") as skeleton:
+        skeleton.open_session(stations[0].config.zenoh)
+        service = PredictorService(skeleton, stations, inbox=VARIANTS[variant])
+        return skeleton.run(service.work, service.wake)
 
 
 def one_run(

@@ -8,7 +8,7 @@ number of payloads it has refused (``refused()``), whether it is alive, and
 (raises AssertionError when not).
 
 - :class:`AcquisitionTarget`: :class:`Acquisition` on a python-can
-  ``virtual`` bus, its decision subscriber (``subscribe_decisions``); a good
+  ``virtual`` bus, its decision subscriber (``decision_handler``); a good
   decision must become a ``StopCommand`` frame on the bus;
 - :class:`PredictorTarget`: :class:`PredictorService` for station pt1; a
   good run must be decided;
@@ -33,7 +33,7 @@ import zenoh
 from mcap.reader import make_reader
 
 from services.acquisition.acquisition import Acquisition
-from services.acquisition.service import subscribe_decisions
+from services.acquisition.service import decision_handler
 from services.predictor.service import PredictorService
 from services.recorder.mcap_files.mcap_sink import RAW_ENCODING
 from shared import channels, keys
@@ -42,6 +42,7 @@ from shared.channels import CHANNELS
 from shared.codec import decode, encode
 from shared.config import load_line, load_station
 from shared.messages import BusStats, Sample, StopDecision, ToolState
+from shared.service_skeleton import ServiceSkeleton
 from shared.zenoh_session import zenoh_config
 from tests.fuzz.payloads import template
 from tests.live_recorder import (
@@ -147,7 +148,9 @@ class AcquisitionTarget(_Target):
         self.database = StationDatabase(DBC_FILE)
         self.outlet = _Outlet()
         self.acquisition = Acquisition(self.station, True, self.bus, self.database, self.outlet)
-        self.subscriber = subscribe_decisions(self.served, self.acquisition)
+        self.subscriber = self.served.declare_subscriber(
+            channels.DECISION.key(self.station), decision_handler(self.acquisition)
+        )
         self._stop = threading.Event()
         self._loop = threading.Thread(target=self._poll, daemon=True)
         self._loop.start()
@@ -210,7 +213,8 @@ class PredictorTarget(_Target):
         super().__init__()
         path = folder / "pt1.toml"
         path.write_text(station_text(folder, "pt1", PROGRAM_OF["pt1"], self.endpoint))
-        self.service = PredictorService(self.served, load_line([path]))
+        self.skeleton = ServiceSkeleton("predictor", self.served)
+        self.service = PredictorService(self.skeleton, load_line([path]))
         self._stop = threading.Event()
         self._worker = threading.Thread(target=self.service.work, args=(self._stop,), daemon=True)
         self._worker.start()
@@ -254,7 +258,7 @@ class PredictorTarget(_Target):
         self._stop.set()
         self.service.wake()
         self._worker.join(5.0)
-        self.service.close()
+        self.skeleton.close()  # the service's declarations, then the served session
         super().close()
 
 

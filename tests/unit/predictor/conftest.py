@@ -11,6 +11,7 @@ import zenoh
 
 from services.predictor.service import PredictorService
 from shared.config import LoadedStation, load_line
+from shared.service_skeleton import ServiceSkeleton
 from shared.zenoh_session import zenoh_config
 from tests.live_recorder import free_port
 from tests.unit.predictor.live_predictor import PROGRAM_OF, station_text
@@ -33,9 +34,10 @@ def stations(tmp_path: Path, endpoint: str) -> list[LoadedStation]:
 
 @pytest.fixture
 def service(stations: list[LoadedStation]) -> Iterator[PredictorService]:
-    session = zenoh.open(zenoh_config("peer", listen=stations[0].config.zenoh.listen))
+    skeleton = ServiceSkeleton("predictor")
+    skeleton.own_session(zenoh.open(zenoh_config("peer", listen=stations[0].config.zenoh.listen)))
     stop = threading.Event()
-    predictor = PredictorService(session, stations)
+    predictor = PredictorService(skeleton, stations)
     worker = threading.Thread(target=predictor.work, args=(stop,), daemon=True)
     worker.start()
     try:
@@ -44,6 +46,5 @@ def service(stations: list[LoadedStation]) -> Iterator[PredictorService]:
         stop.set()
         predictor.wake()
         worker.join(5.0)
-        predictor.close()
-        session.close()
+        skeleton.close()
     assert not worker.is_alive()

@@ -23,6 +23,7 @@ from shared.messages import (
     StickSlipEvent,
     StopDecision,
 )
+from shared.service_skeleton import ServiceSkeleton
 from shared.zenoh_session import zenoh_config
 from tests.unit.predictor.live_predictor import (
     PROGRAM_OF,
@@ -129,7 +130,7 @@ def test_a_second_predictor_for_a_served_station_is_refused(
     with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
         wait_for_token(session, keys.health_key("pt2", "predictor"))
         with pytest.raises(ConfigError, match="pt2 already have a predictor"):
-            PredictorService(session, stations[1])
+            PredictorService(ServiceSkeleton("predictor", session), stations[1])
 
 
 def test_a_run_whose_end_never_arrived_is_forgotten_when_the_next_starts(

@@ -33,6 +33,7 @@ from shared.messages import (
     StopDecision,
     ToolState,
 )
+from shared.service_skeleton import ServiceSkeleton
 from shared.zenoh_session import zenoh_config
 from tests.live_recorder import (
     RunningRecorder,
@@ -229,10 +230,10 @@ def test_one_recorder_serves_several_station_files(
     text = st2_file.read_text().replace('id = "st1"', 'id = "st2"')
     st2_file.write_text(text.replace("tool_id = 7", "tool_id = 8"))
     st2 = load_station(st2_file)
-    session = zenoh.open(zenoh_config("peer", listen=[endpoint]))
-    service = RecorderService([st1, st2], session, rerun_files=False)
+    skeleton = ServiceSkeleton("recorder", zenoh.open(zenoh_config("peer", listen=[endpoint])))
+    service = RecorderService([st1, st2], skeleton, rerun_files=False)
     stats: list[dict[str, Any]] = []
-    with serving(service, session), zenoh.open(zenoh_config("peer", connect=[endpoint])) as client:
+    with serving(service, skeleton), zenoh.open(zenoh_config("peer", connect=[endpoint])) as client:
         watcher = client.declare_subscriber(
             channels.RECORDER.key("*"),
             lambda sample: stats.append(json.loads(sample.payload.to_bytes())),
@@ -294,8 +295,9 @@ def at_station(message: Any, station: str, tool_id: int) -> Any:
 
 
 @contextlib.contextmanager
-def serving(service: RecorderService, session: zenoh.Session) -> Iterator[RecorderService]:
-    """The service's worker running; on exit it is stopped, closed, and its session too."""
+def serving(service: RecorderService, skeleton: ServiceSkeleton) -> Iterator[RecorderService]:
+    """The service's worker running; on exit it is stopped, then its skeleton (its
+    declarations, then its session)."""
     stop = threading.Event()
     worker = threading.Thread(target=service.work, args=(stop,))
     worker.start()
@@ -305,8 +307,7 @@ def serving(service: RecorderService, session: zenoh.Session) -> Iterator[Record
         stop.set()
         service.wake()
         worker.join(10)
-        service.close()
-        session.close()
+        skeleton.close()
 
 
 def test_a_view_only_recorder_takes_none_of_the_line_recorders_duties(
@@ -317,10 +318,10 @@ def test_a_view_only_recorder_takes_none_of_the_line_recorders_duties(
     line's recorder; it still records what it hears (into its own folder)."""
     recordings = tmp_path / "viewer"
     st1 = load_station(write_station_file(tmp_path / "st1.toml", recordings, listen=[endpoint]))
-    session = zenoh.open(zenoh_config("peer", listen=[endpoint]))
-    service = RecorderService(st1, session, rerun_files=False, view_only=True)
+    skeleton = ServiceSkeleton("viewer", zenoh.open(zenoh_config("peer", listen=[endpoint])))
+    service = RecorderService(st1, skeleton, rerun_files=False, view_only=True)
     stats: list[bytes] = []
-    with serving(service, session), zenoh.open(zenoh_config("peer", connect=[endpoint])) as client:
+    with serving(service, skeleton), zenoh.open(zenoh_config("peer", connect=[endpoint])) as client:
         watcher = client.declare_subscriber(
             channels.RECORDER.key("*"), lambda sample: stats.append(b"")
         )
