@@ -75,9 +75,11 @@ def test_a_station_twice_is_an_error_naming_both_files(tmp_path: Path) -> None:
 
 
 def test_different_zenoh_sections_are_an_error_naming_both_files(tmp_path: Path) -> None:
-    first = write_station(tmp_path)
-    (tmp_path / "b").mkdir()
-    second = write_station(tmp_path / "b", replacements={'id = "st1"': 'id = "st2"'})
+    first = write_station(tmp_path, zenoh_port=7001)
+    (tmp_path / "b").mkdir()  # another router: two free ports drawn apart may be the same one
+    second = write_station(
+        tmp_path / "b", zenoh_port=7002, replacements={'id = "st1"': 'id = "st2"'}
+    )
     with pytest.raises(ConfigError, match="zenoh: the sections differ") as err:
         load_line([first, second])
     assert str(first) in str(err.value) and str(second) in str(err.value)
