@@ -8,7 +8,8 @@ codecs, zenoh and CAN helpers, and the paper's analytical model.
 - contracts: :mod:`.messages` (payloads), :mod:`.keys` (zenoh key expressions),
   :mod:`.message_fields` (every field's bounds), :mod:`.message_shape` (what a
   decoder derives from a type), :mod:`.codec` (JSON and schemas), :mod:`.trace`
-  (the offline CSV)
+  (the offline CSV), :mod:`.channels` (every channel: topic, message, publisher),
+  :mod:`.tightening_judgement` (a run's figures against its windows: OK/NOK)
 - CAN: :mod:`.can_bus` (open the bus), :mod:`.can_database` (the DBC, checked),
   :mod:`.sensor_range` (what the sensors can measure)
 - zenoh: :mod:`.zenoh_session` (sessions, the router link), :mod:`.queued_publisher`

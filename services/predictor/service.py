@@ -8,8 +8,8 @@ zenoh callback, one at a time (:mod:`services.predictor.station_inbox`).
 Each run is predicted with its own station's programs, force sensor, joint
 constants and ``[predictor]`` section. Out, per station: ``events`` and ``intensity``
 per stick-slip event, ``decision`` (REAL_TIME priority, express, blocking
-congestion control: a stop must never be dropped), ``runs`` per run. One
-liveliness token ``boltwatch/<st>/health/predictor`` per served station; a
+congestion control: a stop must never be dropped), ``results`` and ``runs`` per
+run. One liveliness token ``boltwatch/<st>/health/predictor`` per served station; a
 station that already has a predictor on the line is refused at start-up, so
 two predictors never both decide for one station.
 
@@ -172,9 +172,8 @@ class PredictorService:
         return False
 
     def _on_tool(self, runs: StationRuns, state: ToolState) -> None:
-        summary = runs.on_tool(state)
-        if summary is not None:
-            self._publish(state.station, channels.RUNS.topic, summary)
+        for message in runs.on_tool(state):  # a run's result and summary when it ended
+            self._publish(state.station, channels.of_message(message).topic, message)
 
     def _on_sample(self, runs: StationRuns, sample: Sample) -> None:
         for message in runs.on_sample(sample, time.time_ns()):
