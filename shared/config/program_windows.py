@@ -55,13 +55,19 @@ class ProgramWindows(StrictModel):
                     f"{low_key} {low:g} {unit} is not below {high_key} {high:g} {unit}: "
                     "no run could be OK"
                 )
-            limit = getattr(self, limit_key, None)
+        return self
+
+    def windows_past_limits(self) -> str | None:
+        """A minimum at or above its hard limit (``max_torque_nm``, ...), or None; the
+        program's validator asks, after its own limits are checked."""
+        for _, low_key, _, limit_key, unit in WINDOWS:
+            low, limit = getattr(self, low_key), getattr(self, limit_key, None)
             if low is not None and limit is not None and low >= limit:
-                raise ValueError(
+                return (
                     f"{low_key} {low:g} {unit} is not below the hard limit {limit_key} "
                     f"{limit:g} {unit}: the tool stops before it, every run would be NOK"
                 )
-        return self
+        return None
 
     def window(self, figure: str) -> tuple[float | None, float | None]:
         """(minimum, maximum) of ``figure`` ("torque", "angle", "force"); None: no bound."""

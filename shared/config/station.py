@@ -167,6 +167,9 @@ class Program(ProgramWindows):
                 f"start_force_n {self.start_force_n:g} N is not below target_force_n "
                 f"{self.target_force_n:g} N: the run would start past its target"
             )
+        past = self.windows_past_limits()
+        if past is not None:
+            raise ValueError(past)
         return self
 
     def limits_beyond(self, sensor_range: SensorRange) -> str | None:

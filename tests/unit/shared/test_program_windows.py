@@ -12,11 +12,12 @@ from shared.errors import ConfigError
 from tests.paths import CONFIG, STATION_FILE
 
 PROGRAM_1 = "max_time_s = 6.0\n"
+SHIPPED_WINDOW = r"^(torque|angle|force)_(min|max)_(nm|deg|n) = .*\n"
 
 
 def station_with(tmp_path: Path, program_1_keys: str, old: str = "", new: str = "") -> Path:
-    """The shipped station file, absolute paths, ``program_1_keys`` added to program 1."""
-    text = STATION_FILE.read_text()
+    """The shipped station file, absolute paths, its windows replaced by ``program_1_keys``."""
+    text = re.sub(SHIPPED_WINDOW, "", STATION_FILE.read_text(), flags=re.MULTILINE)
     text = text.replace('"joints/', f'"{CONFIG}/joints/').replace('"can/', f'"{CONFIG}/can/')
     assert PROGRAM_1 in text
     text = text.replace(PROGRAM_1, PROGRAM_1 + program_1_keys, 1)
@@ -26,6 +27,14 @@ def station_with(tmp_path: Path, program_1_keys: str, old: str = "", new: str = 
     path = tmp_path / "station.toml"
     path.write_text(text)
     return path
+
+
+def test_the_shipped_station_judges_program_1_and_not_program_2() -> None:
+    config = load_station(STATION_FILE).config
+    assert config.program(1).window("force") == (53000.0, 59000.0)
+    assert config.program(1).window("torque") == (180.0, 240.0)
+    assert config.program(1).window("angle") == (35.0, 65.0)
+    assert config.program(2).window("force") == (None, None)
 
 
 def test_windows_are_read_each_bound_optional(tmp_path: Path) -> None:
