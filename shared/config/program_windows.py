@@ -48,7 +48,7 @@ class ProgramWindows(StrictModel):
 
     @model_validator(mode="after")
     def _windows_are_open(self) -> ProgramWindows:
-        for _, low_key, high_key, limit_key, unit in WINDOWS:
+        for _, low_key, high_key, _, unit in WINDOWS:
             low, high = getattr(self, low_key), getattr(self, high_key)
             if low is not None and high is not None and low >= high:
                 raise ValueError(
