@@ -23,6 +23,8 @@ topic              publisher             message, when
 ``intensity``      predictor             :class:`Intensity`, one per event
 ``decision``       predictor             :class:`StopDecision`, at most one per run
 ``runs``           predictor             :class:`RunSummary`, one per run
+``results``        predictor (import,    :class:`TighteningResult`, one per run, just
+                   a bridge)             before its summary: OK/NOK against the windows
 ``predictor``      predictor             :class:`PredictorStats`, once a second
 ``recorder``       recorder              :class:`RecorderStats`, once a second
 ``wear/alert``     recorder              :class:`WearAlert`, when a tool is due
@@ -63,6 +65,7 @@ from shared.messages import (
     SampleBatch,
     StickSlipEvent,
     StopDecision,
+    TighteningResult,
     ToolState,
     WearAlert,
 )
@@ -125,6 +128,7 @@ DECISION = Channel(
     "decision", StopDecision, "predictor", Qos(priority=zenoh.Priority.REAL_TIME, express=True)
 )
 RUNS = Channel("runs", RunSummary, "predictor")
+RESULTS = Channel("results", TighteningResult, "predictor")
 PREDICTOR = Channel("predictor", PredictorStats, "predictor")
 RECORDER = Channel("recorder", RecorderStats, "recorder")
 WEAR_ALERT = Channel("wear/alert", WearAlert, "recorder")
@@ -140,6 +144,7 @@ CHANNELS: tuple[Channel[Any], ...] = (
     INTENSITY,
     DECISION,
     RUNS,
+    RESULTS,
     PREDICTOR,
     RECORDER,
     WEAR_ALERT,

@@ -2,7 +2,7 @@
 
 :class:`MessageShape` holds, per field, the Python types ``json.loads`` may
 give for it, its enum values, its bounds (:mod:`shared.message_fields`) and,
-for a list of nested messages, the shape of the items. :meth:`~MessageShape.checked`
+for a nested message (or a list of them), its shape. :meth:`~MessageShape.checked`
 checks a list of field values field by field, converts what JSON Schema
 allows (``1.0`` for an integer, ``1`` for a number) and raises
 :class:`~shared.errors.InputError` naming the first field that is wrong;
@@ -84,7 +84,8 @@ class MessageShape(Generic[MessageT]):
         self.numbers: dict[int, NumberRange] = {}
         self.texts: dict[int, TextRange] = {}
         self.enums: dict[int, frozenset[Any]] = {}
-        self.nested: dict[int, MessageShape[Any]] = {}
+        self.nested: dict[int, MessageShape[Any]] = {}  # a list of nested messages
+        self.nested_one: dict[int, MessageShape[Any]] = {}  # one nested message
         for index, name in enumerate(self.names):
             self._derive(index, hints[name], narrower.get(name))
 
@@ -97,12 +98,8 @@ class MessageShape(Generic[MessageT]):
                 values = typing.get_args(base)
                 allowed.update(type(value) for value in values)
                 self.enums[index] = self.enums.get(index, frozenset()) | frozenset(values)
-            elif origin is list:
-                (item,) = typing.get_args(base)
-                if not dataclasses.is_dataclass(item):
-                    raise TypeError(f"no decoder for a list of {item!r}")
-                allowed.add(list)
-                self.nested[index] = MessageShape(typing.cast(type, item))
+            elif origin is list or dataclasses.is_dataclass(base):
+                allowed.add(self._derive_nested(index, base))
             elif base is type(None):
                 allowed.add(type(None))
             elif base in (int, float):
@@ -126,6 +123,17 @@ class MessageShape(Generic[MessageT]):
             if type(None) in allowed:
                 self.enums[index] |= {None}
         self.allowed.append(frozenset(allowed))
+
+    def _derive_nested(self, index: int, base: Any) -> type:
+        """A list of nested messages (its JSON type: list) or one nested message (dict)."""
+        if typing.get_origin(base) is list:
+            (item,) = typing.get_args(base)
+            if not dataclasses.is_dataclass(item):
+                raise TypeError(f"no decoder for a list of {item!r}")
+            self.nested[index] = MessageShape(typing.cast(type, item))
+            return list
+        self.nested_one[index] = MessageShape(typing.cast(type, base))
+        return dict
 
     def error(self, text: str) -> InputError:
         return InputError(f"not a valid {self.type_name} message: {text}")
@@ -171,6 +179,12 @@ class MessageShape(Generic[MessageT]):
         text = self.texts.get(index)
         if text is not None and type(value) is str:
             self._check_text(index, value, text)
+        one_shape = self.nested_one.get(index)
+        if one_shape is not None:
+            try:
+                return one_shape.from_data(value)
+            except InputError as err:
+                raise self.error(f"{self.names[index]}: {err}") from None
         item_shape = self.nested.get(index)
         if item_shape is not None:
             try:

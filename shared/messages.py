@@ -243,6 +243,8 @@ class RunSummary:
     # the predictor's decision when it did not stop the tool (it came after the tool had
     # stopped, or its StopCommand never went out): a late decision, not the stop reason
     late_decision: StopReasonName | None = None
+    # the angle of the run's last measured sample (deg since the run started); None: unknown
+    reached_angle_deg: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -364,3 +366,73 @@ class WearAlert:
     threshold: float
     runs_since_service: Count
     last_service_ns: TimeNs | None
+
+
+#: where a figure ended against its window; ``not_judged``: no window, or no value
+FigureStatus = Literal["low", "ok", "high", "not_judged"]
+#: the run's verdict, as every tightening system of a plant says it
+Verdict = Literal["OK", "NOK"]
+#: a step's status as its controller gave it; ``not_judged``: it gave none
+StepStatus = Literal["OK", "NOK", "not_judged"]
+#: who made a result: the live predictor (``RunSummary`` + the program's windows), a
+#: controller on the line (its own result, live), ``boltwatch import`` (a controller's file)
+ResultSource = Literal["predictor", "controller", "import"]
+
+
+@dataclass(frozen=True, slots=True)
+class JudgedFigure:
+    """A run's final figure (torque, angle or preload), its window and where it ended."""
+
+    __pydantic_config__ = WIRE_CONFIG
+
+    value: float | None  # None: not measured
+    min: float | None  # the window's bounds; None: no bound on that side
+    max: float | None
+    status: FigureStatus
+
+
+@dataclass(frozen=True, slots=True)
+class ResultStep:
+    """One step of a controller's program in a result: what ended it, and its status."""
+
+    __pydantic_config__ = WIRE_CONFIG
+
+    name: str  # as the controller names it, e.g. "Tightening 1.4"
+    function: str  # the tightening function that ended it ("TF Torque"); "" when none
+    nominal: float | None  # that function's nominal and actual value (its own unit)
+    actual: float | None
+    status: StepStatus
+
+
+@dataclass(frozen=True, slots=True)
+class TighteningResult:
+    """The result of one tightening: OK or NOK against its program's windows.
+
+    What a plant's quality report speaks: the final torque, angle and preload
+    each with its window and status, the verdict and why, the steps of a
+    controller's program, and boltwatch's own figures of the run (stick-slip
+    events, process intensity, what stopped the tool). One per run on
+    ``boltwatch/<st>/results``, made by :mod:`shared.tightening_judgement`.
+    """
+
+    __pydantic_config__ = WIRE_CONFIG
+
+    station: StationId
+    tightening_id: Id  # the tool controller's id of the tightening (the run id of our tools)
+    run_id: Id
+    tool_id: Id
+    program_id: Id
+    program_name: str  # "" when unknown
+    time_ns: TimeNs  # when the run ended
+    part_id: str | None  # the part (work piece, VIN) tightened; None: unknown
+    batch_counter: Count | None  # the run's count within its batch; None: no batch known
+    final_torque_nm: JudgedFigure
+    final_angle_deg: JudgedFigure  # since the run started (a controller: its last step's angle)
+    final_force_n: JudgedFigure  # the preload
+    result: Verdict
+    nok_reasons: str  # why NOK, short texts separated by "; "; "" when OK
+    stop_reason: StopReasonName | None  # the StopCommand boltwatch sent; None: the tool stopped
+    events: Count | None  # stick-slip events; None: no predictor saw the run
+    process_intensity: float | None  # I_process, eq. 68; None: no predictor saw the run
+    source: ResultSource
+    steps: list[ResultStep] = field(default_factory=list)  # a controller's; empty live

@@ -1,11 +1,14 @@
 """The table ``boltwatch up`` prints: one row per tightening run, for a plant engineer.
 
 With several stations (``--stations N``) the first column names the station.
+The ``result`` column is the run's verdict (its ``TighteningResult`` on
+``boltwatch/<st>/results``: OK, or NOK against the program's windows); ``-``
+when no result arrived for the run.
 """
 
 from __future__ import annotations
 
-from shared.messages import RunSummary
+from shared.messages import RunSummary, TighteningResult
 
 COLUMNS = (
     ("run", 10),
@@ -13,6 +16,7 @@ COLUMNS = (
     ("target", 10),
     ("reached", 10),
     ("error %", 8),
+    ("result", 6),
     ("events", 6),
     ("stop reason", 20),
     ("intensity", 10),
@@ -30,7 +34,9 @@ def header(station_column: bool = False) -> str:
     return f"{line}\n{'-' * len(line)}"
 
 
-def row(summary: RunSummary, station_column: bool = False) -> str:
+def row(
+    summary: RunSummary, station_column: bool = False, result: TighteningResult | None = None
+) -> str:
     if summary.target_force_n is not None:
         target = f"{summary.target_force_n / 1000:.2f} kN"
         reached = _kilo(summary.reached_force_n, "kN")
@@ -45,6 +51,7 @@ def row(summary: RunSummary, station_column: bool = False) -> str:
         target,
         reached,
         error,
+        result.result if result is not None else "-",
         str(summary.events),
         reason,
         f"{summary.process_intensity:.3g}",
@@ -58,12 +65,15 @@ def _kilo(value: float | None, unit: str) -> str:
     return "-" if value is None else f"{value / 1000:.2f} {unit}"
 
 
-def totals(summaries: list[RunSummary]) -> str:
-    """One line: runs, mean and worst |error|."""
+def totals(summaries: list[RunSummary], results: list[TighteningResult] | None = None) -> str:
+    """One line: runs, mean and worst |error|, and how many were OK and NOK."""
     errors = [abs(s.error_pct) for s in summaries if s.error_pct is not None]
-    if not errors:
-        return f"{len(summaries)} runs"
-    return (
-        f"{len(summaries)} runs, |error| mean {sum(errors) / len(errors):.2f} %, "
-        f"worst {max(errors):.2f} %"
-    )
+    line = f"{len(summaries)} runs"
+    if errors:
+        line += f", |error| mean {sum(errors) / len(errors):.2f} %, worst {max(errors):.2f} %"
+    if results is not None:
+        nok = sum(1 for result in results if result.result == "NOK")
+        line += f", {len(results) - nok} OK, {nok} NOK"
+        if len(results) < len(summaries):
+            line += f", {len(summaries) - len(results)} without a result"
+    return line

@@ -7,7 +7,9 @@ acquisition (``edge``, the default) or in ONE line predictor serving every
 station placed on the line. Watches the line from its own zenoh client
 session: liveliness tokens for readiness, ``tool`` and ``runs`` for the
 table (a summary counts only for a run seen starting on the tool channel,
-once: :mod:`services.cli.run_tally`), ``bus`` for each acquisition's counters.
+once: :mod:`services.cli.run_tally`), ``results`` for its OK/NOK column (a
+run's result is published just before its summary), ``bus`` for each
+acquisition's counters.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from shared import channels, keys
 from shared.codec import decode
 from shared.config import LoadedStation, Program
 from shared.errors import BoltwatchError, TransportError
-from shared.messages import BusStats, RunSummary, ToolState
+from shared.messages import BusStats, RunSummary, TighteningResult, ToolState
 from shared.zenoh_session import open_from, zenoh_config
 
 LOG = logging.getLogger(__name__)
@@ -63,6 +65,8 @@ class StationRun:
         self.supervisor = StationSupervisor([s.path for s in self.stations], log_dir)
         self.tally = RunTally(s.station_id for s in self.stations)
         self.bus_stats: dict[str, BusStats] = {}
+        #: (station, run id) -> the run's result (its OK/NOK), as heard on its results key
+        self.results: dict[tuple[str, int], TighteningResult] = {}
         self.started_s = time.time()
         self._session: zenoh.Session | None = None
         self._stopped = False
@@ -106,9 +110,10 @@ class StationRun:
             )
             for topic in (
                 channels.TOOL.topic,
+                channels.RESULTS.topic,
                 channels.RUNS.topic,
                 channels.BUS.topic,
-            )  # a run's start before its summary
+            )  # a run's start and its result before its summary
         ]
         self.supervisor.start("recorder")
         if self.line_predicted:
@@ -223,14 +228,23 @@ class StationRun:
             try:
                 if topic == channels.TOOL.topic:
                     self.tally.tool_state(station_id, decode(ToolState, sample.payload.to_bytes()))
+                elif topic == channels.RESULTS.topic:
+                    result = decode(TighteningResult, sample.payload.to_bytes())
+                    if result.station == station_id:
+                        self.results[(station_id, result.run_id)] = result
                 elif topic == channels.RUNS.topic:
                     summary = decode(RunSummary, sample.payload.to_bytes())
                     if self.tally.summary(station_id, summary):
-                        print(run_table.row(summary, self.line), flush=True)
+                        print(self._row(summary), flush=True)
                 elif topic == channels.BUS.topic:
                     self.bus_stats[station_id] = decode(BusStats, sample.payload.to_bytes())
             except BoltwatchError as err:
                 LOG.warning("unreadable %s message: %s", topic, err)
+
+    def _row(self, summary: RunSummary) -> str:
+        return run_table.row(
+            summary, self.line, self.results.get((summary.station, summary.run_id))
+        )
 
     def _check_alive(self, expected_exits: set[str]) -> None:
         if self._stopped:
@@ -261,8 +275,13 @@ class StationRun:
         if every_summary:
             print(run_table.header(self.line))
             for summary in every_summary:
-                print(run_table.row(summary, self.line))
-            print(run_table.totals(every_summary))
+                print(self._row(summary))
+            results = [
+                result
+                for s in every_summary
+                if (result := self.results.get((s.station, s.run_id))) is not None
+            ]
+            print(run_table.totals(every_summary, results))
         left_out = self.tally.note()
         if left_out is not None:
             print(left_out)

@@ -21,6 +21,8 @@ Per station:
 - last run: the latest ToolState; failing that the run of the latest Sample
   (then running), failing that the latest RunSummary;
 - last decision, last run summary: the latest of each, with its age;
+- last result: the latest TighteningResult, its OK/NOK and why
+  (:mod:`services.cli.status_last_result`);
 - recorder: the latest RecorderStats (``boltwatch/<st>/recorder``, once a
   second): lag of samples into the recorder (p50/max over its last second,
   None when no samples came), messages written, samples the acquisition
@@ -39,6 +41,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
+from services.cli.status_last_result import LastResult, last_result
 from shared import channels, keys
 from shared.codec import decode, encode
 from shared.errors import InputError
@@ -50,6 +53,7 @@ from shared.messages import (
     Sample,
     SampleBatch,
     StopDecision,
+    TighteningResult,
     ToolState,
 )
 
@@ -57,6 +61,14 @@ from shared.messages import (
 KNOWN_SERVICES = ("acquisition", "predictor", "recorder", "rig")
 
 _NS = 1_000_000_000
+
+#: topics of which only the latest message counts: topic -> (its message type, _Seen field)
+_LATEST: dict[str, tuple[type, str]] = {
+    channels.TOOL.topic: (ToolState, "tool"),
+    channels.DECISION.topic: (StopDecision, "decision"),
+    channels.RUNS.topic: (RunSummary, "summary"),
+    channels.RESULTS.topic: (TighteningResult, "result"),
+}
 
 
 @dataclass
@@ -72,6 +84,7 @@ class _Seen:
     tool: ToolState | None = None
     decision: StopDecision | None = None
     summary: RunSummary | None = None
+    result: TighteningResult | None = None
     recorder: RecorderStats | None = None
     recorder_received_ns: int = 0
     predictor: PredictorStats | None = None
@@ -168,6 +181,7 @@ class StationStatus:
     recorder: RecorderHealth | None  # None: no RecorderStats in the window
     unreadable_messages: int
     predictor: PredictorHealth | None = None  # None: no PredictorStats in the window
+    last_result: LastResult | None = None  # None: no TighteningResult in the window
 
 
 @dataclass(frozen=True)
@@ -222,12 +236,9 @@ class StatusCollector:
                     seen.first_bus = stats
                 seen.bus = stats
                 seen.bus_received_ns = received_ns
-            elif topic == channels.TOOL.topic:
-                seen.tool = decode(ToolState, payload)
-            elif topic == channels.DECISION.topic:
-                seen.decision = decode(StopDecision, payload)
-            elif topic == channels.RUNS.topic:
-                seen.summary = decode(RunSummary, payload)
+            elif topic in _LATEST:
+                message_type, attribute = _LATEST[topic]
+                setattr(seen, attribute, decode(message_type, payload))
             elif topic == channels.RECORDER.topic:
                 seen.recorder = decode(RecorderStats, payload)
                 seen.recorder_received_ns = received_ns
@@ -262,6 +273,7 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
         recorder=_recorder_health(seen.recorder, seen.recorder_received_ns, now_ns),
         unreadable_messages=unreadable,
         predictor=_predictor_health(seen.predictor, seen.predictor_received_ns, now_ns),
+        last_result=last_result(seen.result, now_ns),
     )
 
 

@@ -18,6 +18,7 @@ from services.cli.station_status import (
     StationStatus,
     StatusReport,
 )
+from services.cli.status_last_result import result_text
 
 
 def format_report(report: StatusReport) -> str:
@@ -56,6 +57,7 @@ def _station_lines(status: StationStatus) -> list[str]:
         line("last run", _run_text(status.last_run)),
         line("last decision", _decision_text(status.last_decision)),
         line("last summary", _summary_text(status.last_summary)),
+        line("last result", result_text(status.last_result)),
         line("predictor", _predictor_text(status.predictor)),
         line("recorder", _recorder_text(status.recorder)),
     ]

@@ -3,7 +3,8 @@
 - :mod:`.core`: the pure algorithm (samples in, events and decisions out)
 - :mod:`.service` (zenoh wiring), :mod:`.arguments`, :mod:`.station_inbox`,
   :mod:`.served_station` (one station's configuration), :mod:`.active_run`
-  (one run's core and summary), :mod:`.run_messages` (core outputs as messages,
+  (one run's core and summary), :mod:`.run_result` (a run's summary judged against its
+  program's windows: its TighteningResult), :mod:`.run_messages` (core outputs as messages,
   live and replayed alike), :mod:`.station_counts` (what it could not use, per
   station: PredictorStats), :mod:`.station_runs` (one station's runs: states and
   samples in, messages out, for both placements), :mod:`.station_refusal` (one

@@ -94,6 +94,10 @@ class ActiveRun:
         if reached_force is not None and not force_low <= reached_force <= force_high:
             reached_force = None  # the last force was no measurement
         reached_torque = last.torque_nm if last is not None else 0.0
+        reached_angle = last.angle_deg if last is not None else None
+        angle_low, angle_high = self.settings.sensor_range.angle_deg
+        if reached_angle is not None and not angle_low <= reached_angle <= angle_high:
+            reached_angle = None  # NaN, or beyond the sensor: no measurement
         error_pct = None
         target_force = self.program.target_force_n
         target_torque = self.program.target_torque_nm
@@ -111,6 +115,7 @@ class ActiveRun:
             target_torque_nm=target_torque,
             reached_force_n=reached_force,
             reached_torque_nm=reached_torque,
+            reached_angle_deg=reached_angle,
             error_pct=error_pct,
             events=self.core.events,
             stop_reason=end.stop_command,

@@ -9,7 +9,7 @@ decides, back to the bus as a ``StopCommand`` in the same call: no zenoh hop,
 no second process, no router between the sample and the stop.
 
 It still publishes on zenoh everything the line predictor publishes
-(``events``, ``intensity``, ``decision``, ``runs``), through the station's
+(``events``, ``intensity``, ``decision``, ``results``, ``runs``), through the station's
 queued publisher: the CAN thread only queues. It holds the station's
 ``health/predictor`` token, so ``boltwatch status`` sees the station's
 predictor, and a second predictor for the station (a line predictor) is
@@ -65,9 +65,8 @@ class EdgePredictor:
         )
 
     def on_tool_state(self, state: ToolState) -> None:
-        summary = self._runs.on_tool(state)
-        if summary is not None:
-            self._publish(summary)
+        for message in self._runs.on_tool(state):  # a run's result and summary when it ended
+            self._publish(message)
 
     def on_sample(self, sample: Sample) -> StopDecision | None:
         decision = None

@@ -8,8 +8,8 @@ zenoh callback, one at a time (:mod:`services.predictor.station_inbox`).
 Each run is predicted with its own station's programs, force sensor, joint
 constants and ``[predictor]`` section. Out, per station: ``events`` and ``intensity``
 per stick-slip event, ``decision`` (REAL_TIME priority, express, blocking
-congestion control: a stop must never be dropped), ``runs`` per run. One
-liveliness token ``boltwatch/<st>/health/predictor`` per served station; a
+congestion control: a stop must never be dropped), ``results`` and ``runs`` per
+run. One liveliness token ``boltwatch/<st>/health/predictor`` per served station; a
 station that already has a predictor on the line is refused at start-up, so
 two predictors never both decide for one station.
 
@@ -158,9 +158,8 @@ class PredictorService:
         return False
 
     def _on_tool(self, runs: StationRuns, state: ToolState) -> None:
-        summary = runs.on_tool(state)
-        if summary is not None:
-            self._publish(state.station, channels.RUNS, summary)
+        for message in runs.on_tool(state):  # a run's result and summary when it ended
+            self._publish(state.station, message)
 
     def _on_sample(self, runs: StationRuns, sample: Sample) -> None:
         for message in runs.on_sample(sample, time.time_ns()):
@@ -192,17 +191,15 @@ class PredictorService:
         return sum(runs.counts.repeated_runs for runs in self._runs.values())
 
     def _send(self, station: str, message: Outgoing) -> None:
+        self._publish(station, message)
         if isinstance(message, StopDecision):
-            self._publish(station, channels.DECISION, message)
             LOG.info(
                 "%s run %s: stop (%s) %s", station, message.run_id, message.reason, message.detail
             )
-        elif isinstance(message, Intensity):
-            self._publish(station, channels.INTENSITY, message)
-        else:
-            self._publish(station, channels.EVENTS, message)
 
-    def _publish(self, station: str, channel: channels.Channel[Any], message: object) -> None:
+    def _publish(self, station: str, message: object) -> None:
+        """``message`` on its channel of ``station``."""
+        channel = channels.of_message(message)
         publisher = self._publishers.get((station, channel.topic))
         if publisher is None:  # the channel's options: decisions REAL_TIME and express;
             # every channel BLOCK (zenoh's default DROP lost events under load, silently)

@@ -9,7 +9,9 @@ predictor (:mod:`.service`, fed from zenoh) and the edge predictor
   (counted in :attr:`repeated_runs`);
 - a new run of the station ends its older ones, unheard (their ``done`` was
   lost in an outage: counted in :attr:`unfinished_runs`, no summary);
-- ``done`` / ``aborted`` ends a run: its :class:`RunSummary`;
+- ``done`` / ``aborted`` ends a run: its :class:`TighteningResult` (the summary
+  judged against the program's windows: :mod:`.run_result`), then its
+  :class:`RunSummary`;
 - a sample of no running run is dropped and counted.
 
 What it counts (:attr:`counts`, a :class:`~.station_counts.StationCounts`:
@@ -25,10 +27,11 @@ import logging
 from collections import deque
 
 from services.predictor.active_run import ActiveRun, Outgoing
+from services.predictor.run_result import tightening_result
 from services.predictor.served_station import ServedStation
 from services.predictor.station_counts import StationCounts
 from shared.log_limit import RateLimitedLog
-from shared.messages import RunSummary, Sample, ToolState
+from shared.messages import RunSummary, Sample, TighteningResult, ToolState
 
 LOG = logging.getLogger(__name__)
 
@@ -47,30 +50,33 @@ class StationRuns:
         self._log_no_program = RateLimitedLog(LOG, logging.ERROR)
         self._log_unfinished = RateLimitedLog(LOG)
 
-    def on_tool(self, state: ToolState) -> RunSummary | None:
-        """A run state of the station; the run's summary when it ended."""
+    def on_tool(self, state: ToolState) -> list[TighteningResult | RunSummary]:
+        """A run state of the station; when it ended a run, the run's result and summary
+        (in the order to publish them: a summary's reader finds the result already there)."""
         if state.state == "running":
             self._start(state)
-            return None
+            return []
         if state.state not in ("done", "aborted"):
-            return None
+            return []
         run = self._runs.pop(state.run_id, None)
         if run is None:
-            return None
+            return []
         summary = run.summary(state)
+        result = tightening_result(summary, run.program)
         self.counts.run_ended(run.core.input_report)
         LOG.info(
-            "%s run %s %s: %d events, stop %s%s, error %s %%, %s",
+            "%s run %s %s %s: %d events, stop %s%s, error %s %%, %s",
             state.station,
             state.run_id,
             state.state,
+            result.result,
             summary.events,
             summary.stop_reason or "by the tool",
             f" (late decision: {summary.late_decision})" if summary.late_decision else "",
             f"{summary.error_pct:.2f}" if summary.error_pct is not None else "-",
             run.core.input_report.as_dict(),
         )
-        return summary
+        return [result, summary]
 
     def on_sample(self, sample: Sample, wall_ns: int) -> list[Outgoing]:
         """Feed a sample to its run; the events, intensities and decision it produced."""

@@ -16,6 +16,7 @@ from pydantic import AfterValidator, Field, ValidationInfo, field_validator, mod
 from shared.can_database import StationDatabase
 from shared.config.joint import JointConfig, load_joint
 from shared.config.loading import StrictModel, read_toml, resolve_relative, validate
+from shared.config.program_windows import ProgramWindows
 from shared.errors import CanDatabaseError, ConfigError
 from shared.folders import FolderError, make_folder
 from shared.sensor_range import SensorRange
@@ -120,8 +121,9 @@ class ZenohSection(StrictModel):
         return self.tls_root_ca is not None
 
 
-class Program(StrictModel):
-    """A tightening program of the tool controller, selected by ``ProgramId`` on CAN."""
+class Program(ProgramWindows):
+    """A tightening program of the tool controller, selected by ``ProgramId`` on CAN,
+    with the windows its runs are judged against (:mod:`shared.config.program_windows`)."""
 
     id: int = Field(ge=1, le=255)
     name: str
@@ -165,6 +167,9 @@ class Program(StrictModel):
                 f"start_force_n {self.start_force_n:g} N is not below target_force_n "
                 f"{self.target_force_n:g} N: the run would start past its target"
             )
+        past = self.windows_past_limits()
+        if past is not None:
+            raise ValueError(past)
         return self
 
     def limits_beyond(self, sensor_range: SensorRange) -> str | None:
@@ -327,6 +332,17 @@ def load_station(path: Path) -> LoadedStation:
                 f"{path}: programs[{index}].{beyond} in the scaling of {dbc_path}: the tool could "
                 "never send a reading at its own limit (widen the signal in the DBC or lower "
                 "the limit)"
+            )
+        if program.has_force_window and not config.station.has_force_sensor:
+            raise ConfigError(
+                f"{path}: programs[{index}]: force_min_n / force_max_n need a force sensor "
+                "(station.has_force_sensor is false: no preload to judge)"
+            )
+        beyond = program.windows_beyond(sensor_range)
+        if beyond is not None:
+            raise ConfigError(
+                f"{path}: programs[{index}].{beyond} in the scaling of {dbc_path}: no reading "
+                "could ever be judged against it (narrow the window or widen the signal)"
             )
     program_joints = {}
     for index, program in enumerate(config.programs):

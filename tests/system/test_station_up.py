@@ -105,6 +105,28 @@ def test_up_tightens_stops_and_records_every_sample(tmp_path: Path) -> None:
         indexes = sorted(e["index"] for e in events if e["run_id"] == summary["run_id"])
         assert indexes == list(range(1, summary["events"] + 1)), summary["run_id"]
 
+    # Issue 18: one TighteningResult per run on its channel, in the run's file, judged
+    # against program 1's windows in the station file; its OK/NOK in up's table
+    results = {r["run_id"]: r for r in messages["boltwatch/st1/results"]}
+    assert len(messages["boltwatch/st1/results"]) == 3
+    assert set(results) == {s["run_id"] for s in summaries}
+    rows = [line.split() for line in result.stdout.splitlines() if line[:1].isdigit()]
+    verdicts = {int(row[0]): row[7] for row in rows if len(row) > 7 and row[7] in ("OK", "NOK")}
+    for summary in summaries:
+        judged = results[summary["run_id"]]
+        assert judged["source"] == "predictor" and judged["tightening_id"] == summary["run_id"]
+        assert judged["final_force_n"]["value"] == summary["reached_force_n"]
+        assert judged["final_torque_nm"]["value"] == summary["reached_torque_nm"]
+        assert judged["final_angle_deg"]["value"] == summary["reached_angle_deg"]
+        assert (judged["final_force_n"]["min"], judged["final_force_n"]["max"]) == (53e3, 59e3)
+        force = summary["reached_force_n"]
+        expected = "low" if force < 53e3 else "high" if force > 59e3 else "ok"
+        assert judged["final_force_n"]["status"] == expected
+        assert judged["result"] in ("OK", "NOK") and (judged["result"] == "OK") == (
+            judged["nok_reasons"] == ""
+        )
+        assert verdicts[summary["run_id"]] == judged["result"]  # up's table says the same
+
 
 def start_up(station: Path, runs: int) -> subprocess.Popen[str]:
     return subprocess.Popen(

@@ -149,6 +149,7 @@ PREDICTOR_PUTS = {
     channels.INTENSITY.topic,
     channels.DECISION.topic,
     channels.RUNS.topic,
+    channels.RESULTS.topic,  # issue 18: a run's TighteningResult
     channels.PREDICTOR.topic,
 }
 ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), per station

@@ -3,9 +3,11 @@
 Each :class:`ControllerRun` becomes the messages a live station publishes
 (``ToolState`` running, one ``Sample`` per controller sample with ``force_n``
 None, ``ToolState`` done), the controller's own result (``ControllerResult``
-on ``boltwatch/<st>/controller``) and, when given, what the predictor made of
-it (:class:`PredictorReplay`: events, intensities, the advisory decision
-after the sample that caused each, and the ``RunSummary`` at the end). They
+on ``boltwatch/<st>/controller``), the run's ``TighteningResult`` made from
+it (:mod:`.controller_judgement`, on ``boltwatch/<st>/results``) and, when
+given, what the predictor made of it (:class:`PredictorReplay`: events,
+intensities, the advisory decision after the sample that caused each, and
+the ``RunSummary`` at the end). They
 are written with the recorder's own :class:`~services.recorder.mcap_files.mcap_sink.McapSink`
 (and :class:`~services.recorder.rerun_files.rerun_sink.RerunSink`): same channels,
 schemas, metadata records, folders and file names as a live recording, plus
@@ -41,6 +43,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from services.recorder.controller_import.controller_judgement import imported_result
 from services.recorder.controller_import.controller_run import ControllerRun
 from services.recorder.controller_import.import_files import (
     put_in_place,
@@ -125,7 +128,11 @@ def controller_messages(
     for _, topic, message in outputs[next_output:]:
         yield topic, message, end_ns
     yield channels.TOOL.topic, _state(station, run, "done", end_ns), end_ns
-    yield channels.CONTROLLER.topic, run.result(station, end_ns), end_ns
+    controller = run.result(station, end_ns)
+    yield channels.CONTROLLER.topic, controller, end_ns
+    summary = replay.summary if replay is not None else None
+    result = imported_result(controller, summary, run.header.get("prg name", ""))
+    yield channels.RESULTS.topic, result, end_ns
     if replay is not None:
         yield channels.RUNS.topic, replay.summary, end_ns
 

@@ -22,6 +22,7 @@ from shared.messages import (
     Sample,
     StickSlipEvent,
     StopDecision,
+    TighteningResult,
 )
 from shared.service_skeleton import ServiceSkeleton
 from shared.zenoh_session import zenoh_config
@@ -63,6 +64,12 @@ def check_run(
     assert summary.samples == len(trace.rows())  # no sample of another station counted
     assert summary.error_pct is not None
     assert summary.reached_force_n == pytest.approx(trace.force_n[-1])
+    # issue 18: the run's result, published before its summary, on its own channel
+    (result,) = [codec.decode(TighteningResult, p) for p in by_key[f"{station}/results"]]
+    assert (result.station, result.run_id, result.source) == (station, 42, "predictor")
+    assert result.final_force_n.value == summary.reached_force_n
+    assert (result.events, result.stop_reason) == (summary.events, summary.stop_reason)
+    assert result.result == "OK"  # no windows in these programs, no fault
 
 
 def test_one_service_predicts_each_station_with_its_own_configuration(
@@ -101,6 +108,7 @@ def test_one_service_predicts_each_station_with_its_own_configuration(
         channels.INTENSITY.topic,
         channels.DECISION.topic,
         channels.RUNS.topic,
+        channels.RESULTS.topic,
     )
     assert not [key for key in by_key if key.startswith("pt3/") and key[4:] in predictor_topics]
     assert service.dropped_samples == 1
