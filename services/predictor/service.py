@@ -28,7 +28,6 @@ import logging
 import threading
 import time
 from collections.abc import Sequence
-from typing import Any
 
 import zenoh
 
@@ -43,7 +42,7 @@ from shared.config import LoadedStation, load_line
 from shared.config.line import stations_by_id
 from shared.errors import InputError
 from shared.log_limit import RateLimitedLog
-from shared.messages import Intensity, Sample, StopDecision, ToolState
+from shared.messages import Sample, StopDecision, ToolState
 from shared.receive_threads import use_one_receive_thread
 from shared.service_skeleton import ServiceSkeleton, Stop
 
