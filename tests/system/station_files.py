@@ -94,6 +94,25 @@ def is_running(pid: int) -> bool:
         return False
 
 
+def process_report(pid: int) -> str:
+    """What a process is doing, for an assertion message: its command line, state, and
+    each thread's name, state and kernel wait channel (Linux /proc)."""
+    lines = [f"{pid}: {command_line(pid)[:200]}"]
+    with contextlib.suppress(OSError):
+        for task in sorted(Path(f"/proc/{pid}/task").iterdir()):
+            with contextlib.suppress(OSError):
+                status = dict(
+                    line.split(":\t", 1)
+                    for line in (task / "status").read_text().splitlines()
+                    if ":\t" in line
+                )
+                wchan = (task / "wchan").read_text()
+                lines.append(
+                    f"  {task.name} {status.get('Name', '?')}: {status.get('State', '?')} {wchan}"
+                )
+    return "\n".join(lines)
+
+
 def kill_all(pids: list[int]) -> None:
     for pid in pids:
         with contextlib.suppress(ProcessLookupError):

@@ -26,6 +26,7 @@ from tests.system.station_files import (
     command_line,
     is_running,
     kill_all,
+    process_report,
     write_station,
 )
 
@@ -222,8 +223,9 @@ def test_services_stop_cleanly_when_up_is_killed_outright(tmp_path: Path) -> Non
         time.monotonic() < deadline
     ):
         time.sleep(0.1)
+    report = "\n".join(process_report(pid) for pid in alive)
     kill_all(alive)
-    assert alive == []
+    assert alive == [], report
     recordings = list((tmp_path / "recordings").rglob("*.mcap"))
     assert recordings
     for path in recordings:
