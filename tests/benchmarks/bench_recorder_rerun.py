@@ -11,19 +11,24 @@ Stations per core = 1 s of CPU / (CPU per sample x 1000 samples per second).
 
 from __future__ import annotations
 
+import sys
 import tempfile
 import time
 from pathlib import Path
 
-from services.recorder.live.file_metadata import FileMetadata
-from services.recorder.live.incoming import Received, classify
-from services.recorder.live.recorder import Recorder
-from services.recorder.live.run_files import FileLimits
-from services.recorder.rerun_files.rerun_sink import RerunOptions, RerunSink
-from shared.codec import encode
-from shared.config import load_station
-from shared.messages import Sample, StickSlipEvent, ToolState
-from tests.live_recorder import write_station_file
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO) not in sys.path:  # run as a script from anywhere
+    sys.path.insert(0, str(REPO))
+
+from services.recorder.live.file_metadata import FileMetadata  # noqa: E402
+from services.recorder.live.incoming import Received, classify  # noqa: E402
+from services.recorder.live.recorder import Recorder  # noqa: E402
+from services.recorder.live.run_files import FileLimits  # noqa: E402
+from services.recorder.rerun_files.rerun_sink import RerunOptions, RerunSink  # noqa: E402
+from shared.codec import encode  # noqa: E402
+from shared.config import load_station  # noqa: E402
+from shared.messages import Sample, StickSlipEvent, ToolState  # noqa: E402
+from tests.live_recorder import write_station_file  # noqa: E402
 
 SAMPLES = 60_000  # one minute at 1 kHz
 RATE_HZ = 1000
@@ -97,9 +102,11 @@ def bench_recorder(tmp: Path, payloads: list[tuple[str, bytes]], rerun: bool) ->
 def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         tmp = Path(folder)
-        payloads = run_payloads(time.time_ns())
-        items = [classify(key, payload, 0) for key, payload in payloads]
-        for batch in (100, 250, 1000):
+        t0_ns = time.time_ns()
+        payloads = run_payloads(t0_ns)
+        arrival_ns = t0_ns + SAMPLES * 1_000_000  # after every sample's time: none refused
+        items = [classify(key, payload, arrival_ns) for key, payload in payloads]
+        for batch in (100, 250, 1000, 2000):
             bench_sink(tmp, items, batch)
         mcap_us = bench_recorder(tmp, payloads, rerun=False)
         both_us = bench_recorder(tmp, payloads, rerun=True)
