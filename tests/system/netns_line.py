@@ -27,7 +27,8 @@ SERVER_ADDRESS = f"{SUBNET}.1"
 PREFIX = 24
 
 
-def _ip(*args: str) -> None:
+def run_ip(*args: str) -> None:
+    """``ip ARGS...`` (iproute2); CalledProcessError when it fails."""
     subprocess.run(["ip", *args], check=True, capture_output=True, text=True, timeout=10)
 
 
@@ -37,12 +38,12 @@ def unavailable_reason() -> str | None:
         return "no `ip` command (Debian package iproute2)"
     probe = f"bwprobe{uuid.uuid4().hex[:8]}"
     try:
-        _ip("netns", "add", probe)
+        run_ip("netns", "add", probe)
     except subprocess.CalledProcessError as err:
         return f"cannot create a network namespace: {err.stderr.strip()}"
     except OSError as err:
         return f"cannot run ip: {err}"
-    _ip("netns", "del", probe)
+    run_ip("netns", "del", probe)
     return None
 
 
@@ -78,38 +79,39 @@ class Line:
 
     def _build(self) -> None:
         self._add_namespace(self.server)
-        _ip("-n", self.server, "link", "add", "br0", "type", "bridge")
-        _ip("-n", self.server, "addr", "add", f"{SERVER_ADDRESS}/{PREFIX}", "dev", "br0")
-        _ip("-n", self.server, "link", "set", "br0", "up")
+        run_ip("-n", self.server, "link", "add", "br0", "type", "bridge")
+        run_ip("-n", self.server, "addr", "add", f"{SERVER_ADDRESS}/{PREFIX}", "dev", "br0")
+        run_ip("-n", self.server, "link", "set", "br0", "up")
         for index in range(1, self.stations + 1):
             name = self.station(index)
             self._add_namespace(name)
-            _ip("-n", name, "route", "add", "224.0.0.0/4", "dev", "lo")
+            run_ip("-n", name, "route", "add", "224.0.0.0/4", "dev", "lo")
             cable = self._cable(index)
-            _ip(
+            run_ip(
                 "-n", self.server, "link", "add", cable, "type", "veth", "peer", "name", f"{cable}p"
             )
-            _ip("-n", self.server, "link", "set", cable, "master", "br0")
-            _ip("-n", self.server, "link", "set", f"{cable}p", "netns", name)
-            _ip("-n", name, "link", "set", f"{cable}p", "name", "eth0")
-            _ip("-n", name, "addr", "add", f"{self.station_address(index)}/{PREFIX}", "dev", "eth0")
-            _ip("-n", name, "link", "set", "eth0", "up")
-            _ip("-n", self.server, "link", "set", cable, "up")
+            run_ip("-n", self.server, "link", "set", cable, "master", "br0")
+            run_ip("-n", self.server, "link", "set", f"{cable}p", "netns", name)
+            run_ip("-n", name, "link", "set", f"{cable}p", "name", "eth0")
+            address = f"{self.station_address(index)}/{PREFIX}"
+            run_ip("-n", name, "addr", "add", address, "dev", "eth0")
+            run_ip("-n", name, "link", "set", "eth0", "up")
+            run_ip("-n", self.server, "link", "set", cable, "up")
 
     def _cable(self, index: int) -> str:
         return f"cable{index}"
 
     def _add_namespace(self, name: str) -> None:
-        _ip("netns", "add", name)
+        run_ip("netns", "add", name)
         self._made.append(name)
-        _ip("-n", name, "link", "set", "lo", "up")
+        run_ip("-n", name, "link", "set", "lo", "up")
 
     def cut(self, index: int) -> None:
         """Pull station ``index``'s cable at the line server's end."""
-        _ip("-n", self.server, "link", "set", self._cable(index), "down")
+        run_ip("-n", self.server, "link", "set", self._cable(index), "down")
 
     def reconnect(self, index: int) -> None:
-        _ip("-n", self.server, "link", "set", self._cable(index), "up")
+        run_ip("-n", self.server, "link", "set", self._cable(index), "up")
 
     def close(self) -> None:
         for name in reversed(self._made):

@@ -30,6 +30,7 @@ from mcap.reader import make_reader
 
 from services.cli.station_supervisor import stop_processes
 from tests.paths import REPO
+from tests.system.netns_line import run_ip
 from tests.system.station_files import free_tcp_port, write_station
 
 LINES = (1, 2)
@@ -60,10 +61,6 @@ class LoopbackPlant:
         return []
 
 
-def _ip(*args: str) -> None:
-    subprocess.run(["ip", *args], check=True, capture_output=True, text=True, timeout=10)
-
-
 @dataclass
 class NamespacePlant:
     """Each line server in its own network namespace, the two joined by one veth pair
@@ -89,17 +86,17 @@ class NamespacePlant:
         try:
             for line in LINES:
                 name = self.namespace(line)
-                _ip("netns", "add", name)
+                run_ip("netns", "add", name)
                 self._made.append(name)
-                _ip("-n", name, "link", "set", "lo", "up")
-                _ip("-n", name, "route", "add", "224.0.0.0/4", "dev", "lo")
+                run_ip("-n", name, "link", "set", "lo", "up")
+                run_ip("-n", name, "route", "add", "224.0.0.0/4", "dev", "lo")
             one, two = (self.namespace(line) for line in LINES)
-            _ip("-n", one, "link", "add", "plant0", "type", "veth", "peer", "name", "plant1")
-            _ip("-n", one, "link", "set", "plant1", "netns", two)
+            run_ip("-n", one, "link", "add", "plant0", "type", "veth", "peer", "name", "plant1")
+            run_ip("-n", one, "link", "set", "plant1", "netns", two)
             for line, device in zip(LINES, ("plant0", "plant1"), strict=True):
                 name = self.namespace(line)
-                _ip("-n", name, "addr", "add", f"{self.address(line)}/24", "dev", device)
-                _ip("-n", name, "link", "set", device, "up")
+                run_ip("-n", name, "addr", "add", f"{self.address(line)}/24", "dev", device)
+                run_ip("-n", name, "link", "set", device, "up")
         except BaseException:
             self.close()
             raise
