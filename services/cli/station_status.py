@@ -43,7 +43,7 @@ from typing import Any
 
 from services.cli.status_last_result import LastResult, last_result
 from shared import channels, keys
-from shared.codec import decode, encode
+from shared.codec import decode
 from shared.errors import InputError
 from shared.messages import (
     BusStats,
@@ -77,7 +77,9 @@ class _Seen:
 
     services: set[str] = field(default_factory=set)
     samples: int = 0
-    last_sample_payload: bytes | None = None
+    # the latest sample: its payload (one message per sample: decoded once, at report time)
+    # or, from a batch (decoded already to be counted), the sample itself
+    last_sample: bytes | Sample | None = None
     first_bus: BusStats | None = None
     bus: BusStats | None = None
     bus_received_ns: int = 0
@@ -224,12 +226,12 @@ class StatusCollector:
             if topic == channels.SAMPLES.topic:
                 # 1 kHz: count only; the latest is decoded once, at report time.
                 seen.samples += 1
-                seen.last_sample_payload = payload
+                seen.last_sample = payload
             elif topic == channels.SAMPLE_BATCHES.topic:  # an edge station's, 100 a second
                 batch = decode(SampleBatch, payload)
                 if batch.samples:
                     seen.samples += len(batch.samples)
-                    seen.last_sample_payload = encode(batch.samples[-1])
+                    seen.last_sample = batch.samples[-1]
             elif topic == channels.BUS.topic:
                 stats = decode(BusStats, payload)
                 if seen.first_bus is None:
@@ -259,8 +261,8 @@ class StatusCollector:
 def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationStatus:
     services = {service: service in seen.services for service in KNOWN_SERVICES}
     services.update(dict.fromkeys(sorted(seen.services - set(KNOWN_SERVICES)), True))
-    last_sample = _decode_sample(seen.last_sample_payload)
-    unreadable = seen.unreadable + (1 if seen.last_sample_payload and last_sample is None else 0)
+    last_sample = _decode_sample(seen.last_sample)
+    unreadable = seen.unreadable + (1 if seen.last_sample and last_sample is None else 0)
     return StationStatus(
         station=name,
         services=services,
@@ -277,9 +279,9 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
     )
 
 
-def _decode_sample(payload: bytes | None) -> Sample | None:
-    if payload is None:
-        return None
+def _decode_sample(payload: bytes | Sample | None) -> Sample | None:
+    if payload is None or isinstance(payload, Sample):
+        return payload
     try:
         return decode(Sample, payload)
     except InputError:
