@@ -24,7 +24,7 @@ from shared import channels
 from shared.codec import encode
 from shared.messages import SampleBatch
 
-SAMPLE = "boltwatch.Sample"
+SAMPLE = channels.SAMPLES.schema_name
 #: the most a sample's log time is put before its batch's arrival: a batch spans 10 ms,
 #: one gathered over a stall of the station's publisher at most a second of log time
 MAX_SPREAD_NS = 1_000_000_000
