@@ -317,7 +317,7 @@ def rerun_options(write_files: bool, live_url: str | None) -> RerunOptions | Non
         return None
     if live_url is None:
         return RerunOptions(write_files=write_files)
-    return RerunOptions(LIVE_BATCH_SAMPLES, live_url, write_files)
+    return RerunOptions(LIVE_BATCH_SAMPLES, live_url=live_url, write_files=write_files)
 
 
 def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
