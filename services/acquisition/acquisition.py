@@ -18,7 +18,8 @@ scheduling, the Counter does not.
 ``decision`` (a payload) and ``send_stop`` (a decoded decision) may be
 called from another thread (the zenoh decision callback) and turn a decision
 for the running run into one CAN ``StopCommand``. A payload that is not a
-valid :class:`StopDecision` of this station (bad JSON, an unknown reason, a
+valid :class:`StopDecision` of this station (bad JSON, an unknown reason, an
+advisory decision (decided after the fact, never acted on), a
 string run id, a time no clock can hold, a run id wider than the DBC's
 ``RunId``, another station's id) is counted
 in ``BusStats.bad_decisions`` and logged once, then at most every 10 s; a
@@ -256,6 +257,8 @@ class Acquisition:
             decision = self._decode_decision(payload)
             if decision.station != self.station_id:
                 raise InputError(f"a decision of station {decision.station!r}, not of this one")
+            if decision.advisory:  # decided after the fact (import, a controller's bridge)
+                raise InputError("an advisory decision (decided after the fact) stops no tool")
         except InputError as err:
             self._bad_decisions += 1
             self._log_bad_decision(

@@ -13,6 +13,10 @@ may declare subscribers, queryables and liveliness tokens under
   ``[predictor] placement = "edge"``, the default),
 - ``<st>-predictor`` may put the predictor's keys (a line predictor,
   ``boltwatch serve predictor`` for a station with ``placement = "line"``),
+- ``<st>-openprotocol`` may put what an Open Protocol bridge publishes for its
+  station (``boltwatch serve openprotocol``: the run's samples, tool states,
+  the advisory predictor's keys, the controller's result, tool data, alarms and
+  its own stats; :func:`shared.channels.topics_of` ``("openprotocol")``),
 - ``line-recorder`` may put ``boltwatch/<st>/recorder`` and ``wear/**``.
 
 No one else may put a station's decision; in a plant of several lines the
@@ -44,6 +48,7 @@ from shared import channels, keys
 
 ACQUISITION_TOPICS = channels.topics_of("acquisition")
 PREDICTOR_TOPICS = channels.topics_of("predictor")
+BRIDGE_TOPICS = channels.topics_of("openprotocol")
 #: its channels below ``wear/**`` (the alert) and the wear ledger's queryable
 RECORDER_TOPICS = (
     *(topic for topic in channels.topics_of("recorder") if not topic.startswith(keys.WEAR)),
@@ -65,7 +70,8 @@ _DECLARATIONS = [
 
 def station_subjects(station: str) -> dict[str, str]:
     """Role -> certificate common name of the services of ``station``."""
-    return {role: f"{station}-{role}" for role in ("acquisition", "predictor", "rig")}
+    roles = ("acquisition", "predictor", "openprotocol", "rig")
+    return {role: f"{station}-{role}" for role in roles}
 
 
 def line_access_control(
@@ -95,6 +101,7 @@ def line_access_control(
         for role, topics in (
             ("acquisition", ACQUISITION_TOPICS + PREDICTOR_TOPICS),  # + the edge predictor
             ("predictor", PREDICTOR_TOPICS),
+            ("openprotocol", BRIDGE_TOPICS),
         ):
             rule_id = f"{station}-{role}-puts"
             rules.append(
@@ -108,7 +115,9 @@ def line_access_control(
         forwarded = [
             keys.station_key(st, topic)
             for st in its_stations
-            for topic in (*ACQUISITION_TOPICS, *PREDICTOR_TOPICS, *RECORDER_TOPICS)
+            for topic in dict.fromkeys(
+                (*ACQUISITION_TOPICS, *PREDICTOR_TOPICS, *BRIDGE_TOPICS, *RECORDER_TOPICS)
+            )
         ]
         rules.append(_rule(rule_id, ["put"], ["ingress"], forwarded))
         policies.append({"id": rule_id, "rules": [rule_id], "subjects": [router]})

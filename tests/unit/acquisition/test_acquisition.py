@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from collections.abc import Iterator
 
@@ -10,6 +11,7 @@ import pytest
 
 from services.acquisition.acquisition import Acquisition
 from shared.can_database import StationDatabase
+from shared.codec import encode
 from shared.messages import BusStats, Sample, StopDecision, StopReason, ToolState
 from tests.paths import DBC_FILE
 
@@ -116,6 +118,23 @@ def test_stop_command_only_for_the_running_run_and_only_once(
     assert signals == {"RunId": 7, "Reason": int(StopReason.PLATEAU_CLOSEST)}
     assert tool.recv(0.05) is None
     assert acquisition.stats().stop_commands == 1
+
+
+def test_an_advisory_decision_on_the_wire_stops_no_tool(
+    buses: tuple[can.BusABC, can.BusABC],
+) -> None:
+    """An advisory decision (``boltwatch import``, an Open Protocol bridge: decided after the
+    fact) put on a station's ``decision`` key never becomes a StopCommand; it is counted."""
+    tool, station = buses
+    acquisition = Acquisition("st1", True, station, DATABASE, ListOutlet())
+    tool.send(status(7, 1))
+    drain(acquisition, station)
+    advisory = dataclasses.replace(decision(7), advisory=True)
+    assert not acquisition.decision(encode(advisory))
+    assert tool.recv(0.05) is None
+    stats = acquisition.stats()
+    assert (stats.stop_commands, stats.bad_decisions) == (0, 1)
+    assert acquisition.decision(encode(decision(7)))  # the run can still be stopped
 
 
 def test_torque_only_station_publishes_without_force(buses: tuple[can.BusABC, can.BusABC]) -> None:

@@ -8,6 +8,7 @@ import pytest
 
 from services.router.access_control import (
     ACQUISITION_TOPICS,
+    BRIDGE_TOPICS,
     PREDICTOR_TOPICS,
     line_access_control,
 )
@@ -39,11 +40,23 @@ def test_a_line_predictor_may_put_only_the_predictors_keys(station: str) -> None
 
 
 @pytest.mark.parametrize("station", STATIONS)
+def test_an_open_protocol_bridge_may_put_what_a_bridge_publishes(station: str) -> None:
+    """``boltwatch serve openprotocol`` presents ``<st>-openprotocol``: the run's samples and
+    tool states, the advisory predictor's keys, the controller's result, tool data, alarms."""
+    acl = line_access_control(STATIONS)
+    granted = put_keys_granted(acl, f"{station}-openprotocol")
+    assert granted == station_keys(station, BRIDGE_TOPICS)
+    assert channels.TOOL_DATA.key(station) in granted and channels.BUS.key(station) not in granted
+
+
+@pytest.mark.parametrize("station", STATIONS)
 def test_no_other_identity_may_put_a_stations_decision(station: str) -> None:
+    """The bridge's decisions are advisory: an acquisition never turns one into a stop."""
     acl = line_access_control(STATIONS)
     decision = channels.DECISION.key(station)
     deciders = {name for name in common_names(acl) if decision in put_keys_granted(acl, name)}
-    assert deciders == {f"{station}-acquisition", f"{station}-predictor"}
+    roles = ("acquisition", "predictor", "openprotocol")
+    assert deciders == {f"{station}-{role}" for role in roles}
     assert not any(decision in put_keys_granted(acl, n) for n in ("rogue", "router"))
 
 
@@ -68,7 +81,7 @@ def test_another_lines_router_may_forward_its_own_stations_only() -> None:
     assert "line2-router" in line["subjects"]  # declarations, queries, replies, delivery
     decision = channels.DECISION.key("st1")
     deciders = {name for name in common_names(acl) if decision in put_keys_granted(acl, name)}
-    assert deciders == {"st1-acquisition", "st1-predictor"}
+    assert deciders == {"st1-acquisition", "st1-predictor", "st1-openprotocol"}
 
 
 def test_a_peer_naming_this_lines_station_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
