@@ -23,7 +23,9 @@ Every sample is checked here and what was done is counted in
   its start;
 - force missing, not finite or outside the range, on a station with a force
   sensor: the last good force is held (``held_force``; the plateau does not
-  move during a stick phase anyway). Before the first good force of the run
+  move during a stick phase anyway) for the stop rules, and marked as not
+  measured: a plateau's mean leaves it out (held across a slip, it would
+  pull the new plateau toward the old one). Before the first good force of the run
   there is none to hold: the sample has no force (``no_force``), which the
   plateau means and the force rules skip, so a lost first frame costs one
   sample, not the run;
@@ -79,9 +81,10 @@ class InputReport:
 
 
 #: One accepted sample, finite throughout: (time_s, torque_nm, force_n, angle_deg,
-#: angle_measured); force_n is None when the sample has no force (no sensor, or none yet in
-#: this run); angle_measured is False when its angle is held (not measured).
-GuardedSample = tuple[float, float, float | None, float, bool]
+#: angle_measured, force_measured); force_n is None when the sample has no force (no sensor,
+#: or none yet in this run); angle_measured / force_measured are False when that value is
+#: held (the last good one, not measured: a plateau's mean leaves a held force out).
+GuardedSample = tuple[float, float, float | None, float, bool, bool]
 RawSample = tuple[float, float, float, float]  # as given: (time_s, torque_nm, force_n, angle_deg)
 
 
@@ -105,9 +108,9 @@ class InputGuard:
         # (-1), then the first step (FIRST_DT_MAX_S) until Δt is known
         self._max_dt_s = -1.0
         #: the sample to use on USE and USE_HELD
-        self.sample: GuardedSample = (0.0, 0.0, None, 0.0, True)
+        self.sample: GuardedSample = (0.0, 0.0, None, 0.0, True, True)
         #: the held sample, confirmed, to use first on USE_HELD and USE_HELD_HOLD
-        self.confirmed: GuardedSample = (0.0, 0.0, None, 0.0, True)
+        self.confirmed: GuardedSample = (0.0, 0.0, None, 0.0, True, True)
 
     def check(self, time_s: float, torque_nm: float, force_n: float, angle_deg: float) -> int:
         """DROP, USE, HOLD, USE_HELD or USE_HELD_HOLD (see the module's constants)."""
@@ -143,9 +146,9 @@ class InputGuard:
                     report.saturated += 1
                 if self._has_force:
                     self._last_force_n = force_n
-                    self.sample = (time_s, torque_nm, force_n, angle_deg, True)
+                    self.sample = (time_s, torque_nm, force_n, angle_deg, True, True)
                 else:
-                    self.sample = (time_s, torque_nm, None, angle_deg, True)
+                    self.sample = (time_s, torque_nm, None, angle_deg, True, True)
                 return USE
             return self._unusual(dt_s, (time_s, torque_nm, force_n, angle_deg))
         return self._after_jump(held, (time_s, torque_nm, force_n, angle_deg))
@@ -236,6 +239,7 @@ class InputGuard:
         if torque_nm == self._torque_high or torque_nm == self._torque_low:  # noqa: PLR1714
             report.saturated += 1
         force: float | None = None
+        force_measured = True
         if self._has_force:
             if self._force_low <= force_n <= self._force_high:
                 force = self._last_force_n = force_n
@@ -243,13 +247,14 @@ class InputGuard:
                 report.no_force += 1
             else:
                 force = self._last_force_n
+                force_measured = False
                 report.held_force += 1
         measured = self._angle_low <= angle_deg <= self._angle_high
         if measured:
             self._last_angle_deg = angle_deg
         else:
             report.held_angle += 1
-        return (time_s, torque_nm, force, self._last_angle_deg, measured)
+        return (time_s, torque_nm, force, self._last_angle_deg, measured, force_measured)
 
     def _bad(self) -> int:
         self.bad_run += 1

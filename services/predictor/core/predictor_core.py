@@ -133,13 +133,13 @@ class PredictorCore:
         return out  # USE_HELD_HOLD: this sample is held in turn
 
     def _use(self, sample: GuardedSample) -> list[CoreOutput]:
-        time_s, torque_nm, force, angle_deg, angle_measured = sample
+        time_s, torque_nm, force, angle_deg, angle_measured, force_measured = sample
         index = self._count
         self._count = index + 1
         if index == 0:
             self._start_time_s = time_s
             self._start_angle_deg = angle_deg
-        self._forces.add(force)
+        self._forces.add(force if force_measured else None)
         self._motion.add(time_s, angle_deg, angle_measured)
         self._add_torque_noise(torque_nm)
         out: list[CoreOutput] = []

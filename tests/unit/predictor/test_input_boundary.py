@@ -15,7 +15,7 @@ import math
 from functools import cache
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from services.predictor.core import CoreDecision, EventFigures, PredictorCore, PredictorSettings
@@ -93,6 +93,9 @@ ABSURD = st.sampled_from([1e300, -1e300, 1e308, -1e308, math.inf, -math.inf, mat
 
 @settings(max_examples=60, deadline=None)
 @given(index=st.integers(1, 900), column=st.integers(0, 3), value=ABSURD, count=st.integers(1, 3))
+# three forces lost across a slip (its force step at 722): held, they once pulled the new
+# plateau toward the old one and the stop went a plateau later (target_reached at 0.755 s)
+@example(index=721, column=2, value=1e300, count=3)
 def test_an_absurd_value_never_moves_the_decision(
     index: int, column: int, value: float, count: int
 ) -> None:
