@@ -14,22 +14,35 @@ channel: its message type in :mod:`shared.messages`, its row below.
 topic              publisher             message, when
 =================  ====================  ===========================================
 ``samples``        acquisition           :class:`Sample`, one per 1 kHz sample (placement
-                                         line: what the line's predictor decides on)
+                   (openprotocol)        line: what the line's predictor decides on)
 ``sample_batches`` acquisition           :class:`SampleBatch`, every 10 ms (placement
-                                         edge: what the line records)
+                   (openprotocol)        edge: what the line records)
 ``tool``           acquisition           :class:`ToolState`, on every change
+                   (openprotocol)
 ``bus``            acquisition           :class:`BusStats`, once a second
 ``events``         predictor             :class:`StickSlipEvent`, one per event
+                   (openprotocol)
 ``intensity``      predictor             :class:`Intensity`, one per event
+                   (openprotocol)
 ``decision``       predictor             :class:`StopDecision`, at most one per run
+                   (openprotocol)        (a bridge's: advisory, the controller stopped)
 ``runs``           predictor             :class:`RunSummary`, one per run
+                   (openprotocol)
 ``results``        predictor (import,    :class:`TighteningResult`, one per run, just
-                   a bridge)             before its summary: OK/NOK against the windows
+                   openprotocol)         before its summary: OK/NOK against the windows
 ``predictor``      predictor             :class:`PredictorStats`, once a second
 ``recorder``       recorder              :class:`RecorderStats`, once a second
 ``wear/alert``     recorder              :class:`WearAlert`, when a tool is due
-``controller``     import (a bridge)     :class:`ControllerResult`, one per run
+``controller``     import (openprotocol) :class:`ControllerResult`, one per run
+``tool_data``      openprotocol          :class:`ToolData`, when the controller says it
+``alarms``         openprotocol          :class:`ControllerAlarm`, per alarm message
+``openprotocol``   openprotocol          :class:`BridgeStats`, once a second
 =================  ====================  ===========================================
+
+In brackets: who else may put the channel (:attr:`Channel.also_by`). A
+controller bridge (``boltwatch serve openprotocol``, publisher
+``openprotocol``) stands for a CAN station's acquisition and predictor: it
+publishes what they would, from what its controller says.
 
 A station's samples go toward the line once, on one of the two sample
 channels: one message per sample where a line predictor decides on them
@@ -55,7 +68,9 @@ import zenoh
 
 from shared import keys
 from shared.messages import (
+    BridgeStats,
     BusStats,
+    ControllerAlarm,
     ControllerResult,
     Intensity,
     PredictorStats,
@@ -66,6 +81,7 @@ from shared.messages import (
     StickSlipEvent,
     StopDecision,
     TighteningResult,
+    ToolData,
     ToolState,
     WearAlert,
 )
@@ -101,13 +117,21 @@ class Channel(Generic[MessageT]):
 
     topic: str
     message_type: type[MessageT]
+    #: the service that puts it (what the access control lets put it, per role)
     publisher: str
     qos: Qos = field(default_factory=Qos)
+    #: who else may put it, in the place of ``publisher`` (a controller bridge, an import)
+    also_by: tuple[str, ...] = ()
     #: the registry name of its message type (``boltwatch.<Type>``): MCAP schema names
     schema_name: str = field(init=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "schema_name", f"boltwatch.{self.message_type.__name__}")
+
+    @property
+    def publishers(self) -> tuple[str, ...]:
+        """Every service that may put it: ``publisher`` first, then ``also_by``."""
+        return (self.publisher, *self.also_by)
 
     def key(self, station: str) -> str:
         """``boltwatch/<station>/<topic>``."""
@@ -118,21 +142,31 @@ class Channel(Generic[MessageT]):
         return session.declare_publisher(self.key(station), **self.qos.options())
 
 
-SAMPLES = Channel("samples", Sample, "acquisition", Qos(express=True))
-SAMPLE_BATCHES = Channel("sample_batches", SampleBatch, "acquisition", Qos(express=True))
-TOOL = Channel("tool", ToolState, "acquisition", Qos(express=True))
+#: what a controller bridge puts in the place of a CAN station's acquisition and predictor
+_BRIDGE = ("openprotocol",)
+
+SAMPLES = Channel("samples", Sample, "acquisition", Qos(express=True), _BRIDGE)
+SAMPLE_BATCHES = Channel("sample_batches", SampleBatch, "acquisition", Qos(express=True), _BRIDGE)
+TOOL = Channel("tool", ToolState, "acquisition", Qos(express=True), _BRIDGE)
 BUS = Channel("bus", BusStats, "acquisition")
-EVENTS = Channel("events", StickSlipEvent, "predictor")
-INTENSITY = Channel("intensity", Intensity, "predictor")
+EVENTS = Channel("events", StickSlipEvent, "predictor", also_by=_BRIDGE)
+INTENSITY = Channel("intensity", Intensity, "predictor", also_by=_BRIDGE)
 DECISION = Channel(
-    "decision", StopDecision, "predictor", Qos(priority=zenoh.Priority.REAL_TIME, express=True)
+    "decision",
+    StopDecision,
+    "predictor",
+    Qos(priority=zenoh.Priority.REAL_TIME, express=True),
+    _BRIDGE,
 )
-RUNS = Channel("runs", RunSummary, "predictor")
-RESULTS = Channel("results", TighteningResult, "predictor")
+RUNS = Channel("runs", RunSummary, "predictor", also_by=_BRIDGE)
+RESULTS = Channel("results", TighteningResult, "predictor", also_by=("import", *_BRIDGE))
 PREDICTOR = Channel("predictor", PredictorStats, "predictor")
 RECORDER = Channel("recorder", RecorderStats, "recorder")
 WEAR_ALERT = Channel("wear/alert", WearAlert, "recorder")
-CONTROLLER = Channel("controller", ControllerResult, "import")
+CONTROLLER = Channel("controller", ControllerResult, "import", also_by=_BRIDGE)
+TOOL_DATA = Channel("tool_data", ToolData, "openprotocol")
+ALARMS = Channel("alarms", ControllerAlarm, "openprotocol")
+OPENPROTOCOL = Channel("openprotocol", BridgeStats, "openprotocol")
 
 #: every channel, in the order of the table above
 CHANNELS: tuple[Channel[Any], ...] = (
@@ -149,6 +183,9 @@ CHANNELS: tuple[Channel[Any], ...] = (
     RECORDER,
     WEAR_ALERT,
     CONTROLLER,
+    TOOL_DATA,
+    ALARMS,
+    OPENPROTOCOL,
 )
 
 _BY_TOPIC: dict[str, Channel[Any]] = {channel.topic: channel for channel in CHANNELS}
@@ -164,8 +201,9 @@ def by_topic(topic: str) -> Channel[Any] | None:
 
 
 def topics_of(publisher: str) -> tuple[str, ...]:
-    """The topics ``publisher`` puts, in the order of :data:`CHANNELS`."""
-    return tuple(channel.topic for channel in CHANNELS if channel.publisher == publisher)
+    """The topics ``publisher`` puts, or may put (:attr:`Channel.also_by`), in the order of
+    :data:`CHANNELS`."""
+    return tuple(channel.topic for channel in CHANNELS if publisher in channel.publishers)
 
 
 def of_message(message: object) -> Channel[Any]:

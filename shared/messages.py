@@ -11,6 +11,10 @@ chunk, figures finite, texts of limited length): the aliases of
 :mod:`shared.message_fields` say how, and the decoder refuses the rest
 (``__pydantic_config__``: :data:`~shared.message_fields.WIRE_CONFIG`). Which
 channel carries which message, who puts it and how: :mod:`shared.channels`.
+
+What tool controllers say (a controller's result, its tool data and alarms, a
+controller bridge's counters) is in :mod:`shared.controller_messages` and
+imported from here as every other message.
 """
 
 from __future__ import annotations
@@ -19,7 +23,16 @@ from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import Literal
 
-from shared.message_fields import WIRE_CONFIG, Count, Id, Int64, Measured, StationId, TimeNs
+from shared.controller_messages import (  # noqa: F401  (re-exported: one import for every message)
+    AlarmKind,
+    BridgeStats,
+    ControllerAlarm,
+    ControllerFunction,
+    ControllerResult,
+    ControllerStep,
+    ToolData,
+)
+from shared.message_fields import WIRE_CONFIG, Count, Id, Measured, StationId, TimeNs
 
 ToolStateName = Literal["idle", "running", "done", "aborted"]
 StopReasonName = Literal[
@@ -288,69 +301,6 @@ class PredictorStats:
     samples_without_run: Count  # samples of a run that was not running here: dropped
     unfinished_runs: Count  # runs whose end never arrived (a network outage): no summary
     repeated_runs: Count  # ToolStates starting a run id that had started already: ignored
-
-
-@dataclass(frozen=True, slots=True)
-class ControllerFunction:
-    """One function of a controller step, with its nominal and actual value.
-
-    Tightening functions (``TF ...``) end the step when reached; monitoring
-    functions (``MF ...``, ``MFs ...``) are windows the step must stay in.
-    Values are in the function's own unit: torque in the run's
-    ``torque_unit``, angle in degrees, time in seconds.
-    """
-
-    __pydantic_config__ = WIRE_CONFIG
-
-    name: str  # as the controller names it, e.g. "TF Torque", "MFs TorqueMax"
-    nominal: float | None  # ``nom``; None when the controller gave none
-    actual: float | None  # ``act``
-
-
-@dataclass(frozen=True, slots=True)
-class ControllerStep:
-    """One step of a controller's tightening program and how it went."""
-
-    __pydantic_config__ = WIRE_CONFIG
-
-    name: str  # e.g. "Finding", "Thread forming", "Tightening 1.4"
-    result: str  # "OK" or "NOK" as the controller wrote it ("" when it wrote none)
-    quality_code: str
-    samples: Count  # samples of the step's graph
-    functions: list[ControllerFunction] = field(default_factory=list)
-
-
-@dataclass(frozen=True, slots=True)
-class ControllerResult:
-    """A tool controller's own result of one run: its verdict, codes and every step's values.
-
-    Published once per run, when it ended (imported controller runs; a
-    controller bridge would publish the same). Batch counters are the
-    controller's, ``-1`` where it keeps no batch, None where the file had none.
-    """
-
-    __pydantic_config__ = WIRE_CONFIG
-
-    station: StationId
-    run_id: Id
-    tool_id: Id
-    program_id: Id
-    time_ns: TimeNs  # the run's last sample
-    result: str  # "OK" or "NOK": the controller's verdict on the whole run
-    quality_code: str
-    part_id: str  # ``id code``: the part (work piece) the run tightened
-    torque_unit: str
-    # trailing samples of the last step's graph that are the tool unloading (``torsion release``)
-    torsion_release_samples: Count | None
-    batch_number: Int64 | None
-    batch_ok: Int64 | None
-    batch_nok: Int64 | None
-    batch_max_ok: Int64 | None
-    batch_max_nok: Int64 | None
-    batch_canceled: Int64 | None
-    batch_direction_ok: Int64 | None
-    batch_direction_nok: Int64 | None
-    steps: list[ControllerStep] = field(default_factory=list)
 
 
 @dataclass(frozen=True, slots=True)

@@ -42,7 +42,9 @@ from shared.message_fields import (
     TextRange,
 )
 from shared.messages import (
+    BridgeStats,
     BusStats,
+    ControllerAlarm,
     ControllerFunction,
     ControllerResult,
     ControllerStep,
@@ -58,6 +60,7 @@ from shared.messages import (
     StickSlipEvent,
     StopDecision,
     TighteningResult,
+    ToolData,
     ToolState,
 )
 
@@ -166,6 +169,46 @@ def template(topic: str, station: str, now_ns: int, run_id: int = 1) -> Any:
             [ControllerStep("Finding", "OK", "1", 9, [ControllerFunction("TF Angle", 1.0, 1.5)])],
         ),
         "wear/alert": lambda: WearAlert(station, 3, now_ns, 2e9, 1e9, 4, None),
+        "tool_data": lambda: ToolData(
+            station=station,
+            tool_id=3,
+            time_ns=now_ns,
+            tool_serial="B1234567",
+            controller_serial="C98765",
+            tightenings=12_345,
+            tightenings_since_service=345,
+            last_calibration_ns=now_ns - 86_400_000_000_000,
+            last_service_ns=None,
+            calibration_value_nm=50.5,
+            tool_type="01",
+            tool_model=None,
+            controller_software="Power Focus 6000 3.1",
+        ),
+        "alarms": lambda: ControllerAlarm(
+            station, now_ns, now_ns, "E404", "raised", True, False, True, "tool overheated"
+        ),
+        "openprotocol": lambda: BridgeStats(
+            station=station,
+            time_ns=now_ns,
+            started_ns=now_ns - 60_000_000_000,
+            controller="192.0.2.10:4545",
+            connected=True,
+            result_revision=2,
+            connects=1,
+            link_drops=0,
+            keep_alives_sent=6,
+            results=run_id,
+            results_filled=0,
+            repeated_results=0,
+            traces=run_id,
+            traces_without_result=0,
+            garbage_bytes=0,
+            bad_messages=0,
+            refused_values=0,
+            controller_errors=0,
+            last_tightening_id=run_id,
+            last_error=None,
+        ),
     }
     return made[topic]()
 
