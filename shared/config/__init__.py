@@ -4,7 +4,8 @@ Load with :func:`load_station` (which also loads the joint it names) or
 :func:`load_joint`; pass the result down, never re-read it.
 
 - :mod:`.station` (the station file), :mod:`.program_windows` (a program's
-  windows: where a run must end to be OK), :mod:`.joint` (the joint file),
+  windows: where a run must end to be OK), :mod:`.openprotocol` (a controller that
+  speaks Open Protocol, and the simulated one's side), :mod:`.joint` (the joint file),
   :mod:`.line` (a line: stations served together, stations derived from one)
 - :mod:`.loading` (TOML into a validated model, errors naming file and key),
   :mod:`.toml_writer` (the files boltwatch derives from others)

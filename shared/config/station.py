@@ -16,6 +16,7 @@ from pydantic import AfterValidator, Field, ValidationInfo, field_validator, mod
 from shared.can_database import StationDatabase
 from shared.config.joint import JointConfig, load_joint
 from shared.config.loading import StrictModel, read_toml, resolve_relative, validate
+from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
 from shared.config.program_windows import ProgramWindows
 from shared.errors import CanDatabaseError, ConfigError
 from shared.folders import FolderError, make_folder
@@ -219,6 +220,10 @@ class RigSection(StrictModel):
     settle_time_s: float = Field(default=0.03, gt=0, description="samples sent after the stop")
     pause_between_runs_s: float = Field(default=0.5, ge=0)
     seed: int | None = Field(default=None, description="none: a fresh seed per process")
+    openprotocol: RigOpenProtocolSection = Field(
+        default_factory=RigOpenProtocolSection,
+        description="the simulated controller toward an Open Protocol bridge",
+    )
 
 
 class RecorderSection(StrictModel):
@@ -241,6 +246,9 @@ class StationConfig(StrictModel):
     predictor: PredictorSection = PredictorSection()
     rig: RigSection = RigSection()
     recorder: RecorderSection
+    openprotocol: OpenProtocolSection | None = Field(
+        default=None, description="the station's tool controller speaks Open Protocol"
+    )
 
     @model_validator(mode="after")
     def _program_ids_unique(self) -> StationConfig:
@@ -344,6 +352,13 @@ def load_station(path: Path) -> LoadedStation:
                 f"{path}: programs[{index}].{beyond} in the scaling of {dbc_path}: no reading "
                 "could ever be judged against it (narrow the window or widen the signal)"
             )
+    bridge, rig_controller = config.openprotocol, config.rig.openprotocol
+    if bridge is not None and bridge.keep_alive_s >= rig_controller.link_timeout_s:
+        raise ConfigError(
+            f"{path}: openprotocol.keep_alive_s: {bridge.keep_alive_s:g} s is not below "
+            f"rig.openprotocol.link_timeout_s {rig_controller.link_timeout_s:g} s: the "
+            "simulated controller would drop the link between two keep-alives"
+        )
     program_joints = {}
     for index, program in enumerate(config.programs):
         if program.joint is not None:
