@@ -1,0 +1,154 @@
+"""Frames to messages and back: the registry of every MID this codec implements.
+
+- :func:`decode` ``(frame) -> message``: by MID and revision; an MID not
+  implemented gives :class:`UnknownMessage` (a value, not an exception); a
+  revision not implemented or malformed content raises
+  :class:`~shared.openprotocol.errors.OpenProtocolError` (``field ==
+  "revision"`` for the former: a controller answers it with 0004 error 97).
+- :func:`encode` ``(message) -> bytes``: the whole message on the wire.
+- :data:`SUPPORTED_REVISIONS`: the revisions implemented per MID, lowest
+  first, so an integrator can ask the highest and fall back, and a controller
+  can refuse the others.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import ClassVar, Final, Protocol, Self
+
+from shared.openprotocol.alarms import (
+    Alarm,
+    AlarmAcknowledge,
+    AlarmAcknowledgedOnController,
+    AlarmAcknowledgedOnControllerAck,
+    AlarmStatus,
+    AlarmStatusAck,
+    AlarmSubscribe,
+    AlarmUnsubscribe,
+)
+from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect
+from shared.openprotocol.errors import OpenProtocolError
+from shared.openprotocol.framing import Frame, HeaderFill, frame_bytes
+from shared.openprotocol.results import (
+    LastTighteningResult,
+    OldResultRequest,
+    OldTighteningResult,
+    ResultAcknowledge,
+    ResultSubscribe,
+    ResultUnsubscribe,
+)
+from shared.openprotocol.session import (
+    CommandAccepted,
+    CommandError,
+    CommunicationStart,
+    CommunicationStartAck,
+    CommunicationStop,
+    KeepAlive,
+)
+from shared.openprotocol.subscriptions import DataSubscribe, DataUnsubscribe
+from shared.openprotocol.tool_data import ToolData, ToolDataRequest
+from shared.openprotocol.traces import TraceCurve
+
+
+class WireMessage(Protocol):
+    """What every message class of this package offers the codec."""
+
+    MID: ClassVar[int]
+
+    @property
+    def revision(self) -> int: ...
+
+    @classmethod
+    def revisions(cls) -> tuple[int, ...]: ...
+
+    @classmethod
+    def from_data(cls, data: bytes, revision: int, dialect: Dialect = ...) -> Self: ...
+
+    def to_data(self, revision: int, dialect: Dialect = ...) -> bytes: ...
+
+
+@dataclass(frozen=True, slots=True)
+class UnknownMessage:
+    """A frame of an MID this codec does not implement, kept whole."""
+
+    frame: Frame
+
+    @property
+    def mid(self) -> int:
+        return self.frame.mid
+
+
+MESSAGE_TYPES: Final[Mapping[int, type[WireMessage]]] = {
+    cls.MID: cls
+    for cls in (
+        CommunicationStart,
+        CommunicationStartAck,
+        CommunicationStop,
+        CommandError,
+        CommandAccepted,
+        KeepAlive,
+        DataSubscribe,
+        DataUnsubscribe,
+        ToolDataRequest,
+        ToolData,
+        ResultSubscribe,
+        LastTighteningResult,
+        ResultAcknowledge,
+        ResultUnsubscribe,
+        OldResultRequest,
+        OldTighteningResult,
+        AlarmSubscribe,
+        Alarm,
+        AlarmAcknowledge,
+        AlarmUnsubscribe,
+        AlarmAcknowledgedOnController,
+        AlarmAcknowledgedOnControllerAck,
+        AlarmStatus,
+        AlarmStatusAck,
+        TraceCurve,
+    )
+}
+SUPPORTED_REVISIONS: Final[Mapping[int, tuple[int, ...]]] = {
+    mid: cls.revisions() for mid, cls in sorted(MESSAGE_TYPES.items())
+}
+KNOWN_MIDS: Final = frozenset(SUPPORTED_REVISIONS)
+
+
+def _check_revision(mid: int, revision: int) -> None:
+    known = SUPPORTED_REVISIONS[mid]
+    if revision not in known:
+        why = f"revision {revision} is not implemented ({', '.join(map(str, known))})"
+        raise OpenProtocolError(mid, "revision", why, revision=revision)
+
+
+def decode(frame: Frame, *, dialect: Dialect = DEFAULT_DIALECT) -> WireMessage | UnknownMessage:
+    """The message of ``frame``; :class:`UnknownMessage` for an MID not implemented."""
+    cls = MESSAGE_TYPES.get(frame.mid)
+    if cls is None:
+        return UnknownMessage(frame)
+    _check_revision(frame.mid, frame.revision)
+    return cls.from_data(frame.data, frame.revision, dialect)
+
+
+def encode(
+    message: WireMessage | UnknownMessage,
+    *,
+    revision: int | None = None,
+    fill: HeaderFill | None = None,
+    dialect: Dialect = DEFAULT_DIALECT,
+    no_ack: bool = False,
+) -> bytes:
+    """The wire bytes of ``message`` at ``revision`` (default: the message's own).
+
+    ``fill`` overrides ``dialect.header_fill``; ``no_ack`` sets the header's
+    no-ack flag (on a subscription: push without waiting for acknowledges).
+    """
+    fill = dialect.header_fill if fill is None else fill
+    if isinstance(message, UnknownMessage):
+        return frame_bytes(message.frame, fill=fill, terminator=dialect.nul_terminator)
+    revision = message.revision if revision is None else revision
+    _check_revision(message.MID, revision)
+    data = message.to_data(revision, dialect)
+    frame = Frame(mid=message.MID, revision=revision, no_ack=no_ack, data=data)
+    return frame_bytes(frame, fill=fill, terminator=dialect.nul_terminator)
