@@ -57,8 +57,11 @@ def controller_result(
     summary: RunSummary | None,
     program_name: str,
     source: ResultSource,
+    tightening_id: int | None = None,
 ) -> TighteningResult:
-    """The result of the controller's run; ``summary``: the predictor's replay of it."""
+    """The result of the controller's run; ``summary``: the predictor's replay of it;
+    ``tightening_id``: the controller's own id when it is not the run id (a bridge's
+    controller whose ids started again: :mod:`services.openprotocol.published_ids`)."""
     last = controller.steps[-1] if controller.steps else None
     torque = _figure(last, "Torque", "TF Torque")
     angle = _figure(last, "Angle", "TF Angle")
@@ -72,7 +75,7 @@ def controller_result(
     reasons += figure_reasons({"torque": (torque, "Nm"), "angle": (angle, "deg")})
     return TighteningResult(
         station=controller.station,
-        tightening_id=controller.run_id,
+        tightening_id=controller.run_id if tightening_id is None else tightening_id,
         run_id=controller.run_id,
         tool_id=controller.tool_id,
         program_id=controller.program_id,
