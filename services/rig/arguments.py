@@ -28,7 +28,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=int,
         default=None,
         help="RunId of the first run, +1 per run (default: the current Unix time in seconds); "
-        "with --controller openprotocol the first tightening id",
+        "with --controller openprotocol the first tightening id (default: one past the "
+        "last the simulated controller numbered, kept in the recordings folder)",
     )
     parser.add_argument(
         "--seed",

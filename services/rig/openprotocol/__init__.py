@@ -8,7 +8,8 @@ the codec of :mod:`shared.openprotocol`, as real controllers do.
 - :mod:`.tightening` (one run of the physics and the controller's result of it; pure),
   :mod:`.result_messages` (that result as MIDs 0061, 0065, 0900; pure)
 - :mod:`.simulated_tool` (the tool on its own pace, listened to or not)
-- :mod:`.result_store` (the results kept to serve by id, bounded)
+- :mod:`.result_store` (the results kept to serve by id, bounded),
+  :mod:`.tightening_counter` (the last tightening id, kept across restarts)
 - :mod:`.controller_state` (results, alarm, tool data, revisions, how it writes),
   :mod:`.controller_counters` (what it counts and logs)
 - :mod:`.integrator_link` (one integrator's session: frames in, bytes out; no sockets)

@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import argparse
 import logging
-import time
 
 from services.rig.openprotocol.simulated_controller import SimulatedController
+from services.rig.openprotocol.tightening_counter import TighteningCounter
 from services.rig.selection import choose_program, choose_seed
 from shared.config import load_station
 from shared.errors import ConfigError
@@ -32,7 +32,8 @@ def main(args: argparse.Namespace) -> int:
     if args.runs is not None and args.runs < 1:
         raise ConfigError(f"--runs must be at least 1 (got {args.runs})")
     seed = choose_seed(args.seed, config.rig.seed)
-    first_id = args.first_run_id if args.first_run_id is not None else int(time.time())
+    counter = TighteningCounter.of_station(station.recordings_folder, config.station.id)
+    first_id = args.first_run_id if args.first_run_id is not None else counter.last() + 1
     controller = SimulatedController(
         station,
         program,
@@ -40,6 +41,7 @@ def main(args: argparse.Namespace) -> int:
         seed=seed,
         runs=args.runs,
         wait_for_integrator=args.wait_for_integrator,
+        counter=counter,
     )
     section = config.openprotocol
     assert section is not None  # SimulatedController refused a station without it

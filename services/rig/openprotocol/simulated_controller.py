@@ -18,7 +18,8 @@ import time
 from services.rig.openprotocol.controller_server import ControllerServer
 from services.rig.openprotocol.controller_state import ControllerState
 from services.rig.openprotocol.simulated_tool import SimulatedTool
-from services.rig.openprotocol.tightening import TighteningJudge
+from services.rig.openprotocol.tightening import Tightening, TighteningJudge
+from services.rig.openprotocol.tightening_counter import TighteningCounter
 from shared.config.station import LoadedStation, Program
 from shared.errors import ConfigError
 from shared.model.stiffness import JointConstants
@@ -43,7 +44,9 @@ class SimulatedController:
         seed: int,
         runs: int | None = None,
         wait_for_integrator: bool = False,
+        counter: TighteningCounter | None = None,
     ) -> None:
+        """``counter``: where the last tightening id is kept across restarts (none: nowhere)."""
         config = station.config
         section = config.openprotocol
         if section is None:
@@ -76,9 +79,10 @@ class SimulatedController:
             config.rig,
             judge,
             has_force_sensor=config.station.has_force_sensor,
-            on_tightening=self.server.report,
+            on_tightening=self._tightened,
         )
         self._wait_for_integrator = wait_for_integrator
+        self._counter = counter
         self._tool_done = threading.Event()
         self._quiet_since: float | None = None
 
@@ -102,6 +106,11 @@ class SimulatedController:
             self.tool.run(self.seed, stop, self.runs, start)
         finally:
             self._tool_done.set()
+
+    def _tightened(self, tightening: Tightening) -> None:
+        if self._counter is not None:
+            self._counter.keep(tightening.tightening_id)
+        self.server.report(tightening)
 
     def _delivered(self) -> bool:
         """With ``runs``: the tool is done and nothing was outstanding for LINGER_S."""
