@@ -160,15 +160,15 @@ def _write(spec: Spec, value: object) -> str:
         if not isinstance(value, int | float) or not math.isfinite(value):
             raise ValueError(f"{value!r} is not a number")
         number = round(value * 100)
-        shown = f"{value}"
-    elif isinstance(value, int):  # bool and IntEnum too
-        number = int(value)
-        shown = f"{value!r}" if isinstance(value, enum.IntEnum) else f"{number}"
-    else:
+        if not 0 <= number < 10**spec.width:
+            raise ValueError(f"{value} is not in [0, {(10**spec.width - 1) / 100}]")
+        return f"{number:0{spec.width}d}"
+    if not isinstance(value, int):  # bool and IntEnum are
         raise ValueError(f"{value!r} is not a whole number")
+    number = int(value)
     if spec.kind == "enum" and spec.enum is not None and number not in set(spec.enum):
         raise ValueError(f"{number} is not a {spec.enum.__name__}")
-    _in_range(spec, number, shown)
+    _in_range(spec, number, f"{number}")
     return f"{number:0{spec.width}d}"
 
 
