@@ -15,9 +15,7 @@ Per station:
   SampleBatch), and, when
   two or more BusStats arrived, the acquisition's own count (``samples``
   delta over ``time_ns`` delta) -- the second tells a slow link from a slow bus;
-- bus faults: from the latest BusStats (counters since the acquisition started);
-  ``bad_frames`` = wrong_length + decode_errors + error_frames + counter_faults
-  (frames that were on our bus and unusable; foreign ``unknown_ids`` are not);
+- bus faults: from the latest BusStats (:mod:`services.cli.status_bus`);
 - last run: the latest ToolState; failing that the run of the latest Sample
   (then running), failing that the latest RunSummary;
 - last decision, last run summary: the latest of each, with its age;
@@ -32,7 +30,9 @@ Per station:
   (its error is the ``last_error``);
 - predictor: the latest PredictorStats (``boltwatch/<st>/predictor``, once a
   second): payloads it refused, samples its core could not use, samples of
-  no running run, runs whose end never arrived.
+  no running run, runs whose end never arrived;
+- a controller bridge's link, faults and newest active alarm, for a station
+  with one (:mod:`services.cli.status_bridge`).
 """
 
 from __future__ import annotations
@@ -41,6 +41,9 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
+from services.cli.status_bridge import TOPICS as BRIDGE_TOPICS
+from services.cli.status_bridge import BridgeSeen, BridgeStatus, bridge_status
+from services.cli.status_bus import BusHealth, bus_health, bus_rate
 from services.cli.status_last_result import LastResult, last_result
 from shared import channels, keys
 from shared.codec import decode
@@ -91,25 +94,8 @@ class _Seen:
     recorder_received_ns: int = 0
     predictor: PredictorStats | None = None
     predictor_received_ns: int = 0
+    bridge: BridgeSeen = field(default_factory=BridgeSeen)
     unreadable: int = 0
-
-
-@dataclass(frozen=True)
-class BusHealth:
-    age_s: float  # since the latest BusStats was received
-    frames: int
-    samples: int
-    counter_gaps: int
-    missed_samples: int
-    bad_frames: int
-    unknown_ids: int
-    receive_errors: int
-    unpaired: int
-    orphans: int
-    stop_commands: int
-    unsent_samples: int  # published with no router reachable
-    late_decisions: int  # decisions for a run the tool was no longer running
-    bad_decisions: int = 0  # decision payloads refused (not a valid StopDecision)
 
 
 @dataclass(frozen=True)
@@ -184,6 +170,7 @@ class StationStatus:
     unreadable_messages: int
     predictor: PredictorHealth | None = None  # None: no PredictorStats in the window
     last_result: LastResult | None = None  # None: no TighteningResult in the window
+    bridge: BridgeStatus | None = None  # None: no controller bridge spoke in the window
 
 
 @dataclass(frozen=True)
@@ -247,6 +234,8 @@ class StatusCollector:
             elif topic == channels.PREDICTOR.topic:
                 seen.predictor = decode(PredictorStats, payload)
                 seen.predictor_received_ns = received_ns
+            elif topic in BRIDGE_TOPICS:
+                seen.bridge.take(topic, payload, received_ns)
         except InputError:
             seen.unreadable += 1
 
@@ -267,8 +256,8 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
         station=name,
         services=services,
         samples_per_s=round(seen.samples / listened_s, 1) if listened_s > 0 else 0.0,
-        bus_samples_per_s=_bus_rate(seen.first_bus, seen.bus),
-        bus=_bus_health(seen.bus, seen.bus_received_ns, now_ns),
+        bus_samples_per_s=bus_rate(seen.first_bus, seen.bus),
+        bus=bus_health(seen.bus, seen.bus_received_ns, now_ns),
         last_run=_last_run(seen.tool, last_sample, seen.summary),
         last_decision=_last_decision(seen.decision, now_ns),
         last_summary=_last_summary(seen.summary, now_ns),
@@ -276,6 +265,7 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
         unreadable_messages=unreadable,
         predictor=_predictor_health(seen.predictor, seen.predictor_received_ns, now_ns),
         last_result=last_result(seen.result, now_ns),
+        bridge=bridge_status(seen.bridge, now_ns),
     )
 
 
@@ -286,39 +276,6 @@ def _decode_sample(payload: bytes | Sample | None) -> Sample | None:
         return decode(Sample, payload)
     except InputError:
         return None
-
-
-def _bus_rate(first: BusStats | None, latest: BusStats | None) -> float | None:
-    """Samples per second the acquisition counted between two BusStats."""
-    if first is None or latest is None or latest.time_ns <= first.time_ns:
-        return None
-    if latest.samples < first.samples:  # the acquisition restarted in the window
-        return None
-    return round((latest.samples - first.samples) / ((latest.time_ns - first.time_ns) / _NS), 1)
-
-
-def _bus_health(stats: BusStats | None, received_ns: int, now_ns: int) -> BusHealth | None:
-    if stats is None:
-        return None
-    return BusHealth(
-        age_s=_age_s(received_ns, now_ns),
-        frames=stats.frames,
-        samples=stats.samples,
-        counter_gaps=stats.counter_gaps,
-        missed_samples=stats.missed_samples,
-        bad_frames=stats.wrong_length
-        + stats.decode_errors
-        + stats.error_frames
-        + stats.counter_faults,
-        unknown_ids=stats.unknown_ids,
-        receive_errors=stats.receive_errors,
-        unpaired=stats.unpaired,
-        orphans=stats.orphans,
-        stop_commands=stats.stop_commands,
-        unsent_samples=stats.unsent_samples,
-        late_decisions=stats.late_decisions,
-        bad_decisions=stats.bad_decisions,
-    )
 
 
 def _recorder_health(

@@ -18,6 +18,7 @@ from services.cli.station_status import (
     StationStatus,
     StatusReport,
 )
+from services.cli.status_bridge import bridge_lines
 from services.cli.status_last_result import result_text
 
 
@@ -60,6 +61,7 @@ def _station_lines(status: StationStatus) -> list[str]:
         line("last result", result_text(status.last_result)),
         line("predictor", _predictor_text(status.predictor)),
         line("recorder", _recorder_text(status.recorder)),
+        *(line(label, text) for label, text in bridge_lines(status.bridge)),
     ]
     if status.unreadable_messages:
         out.append(line("unreadable", f"{status.unreadable_messages} messages"))

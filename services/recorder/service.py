@@ -229,12 +229,11 @@ class RecorderService:
             if received.schema_name == _BUS_STATS and received.message is not None:
                 bus = received.message
                 self.health.bus_stats(received.station, bus.samples, bus.started_ns)
-        if (
-            self.wear is not None
-            and received.schema_name == channels.RUNS.schema_name
-            and received.message is not None
-        ):
-            self.wear.on_summary(received.message, now_ns)
+        if self.wear is not None and received.message is not None:
+            if received.schema_name == channels.RUNS.schema_name:
+                self.wear.on_summary(received.message, now_ns)
+            elif received.schema_name == channels.TOOL_DATA.schema_name:
+                self.wear.on_tool_data(received.message, now_ns)
 
     def _file_batch(self, batch: Received, filed_ns: int) -> None:
         """Each sample of a batch, as a sample that came alone (a refused batch is filed raw

@@ -1,6 +1,7 @@
 """The wear ledger: accumulated vibration intensity per tool (eq. 69).
 
 - :mod:`.wear_ledger`: the SQLite ledger
+- :mod:`.wear_tool_data`: what controllers said of their tools (serial, calibration, service)
 - :mod:`.wear_bound`: what a run can have taken, the bound a summary must keep
 - :mod:`.wear_ledger_file`: a ledger made whole; a broken one recognised and moved aside
 - :mod:`.wear_watch`: summaries in, alerts out, a failing or broken ledger waited out

@@ -36,24 +36,29 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from services.recorder.wear import wear_tool_data
 from services.recorder.wear.wear_bound import RefusedSummaryError, RunLimits, refusal
 from services.recorder.wear.wear_ledger_file import (
+    LEDGER_VERSION,
     BrokenLedgerError,
     create_ledger,
     file_problem,
     identity,
     is_broken_error,
+    migrate,
     schema_problem,
 )
+from services.recorder.wear.wear_tool_data import ControllerTool
 from shared.errors import InputError
-from shared.messages import RunSummary
+from shared.messages import RunSummary, ToolData
 
 LOG = logging.getLogger(__name__)
 
 LEDGER_FILE = "wear.sqlite"
 WORST_RUNS = 3
 
-_SCHEMA = """
+_SCHEMA = (
+    """
 CREATE TABLE IF NOT EXISTS runs (
     station TEXT NOT NULL,
     run_id INTEGER NOT NULL,
@@ -77,6 +82,8 @@ CREATE TABLE IF NOT EXISTS services (
     note TEXT NOT NULL
 );
 """
+    + wear_tool_data.SCHEMA
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -101,6 +108,9 @@ class ToolWear:
     intensity_since_service: float
     worst_runs: list[RunWear] = field(default_factory=list)
     stations: list[str] = field(default_factory=list)  # where its runs were, by name
+    # what its controller said of it last (serial, counters, calibration, service); None:
+    # no controller bridge spoke of it
+    controller: ControllerTool | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -144,7 +154,7 @@ class WearLedger:
                 raise BrokenLedgerError(self.path, problem)
             if not read_only:
                 db.execute("PRAGMA journal_mode=WAL")
-                db.executescript(_SCHEMA)
+                self._migrate(db)
         except (sqlite3.Error, BrokenLedgerError) as err:
             if db is not None:
                 db.close()
@@ -154,6 +164,17 @@ class WearLedger:
                 raise BrokenLedgerError(self.path, str(err)) from err
             raise InputError(f"{self.path}: not a usable wear ledger: {err}") from err
         self._db = db
+
+    def _migrate(self, db: sqlite3.Connection) -> None:
+        was = migrate(db, _SCHEMA)
+        if was is not None:
+            LOG.info(
+                "wear ledger %s: version %d made version %d (tool data added; its runs and "
+                "services kept)",
+                self.path,
+                was,
+                LEDGER_VERSION,
+            )
 
     @contextlib.contextmanager
     def _reading_the_file(self) -> Iterator[None]:
@@ -210,6 +231,11 @@ class WearLedger:
             )
         return cursor.rowcount == 1
 
+    def add_tool_data(self, data: ToolData, recorded_ns: int) -> bool:
+        """Keep what a controller said of a tool; False when a newer one is kept already."""
+        with self._reading_the_file():
+            return wear_tool_data.store(self._db, data, recorded_ns)
+
     def record_service(self, tool_id: int, note: str, serviced_ns: int) -> None:
         """A service of ``tool_id`` now: starts a new interval, keeps the history."""
         with self._reading_the_file(), self._db:
@@ -226,13 +252,12 @@ class WearLedger:
     def _tool_ids(self, station: str | None) -> list[int]:
         if station is not None:
             rows = self._db.execute(
-                "SELECT DISTINCT tool_id FROM runs WHERE station = ? ORDER BY tool_id", (station,)
+                "SELECT DISTINCT tool_id FROM runs WHERE station = ?", (station,)
             )
         else:
-            rows = self._db.execute(
-                "SELECT tool_id FROM runs UNION SELECT tool_id FROM services ORDER BY tool_id"
-            )
-        return [int(tool_id) for (tool_id,) in rows]
+            rows = self._db.execute("SELECT tool_id FROM runs UNION SELECT tool_id FROM services")
+        found = {int(tool_id) for (tool_id,) in rows}
+        return sorted(found.union(wear_tool_data.tool_ids(self._db, station)))
 
     def tools(self, station: str | None = None) -> list[ToolWear]:
         """Every tool's line (or of the tools that ran at ``station``, whole totals), by id."""
@@ -267,6 +292,7 @@ class WearLedger:
             stations = self._db.execute(
                 "SELECT DISTINCT station FROM runs WHERE tool_id = ? ORDER BY station", (tool_id,)
             ).fetchall()
+            controller = wear_tool_data.newest(self._db, tool_id)
         return ToolWear(
             tool_id=tool_id,
             runs=int(runs),
@@ -278,6 +304,7 @@ class WearLedger:
             intensity_since_service=float(total_since),
             worst_runs=[RunWear(str(s), int(r), float(i), int(e)) for s, r, i, e in worst],
             stations=[str(name) for (name,) in stations],
+            controller=controller,
         )
 
     def close(self) -> None:

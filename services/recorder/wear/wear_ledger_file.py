@@ -14,6 +14,14 @@ to do: ``boltwatch wear reset`` moves it aside (:func:`move_aside`: the file
 and its ``-wal`` and ``-shm`` as ``wear.sqlite.broken-<UTC stamp>[-wal|-shm]``,
 kept, so SQLite still reads them together) and starts a new ledger.
 
+The ledger's version is SQLite's ``PRAGMA user_version``
+(:data:`LEDGER_VERSION`): 0 or 1 for a ledger of runs and services only, 2
+with the ``tool_data`` table (:mod:`.wear_tool_data`). A table that came
+with a later version may be missing (the writer adds it, :func:`migrate`:
+nothing of the file is lost); every table that is there must have its
+columns; a ledger of a newer version than this boltwatch knows is not
+written into.
+
 Whether a process has the ledger open is what SQLite's WAL mode itself
 shows (:func:`holder_pid`): every connection holds a read lock on the "DMS"
 byte of the ``-shm`` file (offset 128, SQLite's ``UNIX_SHM_DMS``) for as
@@ -31,6 +39,7 @@ import struct
 from datetime import UTC, datetime
 from pathlib import Path
 
+from services.recorder.wear import wear_tool_data
 from shared.errors import InputError
 
 #: The first 16 bytes of every SQLite 3 database file.
@@ -50,7 +59,12 @@ COLUMNS = {
         "process_intensity", "started_ns", "ended_ns", "recorded_ns",
     ),
     "services": ("id", "tool_id", "serviced_ns", "note"),
+    wear_tool_data.TABLE: wear_tool_data.COLUMNS,
 }  # fmt: skip
+#: ``PRAGMA user_version`` of a ledger this boltwatch writes: 2 since the tool_data table
+LEDGER_VERSION = 2
+#: tables added by a later version (table -> its version): missing in an older ledger
+ADDED_IN = {wear_tool_data.TABLE: 2}
 _NEW_PREFIX = "new-"
 
 
@@ -98,13 +112,33 @@ def schema_problem(db: sqlite3.Connection) -> str | None:
     (application_id,) = db.execute("PRAGMA application_id").fetchone()
     if application_id not in (0, APPLICATION_ID):  # 0: a ledger made before the id
         return f"another application's SQLite file (application_id {application_id:#x})"
+    (version,) = db.execute("PRAGMA user_version").fetchone()
+    if version > LEDGER_VERSION:
+        return (
+            f"a ledger of version {version}, newer than this boltwatch knows "
+            f"({LEDGER_VERSION}): update boltwatch"
+        )
     for table, expected in COLUMNS.items():
         columns = tuple(row[1] for row in db.execute(f"PRAGMA table_info({table})"))
+        if not columns and table in ADDED_IN:
+            continue  # an older ledger: the writer adds it (migrate)
         if not columns:
             return f"another schema: no table {table!r}"
         if columns != expected:
             return f"another schema: table {table!r} has columns {', '.join(columns)}"
     return None
+
+
+def migrate(db: sqlite3.Connection, schema: str) -> int | None:
+    """Bring an open ledger (checked by :func:`schema_problem`) to :data:`LEDGER_VERSION`:
+    the tables it lacks added from ``schema`` (``CREATE TABLE IF NOT EXISTS``), in one
+    transaction; the version it had, or None when it was current."""
+    (version,) = db.execute("PRAGMA user_version").fetchone()
+    if version == LEDGER_VERSION:
+        db.executescript(schema)  # nothing to add; indexes of a ledger made by hand
+        return None
+    db.executescript(f"BEGIN; {schema} PRAGMA user_version = {LEDGER_VERSION}; COMMIT;")
+    return int(version)
 
 
 def create_ledger(path: Path, schema: str) -> None:
@@ -119,6 +153,7 @@ def create_ledger(path: Path, schema: str) -> None:
         db = sqlite3.connect(temporary)
         try:
             db.execute(f"PRAGMA application_id = {APPLICATION_ID}")
+            db.execute(f"PRAGMA user_version = {LEDGER_VERSION}")
             db.execute("PRAGMA journal_mode=WAL")
             db.executescript(schema)
         finally:

@@ -13,7 +13,8 @@ answered (``host`` and ``ledger`` say which). Merging:
   over runs, and each run is in exactly one ledger: runs are keyed by station,
   and a station belongs to one line), the runs and intensity since service;
   its worst runs are the worst of all; its stations the union; its last
-  service the latest any ledger holds.
+  service the latest any ledger holds; what its controller said of it (serial,
+  calibration) the newest any ledger received.
 
 What a merge cannot make exact: a service is recorded in one ledger
 (``boltwatch wear service`` on that line); another line's ledger that has runs
@@ -30,6 +31,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from services.recorder.wear.wear_ledger import WORST_RUNS, RunWear, ToolWear
+from services.recorder.wear.wear_tool_data import ControllerTool
 from shared.errors import InputError
 
 
@@ -57,6 +59,8 @@ def _tool(line: dict[str, Any]) -> ToolWear:
     fields = dict(line)
     fields["worst_runs"] = [RunWear(**run) for run in line["worst_runs"]]
     fields["stations"] = list(line["stations"])
+    controller = line.get("controller")  # absent in a reply of a ledger before tool data
+    fields["controller"] = None if controller is None else ControllerTool.from_dict(controller)
     return ToolWear(**fields)
 
 
@@ -86,6 +90,7 @@ def _merged(parts: list[ToolWear]) -> ToolWear:
     total = sum(part.total_intensity for part in parts)
     serviced = [part for part in parts if part.last_service_ns is not None]
     latest = max(serviced, key=lambda part: part.last_service_ns or 0) if serviced else None
+    said = [part.controller for part in parts if part.controller is not None]
     worst = sorted(
         (run for part in parts for run in part.worst_runs),
         key=lambda run: (-run.process_intensity, run.ended_ns),
@@ -101,4 +106,5 @@ def _merged(parts: list[ToolWear]) -> ToolWear:
         intensity_since_service=sum(part.intensity_since_service for part in parts),
         worst_runs=worst,
         stations=sorted({name for part in parts for name in part.stations}),
+        controller=max(said, key=lambda tool: tool.received_ns) if said else None,
     )

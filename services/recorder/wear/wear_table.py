@@ -1,4 +1,11 @@
-"""The wear ledger as a table for people (``boltwatch wear``)."""
+"""The wear ledger as a table for people (``boltwatch wear``).
+
+Beside each tool: its serial, and the dates of its last calibration and
+service, when a controller said them (a controller bridge's ToolData: ``-``
+otherwise). ``last service`` is the service recorded in boltwatch (``boltwatch
+wear service``), from which "since service" counts; ``tool service`` is the
+controller's date.
+"""
 
 from __future__ import annotations
 
@@ -8,12 +15,15 @@ from services.recorder.wear.wear_ledger import ToolWear
 
 HEADER = (
     "tool",
+    "serial",
     "runs",
     "I_total",
     "I/run",
     "I since service",
     "runs since",
     "last service",
+    "calibrated",
+    "tool service",
     "stations",
     "worst runs",
 )
@@ -32,17 +42,32 @@ def row(wear: ToolWear) -> tuple[str, ...]:
     service = utc_text(wear.last_service_ns)
     if wear.last_service_note:
         service += f" ({wear.last_service_note})"
+    said = wear.controller
     return (
         str(wear.tool_id),
+        said.tool_serial if said else "-",
         str(wear.runs),
         f"{wear.total_intensity:.4g}",
         f"{wear.intensity_per_run:.3g}",
         f"{wear.intensity_since_service:.4g}",
         str(wear.runs_since_service),
         service,
+        _said_date(said.last_calibration_ns if said else None),
+        _said_date(said.last_service_ns if said else None),
         ",".join(wear.stations) or "-",
         worst or "-",
     )
+
+
+def _said_date(time_ns: int | None) -> str:
+    """A date a controller keeps (calibration, service): its day; ``-`` when not said."""
+    if time_ns is None:
+        return "-"
+    return f"{datetime.fromtimestamp(time_ns / 1e9, UTC):%Y-%m-%d}"
+
+
+#: the columns of numbers, right-aligned
+_NUMBERS = frozenset(("runs", "I_total", "I/run", "I since service", "runs since"))
 
 
 def format_table(tools: list[ToolWear], station: str | None = None) -> str:
@@ -56,7 +81,7 @@ def format_table(tools: list[ToolWear], station: str | None = None) -> str:
     lines = []
     for r in rows:
         cells = [
-            cell.rjust(width) if i < 6 else cell.ljust(width)
+            cell.rjust(width) if HEADER[i] in _NUMBERS or i == 0 else cell.ljust(width)
             for i, (cell, width) in enumerate(zip(r, widths, strict=False))
         ]
         lines.append("  ".join([*cells, r[-1]]))

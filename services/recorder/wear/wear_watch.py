@@ -1,5 +1,10 @@
 """Keeps the wear ledger up to date from RunSummaries and alerts when a tool is due.
 
+What a controller says of its tool (a bridge's :class:`~shared.messages.ToolData`)
+goes in beside the runs (:mod:`.wear_tool_data`); while the ledger fails the
+newest of each (station, tool) waits in memory (not kept on disk at a stop: a
+bridge says it again at its next connection).
+
 After each new run the tool's intensity since its last service is compared
 with ``recorder.wear_service_threshold``; at or above it a :class:`WearAlert`
 is published on ``boltwatch/<station>/wear/alert`` after every run until the
@@ -43,7 +48,7 @@ from services.recorder.wear.wear_ledger import ToolWear, WearLedger
 from services.recorder.wear.wear_ledger_file import BrokenLedgerError
 from services.recorder.wear.wear_waiting import load_waiting, save_waiting, waiting_path
 from shared.errors import InputError
-from shared.messages import RunSummary, WearAlert
+from shared.messages import RunSummary, ToolData, WearAlert
 
 LOG = logging.getLogger(__name__)
 
@@ -72,6 +77,9 @@ class WearWatch:
         self._limits = limits
         self._due: set[int] = set()
         self._pending: deque[tuple[RunSummary, int]] = deque(maxlen=PENDING_LIMIT)
+        #: what controllers said of their tools, waiting for the ledger: newest per tool
+        self._tool_data: dict[tuple[str, int], tuple[ToolData, int]] = {}
+        self.tool_data_kept = 0
         self.counted = 0
         self.repeated = 0
         self.refused: Counter[str] = Counter()  # by station
@@ -111,12 +119,21 @@ class WearWatch:
         self._pending.append((summary, now_ns))
         return self._write(now_ns, count_errors=True)
 
+    def on_tool_data(self, data: ToolData, now_ns: int) -> None:
+        """Keep what a controller said of a tool (the newest per station and tool)."""
+        key = (data.station, data.tool_id)
+        waiting = self._tool_data.get(key)
+        if waiting is None or data.time_ns >= waiting[0].time_ns:
+            self._tool_data[key] = (data, now_ns)
+        self._write(now_ns, count_errors=True)
+
     def tick(self, now_ns: int) -> None:
         """Look at the ledger's file now and then; put waiting summaries in when it works."""
         if now_ns < self._check_at_ns:
             return
         self._check_at_ns = now_ns + CHECK_INTERVAL_NS
-        if self._ledger is None and not self._pending and not self._ledger_file.exists():
+        nothing_waits = not self._pending and not self._tool_data
+        if self._ledger is None and nothing_waits and not self._ledger_file.exists():
             return  # no ledger yet and nothing to count: made by the first summary
         self._write(now_ns, count_errors=False)
         if self.last_ledger_error is not None and now_ns >= self._remind_at_ns:
@@ -140,6 +157,10 @@ class WearWatch:
                 except RefusedSummaryError as err:  # its limits changed while it waited
                     self._refuse(err, now_ns)
                 self._pending.popleft()
+            while self._tool_data:
+                key, (data, received_ns) = next(iter(self._tool_data.items()))
+                self.tool_data_kept += ledger.add_tool_data(data, received_ns)
+                del self._tool_data[key]
             if self._waiting_file.exists():  # every run kept there is in the ledger now
                 self._waiting_file.unlink()
         except BrokenLedgerError as err:

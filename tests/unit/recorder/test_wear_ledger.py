@@ -102,8 +102,8 @@ def test_cli_prints_the_table_and_records_services(
         ledger.add_run(summary(1, 1.5), T0_NS, LIMITS)
     assert main(["wear", "--recordings", str(tmp_path)]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0].split()[:4] == ["tool", "runs", "I_total", "I/run"]
-    assert lines[1].split()[:4] == ["7", "1", "1.5", "1.5"]
+    assert lines[0].split()[:5] == ["tool", "serial", "runs", "I_total", "I/run"]
+    assert lines[1].split()[:5] == ["7", "-", "1", "1.5", "1.5"]  # no controller said a serial
     service = ["wear", "service", "7", "--note", "new socket"]
     assert main([*service, "--recordings", str(tmp_path)]) == 0
     out = capsys.readouterr().out
@@ -138,7 +138,7 @@ def test_a_tool_is_one_asset_across_stations_and_a_station_lists_its_tools(
     table = capsys.readouterr().out.splitlines()
     assert "stations" in table[0]
     (line,) = table[1:]
-    assert line.split()[:3] == ["7", "2", "3"]  # whole totals, st1 and st2
+    assert line.split()[:4] == ["7", "-", "2", "3"]  # whole totals, st1 and st2
     assert "st1,st2" in line
     assert main(["wear", "--recordings", str(tmp_path), "--station", "st9"]) == 0
     assert "no runs at station st9" in capsys.readouterr().out

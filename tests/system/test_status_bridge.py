@@ -1,0 +1,116 @@
+"""``boltwatch status`` of a station with a controller bridge (issue 18 §2), as a real process
+against a real router: a fake bridge (a zenoh client session of the test) keeps publishing
+BridgeStats and alarms; status shows the link, the faults that are not zero, the last
+tightening id and the newest active alarm."""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from shared import channels, keys
+from shared.codec import encode
+from shared.messages import BridgeStats, ControllerAlarm
+from shared.zenoh_session import open_from, zenoh_config
+from tests.fuzz.payloads import template
+from tests.system.station_files import write_station
+from tests.system.test_status_command import boltwatch, router  # noqa: F401  (the fixture)
+
+pytestmark = pytest.mark.system
+
+STATION = "op-st4"
+S_NS = 1_000_000_000
+
+
+def bridge_stats(now_ns: int) -> BridgeStats:
+    stats: BridgeStats = template("openprotocol", STATION, now_ns, run_id=4711)
+    return replace(
+        stats,
+        connected=False,
+        connects=3,
+        link_drops=2,
+        results_filled=1,
+        garbage_bytes=17,
+        refused_values=1,
+        last_error="link dropped: no data for 15 s",
+    )
+
+
+def alarms(now_ns: int) -> list[ControllerAlarm]:
+    older = ControllerAlarm(
+        STATION, now_ns - 60 * S_NS, now_ns, "E101", "raised", True, None, None, ""
+    )
+    return [
+        older,
+        replace(older, time_ns=now_ns - 50 * S_NS, kind="acknowledged", active=False),
+        ControllerAlarm(
+            STATION, now_ns - 5 * S_NS, now_ns, "E404", "raised", True, False, True, "overheated"
+        ),
+        ControllerAlarm(
+            STATION, now_ns - 90 * S_NS, now_ns, "E7", "raised", True, None, None, "older"
+        ),
+    ]
+
+
+def test_status_shows_the_bridge_link_its_faults_and_the_newest_active_alarm(
+    router: str,  # noqa: F811
+    tmp_path: Path,
+) -> None:
+    station_file = write_station(tmp_path, zenoh_port=int(router.rsplit(":", 1)[1]))
+    session = open_from(zenoh_config("client", [router], connect_timeout_ms=5000))
+    token = session.liveliness().declare_token(keys.health_key(STATION, "openprotocol"))
+    stop = threading.Event()
+
+    def publish() -> None:
+        while not stop.is_set():
+            now = time.time_ns()
+            session.put(channels.OPENPROTOCOL.key(STATION), encode(bridge_stats(now)))
+            for alarm in alarms(now):
+                session.put(channels.ALARMS.key(STATION), encode(alarm))
+            time.sleep(0.1)
+
+    thread = threading.Thread(target=publish, name="fake-bridge")
+    thread.start()
+    try:
+        text = boltwatch("status", "--config", str(station_file), "--listen-s", "1.2")
+        as_json = boltwatch("status", "--config", str(station_file), "--listen-s", "1.2", "--json")
+    finally:
+        stop.set()
+        thread.join(10)
+        token.undeclare()
+        session.close()
+
+    assert text.returncode == 0, text.stderr
+    block = text.stdout.split(f"station {STATION}\n", 1)[1]
+    lines = {line[:16].strip(): line[16:] for line in block.splitlines()}
+    assert "openprotocol up" in lines["services"]
+    assert lines["controller"].startswith(
+        "NOT CONNECTED to 192.0.2.10:4545, MID 0061 revision 2, 4711 results, last tightening "
+        "4711 (3 connects, "
+    )
+    assert lines["controller"].endswith("; last error: link dropped: no data for 15 s")
+    assert lines["bridge faults"] == (
+        "2 link drops, 1 results filled after a reconnect, 17 garbage bytes, 1 refused values"
+    )
+    assert lines["alarm"].startswith("E404 raised, 5.")
+    assert lines["alarm"].endswith(": overheated (controller NOT ready, tool ready)")
+
+    assert as_json.returncode == 0, as_json.stderr
+    bridge = json.loads(as_json.stdout)["stations"][STATION]["bridge"]
+    assert (bridge["controller"], bridge["connected"], bridge["last_tightening_id"]) == (
+        "192.0.2.10:4545",
+        False,
+        4711,
+    )
+    assert bridge["faults"] == {
+        "link_drops": 2,
+        "results_filled": 1,
+        "garbage_bytes": 17,
+        "refused_values": 1,
+    }
+    assert bridge["alarm"]["error_code"] == "E404"
