@@ -60,8 +60,10 @@ LOG = logging.getLogger(__name__)
 
 #: how long one read waits before the bridge looks at its timers again (seconds)
 POLL_S = 0.05
-#: MIDs of the answers to 0064
+#: the MID of the answer to 0064
 OLD_RESULT = 65
+#: 0004 error code: tightening id not found (0064 id 0 on a controller with no result yet)
+NOT_FOUND = 15
 
 
 class OpenProtocolBridge:
@@ -106,7 +108,6 @@ class OpenProtocolBridge:
         section = self._section
         pause_s = section.reconnect_min_s
         while not stop.is_set():
-            started = False
             try:
                 with ControllerLink(
                     section.host,
@@ -119,14 +120,14 @@ class OpenProtocolBridge:
                     )
                     self._session = session
                     self._start(session)
-                    started = True
                     pause_s = section.reconnect_min_s
                     self._serve(session, stop)
                     session.stop()
                     return
             except LinkLostError as err:
-                if started:
+                if self._counts.connected:  # the session had started (0002)
                     self._counts.link_drops += 1
+                    pause_s = section.reconnect_min_s
                 self._counts.fault("link", f"link to {self._counts.controller} lost: {err}")
             finally:
                 self._session = None
@@ -173,7 +174,9 @@ class OpenProtocolBridge:
     # -- filling the gap -----------------------------------------------------------------
 
     def _fill_from_newest(self, session: ControllerSession) -> None:
-        reply = session.request(OldResultRequest(tightening_id=0), {OLD_RESULT})
+        reply = session.request(
+            OldResultRequest(tightening_id=0), {OLD_RESULT}, expected_errors=(NOT_FOUND,)
+        )
         if isinstance(reply, CommandError):  # no result yet on the controller
             return
         if isinstance(reply, RefusedFrame):

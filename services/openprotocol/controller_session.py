@@ -93,6 +93,8 @@ class ControllerSession:
         self._heard = now
         self._mirrors = False  # the controller has mirrored a keep-alive on this link
         self.controller_name = ""
+        self._garbage_seen = 0  # the link's reader counts since the link started
+        self._bad_frames_seen = 0
 
     # -- writing -----------------------------------------------------------------------
 
@@ -140,16 +142,22 @@ class ControllerSession:
                 return None
         return None
 
-    def request(self, message: Any, replies: set[int]) -> Any:
+    def request(
+        self, message: Any, replies: set[int], expected_errors: tuple[int, ...] = ()
+    ) -> Any:
         """Write ``message``; its answer: a message of a MID in ``replies``, or the 0004 /
-        0005 naming its MID. What comes meanwhile is pushed. LinkLostError when none comes."""
+        0005 naming its MID (a 0004 is counted unless its code is in ``expected_errors``).
+        What comes meanwhile is pushed. LinkLostError when none comes."""
         asked = _mid_of(message)
         self.send(message)
         deadline = self._clock() + self.dead_after_s
         while True:
             for decoded in self._receive(deadline - self._clock()):
                 if _answers(decoded, asked, replies):
-                    if isinstance(decoded, CommandError):
+                    if (
+                        isinstance(decoded, CommandError)
+                        and decoded.error_code not in expected_errors
+                    ):
                         self._counts.controller_errors += 1
                     return decoded
                 self._push(decoded)
@@ -174,7 +182,14 @@ class ControllerSession:
         self.keep_alive()
         wait_s = min(max(0.0, timeout_s), max(0.0, self._next_keep_alive - self._clock()))
         frames = self._link.receive(wait_s)
-        self._counts.garbage_bytes = self._link.garbage_bytes
+        counts = self._counts
+        counts.garbage_bytes += self._link.garbage_bytes - self._garbage_seen
+        self._garbage_seen = self._link.garbage_bytes
+        bad_frames = self._link.bad_frames - self._bad_frames_seen
+        if bad_frames:
+            self._bad_frames_seen = self._link.bad_frames
+            counts.bad_messages += bad_frames
+            counts.fault("bad message", "a message whose length does not fit: skipped")
         decoded: list[Any] = []
         if frames:
             self._heard = self._clock()
