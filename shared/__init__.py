@@ -10,7 +10,9 @@ codecs, zenoh and CAN helpers, and the paper's analytical model.
   key expressions), :mod:`.message_fields` (every field's bounds),
   :mod:`.codec` (JSON and schemas, pydantic), :mod:`.message_shape` (a refused
   payload looked at field by field), :mod:`.trace` (the offline CSV),
-  :mod:`.tightening_judgement` (a run's figures against its windows: OK/NOK)
+  :mod:`.tightening_judgement` (a run's figures against its windows: OK/NOK),
+  :mod:`.controller_judgement` (a controller's own result as a TighteningResult),
+  :mod:`.stopped_run` (a run a controller stopped, and the predictor's replay of it)
 - CAN: :mod:`.can_bus` (open the bus), :mod:`.can_database` (the DBC, checked),
   :mod:`.sensor_range` (what the sensors can measure)
 - zenoh: :mod:`.zenoh_session` (sessions, the router link), :mod:`.queued_publisher`

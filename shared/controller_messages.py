@@ -181,3 +181,5 @@ class BridgeStats:
     controller_errors: Count  # MID 0004 received
     last_tightening_id: Id | None
     last_error: str | None  # the newest fault, in one line; None: none since start
+    # results published without their curves (0900 never came within the bridge's timeout)
+    results_without_traces: Count = 0

@@ -12,7 +12,7 @@
   :mod:`.status_bridge` (a controller bridge's link, faults and alarms);
   with ``wear --plant``: :mod:`.router_client` (a client of the line's router)
 - ``boltwatch import``: :mod:`.import_destination` (recordings or trace CSVs),
-  :mod:`.controller_replay` (the predictor over an imported run: here, because
-  the recorder may not import the predictor)
+  :mod:`.controller_replay` (an imported run as the predictor's advisory replay
+  takes it: here, because the recorder may not import the predictor)
 - ``boltwatch predict``: :mod:`.predict_settings` (its options, or a station's program)
 """

@@ -8,7 +8,7 @@ when no result arrived for the run.
 
 from __future__ import annotations
 
-from shared.messages import RunSummary, TighteningResult
+from shared.messages import BridgeStats, RunSummary, TighteningResult
 
 COLUMNS = (
     ("run", 10),
@@ -77,3 +77,23 @@ def totals(summaries: list[RunSummary], results: list[TighteningResult] | None =
         if len(results) < len(summaries):
             line += f", {len(summaries) - len(results)} without a result"
     return line
+
+
+def bridge_line(stats: BridgeStats) -> str:
+    """The counters of an Open Protocol bridge, as ``up`` reports them at the end."""
+    faults = {
+        "link drops": stats.link_drops,
+        "repeated": stats.repeated_results,
+        "garbage bytes": stats.garbage_bytes,
+        "bad messages": stats.bad_messages,
+        "refused values": stats.refused_values,
+        "controller errors": stats.controller_errors,
+        "curves without result": stats.traces_without_result,
+        "results without curves": stats.results_without_traces,
+    }
+    noted = ", ".join(f"{count} {name}" for name, count in faults.items() if count)
+    return (
+        f"Open Protocol {stats.controller}: {stats.connects} connects, {stats.results} results "
+        f"({stats.results_filled} filled by id), {stats.traces} curves"
+        + (f"; {noted}" if noted else "")
+    )

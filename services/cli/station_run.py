@@ -10,6 +10,11 @@ table (a summary counts only for a run seen starting on the tool channel,
 once: :mod:`services.cli.run_tally`), ``results`` for its OK/NOK column (a
 run's result is published just before its summary), ``bus`` for each
 acquisition's counters.
+
+With ``controller="openprotocol"`` (one station) the rig is an Open Protocol
+controller on TCP and the bridge (``serve openprotocol``) stands in for the
+acquisition and the predictor; ``openprotocol`` (``BridgeStats``) gives the
+counters of the report's last lines.
 """
 
 from __future__ import annotations
@@ -29,14 +34,17 @@ from shared import channels, keys
 from shared.codec import decode
 from shared.config import LoadedStation, Program
 from shared.errors import BoltwatchError, TransportError
-from shared.messages import BusStats, RunSummary, TighteningResult, ToolState
+from shared.messages import BridgeStats, BusStats, RunSummary, TighteningResult, ToolState
 from shared.zenoh_session import open_from, zenoh_config
 
 LOG = logging.getLogger(__name__)
 
 #: every service whose liveliness token each station must show before the rigs start
-#: (an edge predictor's token comes from the station's acquisition)
-SERVICES = ("recorder", "predictor", "acquisition")
+#: (an edge predictor's token comes from the station's acquisition), per kind of controller
+SERVICES = {
+    "can": ("recorder", "predictor", "acquisition"),
+    "openprotocol": ("recorder", "openprotocol"),
+}
 SUMMARY_WAIT_S = 5.0
 RECORDER_DRAIN_S = 1.0
 #: above this many files the report counts recordings per station instead of listing them
@@ -55,7 +63,9 @@ class StationRun:
         runs: int,
         log_dir: Path,
         startup_timeout_s: float,
+        controller: str = "can",
     ) -> None:
+        self.controller = controller
         self.stations = [stations] if isinstance(stations, LoadedStation) else list(stations)
         self.station = self.stations[0]
         self.program = program
@@ -65,6 +75,7 @@ class StationRun:
         self.supervisor = StationSupervisor([s.path for s in self.stations], log_dir)
         self.tally = RunTally(s.station_id for s in self.stations)
         self.bus_stats: dict[str, BusStats] = {}
+        self.bridge_stats: dict[str, BridgeStats] = {}
         #: (station, run id) -> the run's result (its OK/NOK), as heard on its results key
         self.results: dict[tuple[str, int], TighteningResult] = {}
         self.started_s = time.time()
@@ -88,7 +99,7 @@ class StationRun:
         """The tools first, the recorder last (so that the recording holds everything)."""
         per_station = [
             [self.process_name(service, station_id) for station_id in self.station_ids]
-            for service in ("rig", "acquisition")
+            for service in ("rig", "acquisition", "openprotocol")
         ]
         return [*per_station, ["predictor"], ["recorder"], ["router"]]
 
@@ -113,21 +124,26 @@ class StationRun:
                 channels.RESULTS.topic,
                 channels.RUNS.topic,
                 channels.BUS.topic,
+                channels.OPENPROTOCOL.topic,
             )  # a run's start and its result before its summary
         ]
         self.supervisor.start("recorder")
         if self.line_predicted:
             self.supervisor.start("predictor", config_paths=[s.path for s in self.line_predicted])
+        station_service = "openprotocol" if self.controller == "openprotocol" else "acquisition"
         for station in self.stations:
-            name = self.process_name("acquisition", station.station_id)
-            self.supervisor.start("acquisition", name=name, config_paths=[station.path])
+            name = self.process_name(station_service, station.station_id)
+            self.supervisor.start(station_service, name=name, config_paths=[station.path])
         self._wait_until_alive()
         print(f"services up after {time.time() - self.started_s:.1f} s; tightening...\n")
         print(run_table.header(self.line))
+        rig_args = ["--runs", str(self.runs), "--program", str(self.program.id)]
+        if self.controller == "openprotocol":
+            rig_args += ["--controller", "openprotocol", "--wait-for-integrator"]
         rigs = [
             self.supervisor.start(
                 "rig",
-                ["--runs", str(self.runs), "--program", str(self.program.id)],
+                rig_args,
                 name=self.process_name("rig", station.station_id),
                 config_paths=[station.path],
             )
@@ -198,7 +214,11 @@ class StationRun:
     def _wait_until_alive(self) -> None:
         assert self._session is not None
         deadline = time.monotonic() + self.startup_timeout_s
-        missing = {(station_id, service) for station_id in self.station_ids for service in SERVICES}
+        missing = {
+            (station_id, service)
+            for station_id in self.station_ids
+            for service in SERVICES[self.controller]
+        }
         while missing:
             self._check_alive(expected_exits=set())
             for reply in self._session.liveliness().get(keys.health_key("*", "*")):
@@ -238,6 +258,9 @@ class StationRun:
                         print(self._row(summary), flush=True)
                 elif topic == channels.BUS.topic:
                     self.bus_stats[station_id] = decode(BusStats, sample.payload.to_bytes())
+                elif topic == channels.OPENPROTOCOL.topic:
+                    stats = decode(BridgeStats, sample.payload.to_bytes())
+                    self.bridge_stats[station_id] = stats
             except BoltwatchError as err:
                 LOG.warning("unreadable %s message: %s", topic, err)
 
@@ -295,6 +318,9 @@ class StationRun:
                     f"{stats.unknown_ids + stats.wrong_length + stats.decode_errors} bad frames, "
                     f"{stats.stop_commands} stop commands sent"
                 )
+            bridge = self.bridge_stats.get(station_id)
+            if bridge is not None:
+                print(run_table.bridge_line(bridge))
         self._report_recordings()
         print(f"logs: {self.supervisor.log_dir}")
         print(f"took {time.time() - self.started_s:.1f} s")

@@ -12,4 +12,6 @@
 - :mod:`.edge_predictor`: the station's predictor on its acquisition's CAN thread
   (``[predictor] placement = "edge"``, the default)
 - :mod:`.trace_replay`: the core over an offline trace (``boltwatch predict``)
+- :mod:`.advisory_replay`: the core over a run a controller stopped, after the fact
+  (``boltwatch import`` and the Open Protocol bridge)
 """

@@ -37,6 +37,10 @@ RUN_ID_MAX = 0xFFFF_FFFF  # RunId is 32 bits on CAN
 
 
 def main(args: argparse.Namespace) -> int:
+    if getattr(args, "controller", "can") == "openprotocol":
+        from services.rig.openprotocol.controller_service import main as openprotocol_main
+
+        return openprotocol_main(args)
     station = load_station(args.config)
     config = station.config
     program = choose_program(station, args.program)

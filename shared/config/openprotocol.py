@@ -10,11 +10,36 @@ controllers differ, a key says which form this controller uses
 (``trace_byte_order``, ``header_fill``).
 
 ``[rig.openprotocol]`` (:class:`RigOpenProtocolSection`) is the other side:
-how the simulated controller of ``services/rig`` behaves toward a bridge.
+how the simulated controller of ``services/rig`` behaves toward a bridge
+(``boltwatch serve rig --controller openprotocol``), which a real controller
+keeps in its own settings:
+
+- ``ack_timeout_s`` / ``result_resends``: a pushed result (MID 0061) not
+  acknowledged (0062) within ``ack_timeout_s`` is sent again, at most
+  ``result_resends`` times; then the link is dropped with every subscription
+  (3 re-sends as the issue and controller manuals say: the Sturtevant Richmont
+  Global 400 manual's Open Protocol settings give retries 3, ack timeout 10 s).
+- ``link_timeout_s``: a link silent this long is dropped (15 s, the specification).
+- ``mirror_keep_alive``: answer an integrator's keep-alive (9999) with one
+  (most controllers do); false: say nothing (some do; both are real).
+- ``results_kept``: how many tightenings the controller keeps, the newest, to
+  serve by id (0064 -> 0065) while nobody is connected or after.
+- ``max_result_revision``: the highest 0061/0065 revision it speaks (1 plays
+  an older controller: a request for 2 gets 0004 error 97).
+- ``vin_pattern``: the part id (VIN) of each tightening, a Python format text
+  naming ``{station}``, ``{tool_id}``, ``{tightening_id}``, ``{batch_counter}``
+  (at most 25 characters filled with the widest values and an 8-character
+  station id: the VIN field of 0061; a longer station id is cut when filled).
+- ``batch_size``: OK tightenings per batch (the batch counter counts them and
+  starts again at 1 after a complete batch); 0: no batch.
+- ``last_calibration`` / ``last_service``: the dates tool data (0041) gives;
+  none: the day the controller started.
 """
 
 from __future__ import annotations
 
+import datetime as dt
+import string
 import zoneinfo
 from typing import Literal
 
@@ -24,6 +49,15 @@ from shared.config.loading import StrictModel
 
 #: a controller drops a link silent this long (the public specification's 15 s)
 CONTROLLER_LINK_TIMEOUT_S = 15.0
+#: the VIN field of MID 0061 (25 characters)
+VIN_CHARS = 25
+#: the widest value of each name a VIN pattern may use (a station id: 8 characters kept)
+VIN_WIDEST: dict[str, str | int] = {
+    "station": "x" * 8,
+    "tool_id": 65535,
+    "tightening_id": 9_999_999_999,
+    "batch_counter": 9999,
+}
 
 
 class OpenProtocolSection(StrictModel):
@@ -106,3 +140,63 @@ class RigOpenProtocolSection(StrictModel):
         le=600,
         description="it drops a link silent this long",
     )
+    result_resends: int = Field(
+        default=3, ge=0, le=10, description="re-sends of an unacknowledged 0061, then a drop"
+    )
+    mirror_keep_alive: bool = Field(
+        default=True, description="answer a keep-alive (9999) with one; false: stay silent"
+    )
+    results_kept: int = Field(
+        default=1000,
+        ge=1,
+        le=100_000,
+        description="tightenings kept (with their traces) to serve by id (0064)",
+    )
+    max_result_revision: int = Field(
+        default=2, ge=1, le=2, description="highest 0061/0065 revision the controller speaks"
+    )
+    vin_pattern: str = Field(
+        default="SIM{tightening_id:010d}",
+        description="part id of each tightening: {station} {tool_id} {tightening_id} "
+        "{batch_counter}",
+    )
+    batch_size: int = Field(default=10, ge=0, le=9999, description="OK tightenings per batch")
+    last_calibration: dt.date | None = Field(default=None, description="none: the start day")
+    last_service: dt.date | None = Field(default=None, description="none: the start day")
+
+    @field_validator("vin_pattern")
+    @classmethod
+    def _vin_pattern_fits(cls, pattern: str) -> str:
+        try:
+            parsed = list(string.Formatter().parse(pattern))
+        except ValueError as err:
+            raise ValueError(f"not a format text: {err}") from err
+        names = {name for _, name, _, _ in parsed if name is not None}
+        unknown = names - set(VIN_WIDEST)
+        if unknown:
+            raise ValueError(
+                f"names {', '.join(repr(n) for n in sorted(unknown))}; expected only "
+                f"{', '.join(VIN_WIDEST)}"
+            )
+        try:
+            widest = pattern.format(**VIN_WIDEST)
+        except (KeyError, IndexError, ValueError) as err:
+            raise ValueError(f"cannot be filled in: {err}") from err
+        if not widest.isascii() or not widest.isprintable():
+            raise ValueError("must give printable ASCII")
+        if len(widest) > VIN_CHARS:
+            raise ValueError(
+                f"gives {len(widest)} characters at its widest, more than the {VIN_CHARS} "
+                "of the VIN field of MID 0061"
+            )
+        return pattern
+
+    def vin(self, station: str, tool_id: int, tightening_id: int, batch_counter: int) -> str:
+        """The part id of one tightening, cut to the 25 characters of the VIN field."""
+        text = self.vin_pattern.format(
+            station=station,
+            tool_id=tool_id,
+            tightening_id=tightening_id,
+            batch_counter=batch_counter,
+        )
+        return text[:VIN_CHARS]

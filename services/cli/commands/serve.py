@@ -16,13 +16,14 @@ from types import ModuleType
 
 from services.acquisition import arguments as acquisition_arguments
 from services.cli.command_options import add_station_file_option
+from services.openprotocol import arguments as openprotocol_arguments
 from services.predictor import arguments as predictor_arguments
 from services.recorder import arguments as recorder_arguments
 from services.rig import arguments as rig_arguments
 from services.router import arguments as router_arguments
 
 NAME = "serve"
-HELP = "run one long-running service (rig, acquisition, predictor, recorder, router)"
+HELP = "run one long-running service (rig, acquisition, predictor, recorder, router, openprotocol)"
 
 #: service name -> its arguments module (light: no heavy imports, so ``--help`` is fast)
 SERVICES: dict[str, ModuleType] = {
@@ -31,6 +32,7 @@ SERVICES: dict[str, ModuleType] = {
     "predictor": predictor_arguments,
     "recorder": recorder_arguments,
     "router": router_arguments,
+    "openprotocol": openprotocol_arguments,
 }
 
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR")
@@ -44,6 +46,8 @@ SERVICE_HELP = {
     "predictor": "the real-time stick-slip predictor: events, intensity, stop decisions",
     "recorder": "MCAP files per run",
     "router": "the line's zenoh router that stations connect to",
+    "openprotocol": "a tightening controller's results and curves over Open Protocol (TCP), "
+    "published as the station's runs",
 }
 
 
@@ -92,6 +96,11 @@ def _service_main(service: str) -> Callable[[argparse.Namespace], int]:
         from services.predictor.service import main as predictor_main
 
         return predictor_main
+    if service == "openprotocol":  # the predictor replays each run after the fact
+        from services.openprotocol.service import main as openprotocol_main
+        from services.predictor.advisory_replay import replay_run
+
+        return lambda args: openprotocol_main(args, replay=replay_run)
     if service == "recorder":
         from services.recorder.service import main as recorder_main
 

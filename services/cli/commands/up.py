@@ -7,6 +7,16 @@ until every service shows its liveliness token, lets the rig tighten
 in order and prints the table, the bus counters and where the recordings are.
 A service that dies is reported with the end of its log, and the rest stop.
 
+``--controller openprotocol`` runs the station without CAN: the rig is an
+Open Protocol controller (a TCP server on the station file's ``[openprotocol]``
+host:port, ``serve rig --controller openprotocol``) and the bridge (``serve
+openprotocol``) connects to it instead of an acquisition and a predictor; the
+predictor replays each run after the fact inside the bridge. A station file
+without an ``[openprotocol]`` section gets one for the simulated controller on
+this machine (127.0.0.1:4545, a derived file in the run's log folder). The first
+tightening waits until the bridge has subscribed to results (the operator waits
+for the line), the others keep the tool's pace.
+
 ``--stations N`` runs a line of N simulated stations on one router: N
 station files derived from ``--config`` (ids ``st1..stN`` when the base id is
 ``st1``, each with its own CAN multicast port, tool id and rig seed; see
@@ -23,6 +33,7 @@ import signal
 import sys
 import time
 from datetime import UTC, datetime
+from pathlib import Path
 from types import FrameType
 
 from services.cli.command_options import add_station_file_option
@@ -51,11 +62,32 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--program", type=int, default=None, help="program id (default: the first program)"
     )
     parser.add_argument(
+        "--controller",
+        choices=("can", "openprotocol"),
+        default="can",
+        help="can: rig and acquisition on a CAN bus (default); openprotocol: the rig as an "
+        "Open Protocol controller on the station's [openprotocol] host:port and the bridge",
+    )
+    parser.add_argument(
         "--startup-timeout-s",
         type=seconds,
         default=60.0,
         help="how long services may take to come up (default 60 s)",
     )
+
+
+def with_local_controller(config: Path, folder: Path) -> Path:
+    """A copy of the station file ``config`` (paths made absolute) with the section of the
+    simulated controller on this machine, ``[openprotocol] host = "127.0.0.1"`` (port 4545):
+    for a station file that has no ``[openprotocol]`` section of its own."""
+    from shared.config import derive_stations
+
+    (path,) = derive_stations(config, 1, folder)
+    path.write_text(
+        path.read_text() + "\n# boltwatch up --controller openprotocol: the simulated "
+        'controller on this machine\n[openprotocol]\nhost = "127.0.0.1"\n'
+    )
+    return path
 
 
 def run(args: argparse.Namespace) -> int:
@@ -83,6 +115,11 @@ def run(args: argparse.Namespace) -> int:
             f"{station.path}: zenoh: boltwatch up runs a router and needs mode = 'client' "
             "with connect = [its endpoint]"
         )
+    if args.controller == "openprotocol" and args.stations > 1:
+        raise ConfigError(
+            f"--stations {args.stations}: --controller openprotocol runs one station "
+            "(each station's controller needs its own [openprotocol] port)"
+        )
     if args.stations > 1:
         check_derivable(args.config, args.stations)  # its numbers, before anything is written
     station.make_recordings_folder()  # its logs go there too: refused now, naming the key
@@ -93,11 +130,15 @@ def run(args: argparse.Namespace) -> int:
         if args.stations == 1
         else load_line(derive_stations(args.config, args.stations, log_dir / "stations"))
     )
+    if args.controller == "openprotocol" and station.config.openprotocol is None:
+        stations = [load_station(with_local_controller(args.config, log_dir / "stations"))]
 
     def on_signal(signum: int, _frame: FrameType | None) -> None:
         raise StoppedBySignalError(signal.Signals(signum).name)
 
-    station_run = StationRun(stations, program, args.runs, log_dir, args.startup_timeout_s)
+    station_run = StationRun(
+        stations, program, args.runs, log_dir, args.startup_timeout_s, controller=args.controller
+    )
     previous = {s: signal.signal(s, on_signal) for s in (signal.SIGTERM, signal.SIGHUP)}
     try:
         return station_run.run()

@@ -4,8 +4,8 @@ Each :class:`ControllerRun` becomes the messages a live station publishes
 (``ToolState`` running, one ``Sample`` per controller sample with ``force_n``
 None, ``ToolState`` done), the controller's own result (``ControllerResult``
 on ``boltwatch/<st>/controller``), the run's ``TighteningResult`` made from
-it (:mod:`.controller_judgement`, on ``boltwatch/<st>/results``) and, when
-given, what the predictor made of it (:class:`PredictorReplay`: events,
+it (:mod:`shared.controller_judgement`, on ``boltwatch/<st>/results``) and, when
+given, what the predictor made of it (:class:`~shared.stopped_run.PredictorReplay`: events,
 intensities, the advisory decision after the sample that caused each, and
 the ``RunSummary`` at the end). They
 are written with the recorder's own :class:`~services.recorder.mcap_files.mcap_sink.McapSink`
@@ -43,7 +43,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from services.recorder.controller_import.controller_judgement import imported_result
 from services.recorder.controller_import.controller_run import ControllerRun
 from services.recorder.controller_import.import_files import (
     put_in_place,
@@ -61,8 +60,10 @@ from services.recorder.mcap_files.mcap_sink import McapSink
 from services.recorder.wear.wear_bound import CONTRACT_LIMITS, RunLimits
 from shared import channels, keys
 from shared.codec import encode
+from shared.controller_judgement import controller_result
 from shared.errors import BoltwatchError, InputError
 from shared.messages import RunSummary, Sample, ToolState
+from shared.stopped_run import PredictorReplay
 
 if TYPE_CHECKING:
     from services.recorder.rerun_files.rerun_sink import RerunOptions, RerunSink
@@ -77,15 +78,6 @@ TORQUE_SHUTOFF = "MFs TorqueMax"
 
 class RunNotWrittenError(BoltwatchError):
     """The run's files could not be written (disk, folder, Rerun); nothing of it was kept."""
-
-
-@dataclass(frozen=True, slots=True)
-class PredictorReplay:
-    """What the predictor core made of a run, to record beside its samples."""
-
-    #: (index of the sample after which it was published, topic, message), in order
-    outputs: list[tuple[int, str, Any]]
-    summary: RunSummary
 
 
 @dataclass(frozen=True, slots=True)
@@ -131,7 +123,7 @@ def controller_messages(
     controller = run.result(station, end_ns)
     yield channels.CONTROLLER.topic, controller, end_ns
     summary = replay.summary if replay is not None else None
-    result = imported_result(controller, summary, run.header.get("prg name", ""))
+    result = controller_result(controller, summary, run.header.get("prg name", ""), "import")
     yield channels.RESULTS.topic, result, end_ns
     if replay is not None:
         yield channels.RUNS.topic, replay.summary, end_ns

@@ -1,8 +1,13 @@
-"""An imported controller run's :class:`TighteningResult`, from the controller's own values.
+"""A tool controller's run as a :class:`TighteningResult`, from the controller's own values.
 
-A CS351 run carries its verdict and, per step, its tightening functions with
-nominal and actual values (:mod:`.controller_steps`). The result is made
-from those, not from our samples:
+Shared by ``boltwatch import`` (a CS351 controller's file: ``source``
+``"import"``) and the Open Protocol bridge (a controller's live MID 0061/0065
+result: ``source`` ``"controller"``). Both first say what the controller said
+as a :class:`~shared.messages.ControllerResult`: its verdict and, per step, its
+tightening functions with nominal and actual values (the import reads them
+from the file, the bridge makes one step of the result's torque and angle
+limits, targets and finals). The result is made from those, not from our
+samples:
 
 - verdict: the controller's ``result`` (``OK`` / ``NOK``); where it wrote
   neither, the figures judged against their windows decide (as for a live run);
@@ -17,13 +22,14 @@ from those, not from our samples:
   with its nominal and actual value, the step's own OK/NOK;
 - NOK reasons: the steps the controller marked NOK, then the figures out of
   their windows;
-- tightening id: the controller's ``cycle`` (the run id); part: ``id code``;
-  batch counter: ``batch OK`` where the controller keeps a batch (it writes
-  -1 where it keeps none);
+- tightening id: the controller's run id (a CS351's ``cycle``, an Open
+  Protocol tightening id); part: its ``part_id`` (``id code``, the VIN);
+  batch counter: ``batch_ok`` where the controller keeps a batch (-1 or None
+  where it keeps none);
 - events, process intensity: the predictor's replay of the run, when given.
 
-Torque values are taken in Nm, as the rest of the import takes them (the
-CS351 runs at hand all say ``torque unit`` Nm).
+Torque values are taken in Nm (the CS351 runs at hand all say ``torque
+unit`` Nm; Open Protocol gives Nm).
 """
 
 from __future__ import annotations
@@ -33,6 +39,7 @@ from shared.messages import (
     ControllerResult,
     ControllerStep,
     JudgedFigure,
+    ResultSource,
     ResultStep,
     RunSummary,
     StepStatus,
@@ -45,10 +52,16 @@ from shared.tightening_judgement import cut_text, figure_reasons, judge, reasons
 MONITORS = ("TorqueMin", "TorqueMax", "AngleMin", "AngleMax")
 
 
-def imported_result(
-    controller: ControllerResult, summary: RunSummary | None, program_name: str = ""
+def controller_result(
+    controller: ControllerResult,
+    summary: RunSummary | None,
+    program_name: str,
+    source: ResultSource,
+    tightening_id: int | None = None,
 ) -> TighteningResult:
-    """The result of the controller's run; ``summary``: the predictor's replay of it."""
+    """The result of the controller's run; ``summary``: the predictor's replay of it;
+    ``tightening_id``: the controller's own id when it is not the run id (a bridge's
+    controller whose ids started again: :mod:`services.openprotocol.published_ids`)."""
     last = controller.steps[-1] if controller.steps else None
     torque = _figure(last, "Torque", "TF Torque")
     angle = _figure(last, "Angle", "TF Angle")
@@ -62,7 +75,7 @@ def imported_result(
     reasons += figure_reasons({"torque": (torque, "Nm"), "angle": (angle, "deg")})
     return TighteningResult(
         station=controller.station,
-        tightening_id=controller.run_id,
+        tightening_id=controller.run_id if tightening_id is None else tightening_id,
         run_id=controller.run_id,
         tool_id=controller.tool_id,
         program_id=controller.program_id,
@@ -82,7 +95,7 @@ def imported_result(
         stop_reason=None,  # the controller stopped its tool
         events=summary.events if summary is not None else None,
         process_intensity=summary.process_intensity if summary is not None else None,
-        source="import",
+        source=source,
         steps=[_step(step) for step in controller.steps],
     )
 

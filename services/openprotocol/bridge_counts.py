@@ -1,0 +1,92 @@
+"""What the bridge counts since its process started, as the ``BridgeStats`` it publishes.
+
+Written by the link thread only; read once a second by the stats thread (a
+torn read of two counters is one second old at worst, never wrong for long).
+A fault of the link or of a message is counted here and logged once per kind
+(:class:`~shared.log_limit.RateLimitedLog`), never raised: ``boltwatch status``
+shows the counters that are not zero.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from shared.log_limit import RateLimitedLog
+from shared.messages import BridgeStats
+from shared.tightening_judgement import cut_text
+
+LOG = logging.getLogger(__name__)
+
+#: the kinds of faults, each logged once then at most every 10 s
+FAULT_KINDS = (
+    "garbage",
+    "bad message",
+    "refused value",
+    "controller error",
+    "link",
+    "trace",
+    "run id",
+)
+
+
+@dataclass
+class BridgeCounts:
+    """The counters of :class:`~shared.messages.BridgeStats` and the link's state."""
+
+    station: str
+    controller: str  # "host:port"
+    started_ns: int = field(default_factory=time.time_ns)
+    connected: bool = False
+    result_revision: int | None = None
+    connects: int = 0
+    link_drops: int = 0
+    keep_alives_sent: int = 0
+    results: int = 0
+    results_filled: int = 0
+    repeated_results: int = 0
+    results_without_traces: int = 0
+    traces: int = 0
+    traces_without_result: int = 0
+    garbage_bytes: int = 0
+    bad_messages: int = 0
+    refused_values: int = 0
+    controller_errors: int = 0
+    last_tightening_id: int | None = None
+    last_error: str | None = None
+    _logs: dict[str, RateLimitedLog] = field(default_factory=dict)
+
+    def fault(self, kind: str, text: str, level: int = logging.WARNING) -> None:
+        """Log a fault of ``kind`` (rate-limited per kind) and keep it as the last error."""
+        self.last_error = cut_text(text)
+        log = self._logs.get(kind)
+        if log is None:
+            log = self._logs[kind] = RateLimitedLog(LOG, level)
+        log("%s", text)
+
+    def stats(self, clock_ns: Callable[[], int] = time.time_ns) -> BridgeStats:
+        return BridgeStats(
+            station=self.station,
+            time_ns=clock_ns(),
+            started_ns=self.started_ns,
+            controller=self.controller,
+            connected=self.connected,
+            result_revision=self.result_revision,
+            connects=self.connects,
+            link_drops=self.link_drops,
+            keep_alives_sent=self.keep_alives_sent,
+            results=self.results,
+            results_filled=self.results_filled,
+            repeated_results=self.repeated_results,
+            traces=self.traces,
+            traces_without_result=self.traces_without_result,
+            garbage_bytes=self.garbage_bytes,
+            bad_messages=self.bad_messages,
+            refused_values=self.refused_values,
+            controller_errors=self.controller_errors,
+            last_tightening_id=self.last_tightening_id,
+            last_error=self.last_error,
+            results_without_traces=self.results_without_traces,
+        )

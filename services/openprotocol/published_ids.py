@@ -1,0 +1,111 @@
+"""Where the bridge was: the newest tightening it has published, kept across restarts.
+
+A bridge killed (SIGKILL, power) and started again must neither lose a
+tightening nor publish one twice. The controller keeps its results and serves
+them by id (MID 0064 -> 0065), so the bridge only has to know the id up to
+which it has published every tightening: the **watermark**. It is kept in a
+small JSON file in the station's recordings folder
+(``openprotocol_<station>.json``), written atomically (a temporary file in the
+same folder, fsync, rename, fsync of the folder): after a crash the file holds
+the old watermark or the new one, never half of either.
+
+The bridge writes it after the tightening's messages were put on zenoh (on
+the publisher's thread, :meth:`QueuedPublisher.call`): a bridge killed between
+the put and the write publishes that one tightening again when it comes back
+(its run id is the same, so the wear ledger and ``up`` count it once); killed
+before the put, it fetches it again. Nothing is lost either way.
+
+A controller whose ids went backwards (it was reset or replaced: its newest
+id is below the watermark), or that names itself differently in MID 0002, is
+a new **epoch** of the station's controller: its tightening ids start again,
+so its runs get run ids past every run id published before
+(``run_id = run_id_offset + tightening_id``; the offset is the last run id
+published), and none of them is taken for one published already. The
+tightening id of each result stays the controller's own.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import logging
+import os
+import tempfile
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+LOG = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, slots=True)
+class BridgePosition:
+    """What a bridge has published of its controller's tightenings."""
+
+    #: every tightening id up to this one is published (or given up: refused); 0: none yet
+    watermark: int = 0
+    #: added to a tightening id to make its run id (0 until the controller's ids restart)
+    run_id_offset: int = 0
+    #: the controller's name from MID 0002 when the watermark was written ("" unknown)
+    controller_name: str = ""
+
+    def run_id(self, tightening_id: int) -> int:
+        return self.run_id_offset + tightening_id
+
+    def new_epoch(self, controller_name: str) -> BridgePosition:
+        """The controller's ids start again: run ids go on past the last one published."""
+        return BridgePosition(0, self.run_id(self.watermark), controller_name)
+
+
+def position_path(recordings: Path, station: str) -> Path:
+    """``<recordings>/openprotocol_<station>.json``."""
+    return recordings / f"openprotocol_{station}.json"
+
+
+def read_position(path: Path) -> BridgePosition:
+    """The position written last; a missing file is the start (nothing published).
+
+    A file that cannot be read as one (a disk fault, edited by hand) is logged
+    and taken as the start: the controller's newest result then decides where
+    to go on (never lost, maybe published again under the same run id)."""
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+        position = BridgePosition(
+            watermark=_count(document, "watermark"),
+            run_id_offset=_count(document, "run_id_offset"),
+            controller_name=str(document.get("controller_name", "")),
+        )
+    except FileNotFoundError:
+        return BridgePosition()
+    except (OSError, ValueError, TypeError, AttributeError) as err:
+        LOG.error("%s: unreadable (%s): starting from the controller's newest result", path, err)
+        return BridgePosition()
+    return position
+
+
+def write_position(path: Path, position: BridgePosition) -> None:
+    """Replace the file by ``position`` atomically (temporary + fsync + rename + fsync)."""
+    folder = path.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=folder)
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            json.dump(asdict(position), stream)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temporary)
+        raise
+    directory = os.open(folder, os.O_RDONLY)
+    try:
+        os.fsync(directory)
+    finally:
+        os.close(directory)
+
+
+def _count(document: dict[str, object], key: str) -> int:
+    value = document.get(key, 0)
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise ValueError(f"{key}: expected a count, got {value!r}")
+    return value

@@ -1,0 +1,208 @@
+"""What the simulated controller holds across links: results, alarm, tool, how it writes.
+
+One :class:`ControllerState` per controller, used by the serving thread only
+(:mod:`.controller_server`): every :class:`~.integrator_link.IntegratorLink`
+reads its settings and writes through it.
+
+- the results (:class:`~.result_store.ResultStore`, bounded) and the counters;
+- how it writes: the station's ``[openprotocol]`` header fill and 0900 byte
+  order (the codec's :class:`~shared.openprotocol.dialect.Dialect`) and time
+  zone (its time stamps are local time there);
+- the revisions it speaks: what the codec implements
+  (:data:`~shared.openprotocol.codec.SUPPORTED_REVISIONS`), 0061/0064/0065
+  up to ``max_result_revision``;
+- the alarm: a run that ends on a hard limit raises one (0071, codes below,
+  the simulated controller's own: real controllers have their own tables);
+  it stays active until the next run that ends without a limit, which clears
+  it (0074, "acknowledged on the controller"); 0076 after each 0070 says
+  whether one is active;
+- tool data (0041): serial ``SIM-<tool id>``, the tightenings of this
+  controller process (also the count since service), the configured last
+  calibration and service dates (default: the day the controller started),
+  calibration value = the program's hard torque limit.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+import threading
+import zoneinfo
+
+from services.rig.controller import StopSource
+from services.rig.openprotocol.controller_counters import ControllerCounters
+from services.rig.openprotocol.result_messages import (
+    ControllerIdentity,
+    last_result,
+    old_result,
+    trace_curves,
+)
+from services.rig.openprotocol.result_store import ResultStore
+from services.rig.openprotocol.tightening import Tightening
+from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
+from shared.config.station import Program
+from shared.openprotocol.alarms import Alarm, AlarmAcknowledgedOnController, AlarmStatus
+from shared.openprotocol.codec import SUPPORTED_REVISIONS, WireMessage, encode
+from shared.openprotocol.dialect import Dialect
+from shared.openprotocol.session import CommunicationStartAck
+from shared.openprotocol.tool_data import ToolData
+from shared.openprotocol.traces import TraceCurve
+
+LOG = logging.getLogger(__name__)
+
+#: the MIDs whose revision is the 0061/0065 revision (capped by max_result_revision)
+RESULT_MIDS = frozenset({60, 61, 64, 65})
+#: the simulated controller's alarm codes: a run that ended on a hard limit
+ALARM_CODES: dict[StopSource, tuple[str, str]] = {
+    StopSource.LIMIT_TORQUE: ("E101", "torque limit reached: tool stopped"),
+    StopSource.LIMIT_FORCE: ("E102", "force limit reached: tool stopped"),
+    StopSource.LIMIT_ANGLE: ("E103", "angle limit reached: tool stopped"),
+    StopSource.LIMIT_TIME: ("E104", "cycle time limit reached: tool stopped"),
+}
+SUPPLIER_CODE = "BWS"
+SOFTWARE_VERSION = "boltwatch-sim 1"
+
+
+class ControllerState:
+    """The controller's results, alarm, identity and writing settings."""
+
+    def __init__(
+        self,
+        station_id: str,
+        tool_id: int,
+        program: Program,
+        section: OpenProtocolSection,
+        settings: RigOpenProtocolSection,
+        *,
+        started: dt.date | None = None,
+    ) -> None:
+        self.settings = settings
+        self.counters = ControllerCounters()
+        self.store = ResultStore(settings.results_kept)
+        self.identity = ControllerIdentity(station_id, tool_id, zoneinfo.ZoneInfo(section.timezone))
+        self.dialect = Dialect(
+            header_fill="space" if section.header_fill == "spaces" else "zero",
+            trace_byte_order=section.trace_byte_order,
+        )
+        self._program = program
+        started = started or dt.date.today()
+        self._last_calibration = settings.last_calibration or started
+        self._last_service = settings.last_service or started
+        #: the active alarm's (code, text, time_ns), None when no alarm is active
+        self.alarm: tuple[str, str, int] | None = None
+        #: set when an integrator first subscribes to results (``--wait-for-integrator``)
+        self.result_subscriber = threading.Event()
+
+    # -- revisions ---------------------------------------------------------------------
+
+    def knows(self, mid: int) -> bool:
+        return mid in SUPPORTED_REVISIONS
+
+    def highest_revision(self, mid: int) -> int:
+        """The highest revision of ``mid`` the controller answers (0: an MID it does not know)."""
+        revisions = SUPPORTED_REVISIONS.get(mid, ())
+        highest = max(revisions, default=0)
+        if mid in RESULT_MIDS:
+            highest = min(highest, self.settings.max_result_revision)
+        return highest
+
+    # -- what it writes ----------------------------------------------------------------
+
+    def wire(self, message: WireMessage, revision: int | None = None) -> bytes:
+        """``message`` on the wire at ``revision`` (default: its own)."""
+        return encode(message, revision=revision, dialect=self.dialect)
+
+    def start_ack(self, revision: int) -> CommunicationStartAck:
+        identity = self.identity
+        return CommunicationStartAck(
+            cell_id=identity.cell_id,
+            channel_id=identity.channel_id,
+            controller_name=identity.controller_name,
+            supplier_code=SUPPLIER_CODE if revision >= 2 else None,
+            open_protocol_version="2.8.0" if revision >= 3 else None,
+            controller_software_version=SOFTWARE_VERSION if revision >= 3 else None,
+            tool_software_version=SOFTWARE_VERSION if revision >= 3 else None,
+            revision=revision,
+        )
+
+    def result(self, tightening: Tightening, revision: int) -> WireMessage:
+        return last_result(tightening, revision, self.identity)
+
+    def old_result(self, tightening: Tightening, revision: int) -> WireMessage:
+        return old_result(tightening, revision, self.identity)
+
+    def traces(self, tightening: Tightening, trace_types: tuple[int, ...]) -> list[TraceCurve]:
+        return trace_curves(tightening, trace_types, self.identity)
+
+    def tool_data(self, revision: int) -> ToolData:
+        identity = self.identity
+        second = revision >= 2
+        return ToolData(
+            tool_serial=identity.tool_serial,
+            tightenings=self.counters.tightenings,
+            last_calibration=_date_text(self._last_calibration),
+            controller_serial=identity.controller_serial,
+            calibration_value_nm=self._program.max_torque_nm if second else None,
+            last_service=_date_text(self._last_service) if second else None,
+            tightenings_since_service=self.counters.tightenings if second else None,
+            tool_type=1 if second else None,
+            motor_size=0 if second else None,
+            open_end_data="000" if second else None,
+            controller_software_version=SOFTWARE_VERSION if second else None,
+            revision=revision,
+        )
+
+    def alarm_status(self, revision: int) -> AlarmStatus:
+        alarm = self.alarm
+        return AlarmStatus(
+            alarm_active=alarm is not None,
+            error_code=alarm[0] if alarm is not None else "",
+            controller_ready=True,
+            tool_ready=True,
+            time=self.identity.timestamp(alarm[2] if alarm is not None else 0),
+            revision=revision,
+        )
+
+    # -- what happens ------------------------------------------------------------------
+
+    def tightening(self, tightening: Tightening) -> list[WireMessage]:
+        """A finished tightening: kept and counted; the alarm messages it raises or clears
+        (for alarm subscribers: each link writes them at the revision it subscribed)."""
+        self.store.add(tightening)
+        counters = self.counters
+        counters.tightenings += 1
+        counters.ok += tightening.ok
+        counters.nok += not tightening.ok
+        LOG.info(
+            "tightening %d: %s, %.1f Nm, %d deg, stopped by %s, batch %d/%d; %s",
+            tightening.tightening_id,
+            "OK" if tightening.ok else "NOK",
+            tightening.final_torque_nm,
+            round(tightening.final_angle_deg),
+            tightening.curves.stop_source,
+            tightening.batch_counter,
+            tightening.batch_size,
+            counters.line(),
+        )
+        code = ALARM_CODES.get(tightening.curves.stop_source)
+        if code is not None:
+            self.alarm = (code[0], code[1], tightening.ended_ns)
+            counters.alarms += 1
+            LOG.warning("alarm %s: %s (tightening %d)", *code, tightening.tightening_id)
+            return [
+                Alarm(
+                    error_code=code[0],
+                    controller_ready=True,
+                    tool_ready=True,
+                    time=self.identity.timestamp(tightening.ended_ns),
+                    alarm_text=code[1],
+                )
+            ]
+        if self.alarm is not None:
+            cleared, self.alarm = self.alarm[0], None
+            return [AlarmAcknowledgedOnController(error_code=cleared)]
+        return []
+
+
+def _date_text(day: dt.date) -> str:
+    return f"{day.isoformat()}:00:00:00"

@@ -1,0 +1,104 @@
+"""Results and curves in any order come out once, in id order, each with its curves."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from services.openprotocol.controller_tightening import Curve, ResultFigures
+from services.openprotocol.pending_tightenings import MAX_FILL, PendingTightenings
+from services.openprotocol.published_ids import (
+    BridgePosition,
+    read_position,
+    write_position,
+)
+
+
+def figures(tightening_id: int, filled: bool = False) -> ResultFigures:
+    return ResultFigures(
+        tightening_id=tightening_id,
+        program_id=1,
+        time_ns=1_700_000_000_000_000_000,
+        ok=True,
+        torque_nm=200.0,
+        torque_min_nm=180.0,
+        torque_max_nm=240.0,
+        torque_target_nm=200.0,
+        angle_deg=50.0,
+        angle_min_deg=35.0,
+        angle_max_deg=65.0,
+        angle_target_deg=None,
+        part_id="VIN1",
+        batch_size=10,
+        batch_counter=3,
+        strategy="",
+        revision=2,
+        filled=filled,
+    )
+
+
+def curve(tightening_id: int, kind: str) -> Curve:
+    return Curve(tightening_id, kind, 1_700_000_000_000_000_000, 0.001, (1.0, 2.0, 3.0))
+
+
+def test_a_result_waits_for_both_curves_which_may_come_before_or_after_it() -> None:
+    pending = PendingTightenings(watermark=4, wait_for_curves=True, trace_timeout_s=3.0)
+    assert pending.curve(curve(5, "torque"), 0.0)
+    assert pending.result(figures(5), 0.1)
+    assert list(pending.ready(0.2)) == []
+    assert pending.curve(curve(5, "angle"), 0.3)
+    (tightening,) = pending.ready(0.3)
+    assert tightening.complete and tightening.result.tightening_id == 5
+    assert pending.watermark == 5
+    assert not pending.curve(curve(5, "angle"), 0.4), "a curve after its result went: dropped"
+
+
+def test_a_result_whose_curves_never_come_goes_without_them_after_the_timeout() -> None:
+    pending = PendingTightenings(watermark=0, wait_for_curves=True, trace_timeout_s=3.0)
+    pending.result(figures(1), 0.0)
+    assert list(pending.ready(2.9)) == []
+    (tightening,) = pending.ready(3.0)
+    assert tightening.torque is None and tightening.angle is None
+    assert pending.curve(curve(9, "torque"), 3.0)
+    assert pending.expired_curves(5.9) == 0
+    assert pending.expired_curves(6.0) == 1
+
+
+def test_repeats_are_refused_and_order_is_kept_across_a_gap() -> None:
+    pending = PendingTightenings(watermark=10, wait_for_curves=False, trace_timeout_s=3.0)
+    assert not pending.result(figures(10), 0.0), "at the watermark: published already"
+    assert pending.result(figures(14), 0.0)
+    assert not pending.result(figures(14), 0.0), "pending already"
+    assert list(pending.ready(0.0)) == [], "11 to 13 come first"
+    assert pending.missing() == [11, 12, 13]
+    pending.result(figures(11, filled=True), 0.0)
+    pending.give_up(12)  # the controller no longer has it
+    pending.result(figures(13, filled=True), 0.0)
+    assert [t.result.tightening_id for t in pending.ready(0.0)] == [11, 13, 14]
+    assert pending.watermark == 14 and pending.given_up == 1
+    assert pending.missing() == []
+
+
+def test_a_gap_longer_than_the_bound_fetches_only_the_newest() -> None:
+    pending = PendingTightenings(watermark=0, wait_for_curves=False, trace_timeout_s=3.0)
+    pending.controller_newest(MAX_FILL + 500)
+    missing = pending.missing()
+    assert missing == list(range(501, MAX_FILL + 501))
+    assert pending.watermark == 500 and pending.given_up == 500
+
+
+def test_the_position_survives_a_restart_and_a_broken_file_is_the_start(tmp_path: Path) -> None:
+    path = tmp_path / "openprotocol_st1.json"
+    assert read_position(path) == BridgePosition()
+    write_position(path, BridgePosition(41, 0, "ctrl"))
+    assert read_position(path) == BridgePosition(41, 0, "ctrl")
+    assert [p.name for p in tmp_path.iterdir()] == [path.name], "no temporary left"
+    path.write_text('{"watermark": -3}')
+    assert read_position(path) == BridgePosition()
+
+
+def test_a_new_epoch_gives_run_ids_after_every_one_published() -> None:
+    position = BridgePosition(watermark=41, run_id_offset=0, controller_name="a")
+    epoch = position.new_epoch("b")
+    assert epoch == BridgePosition(0, 41, "b")
+    assert epoch.run_id(1) == 42
+    assert epoch.new_epoch("c").run_id(1) == 42, "an epoch without a tightening moves nothing"
