@@ -9,12 +9,13 @@ buffered in plain lists and sent with ``send_columns`` every
 ``batch_samples`` samples, at each flush tick and at close: nothing per
 sample but a few list appends. Writing files only, a batch is what a flush
 tick gathers (:data:`FILE_BATCH_SAMPLES` is more than a second of samples):
-each ``send_columns`` costs Rerun a fixed price, and 250-sample batches made
-Rerun's share of the recorder's CPU 7 µs a sample; with a live viewer, every
+each ``send_columns`` costs Rerun a fixed price; with a live viewer, every
 :data:`LIVE_BATCH_SAMPLES` (0.25 s behind the tool). Events, predictions, the stop decision (a
 replayed one is marked so), the run summary and a controller's result are
 rare and go out at flush ticks (one chunk per entity and tick: each Rerun
-chunk costs about a kilobyte of schema on disk).
+chunk costs about a kilobyte of schema on disk). Every Rerun call (open,
+batches, finish) runs on the process's Rerun thread (:mod:`.rerun_thread`),
+never on the recorder's: the caller only buffers and hands over what it took.
 
 MCAP is the record that matters: every Rerun call here is guarded. The first
 failure is logged with its traceback, the sink disables itself and the
@@ -41,6 +42,7 @@ from services.recorder.rerun_files.rerun_streams import (
     ensure_layout_file,
     return_stream,
 )
+from services.recorder.rerun_files.rerun_thread import RERUN_THREAD, RerunThread
 from shared import channels
 from shared.run_clock import RunClock
 
@@ -62,8 +64,14 @@ class RerunOptions:
     write_files: bool = True  # False: live only (``--no-rerun --rerun-serve``)
 
 
+#: one series' taken batch: (entity path, times ns, values)
+_Batch = tuple[str, list[int], list[float]]
+#: taken text log lines: (times ns, texts, levels)
+_Texts = tuple[list[int], list[str], list[str]]
+
+
 class _Series:
-    """A buffered scalar series: (time_ns, value) pairs, sent as one column batch."""
+    """A buffered scalar series: (time_ns, value) pairs, taken whole and sent as one batch."""
 
     __slots__ = ("path", "times_ns", "values")
 
@@ -77,22 +85,31 @@ class _Series:
             self.times_ns.append(time_ns)
             self.values.append(value)
 
-    def send(self, stream: rr.RecordingStream, run_started_ns: int) -> int:
-        count = len(self.values)
-        if count == 0:
-            return 0
-        stream.send_columns(
-            self.path,
-            indexes=time_columns(self.times_ns, run_started_ns),
-            columns=rr.Scalars.columns(scalars=np.asarray(self.values, dtype=np.float64)),
-        )
-        self.times_ns.clear()
-        self.values.clear()
-        return count
+    def take(self) -> _Batch | None:
+        """What is buffered (None: nothing), leaving the series empty."""
+        if not self.values:
+            return None
+        batch = (self.path, self.times_ns, self.values)
+        self.times_ns, self.values = [], []
+        return batch
+
+
+def _send_batch(stream: rr.RecordingStream, batch: _Batch, run_started_ns: int) -> int:
+    path, times_ns, values = batch
+    stream.send_columns(
+        path,
+        indexes=time_columns(times_ns, run_started_ns),
+        columns=rr.Scalars.columns(scalars=np.asarray(values, dtype=np.float64)),
+    )
+    return len(values)
 
 
 class RerunSink:
-    """Write one run's messages to ``path`` (an ``.rrd``) and, optionally, a live server."""
+    """Write one run's messages to ``path`` (an ``.rrd``) and, optionally, a live server.
+
+    Buffers on the caller's thread; every Rerun call runs on ``thread``
+    (:mod:`.rerun_thread`): opening, each batch and the finish are jobs.
+    """
 
     def __init__(
         self,
@@ -102,11 +119,12 @@ class RerunSink:
         run_started_ns: int,
         options: RerunOptions = RerunOptions(),  # frozen: shared safely
         recording_name: str | None = None,  # default: the file's stem
+        thread: RerunThread = RERUN_THREAD,
     ) -> None:
         self.path = path
         self.run_id = run_id
-        self.samples = 0  # samples sent to Rerun so far
-        self.failed = False
+        self.samples = 0  # samples sent to Rerun so far (counted on the Rerun thread)
+        self.failed = False  # set on the Rerun thread, read on the caller's
         self._run_started_ns = run_started_ns
         self._clock = RunClock(run_started_ns)
         self._batch_samples = max(1, options.batch_samples)
@@ -122,23 +140,33 @@ class RerunSink:
         self._torque = self._series[bp.TORQUE]
         self._angle = self._series[bp.ANGLE]
         self._force = self._series[bp.FORCE]
-        sinks: list[Any] = []
-        if options.write_files:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            ensure_layout_file(path.parent)
-            sinks.append(rr.FileSink(path))
         self._station = station
-        self._stream = borrow_stream(station)
-        if options.live_url is not None:
-            sinks.append(rr.GrpcSink(options.live_url))
+        self._stream: rr.RecordingStream | None = None  # the Rerun thread's, once open
+        self._thread = thread
+        thread.submit(lambda: self._open(options, recording_name or path.stem))
+
+    def _open(self, options: RerunOptions, recording_name: str) -> None:
+        """On the Rerun thread: the file sink, a pooled stream, the recording's header."""
         try:
-            self._stream.set_sinks(*sinks)
+            sinks: list[Any] = []
+            if options.write_files:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                ensure_layout_file(self.path.parent)
+                sinks.append(rr.FileSink(self.path))
+            stream = borrow_stream(self._station)
+            if options.live_url is not None:
+                sinks.append(rr.GrpcSink(options.live_url))
+            try:
+                stream.set_sinks(*sinks)
+            except Exception:
+                stream.disconnect()  # drop the buffered sink, not "dropping data" at exit
+                raise
+            self._stream = stream
+            stream.send_recording_name(recording_name)
+            stream.send_recording_start_time_nanos(self._run_started_ns)
+            bp.log_series_styles(stream)
         except Exception:
-            self._stream.disconnect()  # drop the buffered sink, not "dropping data" at exit
-            raise
-        self._stream.send_recording_name(recording_name or path.stem)
-        self._stream.send_recording_start_time_nanos(run_started_ns)
-        bp.log_series_styles(self._stream)
+            self._fail("open")
 
     def write(self, received: Received) -> None:
         """Buffer one decoded message; send a batch when ``batch_samples`` are waiting."""
@@ -155,7 +183,8 @@ class RerunSink:
                 self._force.add(time_ns, message.force_n)
                 self._pending_samples += 1
                 if self._pending_samples >= self._batch_samples:
-                    self._send_samples()
+                    batches = self._take_samples()
+                    self._thread.submit(lambda: self._send_job(batches, [], None, False))
             elif received.schema_name == channels.EVENTS.schema_name:
                 self._event(message)
             elif received.schema_name == channels.DECISION.schema_name:
@@ -174,29 +203,69 @@ class RerunSink:
             self._fail("write")
 
     def flush(self) -> None:
-        """Send everything buffered (the recorder's flush tick)."""
+        """Send everything buffered (the recorder's flush tick); never waits for Rerun."""
         if self.failed or self._closed:
             return
-        try:
-            self._send()
-            self._stream.flush(timeout_sec=0.0)  # start writing; never wait in the recorder
-        except Exception:
-            self._fail("flush")
+        samples, rare, texts = self._take_all()
+        self._thread.submit(lambda: self._send_job(samples, rare, texts, False))
 
-    def close(self) -> None:
-        """Send what is left, finish the file (footer) and drop the stream; safe twice."""
+    def close(self, wait: bool = True) -> None:
+        """Send what is left, finish the file (footer) and give the stream back; safe twice.
+
+        ``wait=False``: return at once, the Rerun thread finishes the file (the
+        recorder's run files; :meth:`RerunThread.wait` waits for it)."""
         if self._closed:
             return
         self._closed = True
-        try:
+        samples, rare, texts = self._take_all()
+        self._thread.submit(lambda: self._send_job(samples, rare, texts, True))
+        if wait:
+            self._thread.wait()
+
+    def _take_samples(self) -> list[_Batch]:
+        self._pending_samples = 0
+        taken = (self._torque.take(), self._angle.take(), self._force.take())
+        return [batch for batch in taken if batch is not None]
+
+    def _take_all(self) -> tuple[list[_Batch], list[_Batch], _Texts | None]:
+        """Every buffered batch: samples, rare series (one chunk per entity), texts."""
+        samples = self._take_samples()
+        rare = [batch for s in self._series.values() if (batch := s.take()) is not None]
+        texts = None
+        if self._texts:
+            texts = (self._text_times_ns, self._texts, self._levels)
+            self._text_times_ns, self._texts, self._levels = [], [], []
+        return samples, rare, texts
+
+    def _send_job(
+        self, samples: list[_Batch], rare: list[_Batch], texts: _Texts | None, last: bool
+    ) -> None:
+        """On the Rerun thread: send taken batches; ``last``: then finish the file."""
+        stream = self._stream
+        if not self.failed and stream is not None:
+            try:
+                start_ns = self._run_started_ns
+                if samples:
+                    self.samples += _send_batch(stream, samples[0], start_ns)
+                for batch in samples[1:] + rare:
+                    _send_batch(stream, batch, start_ns)
+                if texts is not None:
+                    self._send_texts(stream, *texts)
+                if last:
+                    stream.flush()
+                else:
+                    stream.flush(timeout_sec=0.0)  # start writing; never wait here
+            except Exception:
+                self._fail("close" if last else "send")
+        if not last:
+            return
+        if stream is not None:
+            try:
+                stream.disconnect()  # finishes the file
+            except Exception:
+                self._fail("close")
             if not self.failed:
-                self._send()
-                self._stream.flush()
-            self._stream.disconnect()  # finishes the file
-        except Exception:
-            self._fail("close")
-        if not self.failed:
-            return_stream(self._station, self._stream)
+                return_stream(self._station, stream)
         LOG.info("closed %s: %d samples%s", self.path, self.samples, " (FAILED)" * self.failed)
 
     def _event(self, event: Any) -> None:
@@ -254,24 +323,14 @@ class RerunSink:
         self._texts.append(text)
         self._levels.append(level)
 
-    def _send_samples(self) -> None:
-        start_ns = self._run_started_ns
-        self.samples += self._torque.send(self._stream, start_ns)
-        self._angle.send(self._stream, start_ns)
-        self._force.send(self._stream, start_ns)
-        self._pending_samples = 0
-
-    def _send(self) -> None:
-        """Samples and every rare series (one chunk per entity and flush, not per event)."""
-        self._send_samples()
-        for series in self._series.values():
-            series.send(self._stream, self._run_started_ns)
-        if self._texts:
-            self._send_texts(self._text_times_ns, self._texts, self._levels)
-            self._text_times_ns, self._texts, self._levels = [], [], []
-
-    def _send_texts(self, times_ns: Sequence[int], texts: list[str], levels: list[str]) -> None:
-        self._stream.send_columns(
+    def _send_texts(
+        self,
+        stream: rr.RecordingStream,
+        times_ns: Sequence[int],
+        texts: list[str],
+        levels: list[str],
+    ) -> None:
+        stream.send_columns(
             bp.LOG,
             indexes=time_columns(times_ns, self._run_started_ns),
             columns=rr.TextLog.columns(text=texts, level=levels),
