@@ -5,17 +5,16 @@ Each run file borrows one of its station's :class:`rerun.RecordingStream`
 pooled: :mod:`services.recorder.rerun_files.rerun_streams`) and points it at its own
 ``<same stem>.rrd``, with the layout once per folder in ``boltwatch.rbl``; with live viewing on it
 also streams to the process's gRPC server (:class:`RerunLive`). Samples are
-buffered in plain lists and sent with ``send_columns`` every
-``batch_samples`` samples, at each flush tick and at close: nothing per
-sample but a few list appends. Writing files only, a batch is what a flush
-tick gathers (:data:`FILE_BATCH_SAMPLES` is more than a second of samples):
-each ``send_columns`` costs Rerun a fixed price; with a live viewer, every
-:data:`LIVE_BATCH_SAMPLES` (0.25 s behind the tool). Events, predictions, the stop decision (a
-replayed one is marked so), the run summary and a controller's result are
-rare and go out at flush ticks (one chunk per entity and tick: each Rerun
-chunk costs about a kilobyte of schema on disk). Every Rerun call (open,
-batches, finish) runs on the process's Rerun thread (:mod:`.rerun_thread`),
-never on the recorder's: the caller only buffers and hands over what it took.
+buffered in plain lists and sent with ``send_columns``: nothing per sample
+but a few list appends. Each ``send_columns`` costs Rerun a fixed price (and
+each chunk about a kilobyte of schema on disk), so writing files only,
+everything buffered (samples, events, predictions, the stop decision, the
+summary, a controller's result) goes out every :data:`FILE_BATCH_SAMPLES`
+samples and at close, one chunk per entity: a killed recorder's open ``.rrd``
+lacks up to 2 s, its MCAP one flush interval. With a live viewer, samples go
+every :data:`LIVE_BATCH_SAMPLES` (0.25 s behind the tool) and everything at
+each flush tick. Every Rerun call (open, batches, finish) runs on the
+process's Rerun thread (:mod:`.rerun_thread`), never on the recorder's.
 
 MCAP is the record that matters: every Rerun call here is guarded. The first
 failure is logged with its traceback, the sink disables itself and the
@@ -32,11 +31,17 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import quote
 
-import numpy as np
 import rerun as rr
 
 from services.recorder.live.incoming import Received
 from services.recorder.rerun_files import rerun_blueprint as bp
+from services.recorder.rerun_files.rerun_columns import (
+    Batch,
+    Series,
+    Texts,
+    send_batch,
+    time_columns,
+)
 from services.recorder.rerun_files.rerun_streams import (
     borrow_stream,
     ensure_layout_file,
@@ -49,7 +54,7 @@ from shared.run_clock import RunClock
 LOG = logging.getLogger(__name__)
 
 DEFAULT_GRPC_PORT = 9876
-#: samples per column batch writing files only: more than a flush tick (1 s) gathers
+#: samples per column batch writing files only (2 s at 1 kHz; and at close)
 FILE_BATCH_SAMPLES = 2000
 #: samples per column batch with a live viewer: 0.25 s at 1 kHz
 LIVE_BATCH_SAMPLES = 250
@@ -62,46 +67,6 @@ class RerunOptions:
     batch_samples: int = FILE_BATCH_SAMPLES  # samples sent every this many, and at flushes
     live_url: str | None = None
     write_files: bool = True  # False: live only (``--no-rerun --rerun-serve``)
-
-
-#: one series' taken batch: (entity path, times ns, values)
-_Batch = tuple[str, list[int], list[float]]
-#: taken text log lines: (times ns, texts, levels)
-_Texts = tuple[list[int], list[str], list[str]]
-
-
-class _Series:
-    """A buffered scalar series: (time_ns, value) pairs, taken whole and sent as one batch."""
-
-    __slots__ = ("path", "times_ns", "values")
-
-    def __init__(self, path: str) -> None:
-        self.path = path
-        self.times_ns: list[int] = []
-        self.values: list[float] = []
-
-    def add(self, time_ns: int, value: float | None) -> None:
-        if value is not None:
-            self.times_ns.append(time_ns)
-            self.values.append(value)
-
-    def take(self) -> _Batch | None:
-        """What is buffered (None: nothing), leaving the series empty."""
-        if not self.values:
-            return None
-        batch = (self.path, self.times_ns, self.values)
-        self.times_ns, self.values = [], []
-        return batch
-
-
-def _send_batch(stream: rr.RecordingStream, batch: _Batch, run_started_ns: int) -> int:
-    path, times_ns, values = batch
-    stream.send_columns(
-        path,
-        indexes=time_columns(times_ns, run_started_ns),
-        columns=rr.Scalars.columns(scalars=np.asarray(values, dtype=np.float64)),
-    )
-    return len(values)
 
 
 class RerunSink:
@@ -128,6 +93,7 @@ class RerunSink:
         self._run_started_ns = run_started_ns
         self._clock = RunClock(run_started_ns)
         self._batch_samples = max(1, options.batch_samples)
+        self._live = options.live_url is not None  # sends at flush ticks too
         self._pending_samples = 0
         self._closed = False
         self._text_times_ns: list[int] = []
@@ -136,7 +102,7 @@ class RerunSink:
         names = [bp.TORQUE, bp.ANGLE, bp.FORCE, bp.PEAKS, bp.PLATEAUS, bp.PREDICTED_PEAKS]
         names += [bp.PREDICTED_PLATEAUS, bp.TORQUE_STOP, bp.FORCE_STOP, bp.F_SS, *bp.K_PATHS]
         names += [bp.EVENT_INTENSITY, bp.PROCESS_INTENSITY]
-        self._series = {name: _Series(name) for name in names}
+        self._series = {name: Series(name) for name in names}
         self._torque = self._series[bp.TORQUE]
         self._angle = self._series[bp.ANGLE]
         self._force = self._series[bp.FORCE]
@@ -183,8 +149,7 @@ class RerunSink:
                 self._force.add(time_ns, message.force_n)
                 self._pending_samples += 1
                 if self._pending_samples >= self._batch_samples:
-                    batches = self._take_samples()
-                    self._thread.submit(lambda: self._send_job(batches, [], None, False))
+                    self._hand_over(everything=not self._live)
             elif received.schema_name == channels.EVENTS.schema_name:
                 self._event(message)
             elif received.schema_name == channels.DECISION.schema_name:
@@ -203,10 +168,17 @@ class RerunSink:
             self._fail("write")
 
     def flush(self) -> None:
-        """Send everything buffered (the recorder's flush tick); never waits for Rerun."""
-        if self.failed or self._closed:
-            return
-        samples, rare, texts = self._take_all()
+        """The recorder's flush tick: with a live viewer, send everything buffered (files
+        only: nothing, the file gets whole batches and the rest at close); never waits."""
+        if self._live and not self.failed and not self._closed:
+            self._hand_over(everything=True)
+
+    def _hand_over(self, everything: bool) -> None:
+        """Give what is buffered (samples only, or every series) to the Rerun thread."""
+        if everything:
+            samples, rare, texts = self._take_all()
+        else:
+            samples, rare, texts = self._take_samples(), [], None
         self._thread.submit(lambda: self._send_job(samples, rare, texts, False))
 
     def close(self, wait: bool = True) -> None:
@@ -222,12 +194,12 @@ class RerunSink:
         if wait:
             self._thread.wait()
 
-    def _take_samples(self) -> list[_Batch]:
+    def _take_samples(self) -> list[Batch]:
         self._pending_samples = 0
         taken = (self._torque.take(), self._angle.take(), self._force.take())
         return [batch for batch in taken if batch is not None]
 
-    def _take_all(self) -> tuple[list[_Batch], list[_Batch], _Texts | None]:
+    def _take_all(self) -> tuple[list[Batch], list[Batch], Texts | None]:
         """Every buffered batch: samples, rare series (one chunk per entity), texts."""
         samples = self._take_samples()
         rare = [batch for s in self._series.values() if (batch := s.take()) is not None]
@@ -238,7 +210,7 @@ class RerunSink:
         return samples, rare, texts
 
     def _send_job(
-        self, samples: list[_Batch], rare: list[_Batch], texts: _Texts | None, last: bool
+        self, samples: list[Batch], rare: list[Batch], texts: Texts | None, last: bool
     ) -> None:
         """On the Rerun thread: send taken batches; ``last``: then finish the file."""
         stream = self._stream
@@ -246,9 +218,9 @@ class RerunSink:
             try:
                 start_ns = self._run_started_ns
                 if samples:
-                    self.samples += _send_batch(stream, samples[0], start_ns)
+                    self.samples += send_batch(stream, samples[0], start_ns)
                 for batch in samples[1:] + rare:
-                    _send_batch(stream, batch, start_ns)
+                    send_batch(stream, batch, start_ns)
                 if texts is not None:
                     self._send_texts(stream, *texts)
                 if last:
@@ -385,15 +357,6 @@ class RerunLive:
     def close(self) -> None:
         """Shut the gRPC server down; safe to call twice."""
         self._hub.disconnect()
-
-
-def time_columns(times_ns: Sequence[int], run_started_ns: int) -> list[rr.TimeColumn]:
-    """``run_time`` (duration since run start) and ``log_time`` of integer-ns times."""
-    times = np.asarray(times_ns, dtype=np.int64)
-    return [
-        rr.TimeColumn(bp.RUN_TIME, duration=(times - run_started_ns).view("timedelta64[ns]")),
-        rr.TimeColumn(bp.LOG_TIME, timestamp=times.view("datetime64[ns]")),
-    ]
 
 
 def _n(force_n: float | None) -> str:
