@@ -106,8 +106,12 @@ class PendingTightenings:
                 first + skipped - 1,
                 MAX_FILL,
             )
-            for tightening_id in range(first, first + skipped):
-                self.give_up(tightening_id)
+            # in one step, not id by id: a first connect may find ids counting from billions
+            self.watermark = first + skipped - 1
+            passed = {done for done in self._done if done <= self.watermark}
+            self.given_up += skipped - len(passed)  # those were given up (counted) already
+            self._done -= passed
+            self._advance()
             first = self.watermark + 1
         return [
             tightening_id

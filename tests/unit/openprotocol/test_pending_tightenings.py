@@ -86,6 +86,19 @@ def test_a_gap_longer_than_the_bound_fetches_only_the_newest() -> None:
     assert pending.watermark == 500 and pending.given_up == 500
 
 
+def test_a_first_connect_to_ids_counting_from_billions_gives_the_old_ones_up_at_once() -> None:
+    """A controller whose ids count from 1.8e9 (Unix-time ids): ids 1..newest - MAX_FILL are
+    given up in one step (id by id, the bridge spun for hours and sent no keep-alive)."""
+    newest = 1_800_000_000
+    pending = PendingTightenings(watermark=0, wait_for_curves=False, trace_timeout_s=3.0)
+    pending.give_up(3)  # one given up earlier, below the jump
+    pending.controller_newest(newest)
+    missing = pending.missing()
+    assert missing == list(range(newest - MAX_FILL + 1, newest + 1))
+    assert pending.watermark == newest - MAX_FILL
+    assert pending.given_up == newest - MAX_FILL
+
+
 def test_the_position_survives_a_restart_and_a_broken_file_is_the_start(tmp_path: Path) -> None:
     path = tmp_path / "openprotocol_st1.json"
     assert read_position(path) == BridgePosition()
