@@ -78,7 +78,9 @@ class SimulatedController:
             program,
             config.rig,
             judge,
-            has_force_sensor=config.station.has_force_sensor,
+            # a controller on Open Protocol tightens to torque (0061 carries no preload): its
+            # shutoff is the program's torque target; on preload only for a program without one
+            has_force_sensor=config.station.has_force_sensor and program.target_torque_nm is None,
             on_tightening=self._tightened,
         )
         self._wait_for_integrator = wait_for_integrator

@@ -2,7 +2,9 @@
 
 :func:`tighten` runs the rig's physics under the rig's own
 :class:`~services.rig.controller.RunController` with its conventional
-shutoff (a tool on Open Protocol stops itself; no StopCommand ever comes),
+shutoff (a tool on Open Protocol stops itself; no StopCommand ever comes: on
+the program's torque target, as a controller whose result carries no
+preload does; on preload only for a program without a torque target),
 one sample per millisecond, to the end of the run (settled, or aborted on a
 hard limit). :class:`TighteningJudge` turns those samples into the result a
 controller reports (MID 0061):
