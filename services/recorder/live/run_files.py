@@ -15,8 +15,7 @@ run id (a RunSummary racing the next run's start) still land in it.
 
 With ``rerun`` options each run file (not the idle ones) has a companion
 :class:`RerunSink` writing ``<same stem>.rrd``; it receives what its MCAP
-file receives, is flushed and closed with it (finished on the Rerun thread:
-:mod:`~services.recorder.rerun_files.rerun_thread`), and never stops the MCAP file.
+file receives, is flushed and closed with it, and never stops the MCAP file.
 
 When the disk fails under a file (an :class:`OSError` out of any method),
 the owner (:class:`~services.recorder.live.recorder.Recorder`) calls
@@ -36,7 +35,6 @@ from typing import TYPE_CHECKING
 from services.recorder.live.file_metadata import FileMetadata
 from services.recorder.live.incoming import Received
 from services.recorder.mcap_files.mcap_sink import McapSink
-from services.recorder.rerun_files.rerun_thread import RERUN_THREAD
 from shared import channels
 
 if TYPE_CHECKING:  # rerun is imported only when .rrd files are wanted
@@ -169,15 +167,11 @@ class StationFiles:
         self._last_flush_ns = now_ns
 
     def close(self) -> None:
-        """Finish every open file of the station (its ``.rrd`` files too: waits for them)."""
-        try:
-            for sink in (self.previous, self.current):
-                if sink is not None:
-                    self._close(sink)
-            self.previous = self.current = None
-        finally:
-            if self._rerun is not None:
-                RERUN_THREAD.wait()
+        """Finish every open file of the station."""
+        for sink in (self.previous, self.current):
+            if sink is not None:
+                self._close(sink)
+        self.previous = self.current = None
 
     def abandon(self) -> int:
         """Let go of every open file without writing more (the disk failed); messages lost.
@@ -194,7 +188,7 @@ class StationFiles:
                 self.abandoned_paths.append(sink.path)
             companion = self._rerun_sinks.pop(sink, None)
             if companion is not None:
-                companion.close(wait=False)  # never raises
+                companion.close()  # never raises
         if self._resume is None and self.current is not None:
             self._resume = (self.current.run_id, self._part + 1)
         self.previous = self.current = None
@@ -276,6 +270,6 @@ class StationFiles:
             sink.close()
         finally:
             companion = self._rerun_sinks.pop(sink, None)
-            if companion is not None:  # finished on the Rerun thread; never raises
-                companion.close(wait=False)
+            if companion is not None:
+                companion.close()  # never raises: a Rerun failure is logged, not fatal
         self.closed_paths.append(sink.path)

@@ -1,8 +1,6 @@
 """Rerun: an ``.rrd`` beside each run's MCAP, and the live view.
 
 - :mod:`.rerun_sink`: one run's Rerun recording, written in column batches
-- :mod:`.rerun_columns`: the buffered series and the column batches sent
-- :mod:`.rerun_thread`: the one thread that makes every Rerun call of the process
 - :mod:`.rerun_streams`: recording streams pooled per station (and why)
 - :mod:`.rerun_blueprint`: entity paths and the layout (``boltwatch.rbl``)
 - :mod:`.rrd_recovery`: a truncated ``.rrd`` made readable

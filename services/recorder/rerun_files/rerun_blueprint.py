@@ -23,8 +23,6 @@ and intensity in the middle, the text log at the bottom.
 
 from __future__ import annotations
 
-import functools
-
 import rerun as rr
 import rerun.blueprint as rrb
 
@@ -69,22 +67,15 @@ _POINTS: dict[str, tuple[str, tuple[int, int, int], rr.components.MarkerShape, f
 
 
 def log_series_styles(stream: rr.RecordingStream) -> None:
-    """Static names, colours and markers of every series (once per recording).
-
-    The archetypes are built once per process (:func:`_series_styles`): building
-    them was 80 % of this call, paid at every run start."""
-    for path, style in _series_styles().items():
-        stream.log(path, style, static=True)
-
-
-@functools.cache
-def _series_styles() -> dict[str, rr.SeriesLines | rr.SeriesPoints]:
-    styles: dict[str, rr.SeriesLines | rr.SeriesPoints] = {
-        path: rr.SeriesLines(names=name, colors=color) for path, (name, color) in _LINES.items()
-    }
+    """Static names, colours and markers of every series (once per recording)."""
+    for path, (name, color) in _LINES.items():
+        stream.log(path, rr.SeriesLines(names=name, colors=color), static=True)
     for path, (name, color, marker, size) in _POINTS.items():
-        styles[path] = rr.SeriesPoints(names=name, colors=color, markers=marker, marker_sizes=size)
-    return styles
+        stream.log(
+            path,
+            rr.SeriesPoints(names=name, colors=color, markers=marker, marker_sizes=size),
+            static=True,
+        )
 
 
 def run_blueprint() -> rrb.Blueprint:

@@ -5,16 +5,16 @@ Each run file borrows one of its station's :class:`rerun.RecordingStream`
 pooled: :mod:`services.recorder.rerun_files.rerun_streams`) and points it at its own
 ``<same stem>.rrd``, with the layout once per folder in ``boltwatch.rbl``; with live viewing on it
 also streams to the process's gRPC server (:class:`RerunLive`). Samples are
-buffered in plain lists and sent with ``send_columns``: nothing per sample
-but a few list appends. Each ``send_columns`` costs Rerun a fixed price (and
-each chunk about a kilobyte of schema on disk), so writing files only,
-everything buffered (samples, events, predictions, the stop decision, the
-summary, a controller's result) goes out every :data:`FILE_BATCH_SAMPLES`
-samples and at close, one chunk per entity: a killed recorder's open ``.rrd``
-lacks up to 2 s, its MCAP one flush interval. With a live viewer, samples go
-every :data:`LIVE_BATCH_SAMPLES` (0.25 s behind the tool) and everything at
-each flush tick. Every Rerun call (open, batches, finish) runs on the
-process's Rerun thread (:mod:`.rerun_thread`), never on the recorder's.
+buffered in plain lists and sent with ``send_columns`` every
+``batch_samples`` samples, at each flush tick and at close: nothing per
+sample but a few list appends. Writing files only, a batch is what a flush
+tick gathers (:data:`FILE_BATCH_SAMPLES` is more than a second of samples):
+each ``send_columns`` costs Rerun a fixed price, and 250-sample batches made
+Rerun's share of the recorder's CPU 7 µs a sample; with a live viewer, every
+:data:`LIVE_BATCH_SAMPLES` (0.25 s behind the tool). Events, predictions, the stop decision (a
+replayed one is marked so), the run summary and a controller's result are
+rare and go out at flush ticks (one chunk per entity and tick: each Rerun
+chunk costs about a kilobyte of schema on disk).
 
 MCAP is the record that matters: every Rerun call here is guarded. The first
 failure is logged with its traceback, the sink disables itself and the
@@ -31,30 +31,23 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import quote
 
+import numpy as np
 import rerun as rr
 
 from services.recorder.live.incoming import Received
 from services.recorder.rerun_files import rerun_blueprint as bp
-from services.recorder.rerun_files.rerun_columns import (
-    Batch,
-    Series,
-    Texts,
-    send_batch,
-    time_columns,
-)
 from services.recorder.rerun_files.rerun_streams import (
     borrow_stream,
     ensure_layout_file,
     return_stream,
 )
-from services.recorder.rerun_files.rerun_thread import RERUN_THREAD, RerunThread
 from shared import channels
 from shared.run_clock import RunClock
 
 LOG = logging.getLogger(__name__)
 
 DEFAULT_GRPC_PORT = 9876
-#: samples per column batch writing files only (2 s at 1 kHz; and at close)
+#: samples per column batch writing files only: more than a flush tick (1 s) gathers
 FILE_BATCH_SAMPLES = 2000
 #: samples per column batch with a live viewer: 0.25 s at 1 kHz
 LIVE_BATCH_SAMPLES = 250
@@ -69,12 +62,37 @@ class RerunOptions:
     write_files: bool = True  # False: live only (``--no-rerun --rerun-serve``)
 
 
-class RerunSink:
-    """Write one run's messages to ``path`` (an ``.rrd``) and, optionally, a live server.
+class _Series:
+    """A buffered scalar series: (time_ns, value) pairs, sent as one column batch."""
 
-    Buffers on the caller's thread; every Rerun call runs on ``thread``
-    (:mod:`.rerun_thread`): opening, each batch and the finish are jobs.
-    """
+    __slots__ = ("path", "times_ns", "values")
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+        self.times_ns: list[int] = []
+        self.values: list[float] = []
+
+    def add(self, time_ns: int, value: float | None) -> None:
+        if value is not None:
+            self.times_ns.append(time_ns)
+            self.values.append(value)
+
+    def send(self, stream: rr.RecordingStream, run_started_ns: int) -> int:
+        count = len(self.values)
+        if count == 0:
+            return 0
+        stream.send_columns(
+            self.path,
+            indexes=time_columns(self.times_ns, run_started_ns),
+            columns=rr.Scalars.columns(scalars=np.asarray(self.values, dtype=np.float64)),
+        )
+        self.times_ns.clear()
+        self.values.clear()
+        return count
+
+
+class RerunSink:
+    """Write one run's messages to ``path`` (an ``.rrd``) and, optionally, a live server."""
 
     def __init__(
         self,
@@ -84,16 +102,14 @@ class RerunSink:
         run_started_ns: int,
         options: RerunOptions = RerunOptions(),  # frozen: shared safely
         recording_name: str | None = None,  # default: the file's stem
-        thread: RerunThread = RERUN_THREAD,
     ) -> None:
         self.path = path
         self.run_id = run_id
-        self.samples = 0  # samples sent to Rerun so far (counted on the Rerun thread)
-        self.failed = False  # set on the Rerun thread, read on the caller's
+        self.samples = 0  # samples sent to Rerun so far
+        self.failed = False
         self._run_started_ns = run_started_ns
         self._clock = RunClock(run_started_ns)
         self._batch_samples = max(1, options.batch_samples)
-        self._live = options.live_url is not None  # sends at flush ticks too
         self._pending_samples = 0
         self._closed = False
         self._text_times_ns: list[int] = []
@@ -102,37 +118,27 @@ class RerunSink:
         names = [bp.TORQUE, bp.ANGLE, bp.FORCE, bp.PEAKS, bp.PLATEAUS, bp.PREDICTED_PEAKS]
         names += [bp.PREDICTED_PLATEAUS, bp.TORQUE_STOP, bp.FORCE_STOP, bp.F_SS, *bp.K_PATHS]
         names += [bp.EVENT_INTENSITY, bp.PROCESS_INTENSITY]
-        self._series = {name: Series(name) for name in names}
+        self._series = {name: _Series(name) for name in names}
         self._torque = self._series[bp.TORQUE]
         self._angle = self._series[bp.ANGLE]
         self._force = self._series[bp.FORCE]
+        sinks: list[Any] = []
+        if options.write_files:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            ensure_layout_file(path.parent)
+            sinks.append(rr.FileSink(path))
         self._station = station
-        self._stream: rr.RecordingStream | None = None  # the Rerun thread's, once open
-        self._thread = thread
-        thread.submit(lambda: self._open(options, recording_name or path.stem))
-
-    def _open(self, options: RerunOptions, recording_name: str) -> None:
-        """On the Rerun thread: the file sink, a pooled stream, the recording's header."""
+        self._stream = borrow_stream(station)
+        if options.live_url is not None:
+            sinks.append(rr.GrpcSink(options.live_url))
         try:
-            sinks: list[Any] = []
-            if options.write_files:
-                self.path.parent.mkdir(parents=True, exist_ok=True)
-                ensure_layout_file(self.path.parent)
-                sinks.append(rr.FileSink(self.path))
-            stream = borrow_stream(self._station)
-            if options.live_url is not None:
-                sinks.append(rr.GrpcSink(options.live_url))
-            try:
-                stream.set_sinks(*sinks)
-            except Exception:
-                stream.disconnect()  # drop the buffered sink, not "dropping data" at exit
-                raise
-            self._stream = stream
-            stream.send_recording_name(recording_name)
-            stream.send_recording_start_time_nanos(self._run_started_ns)
-            bp.log_series_styles(stream)
+            self._stream.set_sinks(*sinks)
         except Exception:
-            self._fail("open")
+            self._stream.disconnect()  # drop the buffered sink, not "dropping data" at exit
+            raise
+        self._stream.send_recording_name(recording_name or path.stem)
+        self._stream.send_recording_start_time_nanos(run_started_ns)
+        bp.log_series_styles(self._stream)
 
     def write(self, received: Received) -> None:
         """Buffer one decoded message; send a batch when ``batch_samples`` are waiting."""
@@ -149,7 +155,7 @@ class RerunSink:
                 self._force.add(time_ns, message.force_n)
                 self._pending_samples += 1
                 if self._pending_samples >= self._batch_samples:
-                    self._hand_over(everything=not self._live)
+                    self._send_samples()
             elif received.schema_name == channels.EVENTS.schema_name:
                 self._event(message)
             elif received.schema_name == channels.DECISION.schema_name:
@@ -168,76 +174,29 @@ class RerunSink:
             self._fail("write")
 
     def flush(self) -> None:
-        """The recorder's flush tick: with a live viewer, send everything buffered (files
-        only: nothing, the file gets whole batches and the rest at close); never waits."""
-        if self._live and not self.failed and not self._closed:
-            self._hand_over(everything=True)
+        """Send everything buffered (the recorder's flush tick)."""
+        if self.failed or self._closed:
+            return
+        try:
+            self._send()
+            self._stream.flush(timeout_sec=0.0)  # start writing; never wait in the recorder
+        except Exception:
+            self._fail("flush")
 
-    def _hand_over(self, everything: bool) -> None:
-        """Give what is buffered (samples only, or every series) to the Rerun thread."""
-        if everything:
-            samples, rare, texts = self._take_all()
-        else:
-            samples, rare, texts = self._take_samples(), [], None
-        self._thread.submit(lambda: self._send_job(samples, rare, texts, False))
-
-    def close(self, wait: bool = True) -> None:
-        """Send what is left, finish the file (footer) and give the stream back; safe twice.
-
-        ``wait=False``: return at once, the Rerun thread finishes the file (the
-        recorder's run files; :meth:`RerunThread.wait` waits for it)."""
+    def close(self) -> None:
+        """Send what is left, finish the file (footer) and drop the stream; safe twice."""
         if self._closed:
             return
         self._closed = True
-        samples, rare, texts = self._take_all()
-        self._thread.submit(lambda: self._send_job(samples, rare, texts, True))
-        if wait:
-            self._thread.wait()
-
-    def _take_samples(self) -> list[Batch]:
-        self._pending_samples = 0
-        taken = (self._torque.take(), self._angle.take(), self._force.take())
-        return [batch for batch in taken if batch is not None]
-
-    def _take_all(self) -> tuple[list[Batch], list[Batch], Texts | None]:
-        """Every buffered batch: samples, rare series (one chunk per entity), texts."""
-        samples = self._take_samples()
-        rare = [batch for s in self._series.values() if (batch := s.take()) is not None]
-        texts = None
-        if self._texts:
-            texts = (self._text_times_ns, self._texts, self._levels)
-            self._text_times_ns, self._texts, self._levels = [], [], []
-        return samples, rare, texts
-
-    def _send_job(
-        self, samples: list[Batch], rare: list[Batch], texts: Texts | None, last: bool
-    ) -> None:
-        """On the Rerun thread: send taken batches; ``last``: then finish the file."""
-        stream = self._stream
-        if not self.failed and stream is not None:
-            try:
-                start_ns = self._run_started_ns
-                if samples:
-                    self.samples += send_batch(stream, samples[0], start_ns)
-                for batch in samples[1:] + rare:
-                    send_batch(stream, batch, start_ns)
-                if texts is not None:
-                    self._send_texts(stream, *texts)
-                if last:
-                    stream.flush()
-                else:
-                    stream.flush(timeout_sec=0.0)  # start writing; never wait here
-            except Exception:
-                self._fail("close" if last else "send")
-        if not last:
-            return
-        if stream is not None:
-            try:
-                stream.disconnect()  # finishes the file
-            except Exception:
-                self._fail("close")
+        try:
             if not self.failed:
-                return_stream(self._station, stream)
+                self._send()
+                self._stream.flush()
+            self._stream.disconnect()  # finishes the file
+        except Exception:
+            self._fail("close")
+        if not self.failed:
+            return_stream(self._station, self._stream)
         LOG.info("closed %s: %d samples%s", self.path, self.samples, " (FAILED)" * self.failed)
 
     def _event(self, event: Any) -> None:
@@ -295,14 +254,24 @@ class RerunSink:
         self._texts.append(text)
         self._levels.append(level)
 
-    def _send_texts(
-        self,
-        stream: rr.RecordingStream,
-        times_ns: Sequence[int],
-        texts: list[str],
-        levels: list[str],
-    ) -> None:
-        stream.send_columns(
+    def _send_samples(self) -> None:
+        start_ns = self._run_started_ns
+        self.samples += self._torque.send(self._stream, start_ns)
+        self._angle.send(self._stream, start_ns)
+        self._force.send(self._stream, start_ns)
+        self._pending_samples = 0
+
+    def _send(self) -> None:
+        """Samples and every rare series (one chunk per entity and flush, not per event)."""
+        self._send_samples()
+        for series in self._series.values():
+            series.send(self._stream, self._run_started_ns)
+        if self._texts:
+            self._send_texts(self._text_times_ns, self._texts, self._levels)
+            self._text_times_ns, self._texts, self._levels = [], [], []
+
+    def _send_texts(self, times_ns: Sequence[int], texts: list[str], levels: list[str]) -> None:
+        self._stream.send_columns(
             bp.LOG,
             indexes=time_columns(times_ns, self._run_started_ns),
             columns=rr.TextLog.columns(text=texts, level=levels),
@@ -357,6 +326,15 @@ class RerunLive:
     def close(self) -> None:
         """Shut the gRPC server down; safe to call twice."""
         self._hub.disconnect()
+
+
+def time_columns(times_ns: Sequence[int], run_started_ns: int) -> list[rr.TimeColumn]:
+    """``run_time`` (duration since run start) and ``log_time`` of integer-ns times."""
+    times = np.asarray(times_ns, dtype=np.int64)
+    return [
+        rr.TimeColumn(bp.RUN_TIME, duration=(times - run_started_ns).view("timedelta64[ns]")),
+        rr.TimeColumn(bp.LOG_TIME, timestamp=times.view("datetime64[ns]")),
+    ]
 
 
 def _n(force_n: float | None) -> str:

@@ -118,30 +118,6 @@ def test_a_run_becomes_a_verified_rrd_with_every_sample(tmp_path: Path) -> None:
     assert rows[f"/{bp.LOG}"] == 4  # running, stop decision, done, run summary
 
 
-def test_a_file_gets_one_chunk_per_entity_and_batch_whatever_the_flush_ticks(
-    tmp_path: Path,
-) -> None:
-    """Each Rerun chunk costs a send and a kilobyte of schema: writing files only, a run of
-    1000 samples flushed every 100 samples is one chunk per entity (a batch is 2000 samples),
-    a run of 3000 is two (at 2000 and at close), events included."""
-    for samples, chunks in ((1000, 1), (3000, 2)):
-        items = with_predictions(run_messages(1, samples))
-        path = tmp_path / f"st1_run1_{samples}.rrd"
-        with RerunSink(path, "st1", 1, items[0][1].time_ns, RerunOptions()) as sink:
-            for item in received(1, items):
-                sink.write(item)
-                if item.sequence is not None and item.sequence % 100 == 99:
-                    sink.flush()  # the recorder's flush ticks
-        assert not sink.failed and sink.samples == samples
-        found: Counter[str] = Counter()
-        for chunk in RrdReader(path).stream():
-            if not chunk.is_static:
-                found[chunk.entity_path] += 1
-        assert found[f"/{bp.TORQUE}"] == found[f"/{bp.ANGLE}"] == chunks, found
-        assert found[f"/{bp.PEAKS}"] == chunks, found
-        assert rows_by_entity(path)[f"/{bp.TORQUE}"] == samples
-
-
 def test_the_recorder_writes_one_rrd_beside_each_run_mcap(tmp_path: Path) -> None:
     loaded = station(tmp_path)
     limits = FileLimits(1_000_000_000, 1 << 30, 3600 * 1_000_000_000, late_grace_ns=0)
