@@ -31,6 +31,7 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
+from services.rig.openprotocol.simulated_controller import LINGER_S
 from shared import channels
 from shared.codec import decode
 from shared.messages import BridgeStats
@@ -252,7 +253,12 @@ def test_a_bridge_killed_mid_run_and_started_again_loses_no_tightening(tmp_path:
         )
         os.kill(first.pid, signal.SIGKILL)
         first.process.wait(10)
-        time.sleep(1.0)  # a tightening or two while no bridge listens
+        # the controller tightens on while no bridge listens; the bridge is slow to come back
+        station.wait_for(
+            lambda: f"tightening {RUNS}:" in station.rig.log_path.read_text(),
+            f"the controller's tightening {RUNS}",
+        )
+        time.sleep(LINGER_S + 1.0)
         station.start_bridge()
         stats = station.finish()
         assert stats.started_ns > first_started(station), stats
