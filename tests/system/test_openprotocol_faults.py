@@ -233,9 +233,11 @@ def _status_seven(message: bytes) -> bytes:
     return message[: found.start(1)] + b"7" + message[found.end(1) :]
 
 
-def test_a_result_with_a_field_out_of_range_is_fetched_again(tmp_path: Path) -> None:
+def test_a_last_result_with_a_field_out_of_range_is_fetched_again(tmp_path: Path) -> None:
     with fault_station(tmp_path) as station:
-        refused = station.proxy.damage(Damage(mid=61, nth=2, kind="rewrite", rewrite=_status_seven))
+        refused = station.proxy.damage(
+            Damage(mid=61, nth=RUNS, kind="rewrite", rewrite=_status_seven)
+        )
         stats = station.finish()
         assert refused.done.is_set()
         assert stats.refused_values == 1 and stats.results_filled >= 1, stats
