@@ -47,8 +47,9 @@ pytestmark = pytest.mark.system
 STATION = "st1"
 RUNS = 4
 DONE_TIMEOUT_S = 60.0
-CONTROLLER_ARGS = ("--controller", "openprotocol", "--program", "2", "--first-run-id", "1")
-CONTROLLER_ARGS += ("--wait-for-integrator",)
+#: the controller's arguments besides --runs: short runs, ids from 1, the first once subscribed
+CONTROLLER_ARGS: tuple[str, ...] = ("--controller", "openprotocol", "--program", "2")
+CONTROLLER_ARGS += ("--first-run-id", "1", "--wait-for-integrator")
 #: short timers, so that each fault is over in a second or two
 TIMERS = """
 keep_alive_s = 1.0
