@@ -12,8 +12,11 @@ after the watermark up to it is fetched (0064 per id, 0065; :mod:`.pending_tight
 and published once, in id order, before newer live ones. Each 0061 is
 acknowledged (0062) as soon as it is read, before anything else is done with
 it (a controller re-sends an unacknowledged result three times, then drops the
-link). A controller whose newest id is below the watermark, or that names
-itself differently, starts a new epoch (:mod:`.published_ids`).
+link). A 0061 the codec refuses is acknowledged too, then 0064 id 0 asks the
+newest result and the gap up to it is fetched by id: the refused result
+comes back as a 0065 even when it was the last one. A controller whose
+newest id is below the watermark, or that names itself differently, starts
+a new epoch (:mod:`.published_ids`).
 
 Each tightening goes out through the station's queued publisher as a CAN
 station's services publish a run (:mod:`.tightening_messages`); the
@@ -100,6 +103,8 @@ class OpenProtocolBridge:
             station.station_id, station.config.station.tool_id, section.timezone
         )
         self._session: ControllerSession | None = None
+        #: a pushed 0061 was refused: ask the newest result (its id shows the gap)
+        self._ask_newest = False
 
     # -- the link's life -----------------------------------------------------------------
 
@@ -168,6 +173,9 @@ class OpenProtocolBridge:
     def _serve(self, session: ControllerSession, stop: threading.Event) -> None:
         while not stop.is_set():
             session.poll(POLL_S)
+            if self._ask_newest:
+                self._ask_newest = False
+                self._fill_from_newest(session)
             self._fill(session)
             self._publish_ready()
 
@@ -232,7 +240,8 @@ class OpenProtocolBridge:
             self._take_result(message, filled=False)
         elif isinstance(message, RefusedFrame):
             if message.frame.mid == 61 and session is not None:
-                session.send(ResultAcknowledge())  # not sent again; fetched by id later
+                session.send(ResultAcknowledge())  # not sent again: fetched by id instead
+                self._ask_newest = True  # the newest id shows the gap, the last one too
         elif isinstance(message, TraceCurve):
             if session is not None:
                 session.send(CommandAccepted(mid=900))  # the acknowledge of a pushed 0900

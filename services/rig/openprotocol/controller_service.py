@@ -6,7 +6,8 @@ a ``TransportError``: one line, no traceback), holds the rig's liveliness token
 ``boltwatch/<station>/health/rig`` on a zenoh session from the station file
 as the CAN rig does, and runs :class:`~.simulated_controller.SimulatedController`
 in the work thread of its :class:`~shared.service_skeleton.ServiceSkeleton`:
-``--runs N`` ends (status 0) once N tightenings are delivered, otherwise it
+``--runs N`` ends (status 0) once an integrator has had all N tightenings
+(pushed and acknowledged, or fetched by id after it was away), otherwise it
 runs until SIGINT/SIGTERM.
 """
 

@@ -92,6 +92,8 @@ class ControllerState:
         self.alarm: tuple[str, str, int] | None = None
         #: set when an integrator first subscribes to results (``--wait-for-integrator``)
         self.result_subscriber = threading.Event()
+        #: tightening ids no integrator has had yet (acknowledged 0061 or served 0065)
+        self._undelivered: set[int] = set()
 
     # -- revisions ---------------------------------------------------------------------
 
@@ -165,10 +167,20 @@ class ControllerState:
 
     # -- what happens ------------------------------------------------------------------
 
+    def delivered(self, tightening_id: int) -> None:
+        """An integrator has the result ``tightening_id`` (it acknowledged it, or was served it)."""
+        self._undelivered.discard(tightening_id)
+
+    def undelivered(self) -> int:
+        """How many kept tightenings no integrator has had yet."""
+        self._undelivered = {i for i in self._undelivered if self.store.find(i) is not None}
+        return len(self._undelivered)
+
     def tightening(self, tightening: Tightening) -> list[WireMessage]:
         """A finished tightening: kept and counted; the alarm messages it raises or clears
         (for alarm subscribers: each link writes them at the revision it subscribed)."""
         self.store.add(tightening)
+        self._undelivered.add(tightening.tightening_id)
         counters = self.counters
         counters.tightenings += 1
         counters.ok += tightening.ok

@@ -311,11 +311,13 @@ class IntegratorLink:
             return
         self._send(self._state.old_result(tightening, frame.revision), frame.revision)
         self._counters.old_results_served += 1
+        self._state.delivered(tightening.tightening_id)
 
     def _acknowledged(self, _message: object, _frame: Frame, now: float) -> None:
         if self._pending is None:
             LOG.debug("%s: 0062 with no result awaiting it", self.peer)
             return
+        self._state.delivered(self._pending.tightening_id)
         self._pending = None
         self._counters.results_acked += 1
         self._push_next(now)

@@ -3,10 +3,12 @@
 :class:`SimulatedController` listens from construction (so a port in use is
 an error at start) and :meth:`~SimulatedController.run` serves in the
 calling thread while the tool tightens in its own thread. With ``runs`` the
-tool stops after that many tightenings and the controller stays until every
-result pushed is acknowledged (or its link dropped) and nothing has been
-outstanding for :data:`LINGER_S`, so an integrator gets the last one; then
-``run`` returns. Without ``runs`` it serves until ``stop``.
+tool stops after that many tightenings and the controller stays until an
+integrator has had every tightening it keeps (acknowledged its 0061, or was
+served its 0065: one that was away while the tool tightened fetches them when
+it is back, however late), every result pushed is acknowledged (or its link
+dropped) and nothing has been outstanding for :data:`LINGER_S`; then ``run``
+returns. Without ``runs`` it serves until ``stop``.
 """
 
 from __future__ import annotations
@@ -115,10 +117,11 @@ class SimulatedController:
         self.server.report(tightening)
 
     def _delivered(self) -> bool:
-        """With ``runs``: the tool is done and nothing was outstanding for LINGER_S."""
+        """With ``runs``: the tool is done, an integrator has had every kept tightening, and
+        nothing was outstanding for LINGER_S."""
         if self.runs is None or not self._tool_done.is_set():
             return False
-        if self.server.outstanding:
+        if self.server.outstanding or self.state.undelivered():
             self._quiet_since = None
             return False
         now = time.monotonic()
