@@ -1,4 +1,6 @@
-"""``boltwatch inspect RUN.mcap [--out RUN.png]``: a picture of a recorded run."""
+"""``boltwatch inspect RUN.mcap [--out RUN.png]``: a picture of a recorded run;
+``boltwatch inspect --overlay RUN... [--reference RUN] [--align POINT]``: several runs
+on one figure (:mod:`services.cli.run_overlay`)."""
 
 from __future__ import annotations
 
@@ -6,14 +8,18 @@ import argparse
 from pathlib import Path
 
 from services.cli.command_options import (
-    add_recording_argument,
     add_run_option,
+    add_station_file_option,
     check_png_target,
     warn_damaged_recording,
 )
+from shared.errors import InputError
 
 NAME = "inspect"
-HELP = "draw a recorded run as a post-mortem PNG of the paper's figures (10, 13-15, 22, 23)"
+HELP = (
+    "draw a recorded run as a post-mortem PNG of the paper's figures (10, 13-15, 22, 23), "
+    "or several runs overlaid (--overlay)"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -23,19 +29,62 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "(Fig. 10); f_ss, force step, torque drop and K1-K3 per event (Figs. 13-15); the "
         "errors of the 1st-3rd predictions (Figs. 22, 23, eqs. 61-63). With the joint and "
         "program metadata in the file, the analytical bounds are drawn too. For interactive "
-        "viewing open the .mcap in Foxglove (it needs no plug-in)."
+        "viewing open the .mcap in Foxglove (it needs no plug-in). With --overlay: several "
+        "runs' torque and preload over angle and over time on one figure, aligned at one "
+        "point, with their programs' windows and each run's OK/NOK."
     )
-    add_recording_argument(parser)
     parser.add_argument(
-        "--out", type=Path, default=None, metavar="RUN.png", help="default: beside the recording"
+        "recording", type=Path, nargs="?", default=None, metavar="RUN.mcap", help="the recording"
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        metavar="FILE.png",
+        help="default: beside the recording (--overlay: overlay.png in the current folder)",
     )
     add_run_option(
         parser,
         "run id to draw (default: the run with the most samples; the output names the others)",
     )
+    overlay = parser.add_argument_group("overlay (several runs on one figure)")
+    overlay.add_argument(
+        "--overlay",
+        nargs="+",
+        default=None,
+        metavar="RUN",
+        help="runs to draw: run ids (found in the station's recordings, see --config) or "
+        "MCAP paths",
+    )
+    overlay.add_argument(
+        "--reference", default=None, metavar="RUN", help="a run drawn distinct (black, on top); "
+        "the others are aligned onto it"
+    )  # fmt: skip
+    overlay.add_argument(
+        "--align",
+        default="start",
+        metavar="start|torque:NM|first-slip",
+        help="where runs are aligned: the start of the run, where torque first reaches NM, "
+        "or the first stick-slip event (default: start)",
+    )
+    add_station_file_option(overlay, "station file, whose recordings the run ids are found in")
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.overlay is not None:
+        if args.recording is not None or args.run is not None:
+            raise InputError(
+                "--overlay takes its runs after it (run ids or MCAP paths); "
+                "give no RUN.mcap or --run with it"
+            )
+        from services.cli.run_overlay import run_overlay
+
+        return run_overlay(args)
+    if args.recording is None:
+        raise InputError("give a recording (RUN.mcap) to draw, or --overlay RUN...")
+    if args.reference is not None or args.align != "start":
+        option = "--reference" if args.reference is not None else "--align"
+        raise InputError(f"{option} is an option of --overlay; give --overlay RUN... with it")
     from services.recorder.post_mortem.run_plot import draw_run
 
     target = args.out or args.recording.with_suffix(".png")

@@ -1,0 +1,75 @@
+"""``boltwatch inspect --overlay RUN... [--reference RUN] [--align POINT] [--out FILE.png]``.
+
+A RUN is a run id (all digits, and no file of that name): its MCAP files are
+found in the ``--config`` station's recordings folder; anything else is the
+path of an MCAP file. The runs are read, aligned and drawn by
+:mod:`services.recorder.overlay`; a run that never reaches the alignment
+point is drawn unaligned, with a warning line naming it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from services.cli.command_options import check_png_target
+from services.recorder.overlay.overlay_alignment import parse_alignment
+from services.recorder.overlay.overlay_plot import save_figure
+from services.recorder.overlay.overlay_run import OverlayRun, find_run_files, read_overlay_run
+from services.recorder.overlay.overlay_series import build_overlay
+from shared.config import LoadedStation
+
+DEFAULT_TARGET = Path("overlay.png")
+
+
+class RunFinder:
+    """RUN arguments to runs; the station file is read once, and only for a run id."""
+
+    def __init__(self, station_file: Path) -> None:
+        self.station_file = station_file
+        self._station: LoadedStation | None = None
+
+    def run(self, name: str) -> OverlayRun:
+        path = Path(name)
+        if name.isdigit() and not path.exists():
+            station = self._loaded()
+            files = find_run_files(station.recordings_folder, station.station_id, int(name))
+            return read_overlay_run(name, files, int(name))
+        return read_overlay_run(name, [path])
+
+    def _loaded(self) -> LoadedStation:
+        if self._station is None:
+            from shared.config import load_station
+
+            self._station = load_station(self.station_file)
+        return self._station
+
+
+def run_overlay(args: argparse.Namespace) -> int:
+    alignment = parse_alignment(args.align)
+    target: Path = args.out or DEFAULT_TARGET
+    check_png_target(target, "the overlay")
+    finder = RunFinder(args.config)
+    runs = [finder.run(name) for name in args.overlay]
+    reference = finder.run(args.reference) if args.reference is not None else None
+    overlay = build_overlay(runs, reference, alignment)
+    for run in [*runs, *([reference] if reference else [])]:
+        if run.damage:
+            print(
+                f"boltwatch inspect: warning: {run.damage}; drew what is readable", file=sys.stderr
+            )
+    for series in overlay.unaligned:
+        never = series.note.removeprefix("not aligned: ")
+        print(
+            f"boltwatch inspect: warning: run {series.run_id} {never}: drawn unaligned "
+            "(dotted, from its own start)",
+            file=sys.stderr,
+        )
+    save_figure(overlay, target)
+    verdicts = ", ".join(f"{s.run_id} {s.verdict}" for s in overlay.series)
+    print(
+        f"wrote {target}: {len(overlay.series)} runs ({verdicts}), aligned at "
+        f"{alignment.describe()} onto run {overlay.frame_run}"
+    )
+    return 0
