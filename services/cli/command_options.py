@@ -46,7 +46,7 @@ def warn_damaged_recording(command: str, state: str, what_was_done: str) -> None
 
 
 def add_station_file_option(
-    parser: argparse.ArgumentParser,
+    parser: argparse.ArgumentParser | argparse._ArgumentGroup,
     help_text: str = "station file",
     several: bool = False,
 ) -> None:

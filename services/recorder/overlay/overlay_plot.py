@@ -88,9 +88,7 @@ def build_figure(overlay: Overlay) -> Figure:
         colour = WINDOW_COLOURS[n % len(WINDOW_COLOURS)]
         angles = (windows.angle_min_deg, windows.angle_max_deg)
         torques = (windows.torque_min_nm, windows.torque_max_nm)
-        forces_kn = tuple(
-            None if f is None else f / 1e3 for f in (windows.force_min_n, windows.force_max_n)
-        )
+        forces_kn = (_kn(windows.force_min_n), _kn(windows.force_max_n))
         _window_box(angle_torque, angles, torques, colour)
         _window_box(time_torque, (None, None), torques, colour)
         if angle_force is not None and time_force is not None:
@@ -134,6 +132,10 @@ def _window_box(
     outline = Rectangle((low_x, low_y), *size, fill=False, edgecolor=colour, zorder=5)
     outline.set(linewidth=1.8, linestyle=edge)
     axis.add_patch(outline)
+
+
+def _kn(force_n: float | None) -> float | None:
+    return None if force_n is None else force_n / 1e3
 
 
 def _span(

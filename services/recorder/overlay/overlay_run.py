@@ -91,7 +91,9 @@ def read_overlay_run(label: str, files: list[Path], run_id: int | None = None) -
             if message_type is None:
                 continue
             try:
-                message = decode(message_type, record.data)
+                message: Sample | StickSlipEvent | TighteningResult = decode(
+                    message_type, record.data
+                )
             except InputError:
                 continue  # what cannot be decoded is not drawn
             if isinstance(message, Sample):
