@@ -15,4 +15,5 @@
   :mod:`.controller_replay` (an imported run as the predictor's advisory replay
   takes it: here, because the recorder may not import the predictor)
 - ``boltwatch predict``: :mod:`.predict_settings` (its options, or a station's program)
+- ``boltwatch inspect --overlay``: :mod:`.run_overlay` (run ids or paths to runs, drawn)
 """
