@@ -8,6 +8,7 @@
 - :mod:`.rerun_files`: Rerun ``.rrd`` files and the live view
 - :mod:`.wear`: the wear ledger (per tool), its bound, alerts, reset, the plant view
 - :mod:`.post_mortem`: the paper's figures of a recorded run (``boltwatch inspect``)
+- :mod:`.quality`: statistics per program (``boltwatch report``)
 - :mod:`.controller_import`: controller runs into recordings (``boltwatch import``)
 
 Each room's ``__init__`` says what each of its files is. Test helpers (a
