@@ -4,7 +4,8 @@ Per figure (final torque, angle, preload, process intensity): the values of
 the runs that measured it, in the order the runs ended, their capability
 against the program's window (:mod:`.capability`) and their control chart
 (:mod:`.control_chart`). Per program: the NOK rate, a Pareto of NOK reasons
-(each ``"; "``-separated reason counted once per run, most frequent first),
+(each ``"; "``-separated reason counted once per run by its kind, the text
+before its figures, ``preload low``; most frequent first),
 the stop reasons (``tool`` when the tool stopped by itself) and the stick-slip
 events per run.
 
@@ -67,6 +68,12 @@ class ProgramStatistics:
         return self.noks / self.runs if self.runs else 0.0
 
 
+def reason_kind(reason: str) -> str:
+    """What a NOK reason says without its figures: ``preload low: 52800 N, window 53000 to
+    59000 N`` -> ``preload low`` (the Pareto counts kinds, not values)."""
+    return reason.split(":", 1)[0].strip()
+
+
 def _judged(result: TighteningResult, key: str) -> JudgedFigure | None:
     return {
         "torque": result.final_torque_nm,
@@ -125,7 +132,7 @@ def _one_program(
     reasons: Counter[str] = Counter()
     for run in runs:
         if run.result == "NOK":
-            reasons.update({reason.strip() for reason in run.nok_reasons.split(";")} - {""})
+            reasons.update({reason_kind(reason) for reason in run.nok_reasons.split(";")} - {""})
     stops = Counter(run.stop_reason or TOOL_STOPPED for run in runs)
     events = []
     for run in runs:

@@ -47,8 +47,11 @@ def _result(
     t = _figure(torque, *(TORQUE if windowed else (None, None)))
     a = _figure(angle, ANGLE_MIN if windowed else None, None)
     f = _figure(force, *(FORCE if windowed else (None, None)))
-    reasons = [f"{name} {j.status}" for name, j in (("torque", t), ("angle", a), ("preload", f))]
-    reasons = [reason for reason in reasons if not reason.endswith(("ok", "not_judged"))]
+    judged = (("torque", t), ("angle", a), ("preload", f))
+    # as the predictor words them: the kind, then the figures
+    reasons = [
+        f"{name} {j.status}: {j.value:.1f}" for name, j in judged if j.status in ("low", "high")
+    ]
     return TighteningResult(
         "st1", run_id, run_id, tool, program, f"P{program}", time_ns, None, None, t, a, f,
         "NOK" if reasons else "OK", "; ".join(reasons),
@@ -137,7 +140,9 @@ def test_report_figures_match_numpy(
     assert "Cpk not computed (no window)" in _printed_cpk(printed, 2, "final torque")
     assert "Cpk not computed (no window)" in _printed_cpk(printed, 1, "process intensity")
     # the Pareto: each reason counted once per run, most frequent first
-    reasons = [reason for r in one if r.nok_reasons for reason in r.nok_reasons.split("; ")]
+    reasons = [
+        reason.split(":")[0] for r in one if r.nok_reasons for reason in r.nok_reasons.split("; ")
+    ]
     most = max(reasons.count(reason) for reason in reasons)
     printed_top = re.search(r"NOK reasons: ([a-z ]+) \((\d+)\)", printed)
     assert printed_top is not None and int(printed_top[2]) == most
