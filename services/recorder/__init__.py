@@ -9,6 +9,7 @@
 - :mod:`.wear`: the wear ledger (per tool), its bound, alerts, reset, the plant view
 - :mod:`.post_mortem`: the paper's figures of a recorded run (``boltwatch inspect``)
 - :mod:`.overlay`: several recorded runs on one figure (``boltwatch inspect --overlay``)
+- :mod:`.quality`: statistics per program (``boltwatch report``)
 - :mod:`.controller_import`: controller runs into recordings (``boltwatch import``)
 
 Each room's ``__init__`` says what each of its files is. Test helpers (a

@@ -17,4 +17,5 @@ inside ``run`` so that ``boltwatch --help`` stays fast.
     recover      a truncated recording (.mcap or .rrd) made valid
     import_runs  ``boltwatch import``: controller JSON runs as recordings or trace CSVs
     wear         the wear ledger per tool, a tool's service, a broken ledger replaced
+    report       statistics per program over recorded results (X̄/R, Cp/Cpk, NOK Pareto)
 """

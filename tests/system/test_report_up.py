@@ -1,0 +1,63 @@
+"""``boltwatch report`` over the recordings of a real ``boltwatch up``.
+
+The station tightens six joints (real processes, zenoh on loopback, CAN over
+udp_multicast); the report's figures are checked against numpy computed from
+the results read back from MCAP with the mcap library and json only.
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.paths import REPO
+from tests.system.station_files import write_station
+from tests.system.test_station_up import UP_TIMEOUT_S, read_recordings, up_command
+
+pytestmark = pytest.mark.system
+
+RUNS = 6
+
+
+def test_report_over_runs_of_up(tmp_path: Path) -> None:
+    station = write_station(tmp_path)
+    up = subprocess.run(
+        up_command(station, runs=RUNS),
+        capture_output=True,
+        text=True,
+        timeout=UP_TIMEOUT_S,
+        cwd=REPO,
+        check=False,
+    )
+    assert up.returncode == 0, up.stdout + up.stderr
+    out = tmp_path / "report"
+    command = [sys.executable, "-m", "services.cli", "report", "--config", str(station)]
+    report = subprocess.run(
+        [*command, "--subgroup-size", "2", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=REPO,
+        check=False,
+    )
+    assert report.returncode == 0, report.stdout + report.stderr
+    results = read_recordings(tmp_path / "recordings")["boltwatch/st1/results"]
+    assert len(results) == RUNS
+    assert f"{RUNS} results from" in report.stdout
+    preload = [result["final_force_n"]["value"] for result in results]
+    low, high = results[-1]["final_force_n"]["min"], results[-1]["final_force_n"]["max"]
+    mean, sigma = np.mean(preload), np.std(preload, ddof=1)
+    cpk = min(high - mean, mean - low) / (3 * sigma)
+    line = next(line for line in report.stdout.splitlines() if "final preload" in line)
+    assert f"mean {mean:.6g} " in re.sub(r"\s+", " ", line), line
+    assert f"Cp {(high - low) / (6 * sigma):.3g} Cpk {cpk:.2f}" in line, line
+    noks = sum(1 for result in results if result["result"] == "NOK")
+    assert f"{RUNS} runs, NOK {noks}" in report.stdout
+    page = (out / "report.html").read_text()
+    assert f"{cpk:.2f}" in page and "data:image/png;base64," in page
+    assert (out / "report.png").read_bytes().startswith(b"\x89PNG")
