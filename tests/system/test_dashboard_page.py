@@ -10,8 +10,8 @@ and the wear alert, and load nothing but from its own server. A screenshot
 goes to the test's folder (``BOLTWATCH_DOCS_IMAGES=1``: also to
 docs/images/dashboard.png, the README's picture).
 
-Chromium comes from Debian's package (the Makefile's ``browser`` target, run
-by ``make test`` and .ci/run as root); never ``playwright install``. Where it
+Chromium comes from Debian's package (.ci/run installs it as root when
+missing); never ``playwright install``. Where it
 cannot be installed the test skips with the reason.
 """
 
@@ -76,7 +76,7 @@ def _wait_http(url: str, timeout_s: float = 30.0) -> None:
 
 def test_the_line_page_shows_results_live_in_a_real_browser(tmp_path: Path) -> None:
     if not CHROMIUM.exists():
-        pytest.skip(f"{CHROMIUM} is missing (make browser installs Debian's chromium as root)")
+        pytest.skip(f"{CHROMIUM} is missing (.ci/run installs Debian's chromium as root)")
     sync_api = pytest.importorskip("playwright.sync_api")
     threshold = {"[recorder]\n": "[recorder]\nwear_service_threshold = 4.0e6\n"}
     with live_station(tmp_path, placement="edge", replacements=threshold) as station:
