@@ -32,7 +32,7 @@ from typing import Any
 from shared import channels, keys
 from shared.codec import decode
 from shared.errors import InputError
-from shared.line_status.station_status import StationStatus, StatusCollector
+from shared.line_status.station_status import KNOWN_SERVICES, StationStatus, StatusCollector
 from shared.line_status.status_last_result import last_result
 from shared.messages import RunSummary, TighteningResult
 
@@ -90,6 +90,7 @@ class LineBoard:
         self._window_started_ns = started_ns
         self._started_ns = started_ns
         self._last_window: dict[str, StationStatus] = {}
+        self._windows_closed = 0
         self._history = {station: _History() for station in self._settings}
 
     @property
@@ -124,6 +125,7 @@ class LineBoard:
             self._last_window = {status.station: status for status in report.stations}
             self._window = StatusCollector()
             self._window_started_ns = now_ns
+            self._windows_closed += 1
 
     def wear_reply(self, station: str, payload: bytes, now_ns: int) -> None:
         """The recorder's reply to ``boltwatch/<station>/wear`` (InputError: not one)."""
@@ -149,6 +151,7 @@ class LineBoard:
                     self._settings[name],
                     latest.get(name),
                     self._last_window.get(name),
+                    self._windows_closed > 0,
                     self._history[name],
                     now_ns,
                 )
@@ -219,13 +222,18 @@ def _station_view(
     setting: StationSetting,
     latest: StationStatus | None,
     window: StationStatus | None,
+    window_closed: bool,
     history: _History,
     now_ns: int,
 ) -> dict[str, Any]:
     latest_view = dataclasses.asdict(latest) if latest is not None else {}
+    if window is not None:
+        services = window.services
+    else:  # silent for a whole window, no token: every service down (none: not asked yet)
+        services = dict.fromkeys(KNOWN_SERVICES, False) if window_closed else {}
     return {
         "station": setting.station,
-        "services": window.services if window is not None else {},
+        "services": services,
         "samples_per_s": window.samples_per_s if window is not None else None,
         "bus_samples_per_s": window.bus_samples_per_s if window is not None else None,
         "last_run": latest_view.get("last_run"),
