@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from typing import Any
 
 import pytest
 
@@ -23,7 +24,7 @@ def put(board: LineBoard, topic: str, message: object, station: str = "st1") -> 
     return board.message(keys.station_key(station, topic), encode(message), T0)
 
 
-def station(board: LineBoard, name: str = "st1") -> dict[str, object]:
+def station(board: LineBoard, name: str = "st1") -> dict[str, Any]:
     return next(s for s in board.snapshot(T0 + S)["stations"] if s["station"] == name)
 
 
