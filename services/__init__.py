@@ -1,5 +1,6 @@
 """The boltwatch services: rig (simulated tool + sensors), acquisition,
-predictor, recorder, the line's zenoh router, and the ``boltwatch`` CLI.
+predictor, recorder, the line's zenoh router, the Open Protocol bridge, the
+line's web page (dashboard), and the ``boltwatch`` CLI.
 
 Services never import each other (import-linter checks it); they meet on
 zenoh key expressions (:mod:`shared.keys`). Only :mod:`services.cli` knows

@@ -25,6 +25,7 @@ codecs, zenoh and CAN helpers, and the paper's analytical model.
   (SCHED_FIFO for the stop path), :mod:`.logging_setup`, :mod:`.log_limit` (one
   line for a flood), :mod:`.folders` (make a folder or say why not)
 - :mod:`.openprotocol` (Atlas Copco Open Protocol: framing and messages, no sockets)
+- :mod:`.line_status` (what a line's stations say: ``boltwatch status`` and the line's page)
 - :mod:`.option_types` (argparse types that refuse impossible numbers)
 - :mod:`.run_clock` (a run's clock: epoch ns <-> seconds since the run started)
 """

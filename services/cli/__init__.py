@@ -6,10 +6,8 @@
   path)
 - ``boltwatch up``: :mod:`.station_run`, :mod:`.station_supervisor`, :mod:`.run_table`,
   :mod:`.run_tally` (which summaries count: runs seen starting, once)
-- ``boltwatch status``: :mod:`.station_status`, :mod:`.station_status_text`,
-  :mod:`.status_bus` (the acquisition's rate and bus faults),
-  :mod:`.status_last_result` (the last tightening result: OK/NOK and why),
-  :mod:`.status_bridge` (a controller bridge's link, faults and alarms);
+- ``boltwatch status``: :mod:`.station_status_text` (what it prints of
+  :mod:`shared.line_status`, which collects it; the line's page shares that);
   with ``wear --plant``: :mod:`.router_client` (a client of the line's router)
 - ``boltwatch import``: :mod:`.import_destination` (recordings or trace CSVs),
   :mod:`.controller_replay` (an imported run as the predictor's advisory replay

@@ -1,14 +1,14 @@
 """The text ``boltwatch status`` prints for a person at a terminal.
 
 One block per station, one line per figure, labels in a column; what each
-figure means is said in :mod:`services.cli.station_status`, which collects
+figure means is said in :mod:`shared.line_status.station_status`, which collects
 them. A figure that did not arrive in the listening window is a ``-`` and a
 short guess why, so that an empty line never reads as "all is well".
 """
 
 from __future__ import annotations
 
-from services.cli.station_status import (
+from shared.line_status.station_status import (
     BusHealth,
     LastDecision,
     LastRun,
@@ -18,8 +18,8 @@ from services.cli.station_status import (
     StationStatus,
     StatusReport,
 )
-from services.cli.status_bridge import bridge_lines
-from services.cli.status_last_result import result_text
+from shared.line_status.status_bridge import bridge_lines
+from shared.line_status.status_last_result import result_text
 
 
 def format_report(report: StatusReport) -> str:

@@ -133,11 +133,13 @@ class LiveStation:
         folder: Path,
         recorder_args: tuple[str, ...] = ("--no-rerun",),
         placement: str = "line",
+        replacements: dict[str, str] | None = None,
     ) -> None:
-        """``placement``: "line" (a predictor process of its own) or "edge" (in the acquisition)."""
+        """``placement``: "line" (a predictor process of its own) or "edge" (in the acquisition);
+        ``replacements``: changes to the station file (:func:`write_station`)."""
         self.folder = folder
         self.placement = placement
-        self.station_file = write_station(folder, placement=placement)
+        self.station_file = write_station(folder, placement=placement, replacements=replacements)
         self.loaded = load_station(self.station_file)
         self.recordings = self.loaded.recordings_folder
         self.supervisor = StationSupervisor(self.station_file, folder / "logs")
@@ -253,9 +255,12 @@ def open_client(endpoint: str) -> zenoh.Session:
 
 @contextlib.contextmanager
 def live_station(
-    folder: Path, recorder_args: tuple[str, ...] = ("--no-rerun",), placement: str = "line"
+    folder: Path,
+    recorder_args: tuple[str, ...] = ("--no-rerun",),
+    placement: str = "line",
+    replacements: dict[str, str] | None = None,
 ) -> Iterator[LiveStation]:
-    station = LiveStation(folder, recorder_args, placement)
+    station = LiveStation(folder, recorder_args, placement, replacements)
     try:
         yield station
     finally:

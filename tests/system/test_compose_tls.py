@@ -57,7 +57,7 @@ pytestmark = [
     pytest.mark.skipif(shutil.which("openssl") is None, reason="needs the openssl CLI"),
 ]
 
-RUNNING = ("router", "acquisition-st1", "rig-st1", "recorder")
+RUNNING = ("router", "acquisition-st1", "rig-st1", "recorder", "dashboard")
 TLS_STATIONS = "/etc/boltwatch/compose/tls"
 HEALTHY_WITHIN_S = 60.0
 NOT_ALIVE = 1  # `boltwatch health`: 1 not alive (yet), 2 router unreachable or bad file
@@ -79,6 +79,7 @@ class ComposeLine:
         env = {"BOLTWATCH_CERTS": str(self.certs), "BOLTWATCH_RECORDINGS": str(recordings)}
         self.services: dict[str, Any] = load_merged([BASE_FILE, TLS_FILE], env)["services"]
         self.port = free_tcp_port()
+        self.page_port = free_tcp_port()  # the dashboard's, instead of 0.0.0.0:8080
         self.can_ports = {"43113": str(free_udp_port()), "43114": str(free_udp_port())}
         self.processes: dict[str, subprocess.Popen[bytes]] = {}
         self._containers: dict[tuple[str, str | None], ContainerFiles] = {}
@@ -106,6 +107,7 @@ class ComposeLine:
     def start(self, name: str) -> None:
         command = self.files(name).arguments(self.services[name]["command"])
         command = [a.replace("tls/0.0.0.0:7447", f"tls/127.0.0.1:{self.port}") for a in command]
+        command = [a.replace("0.0.0.0:8080", f"127.0.0.1:{self.page_port}") for a in command]
         assert command[0] == "serve"
         self.processes[name] = serve(command[1:], self.folder / f"{name}.log")
 

@@ -51,6 +51,10 @@ PER_STATION = ("acquisition", "rig")
 VARIABLE = re.compile(r"\$\{([^}]*)\}")
 
 
+#: services of the whole line (every station file); the others serve one station
+LINE_WIDE = ("recorder", "viewer", "dashboard")
+
+
 def served_role(name: str) -> str:
     """``acquisition-st1`` -> ``acquisition``; ``viewer`` is a recorder."""
     return "recorder" if name == "viewer" else name.split("-", maxsplit=1)[0]
@@ -67,11 +71,13 @@ def station_files(name: str) -> list[Path]:
 
 
 def test_the_line_layout_is_there() -> None:
-    expected = {"router", "recorder", "viewer"} | {
+    expected = {"router", "recorder", "viewer", "dashboard"} | {
         f"{role}-{station}" for role in PER_STATION for station in STATIONS
     }
     assert set(SERVICES) == expected
     assert SERVICES["viewer"]["profiles"] == ["viewer"]
+    page = build_parser().parse_args(SERVICES["dashboard"]["command"])
+    assert page.listen == ("0.0.0.0", 8080) and SERVICES["dashboard"]["ports"] == ["8080:8080"]
     for station in STATIONS:  # the simulated bus is multicast inside the station's netns
         assert SERVICES[f"rig-{station}"]["network_mode"] == f"service:acquisition-{station}"
 
@@ -93,8 +99,8 @@ def test_command_is_a_valid_boltwatch_command(name: str) -> None:
     for station in stations:
         assert station.config.zenoh.connect == ["tcp/router:7447"]
     ids = [station.station_id for station in stations]
-    if name in ("recorder", "viewer"):
-        assert ids == list(STATIONS), "the line's recorder serves every station"
+    if name in LINE_WIDE:
+        assert ids == list(STATIONS), f"the line's {name} serves every station"
     else:
         assert ids == [name.split("-", 1)[1]], f"{name} must serve only its own station"
 
@@ -167,6 +173,8 @@ def expected_identity(name: str) -> str:
         return {"router": "router", "recorder": "line-recorder"}[name]
     if name == "viewer":
         return "line-viewer"
+    if name == "dashboard":  # the line's page only listens: the operator's identity
+        return "line-monitor"
     role, station = name.split("-", maxsplit=1)
     return f"{station}-{role}"
 
@@ -267,7 +275,7 @@ def test_each_identity_may_put_exactly_what_its_role_publishes(
         return
     line_policy = next(p for p in acl["policies"] if p["id"] == "line")
     assert common in line_policy["subjects"], f"{common} may not even declare its health token"
-    stations = list(STATIONS) if role == "recorder" else [name.split("-", 1)[1]]
+    stations = list(STATIONS) if name in LINE_WIDE else [name.split("-", 1)[1]]
     puts = set() if name == "viewer" else ROLE_PUTS.get(role, set())
     expected = {keys.station_key(st, topic) for st in stations for topic in puts}
     assert put_keys_granted(acl, common) == expected

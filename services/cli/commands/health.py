@@ -17,7 +17,15 @@ from services.cli.command_options import add_station_file_option
 NAME = "health"
 HELP = "exit 0 if a service is alive for the stations named (for container health checks)"
 
-CHECKED_SERVICES = ("router", "rig", "acquisition", "predictor", "recorder", "viewer")
+CHECKED_SERVICES = (
+    "router",
+    "rig",
+    "acquisition",
+    "predictor",
+    "recorder",
+    "viewer",
+    "dashboard",
+)
 CONNECT_TIMEOUT_MS = 2000
 LIVELINESS_TIMEOUT_S = 2.0
 

@@ -16,6 +16,7 @@ from types import ModuleType
 
 from services.acquisition import arguments as acquisition_arguments
 from services.cli.command_options import add_station_file_option
+from services.dashboard import arguments as dashboard_arguments
 from services.openprotocol import arguments as openprotocol_arguments
 from services.predictor import arguments as predictor_arguments
 from services.recorder import arguments as recorder_arguments
@@ -23,7 +24,10 @@ from services.rig import arguments as rig_arguments
 from services.router import arguments as router_arguments
 
 NAME = "serve"
-HELP = "run one long-running service (rig, acquisition, predictor, recorder, router, openprotocol)"
+HELP = (
+    "run one long-running service (rig, acquisition, predictor, recorder, router, openprotocol, "
+    "dashboard)"
+)
 
 #: service name -> its arguments module (light: no heavy imports, so ``--help`` is fast)
 SERVICES: dict[str, ModuleType] = {
@@ -33,12 +37,13 @@ SERVICES: dict[str, ModuleType] = {
     "recorder": recorder_arguments,
     "router": router_arguments,
     "openprotocol": openprotocol_arguments,
+    "dashboard": dashboard_arguments,
 }
 
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR")
 
 #: services of the line that one process runs for several stations (``--config A B ...``)
-MULTI_STATION = ("predictor", "recorder")
+MULTI_STATION = ("predictor", "recorder", "dashboard")
 
 SERVICE_HELP = {
     "rig": "the simulated tool controller and sensors on the CAN bus",
@@ -48,6 +53,7 @@ SERVICE_HELP = {
     "router": "the line's zenoh router that stations connect to",
     "openprotocol": "a tightening controller's results and curves over Open Protocol (TCP), "
     "published as the station's runs",
+    "dashboard": "the line's web page: services, results, stop reasons, tool wear, alerts, live",
 }
 
 
@@ -105,6 +111,10 @@ def _service_main(service: str) -> Callable[[argparse.Namespace], int]:
         from services.recorder.service import main as recorder_main
 
         return recorder_main
+    if service == "dashboard":
+        from services.dashboard.service import main as dashboard_main
+
+        return dashboard_main
     from services.router.service import main as router_main
 
     return router_main

@@ -3,7 +3,7 @@
 Joins the line's zenoh router as a client, listens to ``boltwatch/*/*`` for
 ``--listen-s`` seconds, then asks which liveliness tokens
 ``boltwatch/*/health/*`` exist, and prints every station seen (see
-:mod:`services.cli.station_status` for what each figure means). Exit 0 when
+:mod:`shared.line_status.station_status` for what each figure means). Exit 0 when
 the router answered (even if no station is alive), 2 when it is unreachable.
 """
 
@@ -20,7 +20,7 @@ from shared.option_types import seconds
 if TYPE_CHECKING:
     import zenoh
 
-    from services.cli.station_status import StatusReport
+    from shared.line_status.station_status import StatusReport
 
 NAME = "status"
 HELP = (
@@ -69,8 +69,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from services.cli.router_client import router_client
-    from services.cli.station_status import to_json
     from services.cli.station_status_text import format_report
+    from shared.line_status.station_status import to_json
 
     endpoint, config = router_client(args.config or DEFAULT_STATION_FILE, args.connect)
     report = _watch(endpoint, config, args.listen_s)
@@ -87,8 +87,8 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
     import time
 
     from services.cli.router_client import open_client
-    from services.cli.station_status import StatusCollector
     from shared import keys
+    from shared.line_status.station_status import StatusCollector
 
     session = open_client(endpoint, config)
 

@@ -6,10 +6,10 @@ import json
 from dataclasses import replace
 
 from services.cli import run_table
-from services.cli.station_status import StatusCollector, to_json
 from services.cli.station_status_text import format_report
 from shared import channels, keys
 from shared.codec import encode
+from shared.line_status.station_status import StatusCollector, to_json
 from shared.messages import JudgedFigure, TighteningResult
 from tests.unit.cli.test_station_status import summary
 

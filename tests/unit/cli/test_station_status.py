@@ -5,10 +5,10 @@ from __future__ import annotations
 import json
 from typing import Any
 
-from services.cli.station_status import LastRun, StatusCollector, to_json
 from services.cli.station_status_text import format_report
 from shared import channels, keys
 from shared.codec import encode
+from shared.line_status.station_status import LastRun, StatusCollector, to_json
 from shared.messages import (
     BusStats,
     PredictorStats,

@@ -4,7 +4,7 @@ From the latest :class:`~shared.messages.TighteningResult` on
 ``boltwatch/<st>/results`` in the listening window (the live predictor's,
 or a controller's): the run, OK or NOK with its reasons, each final figure
 with its status, where it came from and how long ago the run ended.
-Collected by :mod:`services.cli.station_status`, printed by
+Collected by :mod:`shared.line_status.station_status`, printed by
 :mod:`services.cli.station_status_text`.
 """
 

@@ -1,6 +1,7 @@
 """What ``boltwatch status`` saw of each station: pure aggregation.
 
-The command (``services/cli/commands/status.py``) owns the zenoh session; it
+The command (``services/cli/commands/status.py``, and the line's page
+``services/dashboard/``) owns the zenoh session; it
 feeds this module what arrives, and asks it for a report at the end of the
 listening window. Nothing here knows about zenoh or clocks: receive times and
 "now" are passed in (integer nanoseconds since the Unix epoch). The report is
@@ -15,12 +16,12 @@ Per station:
   SampleBatch), and, when
   two or more BusStats arrived, the acquisition's own count (``samples``
   delta over ``time_ns`` delta) -- the second tells a slow link from a slow bus;
-- bus faults: from the latest BusStats (:mod:`services.cli.status_bus`);
+- bus faults: from the latest BusStats (:mod:`shared.line_status.status_bus`);
 - last run: the latest ToolState; failing that the run of the latest Sample
   (then running), failing that the latest RunSummary;
 - last decision, last run summary: the latest of each, with its age;
 - last result: the latest TighteningResult, its OK/NOK and why
-  (:mod:`services.cli.status_last_result`);
+  (:mod:`shared.line_status.status_last_result`);
 - recorder: the latest RecorderStats (``boltwatch/<st>/recorder``, once a
   second): lag of samples into the recorder (p50/max over its last second,
   None when no samples came), messages written, samples the acquisition
@@ -32,7 +33,7 @@ Per station:
   second): payloads it refused, samples its core could not use, samples of
   no running run, runs whose end never arrived;
 - a controller bridge's link, faults and newest active alarm, for a station
-  with one (:mod:`services.cli.status_bridge`).
+  with one (:mod:`shared.line_status.status_bridge`).
 """
 
 from __future__ import annotations
@@ -41,13 +42,13 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-from services.cli.status_bridge import TOPICS as BRIDGE_TOPICS
-from services.cli.status_bridge import BridgeSeen, BridgeStatus, bridge_status
-from services.cli.status_bus import BusHealth, bus_health, bus_rate
-from services.cli.status_last_result import LastResult, last_result
 from shared import channels, keys
 from shared.codec import decode
 from shared.errors import InputError
+from shared.line_status.status_bridge import TOPICS as BRIDGE_TOPICS
+from shared.line_status.status_bridge import BridgeSeen, BridgeStatus, bridge_status
+from shared.line_status.status_bus import BusHealth, bus_health, bus_rate
+from shared.line_status.status_last_result import LastResult, last_result
 from shared.messages import (
     BusStats,
     PredictorStats,

@@ -5,7 +5,7 @@ Counters since the acquisition started, from the latest
 wrong_length + decode_errors + error_frames + counter_faults (frames that
 were on our bus and unusable; foreign ``unknown_ids`` are not); the
 acquisition's own sample rate from the first and the latest BusStats (tells
-a slow link from a slow bus). Collected by :mod:`services.cli.station_status`.
+a slow link from a slow bus). Collected by :mod:`shared.line_status.station_status`.
 """
 
 from __future__ import annotations

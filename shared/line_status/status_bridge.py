@@ -11,7 +11,7 @@ from :class:`~shared.messages.ControllerAlarm` on ``boltwatch/<st>/alarms``:
 the newest alarm still active (each error code's latest word counts; a
 status saying no alarm is active clears them all). A station without a
 bridge shows none of these lines. Collected by
-:mod:`services.cli.station_status`, printed by :mod:`services.cli.station_status_text`.
+:mod:`shared.line_status.station_status`, printed by :mod:`services.cli.station_status_text`.
 """
 
 from __future__ import annotations

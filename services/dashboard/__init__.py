@@ -1,0 +1,16 @@
+"""``boltwatch serve dashboard``: the supervisor's page of the line, live in a browser.
+
+A service of its own: it meets the others on zenoh only (import-linter's
+independence contract) and collects what ``boltwatch status`` collects
+(:mod:`shared.line_status`).
+
+- :mod:`.arguments` (its options, light), :mod:`.service` (``main``: files,
+  session, server)
+- :mod:`.line_board` (what the page shows, pure: status's collectors, the last
+  results, stop reasons, alerts and wear per station)
+- :mod:`.board_feed` (zenoh: subscriptions, liveliness and wear queries per
+  window, its health token)
+- :mod:`.web_app` (aiohttp: the page, ``/board.json``, server-sent ``/events``)
+- ``page/``: ``index.html``, ``dashboard.css``, ``dashboard.js`` (served by the
+  app; nothing from the internet)
+"""

@@ -1,0 +1,35 @@
+"""Command-line options of ``boltwatch serve dashboard`` (light: no heavy imports)."""
+
+from __future__ import annotations
+
+import argparse
+
+DEFAULT_LISTEN = "127.0.0.1:8080"
+
+
+def host_port(text: str) -> tuple[str, int]:
+    """``HOST:PORT`` (``[::1]:8080`` for IPv6) -> (host, port); argparse's error otherwise."""
+    host, colon, port = text.rpartition(":")
+    host = host.removeprefix("[").removesuffix("]")
+    if not colon or not host or not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise argparse.ArgumentTypeError(
+            f"expected HOST:PORT with a port from 1 to 65535, e.g. {DEFAULT_LISTEN} (got {text!r})"
+        )
+    return host, int(port)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The stations come from their files (``--config``); the page's address from --listen."""
+    parser.epilog = (
+        "One web page for the line: per station the services alive, the sample rate, the "
+        "last results (OK/NOK) and stop reasons, each tool's wear against "
+        "recorder.wear_service_threshold, and alerts; live, without reloading. Open "
+        "http://HOST:PORT/ in a browser; nothing on it comes from the internet."
+    )
+    parser.add_argument(
+        "--listen",
+        type=host_port,
+        default=host_port(DEFAULT_LISTEN),
+        metavar="HOST:PORT",
+        help=f"where the page is served (default {DEFAULT_LISTEN}; 0.0.0.0:8080 in a container)",
+    )

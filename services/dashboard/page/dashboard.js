@@ -1,0 +1,118 @@
+// The line's page: draws /board.json and every board that /events sends.
+"use strict";
+
+const stations = document.getElementById("stations");
+const link = document.getElementById("link");
+
+function el(tag, attrs = {}, ...children) {
+  const node = document.createElement(tag);
+  for (const [name, value] of Object.entries(attrs)) node.setAttribute(name, value);
+  for (const child of children) {
+    node.append(child instanceof Node ? child : document.createTextNode(String(child)));
+  }
+  return node;
+}
+
+function fixed(value, digits, unit = "") {
+  return value === null || value === undefined ? "-" : `${value.toFixed(digits)}${unit}`;
+}
+
+function ago(seconds) {
+  if (seconds === null || seconds === undefined) return "-";
+  if (seconds < 60) return `${Math.max(0, seconds).toFixed(0)} s ago`;
+  if (seconds < 3600) return `${(seconds / 60).toFixed(0)} min ago`;
+  return `${(seconds / 3600).toFixed(1)} h ago`;
+}
+
+function none(text) {
+  return el("p", { class: "none" }, text);
+}
+
+function table(headers, rows) {
+  return el("table", {}, el("tr", {}, ...headers.map((h) => el("th", {}, h))), ...rows);
+}
+
+function services(station) {
+  const names = Object.keys(station.services);
+  if (names.length === 0) return none("services: first window not closed yet");
+  return el("div", { class: "services" }, ...names.map((name) =>
+    el("span", { class: station.services[name] ? "alive" : "dead",
+                 "data-service": name }, `${name} ${station.services[name] ? "alive" : "down"}`)));
+}
+
+function figures(station) {
+  const parts = [`samples: ${fixed(station.samples_per_s, 0, " /s")}`];
+  if (station.bus_samples_per_s !== null) parts.push(`bus: ${fixed(station.bus_samples_per_s, 0, " /s")}`);
+  if (station.last_run) parts.push(`last run ${station.last_run.run_id}: ${station.last_run.state}`);
+  if (station.recorder) {
+    parts.push(station.recorder.recording ? "recording" : "NOT recording");
+    if (station.recorder.lag_p50_ms !== null) parts.push(`recorder lag ${fixed(station.recorder.lag_p50_ms, 1, " ms")}`);
+  }
+  if (station.bridge) parts.push(`controller ${station.bridge.controller} ${station.bridge.connected ? "connected" : "NOT connected"}`);
+  return el("p", { class: "figures" }, parts.join(" · "));
+}
+
+function results(station) {
+  if (station.results.length === 0) return none("no result yet");
+  return table(["run", "program", "result", "torque", "angle", "preload", "when"],
+    station.results.map((r) => el("tr", { class: "result", "data-run": r.run_id },
+      el("td", { class: "num" }, r.run_id),
+      el("td", {}, r.program),
+      el("td", {}, el("span", { class: `verdict ${r.result}` }, r.result),
+        r.nok_reasons ? el("div", { class: "reasons" }, r.nok_reasons) : ""),
+      el("td", { class: "num" }, fixed(r.torque_nm, 1, " Nm")),
+      el("td", { class: "num" }, fixed(r.angle_deg, 0, "°")),
+      el("td", { class: "num" }, r.force_n === null ? "-" : fixed(r.force_n / 1000, 2, " kN")),
+      el("td", {}, ago(r.age_s)))));
+}
+
+function stops(station) {
+  if (station.stops.length === 0) return none("no run ended yet");
+  return table(["run", "stop reason", "error", "events", "when"],
+    station.stops.map((s) => el("tr", { class: "stop" },
+      el("td", { class: "num" }, s.run_id),
+      el("td", {}, s.stop_reason + (s.late_decision ? ` (late: ${s.late_decision})` : "")),
+      el("td", { class: "num" }, fixed(s.error_pct, 2, " %")),
+      el("td", { class: "num" }, s.events),
+      el("td", {}, ago(s.age_s)))));
+}
+
+function wear(station) {
+  const threshold = station.wear_threshold;
+  const head = threshold === null ? "no service threshold set (recorder.wear_service_threshold)"
+    : `service threshold ${threshold.toPrecision(3)}`;
+  const rows = station.wear.map((t) => el("tr", { class: "wear" },
+    el("td", { class: "num" }, `tool ${t.tool_id}`),
+    el("td", {}, t.used === null ? "" : el("meter", { min: "0", max: "1", low: "0.8", high: "0.95",
+      optimum: "0", value: String(Math.min(t.used, 1)) })),
+    el("td", { class: t.due ? "num due" : "num" },
+      t.used === null ? t.intensity_since_service.toPrecision(3) : `${(100 * t.used).toFixed(0)} %`),
+    el("td", { class: "num" }, `${t.runs_since_service} runs since service`)));
+  const parts = [el("p", { class: "figures" }, head)];
+  if (rows.length) parts.push(table(["tool", "wear", "", ""], rows));
+  if (station.wear_error) parts.push(none(`wear: ${station.wear_error}`));
+  return el("div", {}, ...parts);
+}
+
+function alerts(station) {
+  const items = station.alerts.map((a) => el("li", { class: "alert" }, `${a.topic}: ${a.text}`));
+  const alarm = station.bridge && station.bridge.alarm;
+  if (alarm) items.unshift(el("li", { class: "alert" }, `controller alarm ${alarm.error_code}: ${alarm.text}`));
+  return items.length ? el("ul", { class: "alerts" }, ...items) : none("no alert");
+}
+
+function draw(board) {
+  stations.replaceChildren(...board.stations.map((station) => el("section",
+    { class: "station", id: `station-${station.station}` },
+    el("h2", {}, `Station ${station.station}`), services(station), figures(station),
+    el("h3", {}, "Last results"), results(station),
+    el("h3", {}, "Last stop reasons"), stops(station),
+    el("h3", {}, "Tool wear"), wear(station),
+    el("h3", {}, "Alerts"), alerts(station))));
+}
+
+fetch("/board.json").then((r) => r.json()).then(draw).catch(() => {});
+const events = new EventSource("/events");
+events.onopen = () => { link.textContent = "live"; link.className = "link up"; };
+events.onerror = () => { link.textContent = "server unreachable: retrying"; link.className = "link down"; };
+events.onmessage = (message) => draw(JSON.parse(message.data));

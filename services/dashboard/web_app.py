@@ -1,0 +1,123 @@
+"""The page's web side (aiohttp): the page, its data, and its live updates.
+
+- ``GET /``: the page (``page/index.html``), and ``GET /page/<file>`` its CSS
+  and script, served from the package: nothing comes from the internet;
+- ``GET /board.json``: the board now (:meth:`LineBoard.snapshot`);
+- ``GET /events``: server-sent events, one ``data:`` line with the board
+  each time it changed (a result, a run's end, an alert; and every window),
+  at most every :data:`MIN_INTERVAL_S`; the browser's EventSource reconnects
+  by itself when the server comes back.
+
+zenoh calls :meth:`Listeners.changed` from its own threads; it wakes every
+open ``/events`` stream on the event loop.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import time
+from pathlib import Path
+
+from aiohttp import web
+
+from services.dashboard.line_board import LineBoard
+
+PAGE = Path(__file__).with_name("page")
+#: the shortest pause between two updates of one stream (a burst of results is one update)
+MIN_INTERVAL_S = 0.2
+#: a comment line this often keeps proxies from closing a quiet stream
+KEEP_ALIVE_S = 15.0
+
+BOARD_KEY = web.AppKey("board", LineBoard)
+
+
+class Listeners:
+    """The open ``/events`` streams, each woken by a token in its queue of one."""
+
+    def __init__(self) -> None:
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._queues: set[asyncio.Queue[bool]] = set()
+
+    def bind(self, loop: asyncio.AbstractEventLoop) -> None:
+        """The server's event loop (at its start)."""
+        self._loop = loop
+
+    def changed(self) -> None:
+        """From any thread: the board changed (before the server runs: nobody to tell)."""
+        loop = self._loop
+        if loop is not None and not loop.is_closed():
+            loop.call_soon_threadsafe(self._wake, True)
+
+    def close(self) -> None:
+        """On the loop: every stream ends (the server stops)."""
+        self._wake(False)
+
+    def _wake(self, more: bool) -> None:
+        for queue in self._queues:
+            if queue.empty():
+                queue.put_nowait(more)
+
+    def add(self) -> asyncio.Queue[bool]:
+        queue: asyncio.Queue[bool] = asyncio.Queue(maxsize=1)
+        self._queues.add(queue)
+        return queue
+
+    def remove(self, queue: asyncio.Queue[bool]) -> None:
+        self._queues.discard(queue)
+
+
+LISTENERS_KEY = web.AppKey("listeners", Listeners)
+
+
+def make_app(board: LineBoard, listeners: Listeners) -> web.Application:
+    app = web.Application()
+    app[BOARD_KEY] = board
+    app[LISTENERS_KEY] = listeners
+    app.router.add_get("/", _index)
+    app.router.add_get("/board.json", _board)
+    app.router.add_get("/events", _events)
+    app.router.add_static("/page/", PAGE)
+    app.on_startup.append(_bind_loop)
+    app.on_shutdown.append(_end_streams)
+    return app
+
+
+async def _bind_loop(app: web.Application) -> None:
+    app[LISTENERS_KEY].bind(asyncio.get_running_loop())
+
+
+async def _index(_request: web.Request) -> web.FileResponse:
+    return web.FileResponse(PAGE / "index.html")
+
+
+async def _board(request: web.Request) -> web.Response:
+    return web.json_response(request.app[BOARD_KEY].snapshot(time.time_ns()))
+
+
+async def _events(request: web.Request) -> web.StreamResponse:
+    board, listeners = request.app[BOARD_KEY], request.app[LISTENERS_KEY]
+    response = web.StreamResponse(
+        headers={"Content-Type": "text/event-stream", "Cache-Control": "no-cache"}
+    )
+    await response.prepare(request)
+    queue = listeners.add()
+    try:
+        more = True
+        while more:
+            snapshot = json.dumps(board.snapshot(time.time_ns()))
+            await response.write(f"data: {snapshot}\n\n".encode())
+            await asyncio.sleep(MIN_INTERVAL_S)
+            try:
+                more = await asyncio.wait_for(queue.get(), KEEP_ALIVE_S)
+            except TimeoutError:
+                await response.write(b": still here\n\n")
+    except ConnectionResetError:
+        pass  # the browser went away
+    finally:
+        listeners.remove(queue)
+    return response
+
+
+async def _end_streams(app: web.Application) -> None:
+    app[LISTENERS_KEY].close()

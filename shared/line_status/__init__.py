@@ -1,0 +1,11 @@
+"""What a line's stations say on zenoh, collected: ``boltwatch status`` and the line's page.
+
+Pure aggregation (no zenoh, no clock: the caller feeds what arrives and the
+time): :mod:`.station_status` (per station: services alive, sample rate, last
+run, decision, summary and result, recorder and predictor health),
+:mod:`.status_bus` (the acquisition's rate and bus faults),
+:mod:`.status_last_result` (the last tightening result: OK/NOK and why),
+:mod:`.status_bridge` (a controller bridge's link, faults and alarms).
+``boltwatch status`` prints it (``services.cli.station_status_text``);
+``boltwatch serve dashboard`` serves it live (``services.dashboard``).
+"""
