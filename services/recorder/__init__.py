@@ -6,6 +6,7 @@
   batches, files, health)
 - :mod:`.mcap_files`: MCAP written, read back, recovered, exported
 - :mod:`.rerun_files`: Rerun ``.rrd`` files and the live view
+- :mod:`.foxglove_live`: the live Foxglove WebSocket (``--foxglove-port``) and its layout
 - :mod:`.wear`: the wear ledger (per tool), its bound, alerts, reset, the plant view
 - :mod:`.post_mortem`: the paper's figures of a recorded run (``boltwatch inspect``)
 - :mod:`.overlay`: several recorded runs on one figure (``boltwatch inspect --overlay``)

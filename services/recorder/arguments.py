@@ -6,6 +6,9 @@ import argparse
 
 from shared.option_types import port_number
 
+DEFAULT_FOXGLOVE_HOST = "127.0.0.1"
+DEFAULT_FOXGLOVE_PORT = 8765
+
 DEFAULT_RERUN_GRPC_PORT = 9876
 DEFAULT_RERUN_WEB_PORT = 9090
 
@@ -43,6 +46,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=port_number,
         default=DEFAULT_RERUN_WEB_PORT,
         help=f"HTTP port of --rerun-web (default {DEFAULT_RERUN_WEB_PORT})",
+    )
+    foxglove = parser.add_argument_group("Foxglove")
+    foxglove.add_argument(
+        "--foxglove-port",
+        type=port_number,
+        nargs="?",
+        const=DEFAULT_FOXGLOVE_PORT,
+        default=None,
+        metavar="PORT",
+        help="also serve every run live as a Foxglove WebSocket on this port "
+        f"(alone: {DEFAULT_FOXGLOVE_PORT}); in Foxglove: Open connection, Foxglove WebSocket, "
+        "ws://HOST:PORT; the layout: config/foxglove/boltwatch-layout.json",
+    )
+    foxglove.add_argument(
+        "--foxglove-host",
+        default=DEFAULT_FOXGLOVE_HOST,
+        metavar="HOST",
+        help=f"address the Foxglove WebSocket listens on (default {DEFAULT_FOXGLOVE_HOST}: this "
+        "machine only; 0.0.0.0: every interface)",
     )
     parser.add_argument(
         "--view-only",

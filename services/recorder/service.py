@@ -22,7 +22,9 @@ raw and counted in the station's ``RecorderStats.bad_payloads``.
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
-(:class:`services.recorder.rerun_files.rerun_sink.RerunLive`). ``--view-only`` makes a
+(:class:`services.recorder.rerun_files.rerun_sink.RerunLive`); ``--foxglove-port`` serves
+every message it files as a Foxglove WebSocket too
+(:class:`services.recorder.foxglove_live.foxglove_server.FoxgloveLive`). ``--view-only`` makes a
 second recorder a live view beside the line's one: it keeps no wear ledger,
 answers no wear query, publishes no RecorderStats and holds the health token
 ``viewer``, so nothing on the line mistakes it for the recorder. Rerun failing never stops
@@ -61,6 +63,7 @@ from shared.messages import RecorderStats, WearAlert
 from shared.service_skeleton import ServiceSkeleton, Stop
 
 if TYPE_CHECKING:
+    from services.recorder.foxglove_live.foxglove_server import FoxgloveLive
     from services.recorder.rerun_files.rerun_sink import RerunLive, RerunOptions
 
 LOG = logging.getLogger(__name__)
@@ -118,10 +121,12 @@ class RecorderService:
         rerun_files: bool = True,
         rerun_live_url: str | None = None,
         view_only: bool = False,
+        foxglove: FoxgloveLive | None = None,
     ) -> None:
         """``view_only``: a live view beside the line's recorder (``--view-only``). Its
         subscriber, queryables and health tokens are declared through ``skeleton``, which
-        undeclares them when it closes."""
+        undeclares them when it closes. ``foxglove``: the live Foxglove server, given
+        every message as it is filed (its owner stops it)."""
         stations = served_stations(loaded)
         first = stations[0]
         session = self._session = skeleton.session
@@ -137,6 +142,7 @@ class RecorderService:
         #: with the ledger's path, which ledger a wear reply comes from (a plant has several)
         self._host = socket.gethostname()
         self.view_only = view_only
+        self.foxglove = foxglove
         self.wear: WearWatch | None = None
         if not view_only:
             self.wear = WearWatch(
@@ -218,6 +224,8 @@ class RecorderService:
             self._file_batch(received, filed_ns)
             return
         self.recorder.write(received)
+        if self.foxglove is not None:
+            self.foxglove.log(received)
         if received.station != OTHER_STATION:
             is_sample = received.schema_name == _SAMPLE
             sample_time_ns = (
@@ -239,9 +247,13 @@ class RecorderService:
         """Each sample of a batch, as a sample that came alone (a refused batch is filed raw
         by :meth:`_handle`: its samples are not received, so they count as missing)."""
         write, written, station = self.recorder.write, self.health.written, batch.station
-        for sample in self._batches.samples(batch):
+        samples = self._batches.samples(batch)
+        for sample in samples:
             write(sample)
             written(station, filed_ns, sample.publish_time_ns, True, False)
+        if self.foxglove is not None:
+            for sample in samples:
+                self.foxglove.log(sample)
 
     def _publish_stats(self, now_ns: int) -> None:
         """Put each station's RecorderStats for everyone but this recorder (not recorded)."""
@@ -333,12 +345,34 @@ def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
         return None
 
 
+def start_foxglove(args: argparse.Namespace, station_ids: Sequence[str]) -> FoxgloveLive | None:
+    """The live Foxglove WebSocket when asked for (``--foxglove-port``); None when off or
+    when it cannot listen (one line: recording goes on without it)."""
+    port = getattr(args, "foxglove_port", None)
+    if port is None:
+        return None
+    host = getattr(args, "foxglove_host", "127.0.0.1")
+    try:
+        from services.recorder.foxglove_live.foxglove_server import FoxgloveLive
+
+        return FoxgloveLive(station_ids, host, port)
+    except Exception as err:  # the SDK raises its own errors (address in use, bad host)
+        LOG.error(
+            "cannot serve Foxglove on %s:%d: %s; recording goes on without it", host, port, err
+        )
+        return None
+
+
 def main(args: argparse.Namespace) -> int:
     loaded = load_line(args.config)  # serve recorder: one or more files, always a list
     served_stations(loaded)  # bad combinations fail before zenoh is opened
     loaded[0].make_recordings_folder()  # and a folder that can never be made
     view_only = getattr(args, "view_only", False)
     with ServiceSkeleton(VIEWER if view_only else "recorder") as skeleton:
+        # listening before the router is reached: a Foxglove app may connect first
+        foxglove = start_foxglove(args, [station.station_id for station in loaded])
+        if foxglove is not None:
+            skeleton.on_stop(Stop.DEVICE, foxglove.close)
         skeleton.open_session(loaded[0].config.zenoh)
         live = start_rerun_live(args)
         if live is not None:
@@ -349,5 +383,6 @@ def main(args: argparse.Namespace) -> int:
             rerun_files=not getattr(args, "no_rerun", False),
             rerun_live_url=live.url if live is not None else None,
             view_only=view_only,
+            foxglove=foxglove,
         )
         return skeleton.run(service.work, service.wake)
