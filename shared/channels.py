@@ -33,6 +33,8 @@ topic              publisher             message, when
 ``predictor``      predictor             :class:`PredictorStats`, once a second
 ``recorder``       recorder              :class:`RecorderStats`, once a second
 ``wear/alert``     recorder              :class:`WearAlert`, when a tool is due
+``quality/alert``  recorder              :class:`QualityAlert`, when a program's Cpk or
+                                         NOKs go out of bounds, and when back
 ``controller``     import (openprotocol) :class:`ControllerResult`, one per run
 ``tool_data``      openprotocol          :class:`ToolData`, when the controller says it
 ``alarms``         openprotocol          :class:`ControllerAlarm`, per alarm message
@@ -74,6 +76,7 @@ from shared.messages import (
     ControllerResult,
     Intensity,
     PredictorStats,
+    QualityAlert,
     RecorderStats,
     RunSummary,
     Sample,
@@ -163,6 +166,7 @@ RESULTS = Channel("results", TighteningResult, "predictor", also_by=("import", *
 PREDICTOR = Channel("predictor", PredictorStats, "predictor")
 RECORDER = Channel("recorder", RecorderStats, "recorder")
 WEAR_ALERT = Channel("wear/alert", WearAlert, "recorder")
+QUALITY_ALERT = Channel("quality/alert", QualityAlert, "recorder")
 CONTROLLER = Channel("controller", ControllerResult, "import", also_by=_BRIDGE)
 TOOL_DATA = Channel("tool_data", ToolData, "openprotocol")
 ALARMS = Channel("alarms", ControllerAlarm, "openprotocol")
@@ -182,6 +186,7 @@ CHANNELS: tuple[Channel[Any], ...] = (
     PREDICTOR,
     RECORDER,
     WEAR_ALERT,
+    QUALITY_ALERT,
     CONTROLLER,
     TOOL_DATA,
     ALARMS,

@@ -318,6 +318,37 @@ class WearAlert:
     last_service_ns: TimeNs | None
 
 
+#: why a quality alert: a rolling Cpk below ``quality.cpk_min``; ``quality.nok_run`` NOKs
+#: in a row; ``quality.nok_max`` NOKs among the last ``quality.nok_window`` results
+QualityAlertKind = Literal["cpk_low", "nok_run", "nok_rate"]
+#: the figure of a ``cpk_low`` alert (None for the NOK kinds: they count verdicts)
+QualityFigure = Literal["torque", "angle", "preload"]
+
+
+@dataclass(frozen=True, slots=True)
+class QualityAlert:
+    """A program's results at a station went out of control (or came back: ``active`` False).
+
+    Put by the recorder when the condition starts, once; again when it has
+    cleared (``active`` False) and again if it returns. ``value`` against
+    ``limit``: the Cpk and ``quality.cpk_min``, the NOKs in a row and
+    ``quality.nok_run``, the NOKs among the last ``runs`` and ``quality.nok_max``.
+    """
+
+    __pydantic_config__ = WIRE_CONFIG
+
+    station: StationId
+    program_id: Id
+    time_ns: TimeNs  # when the result that started (or cleared) it ended
+    kind: QualityAlertKind
+    figure: QualityFigure | None
+    value: float
+    limit: float
+    runs: Count  # the results considered
+    active: bool
+    text: str  # the alert in words
+
+
 #: where a figure ended against its window; ``not_judged``: no window, or no value
 FigureStatus = Literal["low", "ok", "high", "not_judged"]
 #: the run's verdict, as every tightening system of a plant says it

@@ -51,6 +51,7 @@ from services.recorder.live.recorder import Recorder
 from services.recorder.live.recorder_health import RecorderHealth
 from services.recorder.live.run_files import FileLimits
 from services.recorder.live.sample_batches import BatchSamples
+from services.recorder.quality.quality_watch import QualityWatch
 from services.recorder.wear.wear_bound import StationLimits
 from services.recorder.wear.wear_ledger import WearLedger, ledger_path
 from services.recorder.wear.wear_watch import WearWatch
@@ -59,7 +60,7 @@ from shared.codec import encode
 from shared.config import LoadedStation, load_line
 from shared.errors import ConfigError
 from shared.message_fields import MAX_TEXT_CHARS
-from shared.messages import RecorderStats, WearAlert
+from shared.messages import QualityAlert, RecorderStats, WearAlert
 from shared.service_skeleton import ServiceSkeleton, Stop
 
 if TYPE_CHECKING:
@@ -144,7 +145,10 @@ class RecorderService:
         self.view_only = view_only
         self.foxglove = foxglove
         self.wear: WearWatch | None = None
+        self.quality: QualityWatch | None = None
         if not view_only:
+            settings = {station.station_id: station.config.quality for station in stations}
+            self.quality = QualityWatch(settings, self._publish_alert)
             self.wear = WearWatch(
                 self._ledger_file,
                 first.config.recorder.wear_service_threshold,
@@ -237,7 +241,11 @@ class RecorderService:
             if received.schema_name == _BUS_STATS and received.message is not None:
                 bus = received.message
                 self.health.bus_stats(received.station, bus.samples, bus.started_ns)
-        if self.wear is not None and received.message is not None:
+        if received.message is None:
+            return
+        if self.quality is not None and received.schema_name == channels.RESULTS.schema_name:
+            self.quality.on_result(received.message)
+        if self.wear is not None:
             if received.schema_name == channels.RUNS.schema_name:
                 self.wear.on_summary(received.message, now_ns)
             elif received.schema_name == channels.TOOL_DATA.schema_name:
@@ -267,11 +275,11 @@ class RecorderService:
             except zenoh.ZError as err:  # session closing
                 LOG.debug("recorder stats of %s not published: %s", stats.station, err)
 
-    def _publish_alert(self, alert: WearAlert) -> None:
+    def _publish_alert(self, alert: WearAlert | QualityAlert) -> None:
         """Put the alert for the line and record it here: a put this session also heard
         would come back through the inbox on this very thread, which waits when the
         inbox is full, for room only this thread makes."""
-        key = channels.WEAR_ALERT.key(alert.station)
+        key = channels.of_message(alert).key(alert.station)
         payload = encode(alert)
         self._session.put(
             key,

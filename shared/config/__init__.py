@@ -5,7 +5,8 @@ Load with :func:`load_station` (which also loads the joint it names) or
 
 - :mod:`.station` (the station file), :mod:`.program_windows` (a program's
   windows: where a run must end to be OK), :mod:`.openprotocol` (a controller that
-  speaks Open Protocol, and the simulated one's side), :mod:`.joint` (the joint file),
+  speaks Open Protocol, and the simulated one's side), :mod:`.quality` (when the
+  recorder raises a quality alert), :mod:`.joint` (the joint file),
   :mod:`.line` (a line: stations served together, stations derived from one)
 - :mod:`.loading` (TOML into a validated model, errors naming file and key),
   :mod:`.toml_writer` (the files boltwatch derives from others)

@@ -18,6 +18,7 @@ from shared.config.joint import JointConfig, load_joint
 from shared.config.loading import StrictModel, read_toml, resolve_relative, validate
 from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
 from shared.config.program_windows import ProgramWindows
+from shared.config.quality import QualitySection
 from shared.errors import CanDatabaseError, ConfigError
 from shared.folders import FolderError, make_folder
 from shared.sensor_range import SensorRange
@@ -246,6 +247,7 @@ class StationConfig(StrictModel):
     predictor: PredictorSection = PredictorSection()
     rig: RigSection = RigSection()
     recorder: RecorderSection
+    quality: QualitySection = QualitySection()
     openprotocol: OpenProtocolSection | None = Field(
         default=None, description="the station's tool controller speaks Open Protocol"
     )

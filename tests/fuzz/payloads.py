@@ -52,6 +52,7 @@ from shared.messages import (
     JudgedFigure,
     Prediction,
     PredictorStats,
+    QualityAlert,
     RecorderStats,
     ResultStep,
     RunSummary,
@@ -169,6 +170,9 @@ def template(topic: str, station: str, now_ns: int, run_id: int = 1) -> Any:
             [ControllerStep("Finding", "OK", "1", 9, [ControllerFunction("TF Angle", 1.0, 1.5)])],
         ),
         "wear/alert": lambda: WearAlert(station, 3, now_ns, 2e9, 1e9, 4, None),
+        "quality/alert": lambda: QualityAlert(
+            station, 1, now_ns, "cpk_low", "preload", 0.9, 1.33, 50, True, "program 1: low"
+        ),
         "tool_data": lambda: ToolData(
             station=station,
             tool_id=3,

@@ -162,7 +162,12 @@ ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), p
     # the acquisition hosts the station's predictor (placement "edge") and publishes for it
     "acquisition": set(channels.topics_of("acquisition")) | PREDICTOR_PUTS,
     "predictor": PREDICTOR_PUTS,
-    "recorder": {channels.RECORDER.topic, keys.WEAR, f"{keys.WEAR}/**"},
+    "recorder": {
+        channels.RECORDER.topic,
+        channels.QUALITY_ALERT.topic,
+        keys.WEAR,
+        f"{keys.WEAR}/**",
+    },
 }
 needs_openssl = pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl")
 

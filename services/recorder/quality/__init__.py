@@ -7,4 +7,5 @@
 - :mod:`.report_figure`: the report's picture (matplotlib)
 - :mod:`.report_page`: the self-contained HTML page and the terminal summary
 - :mod:`.quality_report`: read, compute, draw, write (``boltwatch report``)
+- :mod:`.quality_watch`: the live quality alert (rolling Cpk, NOK run and rate) on zenoh
 """
