@@ -100,11 +100,13 @@ def write_station_file(
     listen: Sequence[str] = (),
     connect: Sequence[str] = (),
     recorder: Mapping[str, Any] | None = None,
+    quality: Mapping[str, Any] | None = None,
 ) -> Path:
     """A copy of config/station.toml as a zenoh peer on the given endpoints.
 
     ``can.dbc`` and ``station.joint`` point at the repository's files;
-    ``recorder.folder`` is ``recordings``; ``recorder`` overrides recorder keys.
+    ``recorder.folder`` is ``recordings``; ``recorder`` overrides recorder keys;
+    ``quality``: the ``[quality]`` section.
     """
     with STATION_FILE.open("rb") as handle:
         data = tomllib.load(handle)
@@ -113,5 +115,7 @@ def write_station_file(
     data["can"]["dbc"] = str((base / data["can"]["dbc"]).resolve())
     data["zenoh"] = {"mode": "peer", "connect": list(connect), "listen": list(listen)}
     data["recorder"] = {**data["recorder"], "folder": str(recordings), **(recorder or {})}
+    if quality is not None:
+        data["quality"] = dict(quality)
     path.write_text(toml_writer.dumps(data))
     return path
