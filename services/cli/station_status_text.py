@@ -20,6 +20,7 @@ from shared.line_status.station_status import (
 )
 from shared.line_status.status_bridge import bridge_lines
 from shared.line_status.status_last_result import result_text
+from shared.line_status.status_quality_alert import quality_text
 
 
 def format_report(report: StatusReport) -> str:
@@ -59,6 +60,7 @@ def _station_lines(status: StationStatus) -> list[str]:
         line("last decision", _decision_text(status.last_decision)),
         line("last summary", _summary_text(status.last_summary)),
         line("last result", result_text(status.last_result)),
+        line("quality alert", quality_text(status.quality_alert)),
         line("predictor", _predictor_text(status.predictor)),
         line("recorder", _recorder_text(status.recorder)),
         *(line(label, text) for label, text in bridge_lines(status.bridge)),

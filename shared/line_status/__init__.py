@@ -5,7 +5,8 @@ time): :mod:`.station_status` (per station: services alive, sample rate, last
 run, decision, summary and result, recorder and predictor health),
 :mod:`.status_bus` (the acquisition's rate and bus faults),
 :mod:`.status_last_result` (the last tightening result: OK/NOK and why),
-:mod:`.status_bridge` (a controller bridge's link, faults and alarms).
+:mod:`.status_bridge` (a controller bridge's link, faults and alarms),
+:mod:`.status_quality_alert` (the newest active quality alert).
 ``boltwatch status`` prints it (``services.cli.station_status_text``);
 ``boltwatch serve dashboard`` serves it live (``services.dashboard``).
 """

@@ -33,7 +33,9 @@ Per station:
   second): payloads it refused, samples its core could not use, samples of
   no running run, runs whose end never arrived;
 - a controller bridge's link, faults and newest active alarm, for a station
-  with one (:mod:`shared.line_status.status_bridge`).
+  with one (:mod:`shared.line_status.status_bridge`);
+- the newest active quality alert of the recorder (a program's Cpk or NOKs,
+  :mod:`shared.line_status.status_quality_alert`).
 """
 
 from __future__ import annotations
@@ -49,6 +51,12 @@ from shared.line_status.status_bridge import TOPICS as BRIDGE_TOPICS
 from shared.line_status.status_bridge import BridgeSeen, BridgeStatus, bridge_status
 from shared.line_status.status_bus import BusHealth, bus_health, bus_rate
 from shared.line_status.status_last_result import LastResult, last_result
+from shared.line_status.status_quality_alert import TOPIC as QUALITY_TOPIC
+from shared.line_status.status_quality_alert import (
+    ActiveQualityAlert,
+    QualitySeen,
+    quality_alert,
+)
 from shared.messages import (
     BusStats,
     PredictorStats,
@@ -96,6 +104,7 @@ class _Seen:
     predictor: PredictorStats | None = None
     predictor_received_ns: int = 0
     bridge: BridgeSeen = field(default_factory=BridgeSeen)
+    quality: QualitySeen = field(default_factory=QualitySeen)
     unreadable: int = 0
 
 
@@ -172,6 +181,7 @@ class StationStatus:
     predictor: PredictorHealth | None = None  # None: no PredictorStats in the window
     last_result: LastResult | None = None  # None: no TighteningResult in the window
     bridge: BridgeStatus | None = None  # None: no controller bridge spoke in the window
+    quality_alert: ActiveQualityAlert | None = None  # None: none active in the window
 
 
 @dataclass(frozen=True)
@@ -237,6 +247,8 @@ class StatusCollector:
                 seen.predictor_received_ns = received_ns
             elif topic in BRIDGE_TOPICS:
                 seen.bridge.take(topic, payload, received_ns)
+            elif topic == QUALITY_TOPIC:
+                seen.quality.take(payload)
         except InputError:
             seen.unreadable += 1
 
@@ -267,6 +279,7 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
         predictor=_predictor_health(seen.predictor, seen.predictor_received_ns, now_ns),
         last_result=last_result(seen.result, now_ns),
         bridge=bridge_status(seen.bridge, now_ns),
+        quality_alert=quality_alert(seen.quality, now_ns),
     )
 
 

@@ -1,8 +1,8 @@
 """``boltwatch status [--config FILE | --connect ENDPOINT] [--listen-s S] [--json]``.
 
-Joins the line's zenoh router as a client, listens to ``boltwatch/*/*`` for
-``--listen-s`` seconds, then asks which liveliness tokens
-``boltwatch/*/health/*`` exist, and prints every station seen (see
+Joins the line's zenoh router as a client, listens to ``boltwatch/*/*`` and
+``boltwatch/*/quality/alert`` (a topic of two chunks) for ``--listen-s`` seconds,
+then asks which liveliness tokens ``boltwatch/*/health/*`` exist, and prints every station seen (see
 :mod:`shared.line_status.station_status` for what each figure means). Exit 0 when
 the router answered (even if no station is alive), 2 when it is unreachable.
 """
@@ -87,7 +87,7 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
     import time
 
     from services.cli.router_client import open_client
-    from shared import keys
+    from shared import channels, keys
     from shared.line_status.station_status import StatusCollector
 
     session = open_client(endpoint, config)
@@ -102,7 +102,10 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
 
     with session:
         started = time.monotonic()
-        subscriber = session.declare_subscriber(keys.ALL_STATION_TOPICS, on_message)
+        subscribers = [
+            session.declare_subscriber(key, on_message)
+            for key in (keys.ALL_STATION_TOPICS, channels.QUALITY_ALERT.key("*"))
+        ]
         try:
             time.sleep(listen_s)
             replies = session.liveliness().get(
@@ -113,7 +116,8 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
                     with lock:
                         collector.alive(str(reply.ok.key_expr))
         finally:
-            subscriber.undeclare()
+            for subscriber in subscribers:
+                subscriber.undeclare()
         listened_s = time.monotonic() - started
         with lock:
             return collector.report(endpoint, round(listened_s, 2), time.time_ns())
