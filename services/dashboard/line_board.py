@@ -16,7 +16,7 @@ What ``boltwatch status`` collects is reused, not copied
 Beside them, what status does not keep: the last :data:`HISTORY` results and
 stop reasons of each station, the alerts of every alert channel of
 :mod:`shared.channels` (a topic ending in ``alert``: the recorder's
-``wear/alert`` and any other a service adds, shown by its fields), and the
+``wear/alert`` and ``quality/alert``, and any other a service adds, shown by its fields), and the
 wear of each tool from the recorder's ``wear`` queryable against the
 station's ``recorder.wear_service_threshold``.
 """
@@ -45,7 +45,7 @@ _NS = 1_000_000_000
 #: every alert channel of the line: topic -> channel (the channel table, read at start)
 ALERT_CHANNELS = {c.topic: c for c in channels.CHANNELS if c.topic.endswith("alert")}
 #: fields that tell two alerts of one channel apart (the latest of each is kept)
-_ALERT_IDENTITY = ("tool_id", "program_id", "kind")
+_ALERT_IDENTITY = ("tool_id", "program_id", "kind", "figure")
 
 
 @dataclass(frozen=True, slots=True)
@@ -181,13 +181,16 @@ def _remember(history: _History, topic: str, payload: bytes) -> bool:
 
 
 def alert_text(topic: str, fields: dict[str, Any]) -> str:
-    """One line for a person: a wear alert in words, any other alert by its fields."""
+    """One line for a person: a wear or quality alert in words, any other alert by its
+    fields."""
     if topic == channels.WEAR_ALERT.topic:
         return (
             f"tool {fields['tool_id']} due for service: intensity since service "
             f"{fields['intensity_since_service']:.3g} >= threshold {fields['threshold']:.3g} "
             f"({fields['runs_since_service']} runs)"
         )
+    if topic == channels.QUALITY_ALERT.topic:
+        return f"{fields['kind']}: {fields['text']}{'' if fields['active'] else ' (cleared)'}"
     shown = {name: value for name, value in fields.items() if name not in ("station", "time_ns")}
     return ", ".join(f"{name.replace('_', ' ')} {_shown(value)}" for name, value in shown.items())
 

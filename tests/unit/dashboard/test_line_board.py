@@ -12,7 +12,7 @@ from services.dashboard.line_board import HISTORY, LineBoard, StationSetting
 from shared import channels, keys
 from shared.codec import encode
 from shared.errors import InputError
-from shared.messages import WearAlert
+from shared.messages import QualityAlert, QualityFigure, WearAlert
 from tests.unit.cli.test_station_status import T0, S, summary
 
 
@@ -102,11 +102,11 @@ def test_alerts_latest_per_tool_and_any_alert_channel_of_the_table(
     assert [a["time_ns"] for a in alerts] == [T0 - S, T0 - 3 * S]
     assert alerts[0]["text"].startswith("tool 7 due for service: intensity since service 1.2e+06")
     # an alert channel another service adds is shown by its fields, with no change here
-    quality = channels.Channel("quality/alert", WearAlert, "report")
-    monkeypatch.setitem(line_board.ALERT_CHANNELS, quality.topic, quality)
-    assert put(line, quality.topic, alert(9, T0))
+    other = channels.Channel("other/alert", WearAlert, "report")
+    monkeypatch.setitem(line_board.ALERT_CHANNELS, other.topic, other)
+    assert put(line, other.topic, alert(9, T0))
     newest = station(line)["alerts"][0]
-    assert newest["topic"] == "quality/alert"
+    assert newest["topic"] == "other/alert"
     assert newest["text"].startswith("tool id 9, intensity since service 1.2e+06")
 
 
@@ -116,3 +116,25 @@ def test_messages_of_stations_not_served_and_unreadable_ones_are_left() -> None:
     assert not line.message(keys.station_key("st1", channels.RUNS.topic), b"{}", T0)
     assert station(line)["stops"] == [] and station(line)["unreadable_messages"] == 1
     assert not line.message("elsewhere/st1/runs", b"", T0)
+
+
+def quality_alert(figure: QualityFigure, time_ns: int, active: bool = True) -> QualityAlert:
+    words = "below" if active else "back to at least"
+    text = f"program 1: {figure} Cpk 0.9 {words} 1.33 over the last 50 runs"
+    return QualityAlert("st1", 1, time_ns, "cpk_low", figure, 0.9, 1.33, 50, active, text)
+
+
+def test_quality_alerts_show_in_words_one_per_figure_the_latest_word_kept() -> None:
+    line = board()
+    assert put(line, channels.QUALITY_ALERT.topic, quality_alert("preload", T0 - 3 * S))
+    assert put(line, channels.QUALITY_ALERT.topic, quality_alert("torque", T0 - 2 * S))
+    assert put(line, channels.QUALITY_ALERT.topic, quality_alert("preload", T0 - S, False))
+    alerts = station(line)["alerts"]
+    assert [(a["topic"], a["text"]) for a in alerts] == [
+        (
+            "quality/alert",
+            "cpk_low: program 1: preload Cpk 0.9 back to at least 1.33 over the last 50 runs "
+            "(cleared)",
+        ),
+        ("quality/alert", "cpk_low: program 1: torque Cpk 0.9 below 1.33 over the last 50 runs"),
+    ]
