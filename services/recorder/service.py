@@ -18,7 +18,10 @@ with no file is not its station: in a plant each line's recorder records its
 own line's stations, and the subscription never asks the router for the
 others (no other line's sample crosses to this line for it). No payload
 stops it: what it refuses (:mod:`services.recorder.live.incoming`) is recorded
-raw and counted in the station's ``RecorderStats.bad_payloads``.
+raw and counted in the station's ``RecorderStats.bad_payloads``. Every
+TighteningResult it files feeds the quality alert
+(:mod:`services.recorder.quality.quality_watch`, on ``quality/alert``), every
+RunSummary the wear ledger (``wear/alert``); a view-only recorder keeps neither.
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
