@@ -241,6 +241,7 @@ class StatusCollector:
                 setattr(seen, attribute, decode(message_type, payload))
             elif topic == channels.RECORDER.topic:
                 seen.recorder = decode(RecorderStats, payload)
+                seen.quality.take_active(seen.recorder.quality_alerts)
                 seen.recorder_received_ns = received_ns
             elif topic == channels.PREDICTOR.topic:
                 seen.predictor = decode(PredictorStats, payload)

@@ -5,8 +5,9 @@ From :class:`~shared.messages.QualityAlert` on ``boltwatch/<st>/quality/alert``
 bounds, and once more when they are back): each condition's (program, kind,
 figure) latest word counts; the newest of those still active is shown, with
 the number of conditions active. The recorder puts an alert once, when it
-starts: a status listening after that hears it only from the line's page
-(``boltwatch serve dashboard``, which keeps every alert) or the recordings.
+starts, and carries the alerts active now in its once-a-second
+``RecorderStats`` (``quality_alerts``): a status listening later learns of
+them there.
 Collected by :mod:`shared.line_status.station_status`, printed by
 :mod:`services.cli.station_status_text`.
 """
@@ -33,7 +34,14 @@ class QualitySeen:
 
     def take(self, payload: bytes) -> None:
         """One message of :data:`TOPIC` (InputError: not a valid one)."""
-        alert = decode(QualityAlert, payload)
+        self._take(decode(QualityAlert, payload))
+
+    def take_active(self, alerts: list[QualityAlert]) -> None:
+        """The alerts a RecorderStats says are active now."""
+        for alert in alerts:
+            self._take(alert)
+
+    def _take(self, alert: QualityAlert) -> None:
         condition = (alert.program_id, alert.kind, alert.figure)
         known = self.latest.get(condition)
         if known is None or alert.time_ns >= known.time_ns:

@@ -79,6 +79,16 @@ def test_status_shows_the_newest_active_quality_alert(
     try:
         text = status_during_an_alert(session, station_file, 1)
         as_json = status_during_an_alert(session, station_file, 11, "--json")
+        # a status started after the alerts were put learns of them from RecorderStats
+        command = ["status", "--config", str(station_file), "--listen-s", "2.5", "--json"]
+        later = subprocess.run(
+            [sys.executable, "-m", "services.cli", *command],
+            check=False,
+            cwd=REPO,
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
     finally:
         session.close()
         recorder.finish()
@@ -96,3 +106,8 @@ def test_status_shows_the_newest_active_quality_alert(
     # 3rd NOK started the run again: the newest active is the run, two are active
     assert (alert["value"], alert["limit"], alert["runs"]) == (3.0, 3.0, 3)
     assert alert["active_alerts"] == 2
+
+    assert later.returncode == 0, later.stderr
+    heard_later = json.loads(later.stdout)["stations"]["st1"]["quality_alert"]
+    assert heard_later is not None, "an alert put before status listened is not shown"
+    assert (heard_later["kind"], heard_later["active_alerts"]) == ("nok_run", 2)

@@ -33,10 +33,10 @@ lease loses samples while no session ever sees its router go.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
-from shared.messages import RecorderStats
+from shared.messages import QualityAlert, RecorderStats
 
 _NS_PER_MS = 1_000_000
 
@@ -125,11 +125,13 @@ class RecorderHealth:
         recording: bool,
         refused_summaries: Mapping[str, int] | None = None,
         waiting_summaries: int = 0,
+        quality_alerts: Callable[[str], list[QualityAlert]] | None = None,
     ) -> list[RecorderStats]:
         """One RecorderStats per station; starts the next lag window.
 
         ``refused_summaries``: per station, RunSummaries the wear ledger refused;
-        ``waiting_summaries``: runs waiting in memory for the ledger (all stations).
+        ``waiting_summaries``: runs waiting in memory for the ledger (all stations);
+        ``quality_alerts``: a station's quality alerts active now.
         """
         refused = refused_summaries or {}
         out: list[RecorderStats] = []
@@ -150,6 +152,7 @@ class RecorderHealth:
                     refused_summaries=refused.get(station, 0),
                     waiting_summaries=waiting_summaries,
                     bad_payloads=counts.bad_payloads,
+                    quality_alerts=quality_alerts(station) if quality_alerts else [],
                 )
             )
         return out

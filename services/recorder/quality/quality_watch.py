@@ -65,7 +65,14 @@ class QualityWatch:
         self._settings = dict(settings)  # by station
         self._alert = alert
         self._programs: dict[tuple[str, int], _Program] = {}
+        #: the alert that started each condition active now, by (station, program, condition)
+        self._active: dict[tuple[str, int, _Key], QualityAlert] = {}
         self.alerts = 0  # alerts put (starting and clearing)
+
+    def active(self, station: str) -> list[QualityAlert]:
+        """The alerts of ``station`` active now, newest first (RecorderStats carries them)."""
+        alerts = [alert for (st, _, _), alert in self._active.items() if st == station]
+        return sorted(alerts, key=lambda alert: alert.time_ns, reverse=True)
 
     def on_result(self, result: TighteningResult) -> list[QualityAlert]:
         """Take one result; the alerts it starts or clears (each given to ``alert`` too)."""
@@ -91,9 +98,11 @@ class QualityWatch:
                 continue  # still active, or still clear: nothing new to say
             if alert.active:
                 program.active.add(condition)
+                self._active[(*key, condition)] = alert
                 LOG.warning("quality alert at %s: %s", result.station, alert.text)
             else:
                 program.active.discard(condition)
+                self._active.pop((*key, condition), None)
                 LOG.info("quality alert at %s cleared: %s", result.station, alert.text)
             alerts.append(alert)
             self.alerts += 1
