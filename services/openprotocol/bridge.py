@@ -171,6 +171,8 @@ class OpenProtocolBridge:
         )
 
     def _serve(self, session: ControllerSession, stop: threading.Event) -> None:
+        tool_data_asked_s = time.monotonic()
+        results_at_ask = self._counts.results
         while not stop.is_set():
             session.poll(POLL_S)
             if self._ask_newest:
@@ -178,6 +180,12 @@ class OpenProtocolBridge:
                 self._fill_from_newest(session)
             self._fill(session)
             self._publish_ready()
+            # tool data again after each tightening (its counters moved) and every minute:
+            # a recorder that was not listening at the connect gets it all the same
+            now_s = time.monotonic()
+            if self._counts.results != results_at_ask or now_s - tool_data_asked_s >= 60.0:
+                self._reports.ask_tool_data(session)
+                tool_data_asked_s, results_at_ask = now_s, self._counts.results
 
     # -- filling the gap -----------------------------------------------------------------
 

@@ -1,7 +1,8 @@
 """What a controller says besides its tightenings: its tool (0041) and its alarms (0071-0076).
 
-- tool data: asked (0040) after every connect; the 0041 becomes boltwatch's
-  :class:`~shared.messages.ToolData` on ``tool_data`` (the station file's tool
+- tool data: asked (0040) after every connect, after each tightening and every
+  minute (a recorder that was not listening at the connect gets it); the 0041
+  becomes boltwatch's :class:`~shared.messages.ToolData` on ``tool_data`` (the station file's tool
   id, the controller's serials, counters, calibration and service dates), which
   the wear ledger keeps beside the station's tool;
 - alarms: subscribed (0070) after every connect; 0071 (raised), 0074
@@ -55,6 +56,10 @@ class ControllerReports:
         reply = session.request(ToolDataRequest(), {TOOL_DATA_MID})
         if isinstance(reply, ControllerToolData):
             publish(self.tool_data(reply, time.time_ns(), counts))
+
+    def ask_tool_data(self, session: Any) -> None:
+        """0040 without waiting: the 0041 comes as a pushed message (:meth:`pushed`)."""
+        session.send(ToolDataRequest())
 
     def pushed(
         self,

@@ -44,8 +44,10 @@ def test_live_results_with_their_curves_become_runs_once_each(
         assert len(heard.of("samples")) == 3 * SAMPLES
         assert [s.state for s in heard.of("tool")] == ["running", "done"] * 3
         assert len(heard.of("controller")) == 3
-        (tool,) = heard.of("tool_data")
-        assert tool.tool_serial == "SIM-3" and tool.tool_id == 7
+        # tool data at the connect, then again after each tightening (its counters moved)
+        wait_until(lambda: len(heard.of("tool_data")) >= 2, "tool data asked again")
+        tool_data = heard.of("tool_data")
+        assert {(tool.tool_serial, tool.tool_id) for tool in tool_data} == {("SIM-3", 7)}
         assert controller.acks == 3
         assert bridge.counts.traces == 6 and bridge.counts.results_without_traces == 0
         assert bridge.counts.controller_errors == 0
