@@ -19,7 +19,7 @@ from shared.line_status.station_status import (
     StatusReport,
 )
 from shared.line_status.status_bridge import bridge_lines
-from shared.line_status.status_last_result import result_text
+from shared.line_status.status_last_result import amount_text, result_text
 from shared.line_status.status_quality_alert import quality_text
 
 
@@ -140,15 +140,7 @@ def _summary_text(summary: LastSummary | None) -> str:
     error = "-" if summary.error_pct is None else f"{summary.error_pct:+.2f} %"
     how = summary.stop_reason or f"tool stopped itself ({summary.tool_state})"
     return (
-        f"run {summary.run_id}: {_amount(summary.reached, summary.unit)} of "
-        f"{_amount(summary.target, summary.unit)} target, error {error}, {how}, "
+        f"run {summary.run_id}: {amount_text(summary.reached, summary.unit)} of "
+        f"{amount_text(summary.target, summary.unit)} target, error {error}, {how}, "
         f"{summary.events} events, {summary.age_s:.1f} s ago"
     )
-
-
-def _amount(value: float | None, unit: str) -> str:
-    if value is None:
-        return "-"
-    if unit == "N":
-        return f"{value / 1000:.2f} kN"
-    return f"{value:.1f} {unit}"

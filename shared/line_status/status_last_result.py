@@ -58,11 +58,11 @@ def result_text(result: LastResult | None) -> str:
     if result.nok_reasons:
         verdict += f" ({result.nok_reasons})"
     figures = ", ".join(
-        f"{name} {_value(value, unit)} {status.replace('_', ' ')}"
+        f"{name} {amount_text(value, unit)} {status.replace('_', ' ')}"
         for name, value, unit, status in (
             ("torque", result.torque_nm, "Nm", result.torque_status),
             ("angle", result.angle_deg, "deg", result.angle_status),
-            ("preload", result.force_n, "kN", result.force_status),
+            ("preload", result.force_n, "N", result.force_status),
         )
         if value is not None or status != "not_judged"
     )
@@ -73,9 +73,10 @@ def result_text(result: LastResult | None) -> str:
     )
 
 
-def _value(value: float | None, unit: str) -> str:
+def amount_text(value: float | None, unit: str) -> str:
+    """A figure in ``unit`` for a person: ``-`` when None, newtons as kN."""
     if value is None:
         return "-"
-    if unit == "kN":
+    if unit == "N":
         return f"{value / 1000:.2f} kN"
     return f"{value:.1f} {unit}"
