@@ -14,8 +14,9 @@ WEAR = "wear"
 HEALTH = "health"
 
 EVERYTHING = f"{ROOT}/**"
-#: One chunk below every station: samples, tool, bus, events, ... (not health/*).
-ALL_STATION_TOPICS = f"{ROOT}/*/*"
+#: Every topic below every station: samples, tool, bus, events, ..., wear/alert,
+#: quality/alert (liveliness tokens ``health/*`` are not puts: not heard here).
+ALL_STATION_TOPICS = f"{ROOT}/*/**"
 
 
 def station_key(station: str, topic: str) -> str:

@@ -1,7 +1,7 @@
 """``boltwatch status [--config FILE | --connect ENDPOINT] [--listen-s S] [--json]``.
 
-Joins the line's zenoh router as a client, listens to ``boltwatch/*/*`` and
-``boltwatch/*/quality/alert`` (a topic of two chunks) for ``--listen-s`` seconds,
+Joins the line's zenoh router as a client, listens to every station's topics
+(``boltwatch/*/**``: ``quality/alert`` has two chunks) for ``--listen-s`` seconds,
 then asks which liveliness tokens ``boltwatch/*/health/*`` exist, and prints every station seen (see
 :mod:`shared.line_status.station_status` for what each figure means). Exit 0 when
 the router answered (even if no station is alive), 2 when it is unreachable.
@@ -87,7 +87,7 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
     import time
 
     from services.cli.router_client import open_client
-    from shared import channels, keys
+    from shared import keys
     from shared.line_status.station_status import StatusCollector
 
     session = open_client(endpoint, config)
@@ -102,10 +102,7 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
 
     with session:
         started = time.monotonic()
-        subscribers = [
-            session.declare_subscriber(key, on_message)
-            for key in (keys.ALL_STATION_TOPICS, channels.QUALITY_ALERT.key("*"))
-        ]
+        subscriber = session.declare_subscriber(keys.ALL_STATION_TOPICS, on_message)
         try:
             time.sleep(listen_s)
             replies = session.liveliness().get(
@@ -116,8 +113,7 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
                     with lock:
                         collector.alive(str(reply.ok.key_expr))
         finally:
-            for subscriber in subscribers:
-                subscriber.undeclare()
+            subscriber.undeclare()
         listened_s = time.monotonic() - started
         with lock:
             return collector.report(endpoint, round(listened_s, 2), time.time_ns())
