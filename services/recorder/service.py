@@ -258,11 +258,10 @@ class RecorderService:
     def _file_batch(self, batch: Received, filed_ns: int) -> None:
         """Each sample of a batch, as a sample that came alone (a refused batch is filed raw
         by :meth:`_handle`: its samples are not received, so they count as missing)."""
-        write, written, station = self.recorder.write, self.health.written, batch.station
         samples = self._batches.samples(batch)
-        for sample in samples:
-            write(sample)
-            written(station, filed_ns, sample.publish_time_ns, True, False)
+        self.recorder.write_samples(batch.station, samples)
+        times_ns = [sample.publish_time_ns for sample in samples]
+        self.health.samples_written(batch.station, filed_ns, times_ns)
         if self.foxglove is not None:
             for sample in samples:
                 self.foxglove.log(sample)

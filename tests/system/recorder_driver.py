@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from services.recorder.live.file_metadata import FileMetadata
-from services.recorder.live.incoming import classify
+from services.recorder.live.incoming import Received, classify
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.run_files import FileLimits
 from services.recorder.mcap_files.recording_reader import RecordingScan
@@ -26,9 +26,13 @@ T0_NS = 1_800_000_000 * 1_000_000_000
 
 
 class RecorderDriver:
-    """A Recorder on ``recordings`` and a clock; ``now_ns`` advances 1 ms per sample."""
+    """A Recorder on ``recordings`` and a clock; ``now_ns`` advances 1 ms per sample.
 
-    def __init__(self, folder: Path, recordings: Path) -> None:
+    ``batch_samples`` > 1: samples are filed as an edge station's batches are
+    (:meth:`Recorder.write_samples`, that many at once).
+    """
+
+    def __init__(self, folder: Path, recordings: Path, batch_samples: int = 1) -> None:
         loaded = load_station(
             write_station_file(folder / "station.toml", recordings, listen=["tcp/127.0.0.1:1"])
         )
@@ -36,6 +40,8 @@ class RecorderDriver:
         self.recorder = Recorder(recordings, limits, FileMetadata(loaded))
         self.now_ns = T0_NS
         self.sequence = 0
+        self.batch_samples = batch_samples
+        self._batch: list[Received] = []
 
     def start_run(self, run_id: int) -> None:
         self.sequence = 0
@@ -45,7 +51,13 @@ class RecorderDriver:
         for _ in range(count):
             self.now_ns += MS
             sample = Sample("st1", run_id, self.sequence, self.now_ns, 1.0, 0.1, 2.0)
-            self._put("samples", encode(sample))
+            if self.batch_samples == 1:
+                self._put("samples", encode(sample))
+            else:
+                self._batch.append(classify("boltwatch/st1/samples", encode(sample), self.now_ns))
+                if len(self._batch) == self.batch_samples:
+                    self.recorder.write_samples("st1", self._batch)
+                    self._batch = []
             self.sequence += 1
             if self.sequence % 500 == 0:
                 self.recorder.tick(self.now_ns)

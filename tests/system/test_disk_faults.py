@@ -39,10 +39,13 @@ def errors_logged(caplog: pytest.LogCaptureFixture, level: int) -> list[str]:
     return [r.getMessage() for r in caplog.records if r.name == RECORDER_LOG and r.levelno == level]
 
 
-def test_a_disk_that_fills_up_mid_run(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+@pytest.mark.parametrize("batch_samples", [1, 10], ids=["samples", "batches"])
+def test_a_disk_that_fills_up_mid_run(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture, batch_samples: int
+) -> None:
     caplog.set_level(logging.INFO, logger=RECORDER_LOG)
     with tmpfs(tmp_path / "recordings", 1 << 20) as recordings:
-        driver = RecorderDriver(tmp_path, recordings)
+        driver = RecorderDriver(tmp_path, recordings, batch_samples)
         driver.start_run(1)
         driver.samples(1, 2500)
         assert driver.recorder.recording_ok
@@ -97,6 +100,23 @@ def test_a_read_only_folder_then_writable_again(
         recorder.close()
         assert recorded_messages(recordings) + recorder.dropped_messages == recorder.messages
         assert len(errors_logged(caplog, logging.ERROR)) >= 1
+
+
+def test_batches_that_cannot_open_a_file_are_counted_dropped(tmp_path: Path) -> None:
+    """Read-only past the retry interval: the batch that retries the open is lost with it."""
+    with tmpfs(tmp_path / "recordings", 1 << 20) as recordings:
+        driver = RecorderDriver(tmp_path, recordings, batch_samples=10)
+        with read_only(recordings):
+            driver.start_run(1)
+            driver.samples(1, RETRY_INTERVAL_NS // 1_000_000 + 1000)
+            recorder = driver.recorder
+            assert recorder.write_errors >= 2  # the run's start, then a batch's retry
+            assert recorder.dropped_messages == recorder.messages
+        driver.start_run(2)
+        driver.samples(2, 1500)
+        recorder.close()
+        assert recorder.recording_ok
+        assert recorded_messages(recordings) + recorder.dropped_messages == recorder.messages
 
 
 def test_the_station_folder_replaced_by_a_file(tmp_path: Path) -> None:

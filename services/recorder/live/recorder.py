@@ -24,6 +24,7 @@ from __future__ import annotations
 import errno
 import logging
 from collections import Counter
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -78,12 +79,7 @@ class Recorder:
         self._remind_at_ns = 0
 
     def write(self, received: Received) -> None:
-        files = self._stations.get(received.station)
-        if files is None:
-            files = StationFiles(
-                received.station, self._folder, self._limits, self._metadata, self._rerun
-            )
-            self._stations[received.station] = files
+        files = self._files(received.station)
         if not received.decodable:
             self.refused[received.station] += 1
             self._log_refused(
@@ -106,7 +102,26 @@ class Recorder:
         try:
             files.write(received)
         except OSError as err:  # a message already in the file is counted by abandon()
-            self._fault(files, err, now_ns, this_message_lost=files.written == written_before)
+            self._fault(files, err, now_ns, unwritten=int(files.written == written_before))
+            return
+        self._maybe_recovered(files, now_ns)
+
+    def write_samples(self, station: str, samples: Sequence[Received]) -> None:
+        """The decoded Samples of one batch of ``station``, as :meth:`write` files each."""
+        if not samples:
+            return
+        files = self._files(station)
+        self.messages += len(samples)
+        now_ns = samples[-1].log_time_ns
+        if not self.recording_ok and files.current is None and now_ns < self._retry_at_ns:
+            self._drop(len(samples), now_ns)
+            return
+        written_before = files.written
+        try:
+            files.write_samples(samples)
+        except OSError as err:  # samples already in a file are counted by abandon()
+            unwritten = len(samples) - (files.written - written_before)
+            self._fault(files, err, now_ns, unwritten=unwritten)
             return
         self._maybe_recovered(files, now_ns)
 
@@ -115,7 +130,7 @@ class Recorder:
             try:
                 files.tick(now_ns)
             except OSError as err:
-                self._fault(files, err, now_ns, this_message_lost=False)
+                self._fault(files, err, now_ns, unwritten=0)
             else:
                 self._maybe_recovered(files, now_ns)
         if not self.recording_ok:
@@ -128,7 +143,7 @@ class Recorder:
             try:
                 files.close()
             except OSError as err:
-                self._fault(files, err, self._fault_started_ns, this_message_lost=False)
+                self._fault(files, err, self._fault_started_ns, unwritten=0)
             closed.extend(files.closed_paths)
         if self.refused:
             LOG.warning("refused payloads per station, recorded raw: %s", dict(self.refused))
@@ -147,13 +162,19 @@ class Recorder:
         """Files left incomplete by a write fault (``boltwatch recover`` makes them valid)."""
         return [path for files in self._stations.values() for path in files.abandoned_paths]
 
-    def _fault(
-        self, files: StationFiles, err: OSError, now_ns: int, *, this_message_lost: bool
-    ) -> None:
+    def _files(self, station: str) -> StationFiles:
+        files = self._stations.get(station)
+        if files is None:
+            files = StationFiles(station, self._folder, self._limits, self._metadata, self._rerun)
+            self._stations[station] = files
+        return files
+
+    def _fault(self, files: StationFiles, err: OSError, now_ns: int, *, unwritten: int) -> None:
+        """``unwritten``: messages being written that never reached a file (lost too)."""
         path = files.current.path if files.current is not None else None
         self.write_errors += 1
         self.last_write_error = describe_os_error(err, path)
-        lost = files.abandon() + (1 if this_message_lost else 0)
+        lost = files.abandon() + unwritten
         self._retry_at_ns = now_ns + RETRY_INTERVAL_NS
         if self.recording_ok:
             self.recording_ok = False

@@ -103,6 +103,13 @@ class RecorderHealth:
         if sample_time_ns is not None:
             counts.lags_ns.append(received_ns - sample_time_ns)
 
+    def samples_written(self, station: str, received_ns: int, sample_times_ns: list[int]) -> None:
+        """Decoded Samples of ``station`` written (a batch's), as :meth:`written` counts each."""
+        counts = self._counts(station)
+        counts.messages += len(sample_times_ns)
+        counts.samples_received += len(sample_times_ns)
+        counts.lags_ns += [received_ns - time_ns for time_ns in sample_times_ns]
+
     def bus_stats(self, station: str, published_samples: int, started_ns: int) -> None:
         """A BusStats of ``station`` arrived: recount its missing samples."""
         self._counts(station).bus_stats(published_samples, started_ns)

@@ -27,6 +27,7 @@ from __future__ import annotations
 import logging
 import re
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -146,6 +147,34 @@ class StationFiles:
             and received.message
         ):
             self._run_ended = received.message.state in _ENDED_STATES  # a refused one is raw
+        if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
+            self.flush(now_ns)
+
+    def write_samples(self, samples: Sequence[Received]) -> None:
+        """A batch's decoded Samples, in order: :meth:`write`'s checks once for the batch
+        (a sample never starts a run); samples of the run before go to its file."""
+        if not samples:
+            return
+        now_ns = samples[-1].log_time_ns
+        if self.current is None:
+            run_id, part = self._resume or (samples[0].run_id, 1)
+            self._open(run_id, now_ns, part)
+        elif self._over_limits(now_ns):
+            self._continue(now_ns)
+        assert self.current is not None
+        groups: list[tuple[McapSink, Sequence[Received]]] = [(self.current, samples)]
+        previous = self.previous
+        if previous is not None and previous.run_id != self.current.run_id:
+            late = [s for s in samples if s.message.run_id == previous.run_id]
+            if late:
+                on_time = [s for s in samples if s.message.run_id != previous.run_id]
+                groups = [(previous, late), (self.current, on_time)]
+        for sink, group in groups:
+            sink.write_samples(group)
+            self.written += len(group)
+            companion = self._rerun_sinks.get(sink)
+            if companion is not None:
+                companion.write_samples(group)
         if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
             self.flush(now_ns)
 

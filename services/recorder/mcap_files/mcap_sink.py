@@ -27,7 +27,7 @@ import contextlib
 import json
 import logging
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import BinaryIO
 
@@ -35,6 +35,7 @@ from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 
 from services.recorder.live.incoming import Received
+from services.recorder.mcap_files.mcap_messages import MessageAppender
 from services.recorder.mcap_files.recording_reader import RecordingScan
 from shared import channels
 from shared.codec import json_schema
@@ -83,6 +84,7 @@ class McapSink:
                 self._file, chunk_size=_CHUNK_BYTES, compression=CompressionType.ZSTD
             )
             self._writer.start(profile="", library=library)
+            self._messages = MessageAppender(self._writer)
             for name, data in metadata.items():
                 self._writer.add_metadata(name, dict(data))
             self._writer.flush()
@@ -115,19 +117,29 @@ class McapSink:
         if sequence is None:
             sequence = self._counters.get(channel_id, 0)
             self._counters[channel_id] = sequence + 1
-        self._writer.add_message(
-            channel_id=channel_id,
-            log_time=received.log_time_ns,
-            data=received.payload,
-            publish_time=received.publish_time_ns,
-            sequence=sequence & 0xFFFFFFFF,  # MCAP sequence is uint32
-        )
+        row = (sequence & 0xFFFFFFFF, received.log_time_ns, received.publish_time_ns)
+        self._messages.add(channel_id, [(*row, received.payload)])  # MCAP sequence is uint32
         self.messages += 1
         self._unflushed_bytes += len(received.payload) + 31  # + message record header
         self.last_write_ns = received.log_time_ns
         run_id = received.run_id
         if run_id is not None:
             self.run_ids.add(run_id)
+
+    def write_samples(self, samples: Sequence[Received]) -> None:
+        """Append decoded Samples of one station (a batch's, in order) on its samples channel."""
+        if not samples:
+            return
+        channel_id = self._channel_for(samples[0])
+        rows = [
+            (s.message.sequence & 0xFFFFFFFF, s.log_time_ns, s.publish_time_ns, s.payload)
+            for s in samples
+        ]
+        self._messages.add(channel_id, rows)
+        self.messages += len(rows)
+        self._unflushed_bytes += sum(len(row[3]) for row in rows) + 31 * len(rows)
+        self.last_write_ns = rows[-1][1]
+        self.run_ids.update({s.message.run_id for s in samples})
 
     @property
     def unflushed_messages(self) -> int:

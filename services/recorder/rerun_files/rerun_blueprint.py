@@ -23,6 +23,8 @@ and intensity in the middle, the text log at the bottom.
 
 from __future__ import annotations
 
+import functools
+
 import rerun as rr
 import rerun.blueprint as rrb
 
@@ -68,14 +70,21 @@ _POINTS: dict[str, tuple[str, tuple[int, int, int], rr.components.MarkerShape, f
 
 def log_series_styles(stream: rr.RecordingStream) -> None:
     """Static names, colours and markers of every series (once per recording)."""
-    for path, (name, color) in _LINES.items():
-        stream.log(path, rr.SeriesLines(names=name, colors=color), static=True)
-    for path, (name, color, marker, size) in _POINTS.items():
-        stream.log(
-            path,
-            rr.SeriesPoints(names=name, colors=color, markers=marker, marker_sizes=size),
-            static=True,
-        )
+    for path, style in _series_styles():
+        stream.log(path, style, static=True)
+
+
+@functools.cache
+def _series_styles() -> list[tuple[str, rr.SeriesLines | rr.SeriesPoints]]:
+    """The styles, built once: building one costs Rerun more than logging it."""
+    styles: list[tuple[str, rr.SeriesLines | rr.SeriesPoints]] = [
+        (path, rr.SeriesLines(names=name, colors=color)) for path, (name, color) in _LINES.items()
+    ]
+    styles += [
+        (path, rr.SeriesPoints(names=name, colors=color, markers=marker, marker_sizes=size))
+        for path, (name, color, marker, size) in _POINTS.items()
+    ]
+    return styles
 
 
 def run_blueprint() -> rrb.Blueprint:

@@ -77,18 +77,38 @@ class _Series:
             self.times_ns.append(time_ns)
             self.values.append(value)
 
-    def send(self, stream: rr.RecordingStream, run_started_ns: int) -> int:
+    def send(self, stream: rr.RecordingStream, indexes: _TimeIndexes) -> int:
         count = len(self.values)
         if count == 0:
             return 0
         stream.send_columns(
             self.path,
-            indexes=time_columns(self.times_ns, run_started_ns),
+            indexes=indexes.of(self.times_ns),
             columns=rr.Scalars.columns(scalars=np.asarray(self.values, dtype=np.float64)),
         )
         self.times_ns.clear()
         self.values.clear()
         return count
+
+
+class _TimeIndexes:
+    """The time columns of one send, built once per distinct list of times: torque and
+    angle share theirs, and so do an event's figures (building one costs Rerun as much
+    as sending it)."""
+
+    __slots__ = ("_built", "_run_started_ns")
+
+    def __init__(self, run_started_ns: int) -> None:
+        self._run_started_ns = run_started_ns
+        self._built: list[tuple[list[int], list[rr.TimeColumn]]] = []
+
+    def of(self, times_ns: list[int]) -> list[rr.TimeColumn]:
+        for times, columns in self._built:
+            if times == times_ns:
+                return columns
+        columns = time_columns(times_ns, self._run_started_ns)
+        self._built.append((list(times_ns), columns))  # the series clears its own list
+        return columns
 
 
 class RerunSink:
@@ -147,15 +167,7 @@ class RerunSink:
             return
         try:
             if received.schema_name == channels.SAMPLES.schema_name:
-                time_ns = message.time_ns
-                self._torque.times_ns.append(time_ns)
-                self._torque.values.append(message.torque_nm)
-                self._angle.times_ns.append(time_ns)
-                self._angle.values.append(message.angle_deg)
-                self._force.add(time_ns, message.force_n)
-                self._pending_samples += 1
-                if self._pending_samples >= self._batch_samples:
-                    self._send_samples()
+                self._add_samples([message])
             elif received.schema_name == channels.EVENTS.schema_name:
                 self._event(message)
             elif received.schema_name == channels.DECISION.schema_name:
@@ -172,6 +184,28 @@ class RerunSink:
                 )
         except Exception:
             self._fail("write")
+
+    def write_samples(self, samples: Sequence[Received]) -> None:
+        """Buffer decoded Samples (a batch's); send a batch when ``batch_samples`` are waiting."""
+        if self.failed:
+            return
+        try:
+            self._add_samples([received.message for received in samples])
+        except Exception:
+            self._fail("write")
+
+    def _add_samples(self, samples: list[Any]) -> None:
+        times_ns = [sample.time_ns for sample in samples]
+        self._torque.times_ns += times_ns
+        self._torque.values += [sample.torque_nm for sample in samples]
+        self._angle.times_ns += times_ns
+        self._angle.values += [sample.angle_deg for sample in samples]
+        force = self._force
+        for sample in samples:
+            force.add(sample.time_ns, sample.force_n)
+        self._pending_samples += len(samples)
+        if self._pending_samples >= self._batch_samples:
+            self._send_samples()
 
     def flush(self) -> None:
         """Send everything buffered (the recorder's flush tick)."""
@@ -254,18 +288,19 @@ class RerunSink:
         self._texts.append(text)
         self._levels.append(level)
 
-    def _send_samples(self) -> None:
-        start_ns = self._run_started_ns
-        self.samples += self._torque.send(self._stream, start_ns)
-        self._angle.send(self._stream, start_ns)
-        self._force.send(self._stream, start_ns)
+    def _send_samples(self, indexes: _TimeIndexes | None = None) -> None:
+        indexes = indexes or _TimeIndexes(self._run_started_ns)
+        self.samples += self._torque.send(self._stream, indexes)
+        self._angle.send(self._stream, indexes)
+        self._force.send(self._stream, indexes)
         self._pending_samples = 0
 
     def _send(self) -> None:
         """Samples and every rare series (one chunk per entity and flush, not per event)."""
-        self._send_samples()
+        indexes = _TimeIndexes(self._run_started_ns)
+        self._send_samples(indexes)
         for series in self._series.values():
-            series.send(self._stream, self._run_started_ns)
+            series.send(self._stream, indexes)
         if self._texts:
             self._send_texts(self._text_times_ns, self._texts, self._levels)
             self._text_times_ns, self._texts, self._levels = [], [], []

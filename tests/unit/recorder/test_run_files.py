@@ -148,3 +148,26 @@ def test_a_run_id_is_one_file_however_its_state_flips(
     names = sorted(p.name for p in files.closed_paths)
     assert names == ["st1_run42_221320.mcap", "st1_run43_221321.mcap"]
     assert counts(tmp_path / "st1" / "2023-11-14" / names[0]) == {"tool": 30, "samples": 30}
+
+
+def test_a_batch_with_samples_of_the_run_before_splits_between_their_files(
+    tmp_path: Path, station: LoadedStation
+) -> None:
+    """A batch gathered across a run's start: each sample goes to its own run's file, in
+    order, as samples that came alone do."""
+    files = StationFiles("st1", tmp_path, LIMITS, FileMetadata(station))
+    t = T0_NS
+    feed(files, [("tool", tool(1, "running", t), t), ("tool", tool(2, "running", t + 5), t + 5)])
+    batch = [
+        classify("boltwatch/st1/samples", sample(run_id, n, t + 10 + n), t + 20)
+        for n, run_id in enumerate([1, 1, 2, 2, 1])
+    ]
+    files.write_samples(batch)
+    files.close()
+    sequences: dict[str, list[int]] = {}
+    for path in files.closed_paths:
+        with path.open("rb") as handle:
+            found = make_reader(handle).iter_messages(log_time_order=False)
+            sequences[path.name] = [m.sequence for _, c, m in found if c.topic.endswith("samples")]
+    assert sequences == {"st1_run1_221320.mcap": [0, 1, 4], "st1_run2_221320.mcap": [2, 3]}
+    assert files.written == 2 + 5

@@ -1,0 +1,178 @@
+"""The line recorder's filing work for N stations, in-process: what ``bench_line.py`` loads
+the recorder with, without the zenoh receive.
+
+Run on demand (not collected by pytest)::
+
+    .venv/bin/python tests/benchmarks/bench_recorder_line.py --stations 50 --seconds 6
+    .venv/bin/python tests/benchmarks/bench_recorder_line.py --no-rerun --profile 25
+
+A real :class:`~services.recorder.service.RecorderService` (its zenoh session
+peer-only, listening on nothing) is handed, every simulated 5 ms, what N edge
+stations publish toward the line in that time (``bench_line.py``'s generator:
+a ``SampleBatch`` every 10 ms, 1 s runs 0.2 s apart, an event and its
+intensity every 25 ms, tool states, a decision and a summary per run, bus and
+predictor statistics every second), stamped with a simulated clock, and ticks
+as its worker does (flush every half flush interval). No sleeping: the figure
+is CPU per sample (``time.process_time``: every thread of the process, Rerun's
+included) and how many simulated seconds one CPU second files.
+``--profile N`` prints the N heaviest functions (cProfile, cumulative).
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import dataclasses
+import pstats
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO) not in sys.path:  # run as a script from anywhere
+    sys.path.insert(0, str(REPO))
+
+import zenoh  # noqa: E402
+
+from services.recorder.service import RecorderService  # noqa: E402
+from shared import channels  # noqa: E402
+from shared.config import derive_stations, load_station  # noqa: E402
+from shared.service_skeleton import ServiceSkeleton  # noqa: E402
+from shared.zenoh_session import zenoh_config  # noqa: E402
+from tests.benchmarks.bench_line import (  # noqa: E402
+    BATCH_SAMPLES,
+    EVENT_EVERY_TICKS,
+    RUN_MARK,
+    RUN_PAUSE_TICKS,
+    RUN_SAMPLES,
+    run_templated,
+    sample_texts,
+)
+from tests.fuzz.payloads import template  # noqa: E402
+from tests.system.station_files import write_station  # noqa: E402
+from tests.unit.predictor.synthetic import staircase  # noqa: E402
+
+TAKE_MS = 5  # the service's TAKE_INTERVAL_S
+
+
+class StationPayloads:
+    """One synthetic edge station's payloads, pre-encoded with ``%d`` for run id and times."""
+
+    def __init__(self, station: str, rows: list[tuple[float, float, float]], t0_ns: int) -> None:
+        self.station = station
+        texts = sample_texts(station, rows)
+        self.batches = [
+            f'{{"station":"{station}","time_ns":%d,"samples":[' + ",".join(texts[i : i + 10]) + "]}"
+            for i in range(0, len(texts), BATCH_SAMPLES)
+        ]
+        made = {
+            t: template(t, station, t0_ns, RUN_MARK) for t in ("events", "intensity", "decision")
+        }
+        self.events = run_templated(made["events"])
+        self.intensity = run_templated(made["intensity"])
+        self.decision = run_templated(made["decision"])
+        summary = dataclasses.replace(
+            template("runs", station, t0_ns, RUN_MARK),
+            process_intensity=1.5,
+            events=3,
+            samples=1000,
+        )  # as bench_line's: counted in the wear ledger
+        self.summary = run_templated(summary)
+        self.key = {c.topic: c.key(station) for c in channels.CHANNELS}
+
+    def tool(self, run_id: int, state: str, now_ns: int) -> tuple[str, bytes]:
+        text = (
+            f'{{"station":"{self.station}","run_id":{run_id},"tool_id":1,"program_id":1,'
+            f'"state":"{state}","time_ns":{now_ns}}}'
+        )
+        return self.key[channels.TOOL.topic], text.encode()
+
+
+def line_load(stations: list[StationPayloads], seconds: float, t0_ns: int):
+    """Per simulated 5 ms: (now_ns, [(key, payload), ...]) of every station."""
+    run_id = 1_000_000
+    now_ns = t0_ns
+    end_ns = t0_ns + round(seconds * 1e9)
+    pending: list[tuple[str, bytes]] = []
+    while now_ns < end_ns:
+        run_id += 1
+        for n in range(RUN_SAMPLES + RUN_PAUSE_TICKS):
+            now_ns += 1_000_000
+            for station in stations:
+                if n == 0:
+                    pending.append(station.tool(run_id, "running", now_ns))
+                if n < RUN_SAMPLES and n % BATCH_SAMPLES == BATCH_SAMPLES - 1:
+                    times = [x for k in range(10) for x in (run_id, now_ns - (9 - k) * 1_000_000)]
+                    batch = station.batches[n // BATCH_SAMPLES] % (now_ns, *times)
+                    pending.append((station.key[channels.SAMPLE_BATCHES.topic], batch.encode()))
+                if n < RUN_SAMPLES and n % EVENT_EVERY_TICKS == 0:
+                    events = station.events.replace("%d", str(run_id), 1)
+                    pending.append((station.key[channels.EVENTS.topic], events.encode()))
+                    intensity = station.intensity.replace("%d", str(run_id), 1)
+                    pending.append((station.key[channels.INTENSITY.topic], intensity.encode()))
+                if n == RUN_SAMPLES:
+                    pending.append(station.tool(run_id, "done", now_ns))
+                    decision = station.decision.replace("%d", str(run_id), 1)
+                    pending.append((station.key[channels.DECISION.topic], decision.encode()))
+                    summary = station.summary.replace("%d", str(run_id), 1)
+                    pending.append((station.key[channels.RUNS.topic], summary.encode()))
+            if n % TAKE_MS == TAKE_MS - 1:
+                yield now_ns, pending
+                pending = []
+
+
+def bench(count: int, seconds: float, rerun: bool, profile: int) -> None:
+    trace = staircase(torque_noise_nm=0.2, force_noise_n=30.0, duration_s=1.0)
+    rows = [(tq, a, f) for _t, tq, f, a in trace.rows()][:RUN_SAMPLES]
+    with tempfile.TemporaryDirectory() as folder:
+        tmp = Path(folder)
+        paths = derive_stations(write_station(tmp, zenoh_mode="peer"), count, tmp / "stations")
+        loaded = [load_station(path) for path in paths]
+        t0_ns = time.time_ns()
+        stations = [StationPayloads(station.station_id, rows, t0_ns) for station in loaded]
+        load = list(line_load(stations, seconds, t0_ns))  # encoded before the clock starts
+        samples = sum(p.count(b'"torque_nm"') for _now, batch in load for _k, p in batch)
+        with ServiceSkeleton("recorder", zenoh.open(zenoh_config("peer", []))) as skeleton:
+            service = RecorderService(loaded, skeleton, rerun_files=rerun)
+            tick_ns = round(service._tick_s * 1e9)
+            profiler = cProfile.Profile() if profile else None
+            cpu0, wall0 = time.process_time(), time.perf_counter()
+            if profiler:
+                profiler.enable()
+            next_tick_ns = t0_ns
+            for now_ns, batch in load:
+                service._file([(key, payload, now_ns) for key, payload in batch])
+                if now_ns >= next_tick_ns:
+                    service.recorder.tick(now_ns)
+                    if service.wear is not None:
+                        service.wear.tick(now_ns)
+                    next_tick_ns = now_ns + tick_ns
+            service.recorder.close()
+            if profiler:
+                profiler.disable()
+            cpu, wall = time.process_time() - cpu0, time.perf_counter() - wall0
+            if service.wear is not None:
+                service.wear.close()
+        print(
+            f"N={count} {'MCAP + Rerun' if rerun else 'MCAP only'}: {samples} samples, "
+            f"{cpu / samples * 1e6:.2f} µs CPU per sample, wall {wall / samples * 1e6:.2f} µs, "
+            f"{seconds / cpu:.2f} simulated s per CPU s"
+        )
+        if profiler:
+            pstats.Stats(profiler).sort_stats("cumulative").print_stats(profile)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--stations", type=int, default=50)
+    parser.add_argument("--seconds", type=float, default=6.0, help="simulated seconds")
+    parser.add_argument("--no-rerun", action="store_true", help="MCAP only")
+    parser.add_argument("--profile", type=int, default=0, metavar="N")
+    args = parser.parse_args(argv)
+    bench(args.stations, args.seconds, not args.no_rerun, args.profile)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
