@@ -1,4 +1,6 @@
 """``boltwatch inspect RUN.mcap [--out RUN.png]``: a picture of a recorded run;
+``boltwatch inspect RUN.mcap --rerun [--out RUN.rrd]``: its Rerun recording, made from
+the MCAP (:mod:`services.recorder.rerun_files.rrd_from_mcap`);
 ``boltwatch inspect --overlay RUN... [--reference RUN] [--align POINT]``: several runs
 on one figure (:mod:`services.cli.run_overlay`)."""
 
@@ -31,7 +33,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "program metadata in the file, the analytical bounds are drawn too. For interactive "
         "viewing open the .mcap in Foxglove (it needs no plug-in). With --overlay: several "
         "runs' torque and preload over angle and over time on one figure, aligned at one "
-        "point, with their programs' windows and each run's OK/NOK."
+        "point, with their programs' windows and each run's OK/NOK. With --rerun: the run's "
+        "Rerun recording (.rrd), made from the MCAP, for a recorder that writes MCAP only "
+        "(serve recorder --no-rerun, as a line of many stations does)."
     )
     parser.add_argument(
         "recording", type=Path, nargs="?", default=None, metavar="RUN.mcap", help="the recording"
@@ -42,6 +46,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="FILE.png",
         help="default: beside the recording (--overlay: overlay.png in the current folder)",
+    )
+    parser.add_argument(
+        "--rerun",
+        action="store_true",
+        help="write the run's Rerun recording (RUN.rrd beside the recording, or --out "
+        "FILE.rrd) instead of the picture; open it with: rerun RUN.rrd boltwatch.rbl",
     )
     add_run_option(
         parser,
@@ -82,6 +92,8 @@ def run(args: argparse.Namespace) -> int:
         return run_overlay(args)
     if args.recording is None:
         raise InputError("give a recording (RUN.mcap) to draw, or --overlay RUN...")
+    if args.rerun:
+        return _write_rrd(args)
     if args.reference is not None or args.align != "start":
         option = "--reference" if args.reference is not None else "--align"
         raise InputError(f"{option} is an option of --overlay; give --overlay RUN... with it")
@@ -97,5 +109,29 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"wrote {target}: run {run.run_id}, {len(run.samples)} samples, "
         f"{len(run.events)} stick-slip events{also}"
+    )
+    return 0
+
+
+def _write_rrd(args: argparse.Namespace) -> int:
+    if args.run is not None or args.overlay is not None:
+        raise InputError("--rerun writes the whole file's run; give no --run or --overlay with it")
+    target = args.out or args.recording.with_suffix(".rrd")
+    if target.suffix.lower() != ".rrd":
+        raise InputError(
+            f"{target}: a Rerun recording is written as .rrd; give a path ending in .rrd"
+        )
+    if target.exists():
+        raise InputError(f"{target} exists (the recorder wrote it live?); give another --out")
+    from services.recorder.rerun_files.rerun_streams import BLUEPRINT_FILE
+    from services.recorder.rerun_files.rrd_from_mcap import rrd_from_mcap
+
+    written = rrd_from_mcap(args.recording, target)
+    if not written.scan.complete:
+        warn_damaged_recording(NAME, written.scan.describe(), "converted what is readable")
+    print(
+        f"wrote {target}: run {written.run_id} of {written.station}, {written.samples} samples, "
+        f"{written.events} stick-slip events; open it: rerun {target} "
+        f"{target.parent / BLUEPRINT_FILE}"
     )
     return 0

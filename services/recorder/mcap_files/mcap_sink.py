@@ -12,8 +12,10 @@ message's own time, ``sequence`` the Sample's sequence (else a per-channel
 counter). :meth:`McapSink.flush` closes the chunk in progress, hands it to
 the operating system and (``fsync=True``, the default) waits until it is on
 the disk, so a killed recorder, and a power cut too, loses only what came
-after. The header and metadata are flushed the same way when the file is
-opened: a disk that cannot take them fails at once, not a second later.
+after. The header and metadata reach the operating system when the file is
+opened (a full or read-only disk fails at once, not a second later) and the
+disk at the first flush, with the folder's entry for the new file: a run's
+start waits for no disk (at 50 stations, 40 run starts a second).
 
 A disk that fails (full, read-only, I/O error) raises :class:`OSError` from
 any method; the owner then calls :meth:`McapSink.abandon`, which lets go of
@@ -77,6 +79,7 @@ class McapSink:
         self._flushed_bytes = 0  # the file's length at the last flush
         self._closed = False
         self._abandoned = False
+        self._name_synced = not fsync  # the folder's entry for the file, on the disk
         path.parent.mkdir(parents=True, exist_ok=True)
         self._file: BinaryIO = path.open("xb")
         try:
@@ -87,11 +90,8 @@ class McapSink:
             self._messages = MessageAppender(self._writer)
             for name, data in metadata.items():
                 self._writer.add_metadata(name, dict(data))
-            self._writer.flush()
-            self._sync()
+            self._writer.flush()  # to the OS: a full or read-only disk fails here, at once
             self._flushed_bytes = self._file.tell()
-            if fsync:
-                _sync_folder(path.parent)  # the new file's name survives a power cut too
         except BaseException:
             self.abandon()
             raise
@@ -204,6 +204,9 @@ class McapSink:
     def _sync(self) -> None:
         if self._fsync:
             os.fsync(self._file.fileno())
+            if not self._name_synced:  # the new file's name survives a power cut too
+                _sync_folder(self.path.parent)
+                self._name_synced = True
 
     def _channel_for(self, received: Received) -> int:
         schema_name = received.schema_name if received.message is not None else None

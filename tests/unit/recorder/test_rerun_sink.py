@@ -24,6 +24,7 @@ from test_recording import (  # type: ignore[import-not-found]  # sibling test m
     run_messages,
 )
 
+from services.cli.main import main
 from services.cli.station_supervisor import stop_process
 from services.recorder.live.file_metadata import FileMetadata
 from services.recorder.live.incoming import Received, classify
@@ -135,6 +136,32 @@ def test_the_recorder_writes_one_rrd_beside_each_run_mcap(tmp_path: Path) -> Non
         (recording,) = RrdReader(rrd).recordings()
         assert recording.recording_id.startswith("st1")  # pooled streams: rerun_streams.py
         assert rows_by_entity(rrd)[f"/{bp.TORQUE}"] == samples
+
+
+def test_a_run_recorded_as_mcap_only_gets_the_live_rrd_from_its_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``inspect RUN.mcap --rerun`` writes what the recorder writes live, row for row."""
+    loaded = station(tmp_path)
+    limits = FileLimits(1_000_000_000, 1 << 30, 3600 * 1_000_000_000, late_grace_ns=0)
+    recorder = Recorder(loaded.recordings_folder, limits, FileMetadata(loaded), RerunOptions())
+    for item in received(1, with_predictions(run_messages(1, SAMPLES))):
+        recorder.write(item)
+    (mcap,) = [path for path in recorder.close() if path.suffix == ".mcap"]
+    made = tmp_path / "made" / "run1.rrd"
+    made.parent.mkdir()
+
+    assert main(["inspect", str(mcap), "--rerun", "--out", str(made)]) == 0
+    verify(made)
+    live = mcap.with_suffix(".rrd")
+    assert rows_by_entity(made) == rows_by_entity(live)
+    assert rows_by_entity(made)[f"/{bp.TORQUE}"] == SAMPLES
+    assert (made.parent / BLUEPRINT_FILE).is_file()
+    assert f"wrote {made}: run 1 of st1, {SAMPLES} samples, {EVENTS} stick-slip events" in (
+        capsys.readouterr().out
+    )
+    assert main(["inspect", str(mcap), "--rerun"]) == 2  # the live one is there: not replaced
+    assert "exists" in capsys.readouterr().err
 
 
 def test_a_failing_rerun_sink_leaves_the_mcap_file_whole(
