@@ -53,7 +53,9 @@ def rrd_from_mcap(mcap_path: Path, target: Path) -> RrdWritten:
     if not runs:
         raise InputError(f"{mcap_path}: no run in this file (an idle file has none)")
     start = next((r for r in received if r.run_started), None)
-    run_id = start.run_id if start is not None else runs.most_common(1)[0][0]
+    run_id: int = runs.most_common(1)[0][0]
+    if start is not None and start.run_id is not None:  # the run the file was opened for
+        run_id = start.run_id
     first = next(r for r in received if r.run_id == run_id)
     started_ns = start.message.time_ns if start is not None else first.publish_time_ns
     partial = target.with_name(target.name + ".partial")
