@@ -21,6 +21,7 @@ never wrong.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import logging
 import struct
@@ -46,6 +47,12 @@ MessageRow = tuple[int, int, int, bytes]
 
 def _nothing() -> None:
     return None
+
+
+@functools.cache
+def _tell_one_by_one(module: str) -> None:
+    """Once per process: a recorder opens dozens of files a second."""
+    LOG.info("%s: writing messages one by one (add_message), the slower way", module)
 
 
 @dataclass
@@ -79,7 +86,7 @@ class MessageAppender:
             and buffer is not None
         )
         if not usable:
-            LOG.info("mcap %s: writing messages one by one (add_message)", type(writer).__module__)
+            _tell_one_by_one(type(writer).__module__)
         self._chunk: Any = chunk if usable else None
         self._statistics: Any = statistics
         self._finalize: Callable[[], None] = finalize if usable else _nothing
