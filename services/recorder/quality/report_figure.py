@@ -79,16 +79,13 @@ def _label(statistics: FigureStatistics) -> str:
 
 def _draw_mean_chart(axis: Axes, statistics: FigureStatistics) -> None:
     chart = statistics.chart
-    axis.set_title(f"X̄ chart: {_label(statistics)}", fontsize=9)
+    title = f"X̄ chart: {_label(statistics)}"
     if chart is None:
+        axis.set_title(title, fontsize=9)
         _empty(axis, f"{len(statistics.values)} runs: less than one subgroup")
         return
-    groups = range(1, len(chart.means) + 1)
-    axis.plot(groups, chart.means, "o-", color="C0", markersize=3)
-    axis.axhline(chart.centre, color="C2", label=f"X̿ {chart.centre:.4g}")
-    for limit in chart.mean_limits:
-        axis.axhline(limit, color="C3", linestyle="--")
-    _subgroup_axis(axis, chart.size)
+    label = f"X̿ {chart.centre:.4g}"
+    _draw_chart(axis, title, chart.means, chart.centre, label, chart.mean_limits, "C0", chart.size)
 
 
 def _draw_spread_chart(axis: Axes, statistics: FigureStatistics) -> None:
@@ -97,13 +94,29 @@ def _draw_spread_chart(axis: Axes, statistics: FigureStatistics) -> None:
         axis.set_title(f"R chart: {_label(statistics)}", fontsize=9)
         _empty(axis, "no subgroup")
         return
-    axis.set_title(f"{chart.spread} chart: {_label(statistics)}", fontsize=9)
-    groups = range(1, len(chart.spreads) + 1)
-    axis.plot(groups, chart.spreads, "o-", color="C1", markersize=3)
-    axis.axhline(chart.spread_centre, color="C2", label=f"{chart.spread}̄ {chart.spread_centre:.3g}")
-    for limit in chart.spread_limits:
+    title = f"{chart.spread} chart: {_label(statistics)}"
+    label = f"{chart.spread}̄ {chart.spread_centre:.3g}"
+    limits = chart.spread_limits
+    _draw_chart(axis, title, chart.spreads, chart.spread_centre, label, limits, "C1", chart.size)
+
+
+def _draw_chart(
+    axis: Axes,
+    title: str,
+    points: Sequence[float],
+    centre: float,
+    centre_label: str,
+    limits: Sequence[float],
+    colour: str,
+    subgroup_size: int,
+) -> None:
+    """One control chart: a point per subgroup, its centre line and control limits."""
+    axis.set_title(title, fontsize=9)
+    axis.plot(range(1, len(points) + 1), points, "o-", color=colour, markersize=3)
+    axis.axhline(centre, color="C2", label=centre_label)
+    for limit in limits:
         axis.axhline(limit, color="C3", linestyle="--")
-    _subgroup_axis(axis, chart.size)
+    _subgroup_axis(axis, subgroup_size)
 
 
 def _subgroup_axis(axis: Axes, size: int) -> None:
