@@ -94,8 +94,7 @@ class Recorder:
             self._log_unknown("%s is not a boltwatch message key; recording it raw", received.key)
         self.messages += 1
         now_ns = received.log_time_ns
-        waiting = files.current is None and now_ns < self._retry_at_ns  # abandoned, not retried
-        if not self.recording_ok and waiting and not received.run_started:
+        if self._waits_for_retry(files, now_ns) and not received.run_started:
             self._drop(1, now_ns)
             return
         written_before = files.written
@@ -113,7 +112,7 @@ class Recorder:
         files = self._files(station)
         self.messages += len(samples)
         now_ns = samples[-1].log_time_ns
-        if not self.recording_ok and files.current is None and now_ns < self._retry_at_ns:
+        if self._waits_for_retry(files, now_ns):
             self._drop(len(samples), now_ns)
             return
         written_before = files.written
@@ -161,6 +160,11 @@ class Recorder:
     def abandoned_files(self) -> list[Path]:
         """Files left incomplete by a write fault (``boltwatch recover`` makes them valid)."""
         return [path for files in self._stations.values() for path in files.abandoned_paths]
+
+    def _waits_for_retry(self, files: StationFiles, now_ns: int) -> bool:
+        """Writing failed and the station's files were abandoned, not tried again yet: what
+        arrives is dropped (a run's start tries at once)."""
+        return not self.recording_ok and files.current is None and now_ns < self._retry_at_ns
 
     def _files(self, station: str) -> StationFiles:
         files = self._stations.get(station)
