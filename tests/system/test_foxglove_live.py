@@ -13,7 +13,6 @@ schemas and the same bytes as the line recorder's MCAP files.
 from __future__ import annotations
 
 import json
-import subprocess
 from collections import defaultdict
 from pathlib import Path
 
@@ -25,9 +24,8 @@ from shared import channels
 from shared.codec import json_schema
 from tests.foxglove_client import FoxgloveClient
 from tests.live_recorder import free_port, wait_until
-from tests.paths import REPO
 from tests.system.station_files import serve, write_station
-from tests.system.test_station_up import UP_TIMEOUT_S, up_command
+from tests.system.test_station_up import run_up
 
 pytestmark = pytest.mark.system
 
@@ -70,15 +68,7 @@ def test_a_foxglove_client_receives_the_runs_of_a_real_station_live(tmp_path: Pa
     try:
         assert client.subscribed.wait(30), (tmp_path / "viewer.log").read_text()
         assert client.error is None, client.error
-        up = subprocess.run(
-            up_command(station, runs=RUNS),
-            capture_output=True,
-            text=True,
-            timeout=UP_TIMEOUT_S,
-            cwd=REPO,
-            check=False,
-        )
-        assert up.returncode == 0, up.stdout + up.stderr
+        run_up(station, runs=RUNS)
         summaries_key = channels.RUNS.key(STATION)
         wait_until(lambda: len(client.received(summaries_key)) >= RUNS, "the last run summary")
     finally:

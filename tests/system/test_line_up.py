@@ -11,15 +11,13 @@ here: every lost sample must be a counted one (``missed_samples``).
 
 from __future__ import annotations
 
-import subprocess
 from collections import defaultdict
 from pathlib import Path
 
 import pytest
 
-from tests.paths import REPO
 from tests.system.station_files import write_station
-from tests.system.test_station_up import UP_TIMEOUT_S, read_recordings, up_command
+from tests.system.test_station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
 
@@ -29,16 +27,8 @@ RUNS = 2
 
 def test_up_runs_a_line_of_three_stations(tmp_path: Path) -> None:
     station = write_station(tmp_path)
-    result = subprocess.run(
-        [*up_command(station, runs=RUNS), "--stations", str(len(STATIONS))],
-        capture_output=True,
-        text=True,
-        timeout=UP_TIMEOUT_S,
-        cwd=REPO,
-        check=False,
-    )
+    result = run_up(station, RUNS, "--stations", str(len(STATIONS)))
     output = result.stdout + result.stderr
-    assert result.returncode == 0, output
     assert "3 stations st1..st3" in result.stdout and " station " in result.stdout
     for station_id in STATIONS:
         assert f"CAN {station_id}:" in result.stdout, output

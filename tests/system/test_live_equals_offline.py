@@ -22,7 +22,7 @@ import pytest
 from services.recorder.mcap_files.trace_export import export_trace
 from tests.paths import REPO
 from tests.system.station_files import write_station
-from tests.system.test_station_up import UP_TIMEOUT_S, read_recordings, up_command
+from tests.system.test_station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
 
@@ -42,11 +42,7 @@ def offline_stop(trace: Path, station: Path) -> dict[str, object] | None:
 
 def test_every_live_decision_is_the_offline_one(tmp_path: Path) -> None:
     station = write_station(tmp_path)  # the shipped file's placement: edge
-    result = subprocess.run(
-        up_command(station, runs=RUNS),
-        capture_output=True, text=True, timeout=UP_TIMEOUT_S, cwd=REPO, check=False,
-    )  # fmt: skip
-    assert result.returncode == 0, result.stdout + result.stderr
+    run_up(station, runs=RUNS)
     recordings = tmp_path / "recordings"
     messages = read_recordings(recordings)
     decisions = {d["run_id"]: d for d in messages["boltwatch/st1/decision"]}

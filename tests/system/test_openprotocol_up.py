@@ -19,7 +19,7 @@ import pytest
 from tests.live_recorder import free_port
 from tests.paths import REPO
 from tests.system.station_files import write_station
-from tests.system.test_station_up import UP_TIMEOUT_S, read_recordings
+from tests.system.test_station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
 
@@ -31,16 +31,7 @@ def test_up_with_an_open_protocol_controller_records_every_run(tmp_path: Path) -
     station.write_text(
         station.read_text() + f'\n[openprotocol]\nhost = "127.0.0.1"\nport = {free_port()}\n'
     )
-    command = [sys.executable, "-m", "services.cli", "up", "--config", str(station)]
-    result = subprocess.run(
-        [*command, "--runs", str(RUNS), "--controller", "openprotocol"],
-        capture_output=True,
-        text=True,
-        timeout=UP_TIMEOUT_S,
-        cwd=REPO,
-        check=False,
-    )
-    assert result.returncode == 0, result.stdout + result.stderr
+    result = run_up(station, RUNS, "--controller", "openprotocol")
     rows = [line.split() for line in result.stdout.splitlines()]
     # run, prog, target and unit, reached and unit, error %, result, ...
     verdicts = {

@@ -15,7 +15,7 @@ from services.recorder.overlay.overlay_run import find_run_files, read_overlay_r
 from services.recorder.overlay.overlay_series import build_overlay
 from tests.paths import REPO
 from tests.system.station_files import write_station
-from tests.system.test_station_up import UP_TIMEOUT_S, read_recordings, up_command
+from tests.system.test_station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
 
@@ -28,9 +28,7 @@ TIGHT = {
 
 def test_overlay_of_real_runs_found_by_id(tmp_path: Path) -> None:
     station = write_station(tmp_path, replacements=TIGHT)
-    up = subprocess.run(up_command(station, runs=3), capture_output=True, text=True,
-                        timeout=UP_TIMEOUT_S, cwd=REPO, check=False)  # fmt: skip
-    assert up.returncode == 0, up.stdout + up.stderr
+    run_up(station, runs=3)
     results = read_recordings(tmp_path / "recordings")["boltwatch/st1/results"]
     verdicts = {result["run_id"]: result["result"] for result in results}
     assert len(verdicts) == 3

@@ -17,7 +17,7 @@ import pytest
 
 from tests.paths import REPO
 from tests.system.station_files import write_station
-from tests.system.test_station_up import UP_TIMEOUT_S, read_recordings, up_command
+from tests.system.test_station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
 
@@ -26,15 +26,7 @@ RUNS = 6
 
 def test_report_over_runs_of_up(tmp_path: Path) -> None:
     station = write_station(tmp_path)
-    up = subprocess.run(
-        up_command(station, runs=RUNS),
-        capture_output=True,
-        text=True,
-        timeout=UP_TIMEOUT_S,
-        cwd=REPO,
-        check=False,
-    )
-    assert up.returncode == 0, up.stdout + up.stderr
+    run_up(station, runs=RUNS)
     out = tmp_path / "report"
     command = [sys.executable, "-m", "services.cli", "report", "--config", str(station)]
     report = subprocess.run(

@@ -48,6 +48,20 @@ def up_command(station: Path, runs: int) -> list[str]:
     ]
 
 
+def run_up(station: Path, runs: int, *options: str) -> subprocess.CompletedProcess[str]:
+    """``boltwatch up`` to its end; it must exit 0 (its output is the failure's message)."""
+    result = subprocess.run(
+        [*up_command(station, runs), *options],
+        capture_output=True,
+        text=True,
+        timeout=UP_TIMEOUT_S,
+        cwd=REPO,
+        check=False,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    return result
+
+
 def read_recordings(folder: Path) -> dict[str, list[dict[str, Any]]]:
     """Every message of every MCAP file under ``folder``, by topic, decoded with json only."""
     by_topic: dict[str, list[dict[str, Any]]] = defaultdict(list)
@@ -64,15 +78,7 @@ def read_recordings(folder: Path) -> dict[str, list[dict[str, Any]]]:
 
 def test_up_tightens_stops_and_records_every_sample(tmp_path: Path) -> None:
     station = write_station(tmp_path)
-    result = subprocess.run(
-        up_command(station, runs=3),
-        capture_output=True,
-        text=True,
-        timeout=UP_TIMEOUT_S,
-        cwd=REPO,
-        check=False,
-    )
-    assert result.returncode == 0, result.stdout + result.stderr
+    result = run_up(station, runs=3)
     assert "stop reason" in result.stdout and "recordings:" in result.stdout
 
     messages = read_recordings(tmp_path / "recordings")
