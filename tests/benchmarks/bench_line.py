@@ -92,6 +92,12 @@ def run_templated(message: object) -> str:
     return encode(message).decode().replace("%", "%%").replace(str(RUN_MARK), "%d")
 
 
+def run_rows() -> list[tuple[float, float, float]]:
+    """(torque, angle, force) of every sample of a synthetic run: a stick-slip staircase."""
+    trace = staircase(torque_noise_nm=0.2, force_noise_n=30.0, duration_s=1.0)
+    return [(tq, a, f) for _t, tq, f, a in trace.rows()][:RUN_SAMPLES]
+
+
 def sample_texts(station: str, rows: list[tuple[float, float, float]]) -> list[str]:
     """Each sample of a run as JSON with ``%d`` for its run id, then its time."""
     return [
@@ -101,40 +107,54 @@ def sample_texts(station: str, rows: list[tuple[float, float, float]]) -> list[s
     ]
 
 
-class Station:
-    """One synthetic edge station's publishers and pre-encoded messages."""
+class StationPayloads:
+    """What one synthetic edge station publishes, pre-encoded: ``%d`` stands for the run
+    id (and, in a batch, its time and each sample's run id and time)."""
 
-    def __init__(self, session: zenoh.Session, station: str, rows: list, per_sample: bool) -> None:
-        self.put = {  # as the station's publisher: each channel's options (BLOCK: never lossy)
-            channel.topic: channel.declare_publisher(session, station).put
-            for channel in STATION_CHANNELS
-        }
+    def __init__(self, station: str, rows: list[tuple[float, float, float]], now_ns: int) -> None:
         self.station = station
-        self.per_sample = per_sample
         texts = sample_texts(station, rows)
         self.samples = texts
         self.batches = [
             f'{{"station":"{station}","time_ns":%d,"samples":[' + ",".join(texts[i : i + 10]) + "]}"
             for i in range(0, len(texts), BATCH_SAMPLES)
         ]
-        now = time.time_ns()
-        made = {topic: template(topic, station, now, RUN_MARK) for topic in ("events", "intensity")}
+        made = {t: template(t, station, now_ns, RUN_MARK) for t in ("events", "intensity")}
         summary = dataclasses.replace(
-            template("runs", station, now, RUN_MARK), process_intensity=1.5, events=3, samples=1000
+            template("runs", station, now_ns, RUN_MARK),
+            process_intensity=1.5,
+            events=3,
+            samples=1000,
         )
         self.events = run_templated(made["events"]).encode()
         self.intensity = run_templated(made["intensity"]).encode()
-        self.decision = run_templated(template("decision", station, now, RUN_MARK)).encode()
+        self.decision = run_templated(template("decision", station, now_ns, RUN_MARK)).encode()
         self.summary = run_templated(summary).encode()
-        self.predictor = encode(template("predictor", station, now))
+        self.predictor = encode(template("predictor", station, now_ns))
+
+    def tool(self, run_id: int, state: str, now_ns: int) -> bytes:
+        return (
+            f'{{"station":"{self.station}","run_id":{run_id},"tool_id":1,"program_id":1,'
+            f'"state":"{state}","time_ns":{now_ns}}}'
+        ).encode()
+
+
+class Station(StationPayloads):
+    """One synthetic edge station's publishers and pre-encoded messages."""
+
+    def __init__(self, session: zenoh.Session, station: str, rows: list, per_sample: bool) -> None:
+        now = time.time_ns()
+        super().__init__(station, rows, now)
+        self.put = {  # as the station's publisher: each channel's options (BLOCK: never lossy)
+            channel.topic: channel.declare_publisher(session, station).put
+            for channel in STATION_CHANNELS
+        }
+        self.per_sample = per_sample
         self.published = 0
         self.started_ns = now
 
-    def tool(self, run_id: int, state: str, now_ns: int) -> None:
-        self.put[channels.TOOL.topic](
-            f'{{"station":"{self.station}","run_id":{run_id},"tool_id":1,"program_id":1,'
-            f'"state":"{state}","time_ns":{now_ns}}}'
-        )
+    def put_tool(self, run_id: int, state: str, now_ns: int) -> None:
+        self.put[channels.TOOL.topic](self.tool(run_id, state, now_ns))
 
     def bus(self, now_ns: int) -> None:
         stats = BusStats(self.station, now_ns, 0, self.published, *[0] * 11)
@@ -154,8 +174,7 @@ def generate(endpoint: str, station_ids: list[str], seconds: float, per_sample: 
     finished first), then each station's last BusStats."""
     stopped = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stopped.set())
-    trace = staircase(torque_noise_nm=0.2, force_noise_n=30.0, duration_s=1.0)
-    rows = [(tq, a, f) for _t, tq, f, a in trace.rows()][:RUN_SAMPLES]
+    rows = run_rows()
     behind = 0
     with zenoh.open(zenoh_config("client", [endpoint])) as session:
         stations = [Station(session, s, rows, per_sample) for s in station_ids]
@@ -168,7 +187,7 @@ def generate(endpoint: str, station_ids: list[str], seconds: float, per_sample: 
             run_id += 1
             now_ns = time.time_ns()
             for station in stations:
-                station.tool(run_id, "running", now_ns)
+                station.put_tool(run_id, "running", now_ns)
             for n in range(len(rows)):
                 now_ns = time.time_ns()
                 for station in stations:
@@ -202,7 +221,7 @@ def generate(endpoint: str, station_ids: list[str], seconds: float, per_sample: 
             now_ns = time.time_ns()
             for station in stations:
                 station.put[channels.DECISION.topic](station.decision % run_id)
-                station.tool(run_id, "done", now_ns)
+                station.put_tool(run_id, "done", now_ns)
                 station.put[channels.RUNS.topic](station.summary % run_id)
             time.sleep(RUN_PAUSE_TICKS / 1e3)
             next_tick = time.perf_counter()

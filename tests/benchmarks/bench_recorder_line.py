@@ -22,11 +22,11 @@ from __future__ import annotations
 
 import argparse
 import cProfile
-import dataclasses
 import pstats
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
@@ -43,54 +43,21 @@ from shared.zenoh_session import zenoh_config  # noqa: E402
 from tests.benchmarks.bench_line import (  # noqa: E402
     BATCH_SAMPLES,
     EVENT_EVERY_TICKS,
-    RUN_MARK,
     RUN_PAUSE_TICKS,
     RUN_SAMPLES,
-    run_templated,
-    sample_texts,
+    StationPayloads,
+    run_rows,
 )
-from tests.fuzz.payloads import template  # noqa: E402
 from tests.system.station_files import write_station  # noqa: E402
-from tests.unit.predictor.synthetic import staircase  # noqa: E402
 
 TAKE_MS = 5  # the service's TAKE_INTERVAL_S
 
 
-class StationPayloads:
-    """One synthetic edge station's payloads, pre-encoded with ``%d`` for run id and times."""
-
-    def __init__(self, station: str, rows: list[tuple[float, float, float]], t0_ns: int) -> None:
-        self.station = station
-        texts = sample_texts(station, rows)
-        self.batches = [
-            f'{{"station":"{station}","time_ns":%d,"samples":[' + ",".join(texts[i : i + 10]) + "]}"
-            for i in range(0, len(texts), BATCH_SAMPLES)
-        ]
-        made = {
-            t: template(t, station, t0_ns, RUN_MARK) for t in ("events", "intensity", "decision")
-        }
-        self.events = run_templated(made["events"])
-        self.intensity = run_templated(made["intensity"])
-        self.decision = run_templated(made["decision"])
-        summary = dataclasses.replace(
-            template("runs", station, t0_ns, RUN_MARK),
-            process_intensity=1.5,
-            events=3,
-            samples=1000,
-        )  # as bench_line's: counted in the wear ledger
-        self.summary = run_templated(summary)
-        self.key = {c.topic: c.key(station) for c in channels.CHANNELS}
-
-    def tool(self, run_id: int, state: str, now_ns: int) -> tuple[str, bytes]:
-        text = (
-            f'{{"station":"{self.station}","run_id":{run_id},"tool_id":1,"program_id":1,'
-            f'"state":"{state}","time_ns":{now_ns}}}'
-        )
-        return self.key[channels.TOOL.topic], text.encode()
-
-
-def line_load(stations: list[StationPayloads], seconds: float, t0_ns: int):
+def line_load(
+    stations: list[StationPayloads], seconds: float, t0_ns: int
+) -> Iterator[tuple[int, list[tuple[str, bytes]]]]:
     """Per simulated 5 ms: (now_ns, [(key, payload), ...]) of every station."""
+    keys = [{c.topic: c.key(station.station) for c in channels.CHANNELS} for station in stations]
     run_id = 1_000_000
     now_ns = t0_ns
     end_ns = t0_ns + round(seconds * 1e9)
@@ -99,32 +66,29 @@ def line_load(stations: list[StationPayloads], seconds: float, t0_ns: int):
         run_id += 1
         for n in range(RUN_SAMPLES + RUN_PAUSE_TICKS):
             now_ns += 1_000_000
-            for station in stations:
+            for station, key in zip(stations, keys, strict=True):
                 if n == 0:
-                    pending.append(station.tool(run_id, "running", now_ns))
+                    pending.append(
+                        (key[channels.TOOL.topic], station.tool(run_id, "running", now_ns))
+                    )
                 if n < RUN_SAMPLES and n % BATCH_SAMPLES == BATCH_SAMPLES - 1:
                     times = [x for k in range(10) for x in (run_id, now_ns - (9 - k) * 1_000_000)]
                     batch = station.batches[n // BATCH_SAMPLES] % (now_ns, *times)
-                    pending.append((station.key[channels.SAMPLE_BATCHES.topic], batch.encode()))
+                    pending.append((key[channels.SAMPLE_BATCHES.topic], batch.encode()))
                 if n < RUN_SAMPLES and n % EVENT_EVERY_TICKS == 0:
-                    events = station.events.replace("%d", str(run_id), 1)
-                    pending.append((station.key[channels.EVENTS.topic], events.encode()))
-                    intensity = station.intensity.replace("%d", str(run_id), 1)
-                    pending.append((station.key[channels.INTENSITY.topic], intensity.encode()))
+                    pending.append((key[channels.EVENTS.topic], station.events % run_id))
+                    pending.append((key[channels.INTENSITY.topic], station.intensity % run_id))
                 if n == RUN_SAMPLES:
-                    pending.append(station.tool(run_id, "done", now_ns))
-                    decision = station.decision.replace("%d", str(run_id), 1)
-                    pending.append((station.key[channels.DECISION.topic], decision.encode()))
-                    summary = station.summary.replace("%d", str(run_id), 1)
-                    pending.append((station.key[channels.RUNS.topic], summary.encode()))
+                    pending.append((key[channels.TOOL.topic], station.tool(run_id, "done", now_ns)))
+                    pending.append((key[channels.DECISION.topic], station.decision % run_id))
+                    pending.append((key[channels.RUNS.topic], station.summary % run_id))
             if n % TAKE_MS == TAKE_MS - 1:
                 yield now_ns, pending
                 pending = []
 
 
 def bench(count: int, seconds: float, rerun: bool, profile: int) -> None:
-    trace = staircase(torque_noise_nm=0.2, force_noise_n=30.0, duration_s=1.0)
-    rows = [(tq, a, f) for _t, tq, f, a in trace.rows()][:RUN_SAMPLES]
+    rows = run_rows()
     with tempfile.TemporaryDirectory() as folder:
         tmp = Path(folder)
         paths = derive_stations(write_station(tmp, zenoh_mode="peer"), count, tmp / "stations")
