@@ -55,7 +55,9 @@ def test_live_results_with_their_curves_become_runs_once_each(
     finally:
         bridge.finish()
         heard.close()
-    assert controller.stops == 1, "a clean 0003 on shutdown"
+    # the test controller reads the 0003 on its own thread, after the bridge has sent it
+    wait_until(lambda: controller.stops == 1, "a clean 0003 on shutdown")
+    assert controller.stops == 1
     assert read_position(bridge.position_file).watermark == 3
 
 
