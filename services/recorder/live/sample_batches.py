@@ -7,7 +7,10 @@ when each sample was a message of its own, so a Foxglove plot or a reader of
 the files sees no difference: each sample is one :class:`Received` on
 ``boltwatch/<st>/samples`` with the ``boltwatch.Sample`` schema, its own JSON
 as payload (:func:`shared.codec.encode`), ``publish_time`` its ``time_ns`` and
-``sequence`` its ``sequence``.
+``sequence`` its ``sequence``. The JSON of each sample is the station's own,
+cut out of the batch's payload when the batch is in the station publisher's
+compact form (:func:`sample_texts`; as a sample that came alone is recorded
+byte for byte), encoded again otherwise.
 
 ``log_time`` is the time the recorder received it. A batch arrives at once,
 so each sample's arrival is taken as the batch's arrival less how much older
@@ -50,11 +53,35 @@ class BatchSamples:
         arrival_ns = received.log_time_ns
         newest_ns = samples[-1].time_ns
         floor_ns = self._last_log_ns.get(station, 0)
+        texts = sample_texts(received.payload, batch) or [encode(sample) for sample in samples]
         out: list[Received] = []
-        for sample in samples:
+        for sample, text in zip(samples, texts, strict=True):
             own_ns = sample.time_ns
             older_ns = min(max(newest_ns - own_ns, 0), MAX_SPREAD_NS)
             log_ns = floor_ns = max(arrival_ns - older_ns, floor_ns)
-            out.append(Received(key, station, SAMPLE, sample, encode(sample), log_ns, own_ns))
+            out.append(Received(key, station, SAMPLE, sample, text, log_ns, own_ns))
         self._last_log_ns[station] = floor_ns
         return out
+
+
+def sample_texts(payload: bytes, batch: SampleBatch) -> list[bytes] | None:
+    """The JSON of each sample of ``batch`` as it stands in ``payload``, the batch's JSON, when
+    that is ``{"station":..,"time_ns":..,"samples":[{..},..,{..}]}`` written compact (as
+    :func:`shared.codec.encode` writes it); None otherwise.
+
+    Exact because ``batch`` decoded from ``payload``: a sample is a flat object
+    (no arrays, no nested objects) whose only string is its station id, which
+    holds no brace, so ``},{`` occurs only between two samples, and the only
+    ``]`` after the prefix closes the list (a second ``samples`` key would add one).
+    """
+    prefix = b'{"station":"%s","time_ns":%d,"samples":[{' % (batch.station.encode(), batch.time_ns)
+    if (
+        not payload.startswith(prefix)
+        or not payload.endswith(b"}]}")
+        or payload.find(b"]", len(prefix)) != len(payload) - 2
+    ):
+        return None
+    texts = payload[len(prefix) : -3].split(b"},{")
+    if len(texts) != len(batch.samples):
+        return None
+    return [b"{" + text + b"}" for text in texts]

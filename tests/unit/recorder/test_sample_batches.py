@@ -24,10 +24,13 @@ from typing import Any
 import pytest
 import zenoh
 from mcap.reader import make_reader
+from pydantic import TypeAdapter
 
+from services.recorder.live.incoming import Received
+from services.recorder.live.sample_batches import BatchSamples, sample_texts
 from services.recorder.mcap_files.mcap_sink import RAW_ENCODING
 from shared import channels
-from shared.codec import encode
+from shared.codec import decode, encode
 from shared.config import LoadedStation, load_station
 from shared.messages import BusStats, RecorderStats, Sample, SampleBatch, ToolState
 from shared.queued_publisher import QueuedPublisher
@@ -175,3 +178,55 @@ def test_a_lost_batch_and_a_refused_one_are_their_samples_missing(
     assert sequences == [n for n in range(100) if not 30 <= n < 40 and not 70 <= n < 80]
     raw = [m for m in messages if m["topic"] == "boltwatch/st1/sample_batches"]
     assert [(m["encoding"], m["data"]) for m in raw] == [(RAW_ENCODING, refused_payload)]
+
+
+def batch_of(station: str, count: int) -> SampleBatch:
+    t0_ns = 1_700_000_000_000_000_000
+    samples = [
+        Sample(station, RUN, n, t0_ns + n * MS_NS, 5.0 + n / 3, 0.2 * n, None if n % 2 else 1e4)
+        for n in range(count)
+    ]
+    return SampleBatch(station, t0_ns + count * MS_NS, samples)
+
+
+@pytest.mark.parametrize("count", [1, 2, 10])
+def test_a_compact_batch_gives_each_sample_as_the_station_wrote_it(count: int) -> None:
+    batch = batch_of("line-7_b", count)
+    assert sample_texts(encode(batch), batch) == [encode(s) for s in batch.samples]
+
+
+def test_a_batch_in_another_form_is_encoded_again() -> None:
+    batch = batch_of("st1", 3)
+    spaced = json.dumps(dataclasses.asdict(batch)).encode()  # ", " and ": " between items
+    as_dict = dataclasses.asdict(batch)
+    reordered = json.dumps(dict(reversed(as_dict.items())), separators=(",", ":")).encode()
+    for payload in (spaced, reordered):
+        assert decode(SampleBatch, payload) == batch
+        assert sample_texts(payload, batch) is None
+    samples = BatchSamples().samples(received_batch(spaced, batch))
+    assert [s.payload for s in samples] == [encode(s) for s in batch.samples]
+
+
+def test_a_batch_with_two_lists_of_samples_is_encoded_again() -> None:
+    """The decoder takes the last of two ``samples`` keys; a list of one sample before a
+    list of two has as many pieces between braces as there are samples, not the samples."""
+    first, *rest = batch_of("st1", 3).samples
+    one = encode(SampleBatch("st1", first.time_ns, [first]))
+    twice = one[:-1] + b',"samples":' + TypeAdapter(list[Sample]).dump_json(rest) + b"}"
+    batch = decode(SampleBatch, twice)
+    assert batch.samples == rest
+    assert sample_texts(twice, batch) is None
+
+
+def received_batch(payload: bytes, batch: SampleBatch) -> Received:
+    key = channels.SAMPLE_BATCHES.key(batch.station)
+    arrival_ns = batch.time_ns + MS_NS
+    return Received(
+        key,
+        batch.station,
+        channels.SAMPLE_BATCHES.schema_name,
+        batch,
+        payload,
+        arrival_ns,
+        batch.time_ns,
+    )
