@@ -58,7 +58,10 @@ Every channel is put with congestion control BLOCK: zenoh's default (DROP)
 lost events under load, silently, and loss is counted end to end. Samples
 and tool states share one priority, so a run's ``done`` never overtakes its
 samples; a decision is REAL_TIME. Samples, tool states and decisions are
-express (no batching in zenoh: latency counts).
+express (no batching in zenoh: latency counts). Sample batches are not: they
+are recorded, not decided on, and zenoh packs the batches of many stations
+into one frame toward the line's recorder (``bench_line.py`` at 50 stations:
+0.6 to 1.0 µs less of the recorder's CPU per sample, lag no worse).
 """
 
 from __future__ import annotations
@@ -149,7 +152,7 @@ class Channel(Generic[MessageT]):
 _BRIDGE = ("openprotocol",)
 
 SAMPLES = Channel("samples", Sample, "acquisition", Qos(express=True), _BRIDGE)
-SAMPLE_BATCHES = Channel("sample_batches", SampleBatch, "acquisition", Qos(express=True), _BRIDGE)
+SAMPLE_BATCHES = Channel("sample_batches", SampleBatch, "acquisition", Qos(), _BRIDGE)
 TOOL = Channel("tool", ToolState, "acquisition", Qos(express=True), _BRIDGE)
 BUS = Channel("bus", BusStats, "acquisition")
 EVENTS = Channel("events", StickSlipEvent, "predictor", also_by=_BRIDGE)
