@@ -38,6 +38,8 @@ LOG = logging.getLogger(__name__)
 
 #: opcode, record length, channel id, sequence, log time, publish time (MCAP spec, Message)
 _RECORD = struct.Struct("<BQHIQQ")
+#: bytes of a message record before its data
+RECORD_HEADER_BYTES = _RECORD.size
 _MESSAGE_OPCODE = 0x05
 _FIXED_BYTES = 2 + 4 + 8 + 8
 
@@ -91,18 +93,19 @@ class MessageAppender:
         self._statistics: Any = statistics
         self._finalize: Callable[[], None] = finalize if usable else _nothing
 
-    def add(self, channel_id: int, rows: Sequence[MessageRow]) -> None:
-        """Append ``rows`` in order; what ``add_message`` would write for each of them."""
+    def add(self, channel_id: int, rows: Sequence[MessageRow]) -> int:
+        """Append ``rows`` in order, what ``add_message`` would write for each of them; the
+        bytes of their data."""
         if not rows:
-            return
+            return 0
         chunk = self._chunk
         if chunk is None:
             for sequence, log_ns, publish_ns, data in rows:
                 self._writer.add_message(channel_id, log_ns, data, publish_ns, sequence)
-            return
+            return sum(len(row[3]) for row in rows)
         # the chunk's buffer is replaced at each chunk's end: looked up per batch
         buffer = chunk.record_writer._buffer
-        offset = buffer.tell()
+        offset = start = buffer.tell()
         pack = _RECORD.pack
         records: list[bytes] = []
         index: list[tuple[int, int]] = []
@@ -135,3 +138,4 @@ class MessageAppender:
         indices[channel_id].records.extend(index)
         chunk.num_messages += len(rows)
         self._finalize()
+        return offset - start - len(rows) * RECORD_HEADER_BYTES

@@ -7,12 +7,14 @@ channel (``decodable`` False), never silently on the schema'd one.
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 
-from services.recorder.live.incoming import OTHER_STATION, classify
+from services.recorder.live.incoming import MAX_AHEAD_S, OTHER_STATION, classify
 from shared import channels
 from shared.codec import encode, to_dict
-from shared.messages import RunSummary, Sample, StickSlipEvent, ToolState
+from shared.messages import RunSummary, Sample, SampleBatch, StickSlipEvent, ToolState
 
 T_NS = 1_700_000_000_000_000_000
 SAMPLE = Sample("st4", 9, 33, T_NS + 5, 80.0, 12.5, None)
@@ -61,3 +63,26 @@ def test_other_keys_are_raw() -> None:
     assert unknown_topic.station == "st4"
     outside = classify("elsewhere", b"{}", T_NS)
     assert outside.station == OTHER_STATION and outside.schema_name is None
+
+
+def test_a_batch_is_refused_for_its_first_bad_sample_named_by_index() -> None:
+    """A batch's samples are checked as samples that came alone; the first bad one refuses
+    the batch (kept raw) and is named in the problem."""
+    key = channels.SAMPLE_BATCHES.key("st4")
+    good = [dataclasses.replace(SAMPLE, sequence=n, time_ns=T_NS + n) for n in range(5)]
+    received = classify(key, encode(SampleBatch("st4", T_NS + 9, good)), T_NS + 99)
+    assert received.decodable and received.message.samples == good
+    ahead_ns = T_NS + 99 + (MAX_AHEAD_S + 1) * 1_000_000_000
+    bad_samples = {
+        "it names station 'st5', in a batch of its own": {"station": "st5"},
+        f"its time is {MAX_AHEAD_S + 1} s ahead of its arrival": {"time_ns": ahead_ns},
+        "torque_nm nan is outside the sensor's": {"torque_nm": math.nan},
+        "angle_deg 1e+300 is outside the sensor's": {"angle_deg": 1e300},
+        "force_n -1e+300 is outside the sensor's": {"force_n": -1e300},
+    }
+    for problem, change in bad_samples.items():
+        samples = [*good[:3], dataclasses.replace(good[3], **change), good[4]]
+        received = classify(key, encode(SampleBatch("st4", T_NS + 9, samples)), T_NS + 99)
+        assert received.message is None and not received.decodable
+        assert received.problem is not None
+        assert received.problem.startswith(f"samples[3]: {problem}"), received.problem
