@@ -51,6 +51,10 @@ DEFAULT_GRPC_PORT = 9876
 FILE_BATCH_SAMPLES = 2000
 #: samples per column batch with a live viewer: 0.25 s at 1 kHz
 LIVE_BATCH_SAMPLES = 250
+#: the longest a closing sink waits for Rerun to write what it was sent (milliseconds for a
+#: run's file): the recorder's shutdown never waits on Rerun for ever; past it the .rrd
+#: is said to have failed and the MCAP of the run stands
+CLOSE_FLUSH_TIMEOUT_S = 10.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -225,7 +229,7 @@ class RerunSink:
         try:
             if not self.failed:
                 self._send()
-                self._stream.flush()
+                self._stream.flush(timeout_sec=CLOSE_FLUSH_TIMEOUT_S)  # raises past it
             self._stream.disconnect()  # finishes the file
         except Exception:
             self._fail("close")
