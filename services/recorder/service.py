@@ -64,7 +64,6 @@ from shared.config import LoadedStation, load_line
 from shared.errors import ConfigError
 from shared.message_fields import MAX_TEXT_CHARS
 from shared.messages import QualityAlert, RecorderStats, WearAlert
-from shared.receive_threads import use_one_receive_thread
 from shared.service_skeleton import ServiceSkeleton, Stop
 
 if TYPE_CHECKING:
@@ -376,9 +375,6 @@ def start_foxglove(args: argparse.Namespace, station_ids: Sequence[str]) -> Foxg
 
 
 def main(args: argparse.Namespace) -> int:
-    # One receive thread: callbacks never pass the GIL between two receive threads
-    # (measured with bench_line.py, figures in the README).
-    use_one_receive_thread()
     loaded = load_line(args.config)  # serve recorder: one or more files, always a list
     served_stations(loaded)  # bad combinations fail before zenoh is opened
     loaded[0].make_recordings_folder()  # and a folder that can never be made
