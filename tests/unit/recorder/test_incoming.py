@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from typing import Any
 
 from services.recorder.live.incoming import MAX_AHEAD_S, OTHER_STATION, classify
 from shared import channels
@@ -73,7 +74,7 @@ def test_a_batch_is_refused_for_its_first_bad_sample_named_by_index() -> None:
     received = classify(key, encode(SampleBatch("st4", T_NS + 9, good)), T_NS + 99)
     assert received.decodable and received.message.samples == good
     ahead_ns = T_NS + 99 + (MAX_AHEAD_S + 1) * 1_000_000_000
-    bad_samples = {
+    bad_samples: dict[str, dict[str, Any]] = {
         "it names station 'st5', in a batch of its own": {"station": "st5"},
         f"its time is {MAX_AHEAD_S + 1} s ahead of its arrival": {"time_ns": ahead_ns},
         "torque_nm nan is outside the sensor's": {"torque_nm": math.nan},
