@@ -6,11 +6,11 @@ every 10 ms: :mod:`shared.sample_batching`). The MCAP files stay as they were
 when each sample was a message of its own, so a Foxglove plot or a reader of
 the files sees no difference: each sample is one :class:`Received` on
 ``boltwatch/<st>/samples`` with the ``boltwatch.Sample`` schema, its own JSON
-as payload (:func:`shared.codec.encode`), ``publish_time`` its ``time_ns`` and
-``sequence`` its ``sequence``. The JSON of each sample is the station's own,
-cut out of the batch's payload when the batch is in the station publisher's
-compact form (:func:`sample_texts`; as a sample that came alone is recorded
-byte for byte), encoded again otherwise.
+as payload, ``publish_time`` its ``time_ns`` and ``sequence`` its ``sequence``.
+The JSON is the station's own, cut out of the batch's payload when the batch
+is in the form the station's publisher writes (:func:`sample_texts`; a sample
+that came alone is recorded byte for byte too), and encoded again
+(:func:`shared.codec.encode`) otherwise.
 
 ``log_time`` is the time the recorder received it. A batch arrives at once,
 so each sample's arrival is taken as the batch's arrival less how much older
