@@ -125,11 +125,8 @@ class StationFiles:
             self._run_started = (received.run_id, received.message.time_ns)
             self._resume = (received.run_id, 1)  # should the disk fail before the file opens
             self._start_run(received.run_id, now_ns)
-        elif self.current is None:
-            run_id, part = self._resume or (received.run_id, 1)
-            self._open(run_id, now_ns, part)
-        elif self._over_limits(now_ns):
-            self._continue(now_ns)
+        else:
+            self._open_or_continue(received.run_id, now_ns)
         assert self.current is not None
         sink = self.current
         run_id = received.run_id
@@ -147,8 +144,7 @@ class StationFiles:
             and received.message
         ):
             self._run_ended = received.message.state in _ENDED_STATES  # a refused one is raw
-        if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
-            self.flush(now_ns)
+        self._flush_if_due(now_ns)
 
     def write_samples(self, samples: Sequence[Received]) -> None:
         """A batch's decoded Samples, in order: :meth:`write`'s checks once for the batch
@@ -156,11 +152,7 @@ class StationFiles:
         if not samples:
             return
         now_ns = samples[-1].log_time_ns
-        if self.current is None:
-            run_id, part = self._resume or (samples[0].run_id, 1)
-            self._open(run_id, now_ns, part)
-        elif self._over_limits(now_ns):
-            self._continue(now_ns)
+        self._open_or_continue(samples[0].run_id, now_ns)
         assert self.current is not None
         groups: list[tuple[McapSink, Sequence[Received]]] = [(self.current, samples)]
         previous = self.previous
@@ -175,13 +167,24 @@ class StationFiles:
             companion = self._rerun_sinks.get(sink)
             if companion is not None:
                 companion.write_samples(group)
+        self._flush_if_due(now_ns)
+
+    def _open_or_continue(self, run_id: int | None, now_ns: int) -> None:
+        """A file to write a message of ``run_id`` into (not a run's start): opened when there
+        is none (the resumed run's after a fault), continued in a next part past the limits."""
+        if self.current is None:
+            resumed_run_id, part = self._resume or (run_id, 1)
+            self._open(resumed_run_id, now_ns, part)
+        elif self._over_limits(now_ns):
+            self._continue(now_ns)
+
+    def _flush_if_due(self, now_ns: int) -> None:
         if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
             self.flush(now_ns)
 
     def tick(self, now_ns: int) -> None:
         """Flush when the flush interval has passed; close the previous file after its grace."""
-        if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
-            self.flush(now_ns)
+        self._flush_if_due(now_ns)
         if self.previous is not None and now_ns >= self._previous_until_ns:
             self._close(self.previous)
             self.previous = None

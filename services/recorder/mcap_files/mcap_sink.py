@@ -37,7 +37,11 @@ from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 
 from services.recorder.live.incoming import Received
-from services.recorder.mcap_files.mcap_messages import RECORD_HEADER_BYTES, MessageAppender
+from services.recorder.mcap_files.mcap_messages import (
+    RECORD_HEADER_BYTES,
+    MessageAppender,
+    MessageRow,
+)
 from services.recorder.mcap_files.recording_reader import RecordingScan
 from shared import channels
 from shared.codec import json_schema
@@ -118,10 +122,7 @@ class McapSink:
             sequence = self._counters.get(channel_id, 0)
             self._counters[channel_id] = sequence + 1
         row = (sequence & 0xFFFFFFFF, received.log_time_ns, received.publish_time_ns)
-        data_bytes = self._messages.add(channel_id, [(*row, received.payload)])  # uint32 sequence
-        self.messages += 1
-        self._unflushed_bytes += data_bytes + RECORD_HEADER_BYTES
-        self.last_write_ns = received.log_time_ns
+        self._append(channel_id, [(*row, received.payload)])  # MCAP sequence is uint32
         run_id = received.run_id
         if run_id is not None:
             self.run_ids.add(run_id)
@@ -135,11 +136,15 @@ class McapSink:
             (s.message.sequence & 0xFFFFFFFF, s.log_time_ns, s.publish_time_ns, s.payload)
             for s in samples
         ]
+        self._append(channel_id, rows)
+        self.run_ids.update({s.message.run_id for s in samples})
+
+    def _append(self, channel_id: int, rows: list[MessageRow]) -> None:
+        """Write ``rows`` on the channel and count them (messages, bytes not yet flushed)."""
         data_bytes = self._messages.add(channel_id, rows)
         self.messages += len(rows)
         self._unflushed_bytes += data_bytes + RECORD_HEADER_BYTES * len(rows)
         self.last_write_ns = rows[-1][1]
-        self.run_ids.update({s.message.run_id for s in samples})
 
     @property
     def unflushed_messages(self) -> int:
