@@ -116,7 +116,9 @@ class StationPayloads:
         texts = sample_texts(station, rows)
         self.samples = texts
         self.batches = [
-            f'{{"station":"{station}","time_ns":%d,"samples":[' + ",".join(texts[i : i + 10]) + "]}"
+            f'{{"station":"{station}","time_ns":%d,"samples":['
+            + ",".join(texts[i : i + BATCH_SAMPLES])
+            + "]}"
             for i in range(0, len(texts), BATCH_SAMPLES)
         ]
         made = {t: template(t, station, now_ns, RUN_MARK) for t in ("events", "intensity")}
@@ -131,6 +133,10 @@ class StationPayloads:
         self.decision = run_templated(template("decision", station, now_ns, RUN_MARK)).encode()
         self.summary = run_templated(summary).encode()
         self.predictor = encode(template("predictor", station, now_ns))
+
+    def batch(self, index: int, run_id: int, newest_ns: int) -> bytes:
+        """The run's ``index``-th batch, its newest sample at ``newest_ns``, 1 ms apart."""
+        return (self.batches[index] % (newest_ns, *batch_ids(run_id, newest_ns))).encode()
 
     def tool(self, run_id: int, state: str, now_ns: int) -> bytes:
         return (
@@ -195,15 +201,8 @@ def generate(endpoint: str, station_ids: list[str], seconds: float, per_sample: 
                         station.put[channels.SAMPLES.topic](station.samples[n] % (run_id, now_ns))
                         station.published += 1
                     elif n % BATCH_SAMPLES == BATCH_SAMPLES - 1:
-                        first = n - BATCH_SAMPLES + 1
-                        times = [
-                            x
-                            for k in range(BATCH_SAMPLES)
-                            for x in (run_id, now_ns - (9 - k) * 1_000_000)
-                        ]
-                        station.put[channels.SAMPLE_BATCHES.topic](
-                            station.batches[first // BATCH_SAMPLES] % (now_ns, *times)
-                        )
+                        batch = station.batch(n // BATCH_SAMPLES, run_id, now_ns)
+                        station.put[channels.SAMPLE_BATCHES.topic](batch)
                         station.published += BATCH_SAMPLES
                     if n % EVENT_EVERY_TICKS == 0:
                         station.put[channels.EVENTS.topic](station.events % run_id)

@@ -72,9 +72,8 @@ def line_load(
                         (key[channels.TOOL.topic], station.tool(run_id, "running", now_ns))
                     )
                 if n < RUN_SAMPLES and n % BATCH_SAMPLES == BATCH_SAMPLES - 1:
-                    times = [x for k in range(10) for x in (run_id, now_ns - (9 - k) * 1_000_000)]
-                    batch = station.batches[n // BATCH_SAMPLES] % (now_ns, *times)
-                    pending.append((key[channels.SAMPLE_BATCHES.topic], batch.encode()))
+                    batch = station.batch(n // BATCH_SAMPLES, run_id, now_ns)
+                    pending.append((key[channels.SAMPLE_BATCHES.topic], batch))
                 if n < RUN_SAMPLES and n % EVENT_EVERY_TICKS == 0:
                     pending.append((key[channels.EVENTS.topic], station.events % run_id))
                     pending.append((key[channels.INTENSITY.topic], station.intensity % run_id))
