@@ -56,7 +56,7 @@ from services.cli.station_supervisor import stop_process  # noqa: E402
 from shared import channels, keys  # noqa: E402
 from shared.can_database import StationDatabase  # noqa: E402
 from shared.codec import decode, encode  # noqa: E402
-from shared.config import derive_stations, load_station  # noqa: E402
+from shared.config import LoadedStation, derive_stations, load_station  # noqa: E402
 from shared.messages import BusStats, RecorderStats  # noqa: E402
 from shared.zenoh_session import zenoh_config  # noqa: E402
 from tests.benchmarks.bench_stop_path import serve_from  # noqa: E402
@@ -111,8 +111,11 @@ class StationPayloads:
     """What one synthetic edge station publishes, pre-encoded: ``%d`` stands for the run
     id (and, in a batch, its time and each sample's run id and time)."""
 
-    def __init__(self, station: str, rows: list[tuple[float, float, float]], now_ns: int) -> None:
+    def __init__(
+        self, station: str, tool_id: int, rows: list[tuple[float, float, float]], now_ns: int
+    ) -> None:
         self.station = station
+        self.tool_id = tool_id
         texts = sample_texts(station, rows)
         self.samples = texts
         self.batches = [
@@ -124,6 +127,7 @@ class StationPayloads:
         made = {t: template(t, station, now_ns, RUN_MARK) for t in ("events", "intensity")}
         summary = dataclasses.replace(
             template("runs", station, now_ns, RUN_MARK),
+            tool_id=tool_id,
             process_intensity=1.5,
             events=3,
             samples=1000,
@@ -140,7 +144,7 @@ class StationPayloads:
 
     def tool(self, run_id: int, state: str, now_ns: int) -> bytes:
         return (
-            f'{{"station":"{self.station}","run_id":{run_id},"tool_id":1,"program_id":1,'
+            f'{{"station":"{self.station}","run_id":{run_id},"tool_id":{self.tool_id},"program_id":1,'
             f'"state":"{state}","time_ns":{now_ns}}}'
         ).encode()
 
@@ -148,11 +152,13 @@ class StationPayloads:
 class Station(StationPayloads):
     """One synthetic edge station's publishers and pre-encoded messages."""
 
-    def __init__(self, session: zenoh.Session, station: str, rows: list, per_sample: bool) -> None:
+    def __init__(
+        self, session: zenoh.Session, station: LoadedStation, rows: list, per_sample: bool
+    ) -> None:
         now = time.time_ns()
-        super().__init__(station, rows, now)
+        super().__init__(station.station_id, station.config.station.tool_id, rows, now)
         self.put = {  # as the station's publisher: each channel's options (BLOCK: never lossy)
-            channel.topic: channel.declare_publisher(session, station).put
+            channel.topic: channel.declare_publisher(session, self.station).put
             for channel in STATION_CHANNELS
         }
         self.per_sample = per_sample
@@ -175,15 +181,17 @@ def batch_ids(run_id: int, newest_ns: int) -> list[int]:
     return ids
 
 
-def generate(endpoint: str, station_ids: list[str], seconds: float, per_sample: bool) -> int:
-    """Publish the stations' runs for ``seconds`` or until SIGTERM (the run in progress is
-    finished first), then each station's last BusStats."""
+def generate(endpoint: str, station_files: list[str], seconds: float, per_sample: bool) -> int:
+    """Publish the runs of the stations of ``station_files`` (each its id and tool) for
+    ``seconds`` or until SIGTERM (the run in progress is finished first), then each station's
+    last BusStats."""
     stopped = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stopped.set())
     rows = run_rows()
     behind = 0
     with zenoh.open(zenoh_config("client", [endpoint])) as session:
-        stations = [Station(session, s, rows, per_sample) for s in station_ids]
+        loaded = [load_station(Path(file)) for file in station_files]
+        stations = [Station(session, station, rows, per_sample) for station in loaded]
         time.sleep(1.0)  # the router learns the subscribers
         end = time.monotonic() + seconds
         run_id = int(time.time()) * 1000
@@ -317,7 +325,7 @@ def bench(
                 generator = subprocess.Popen(
                     [sys.executable, __file__, "--generate", endpoint, "--seconds", "3600"]
                     + (["--per-sample"] if per_sample else [])
-                    + synthetic,
+                    + files[1:],
                     cwd=REPO,
                     stdout=out,
                     stderr=subprocess.STDOUT,
@@ -404,10 +412,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--keep", type=Path, default=None, help="keep files and logs here")
     parser.add_argument("--generate", default=None, help=argparse.SUPPRESS)
     parser.add_argument("--seconds", type=float, default=0.0, help=argparse.SUPPRESS)
-    parser.add_argument("ids", nargs="*", help=argparse.SUPPRESS)
+    parser.add_argument("files", nargs="*", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.generate:
-        return generate(args.generate, args.ids, args.seconds, args.per_sample)
+        return generate(args.generate, args.files, args.seconds, args.per_sample)
     failed = False
     for count in args.stations:
         with tempfile.TemporaryDirectory(prefix=f"bench-line-{count}-") as tmp:

@@ -231,7 +231,7 @@ def one_run(
                     endpoint,
                     "--seconds",
                     str(seconds),
-                    *ids,
+                    *map(str, paths),
                 ],
                 cwd=REPO,
                 stdout=(folder / "generator.log").open("wb"),

@@ -93,7 +93,10 @@ def bench(count: int, seconds: float, rerun: bool, profile: int) -> None:
         paths = derive_stations(write_station(tmp, zenoh_mode="peer"), count, tmp / "stations")
         loaded = [load_station(path) for path in paths]
         t0_ns = time.time_ns()
-        stations = [StationPayloads(station.station_id, rows, t0_ns) for station in loaded]
+        stations = [
+            StationPayloads(station.station_id, station.config.station.tool_id, rows, t0_ns)
+            for station in loaded
+        ]
         load = list(line_load(stations, seconds, t0_ns))  # encoded before the clock starts
         samples = sum(p.count(b'"torque_nm"') for _now, batch in load for _k, p in batch)
         with ServiceSkeleton("recorder", zenoh.open(zenoh_config("peer", []))) as skeleton:

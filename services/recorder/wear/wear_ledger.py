@@ -48,6 +48,7 @@ from services.recorder.wear.wear_ledger_file import (
     migrate,
     schema_problem,
 )
+from services.recorder.wear.wear_since_service import ServiceInterval, SinceServiceTally
 from services.recorder.wear.wear_tool_data import ControllerTool
 from shared.errors import InputError
 from shared.messages import RunSummary, ToolData
@@ -164,6 +165,7 @@ class WearLedger:
                 raise BrokenLedgerError(self.path, str(err)) from err
             raise InputError(f"{self.path}: not a usable wear ledger: {err}") from err
         self._db = db
+        self._since_service = SinceServiceTally()
 
     def _migrate(self, db: sqlite3.Connection) -> None:
         was = migrate(db, _SCHEMA)
@@ -230,6 +232,13 @@ class WearLedger:
                 ),
             )
         return cursor.rowcount == 1
+
+    def since_service(self, tool_id: int) -> ServiceInterval:
+        """The tool's runs and intensity since its last service, without reading its whole
+        interval each time (:mod:`.wear_since_service`)."""
+        with self._reading_the_file(), self._db:
+            self._db.execute("BEGIN")
+            return self._since_service.interval(self._db, tool_id)
 
     def add_tool_data(self, data: ToolData, recorded_ns: int) -> bool:
         """Keep what a controller said of a tool; False when a newer one is kept already."""

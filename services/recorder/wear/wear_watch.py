@@ -44,7 +44,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from services.recorder.wear.wear_bound import RefusedSummaryError, RunLimits, refusal
-from services.recorder.wear.wear_ledger import ToolWear, WearLedger
+from services.recorder.wear.wear_ledger import WearLedger
 from services.recorder.wear.wear_ledger_file import BrokenLedgerError
 from services.recorder.wear.wear_waiting import load_waiting, save_waiting, waiting_path
 from shared.errors import InputError
@@ -108,12 +108,12 @@ class WearWatch:
         """Summaries waiting in memory for the ledger."""
         return len(self._pending)
 
-    def on_summary(self, summary: RunSummary, now_ns: int) -> ToolWear | None:
-        """Count the run (once); the tool's new line, or None (repeated, refused, waiting)."""
+    def on_summary(self, summary: RunSummary, now_ns: int) -> bool:
+        """Count the run (once); False when it is not counted now (repeated, refused, waiting)."""
         reason = refusal(summary, self._limits(summary))
         if reason is not None:
             self._refuse(RefusedSummaryError(summary, reason), now_ns)
-            return None
+            return False
         if len(self._pending) == PENDING_LIMIT:
             LOG.error("wear ledger: %d summaries waiting, dropping the oldest", PENDING_LIMIT)
         self._pending.append((summary, now_ns))
@@ -145,17 +145,19 @@ class WearWatch:
                 self.last_ledger_error,
             )
 
-    def _write(self, now_ns: int, count_errors: bool) -> ToolWear | None:
-        """Open and check the ledger, then count every waiting summary, oldest first."""
-        wear = None
+    def _write(self, now_ns: int, count_errors: bool) -> bool:
+        """Open and check the ledger, then count every waiting summary, oldest first; whether
+        the newest was counted now."""
+        counted = False
         try:
             ledger = self._open()
             while self._pending:
                 summary, received_ns = self._pending[0]
                 try:
-                    wear = self._count(ledger, summary, received_ns)
+                    counted = self._count(ledger, summary, received_ns)
                 except RefusedSummaryError as err:  # its limits changed while it waited
                     self._refuse(err, now_ns)
+                    counted = False
                 self._pending.popleft()
             while self._tool_data:
                 key, (data, received_ns) = next(iter(self._tool_data.items()))
@@ -165,10 +167,10 @@ class WearWatch:
                 self._waiting_file.unlink()
         except BrokenLedgerError as err:
             self._failed(err, now_ns, count_errors, broken=True)
-            return None
+            return False
         except (InputError, sqlite3.Error, OSError) as err:
             self._failed(err, now_ns, count_errors, broken=False)
-            return None
+            return False
         if self.last_ledger_error is not None:
             LOG.info(
                 "wear ledger %s works again after %.0f s; every waiting run counted",
@@ -177,7 +179,7 @@ class WearWatch:
             )
             self.last_ledger_error = None
             self.broken = False
-        return wear
+        return counted
 
     def _open(self) -> WearLedger:
         """The open ledger, checked: reopened when its file changed under it."""
@@ -249,40 +251,40 @@ class WearWatch:
         self._refusals_not_logged = 0
         LOG.warning("%s%s", err, f" ({more} more refused since the last such line)" if more else "")
 
-    def _count(self, ledger: WearLedger, summary: RunSummary, now_ns: int) -> ToolWear | None:
+    def _count(self, ledger: WearLedger, summary: RunSummary, now_ns: int) -> bool:
         if not ledger.add_run(summary, now_ns, self._limits(summary)):
             self.repeated += 1
             LOG.debug("run %s/%d already in the ledger", summary.station, summary.run_id)
-            return None
+            return False
         self.counted += 1
-        wear = ledger.tool(summary.tool_id)
         if self._threshold is None:
-            return wear
-        if wear.intensity_since_service >= self._threshold:
-            if wear.tool_id not in self._due:
+            return True
+        interval = ledger.since_service(summary.tool_id)
+        if interval.intensity >= self._threshold:
+            if interval.tool_id not in self._due:
                 LOG.warning(
                     "tool %d is due for service: intensity %.3g since last service "
                     "(threshold %.3g, %d runs)",
-                    wear.tool_id,
-                    wear.intensity_since_service,
+                    interval.tool_id,
+                    interval.intensity,
                     self._threshold,
-                    wear.runs_since_service,
+                    interval.runs,
                 )
-                self._due.add(wear.tool_id)
+                self._due.add(interval.tool_id)
             self._alert(
                 WearAlert(
                     station=summary.station,
-                    tool_id=wear.tool_id,
+                    tool_id=interval.tool_id,
                     time_ns=now_ns,
-                    intensity_since_service=wear.intensity_since_service,
+                    intensity_since_service=interval.intensity,
                     threshold=self._threshold,
-                    runs_since_service=wear.runs_since_service,
-                    last_service_ns=wear.last_service_ns,
+                    runs_since_service=interval.runs,
+                    last_service_ns=interval.last_service_ns,
                 )
             )
         else:
-            self._due.discard(wear.tool_id)
-        return wear
+            self._due.discard(interval.tool_id)
+        return True
 
     def close(self) -> None:
         """Close the ledger; runs still waiting are kept on disk for the next recorder."""
