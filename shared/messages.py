@@ -92,16 +92,20 @@ class Sample:
 
 @dataclass(frozen=True, slots=True)
 class SampleBatch:
-    """A station's samples of the last few milliseconds, in order: what the line records.
+    """A station's samples of the last few milliseconds, in order, with the events found in
+    them: what the line records of an edge station.
 
     The acquisition of an edge station sends its samples toward the line in
     batches (:data:`shared.channels.SAMPLE_BATCHES`, one every
     :data:`shared.sample_batching.BATCH_PERIOD_S` at most, at most
     :data:`shared.sample_batching.MAX_BATCH_SAMPLES` samples, never two runs): one
-    zenoh message per batch instead of one per sample. Every sample names the
-    batch's station. The recorder writes each sample as its own MCAP message on
-    ``boltwatch/<station>/samples``, as if it had come alone. Bounded by the
-    payload's size (64 KiB: about 400 samples).
+    zenoh message per batch instead of one per sample. The stick-slip events its
+    predictor found while the batch was in progress, and their intensities, ride
+    in it after the samples (an event found when no batch is in progress goes
+    alone on ``events``). Every message in it names the batch's station. The
+    recorder writes each sample, event and intensity as its own MCAP message on
+    ``boltwatch/<station>/samples``, ``events`` and ``intensity``, as if it had
+    come alone. Bounded by the payload's size (64 KiB: about 400 samples).
     """
 
     __pydantic_config__ = WIRE_CONFIG
@@ -109,6 +113,8 @@ class SampleBatch:
     station: StationId
     time_ns: TimeNs  # when the station's publisher sent it
     samples: list[Sample]
+    events: list[StickSlipEvent] = field(default_factory=list)  # found in these samples
+    intensities: list[Intensity] = field(default_factory=list)  # one per event, in order
 
 
 @dataclass(frozen=True, slots=True)

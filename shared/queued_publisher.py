@@ -18,9 +18,10 @@ Each channel gets its publisher once, with its options (:mod:`shared.channels`).
 With ``batch_samples`` (an edge station: nobody on the line decides on its
 samples), samples go out in batches on ``sample_batches`` instead
 (:mod:`shared.sample_batching`): the thread keeps the batch in progress,
-publishes it when due and before any other message, so the order above
-holds for batches too. Each sample goes toward the line once, on one of the
-two channels.
+puts the events and intensities the predictor finds into it, and publishes it
+when due and before any other message, so the order above holds for batches
+too. Each sample, event and intensity goes toward the line once, alone or in
+a batch.
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ import zenoh
 
 from shared import channels
 from shared.codec import encode
-from shared.messages import Sample
+from shared.messages import Intensity, Sample, StickSlipEvent
 from shared.sample_batching import SampleBatching
 
 LOG = logging.getLogger(__name__)
@@ -44,6 +45,8 @@ LOG = logging.getLogger(__name__)
 CAPACITY = 50_000
 
 _STOP = object()
+#: what rides in the batch in progress (:meth:`SampleBatching.add_found`)
+_FOUND = (StickSlipEvent, Intensity)
 
 
 class QueuedPublisher:
@@ -100,9 +103,12 @@ class QueuedPublisher:
                 self._send_batch()
                 continue
             if batching is not None:
-                if type(item) is tuple and type(item[1]) is Sample:
-                    for batch in batching.add(item[1], time.monotonic()):
+                message = item[1] if type(item) is tuple else None
+                if type(message) is Sample:
+                    for batch in batching.add(message, time.monotonic()):
                         self._put(channels.SAMPLE_BATCHES, batch)
+                    continue
+                if isinstance(message, _FOUND) and batching.add_found(message):
                     continue
                 self._send_batch()  # nothing overtakes the samples queued before it
             if item is _STOP:

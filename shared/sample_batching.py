@@ -9,9 +9,14 @@ samples into a :class:`~shared.messages.SampleBatch` and publishes it on
 :data:`shared.channels.SAMPLE_BATCHES` when the oldest sample in it is
 :data:`BATCH_PERIOD_S` old, when it holds :data:`MAX_BATCH_SAMPLES`, when a
 sample of another run comes, and before anything else the station publishes
-(a run's ``done``, its bus counters, the predictor's events and decisions), so
-the order of everything a station publishes is kept: a batch never overtakes
-the tool state before it, an event never overtakes the samples it was found in.
+(a run's ``done``, its bus counters, the predictor's decisions), so the order
+of everything a station publishes is kept: a batch never overtakes the tool
+state before it. The stick-slip events the predictor finds, and their
+intensities, go into the batch in progress, after the samples they were found
+in (:meth:`SampleBatching.add_found`): at 40 events a second a station would
+otherwise send a batch, an event and an intensity for each, three messages
+where one does. An event with no batch of its run in progress (the batch was
+just sent) goes alone, after it: never before its samples either way.
 
 Clock: ``now_s`` is :func:`time.monotonic` of the publisher thread.
 """
@@ -20,7 +25,7 @@ from __future__ import annotations
 
 import time
 
-from shared.messages import Sample, SampleBatch
+from shared.messages import Intensity, Sample, SampleBatch, StickSlipEvent
 
 #: the longest a sample waits for its batch, seconds (100 batches a second at 1 kHz)
 BATCH_PERIOD_S = 0.010
@@ -41,6 +46,8 @@ class SampleBatching:
         self._period_s = period_s
         self._max_samples = max_samples
         self._samples: list[Sample] = []
+        self._events: list[StickSlipEvent] = []
+        self._intensities: list[Intensity] = []
         self._due_s = 0.0  # when the batch in progress must go (monotonic seconds)
 
     def add(self, sample: Sample, now_s: float) -> list[SampleBatch]:
@@ -58,6 +65,18 @@ class SampleBatching:
             ready.append(self._take())
         return ready
 
+    def add_found(self, message: StickSlipEvent | Intensity) -> bool:
+        """Put an event or its intensity into the batch in progress, after its samples; False
+        when no batch of its run is in progress (it goes alone)."""
+        samples = self._samples
+        if not samples or samples[-1].run_id != message.run_id:
+            return False
+        if isinstance(message, StickSlipEvent):
+            self._events.append(message)
+        else:
+            self._intensities.append(message)
+        return True
+
     def take(self) -> SampleBatch | None:
         """The batch in progress (None when no sample waits); the next one starts empty."""
         return self._take() if self._samples else None
@@ -69,6 +88,8 @@ class SampleBatching:
         return max(0.0, self._due_s - now_s)
 
     def _take(self) -> SampleBatch:
-        batch = SampleBatch(self._station, time.time_ns(), self._samples)
-        self._samples = []
+        batch = SampleBatch(
+            self._station, time.time_ns(), self._samples, self._events, self._intensities
+        )
+        self._samples, self._events, self._intensities = [], [], []
         return batch

@@ -231,6 +231,11 @@ class RecorderService:
         if received.schema_name == _BATCH and received.message is not None:
             self._file_batch(received, filed_ns)
             return
+        self._file_one(received, filed_ns)
+
+    def _file_one(self, received: Received, filed_ns: int) -> None:
+        """File one message (a batch's event too) into its run's file and its counts."""
+        now_ns = received.log_time_ns
         self.recorder.write(received)
         if self.foxglove is not None:
             self.foxglove.log(received)
@@ -256,8 +261,9 @@ class RecorderService:
                 self.wear.on_tool_data(received.message, now_ns)
 
     def _file_batch(self, batch: Received, filed_ns: int) -> None:
-        """Each sample of a batch, as a sample that came alone (a refused batch is filed raw
-        by :meth:`_handle`: its samples are not received, so they count as missing)."""
+        """Each sample of a batch, then its events and intensities, as if each had come alone
+        (a refused batch is filed raw by :meth:`_handle`: its samples are not received, so
+        they count as missing)."""
         samples = self._batches.samples(batch)
         self.recorder.write_samples(batch.station, samples)
         times_ns = [sample.publish_time_ns for sample in samples]
@@ -265,6 +271,8 @@ class RecorderService:
         if self.foxglove is not None:
             for sample in samples:
                 self.foxglove.log(sample)
+        for found in self._batches.found(batch):
+            self._file_one(found, filed_ns)
 
     def _publish_stats(self, now_ns: int) -> None:
         """Put each station's RecorderStats for everyone but this recorder (not recorded)."""

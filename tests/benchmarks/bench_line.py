@@ -13,8 +13,9 @@ udp_multicast CAN bus; the stop path is measured as in ``bench_stop_path.py``
 The N other stations are one generator process publishing exactly what an edge
 station publishes toward the line, at its rates, pre-encoded so the generator
 stays cheap: a ``SampleBatch`` of 10 samples every 10 ms (1 s runs, 0.2 s
-apart), ``ToolState`` running/done around each run, a stick-slip event and its
-intensity every 25 ms, a decision and a summary per run, ``BusStats`` (with
+apart) with the stick-slip events (one every 25 ms) and their intensities
+found in it, ``ToolState`` running/done around each run, a decision and a
+summary per run, ``BusStats`` (with
 its count of published samples: the recorder's loss count) and
 ``PredictorStats`` once a second. ``--per-sample`` publishes each sample as its
 own message instead (the wire before batches; with ``--repo`` a checkout of
@@ -121,7 +122,7 @@ class StationPayloads:
         self.batches = [
             f'{{"station":"{station}","time_ns":%d,"samples":['
             + ",".join(texts[i : i + BATCH_SAMPLES])
-            + "]}"
+            + "]"
             for i in range(0, len(texts), BATCH_SAMPLES)
         ]
         made = {t: template(t, station, now_ns, RUN_MARK) for t in ("events", "intensity")}
@@ -132,15 +133,21 @@ class StationPayloads:
             events=3,
             samples=1000,
         )
-        self.events = run_templated(made["events"]).encode()
-        self.intensity = run_templated(made["intensity"]).encode()
+        self.events = run_templated(made["events"])
+        self.intensity = run_templated(made["intensity"])
         self.decision = run_templated(template("decision", station, now_ns, RUN_MARK)).encode()
         self.summary = run_templated(summary).encode()
         self.predictor = encode(template("predictor", station, now_ns))
 
-    def batch(self, index: int, run_id: int, newest_ns: int) -> bytes:
-        """The run's ``index``-th batch, its newest sample at ``newest_ns``, 1 ms apart."""
-        return (self.batches[index] % (newest_ns, *batch_ids(run_id, newest_ns))).encode()
+    def batch(self, index: int, run_id: int, newest_ns: int, events: int = 0) -> bytes:
+        """The run's ``index``-th batch, its newest sample at ``newest_ns``, 1 ms apart, with
+        ``events`` stick-slip events and their intensities found in it."""
+        samples = self.batches[index] % (newest_ns, *batch_ids(run_id, newest_ns))
+        found = (
+            f',"events":[{",".join([self.events % run_id] * events)}],'
+            f'"intensities":[{",".join([self.intensity % run_id] * events)}]}}'
+        )
+        return (samples + found).encode()
 
     def tool(self, run_id: int, state: str, now_ns: int) -> bytes:
         return (
@@ -171,6 +178,15 @@ class Station(StationPayloads):
     def bus(self, now_ns: int) -> None:
         stats = BusStats(self.station, now_ns, 0, self.published, *[0] * 11)
         self.put[channels.BUS.topic](encode(dataclasses.replace(stats, started_ns=self.started_ns)))
+
+
+def events_in(newest: int) -> int:
+    """Events found in the batch whose newest sample is the run's ``newest``-th: an event every
+    :data:`EVENT_EVERY_TICKS` samples, each riding in the batch in progress (as an edge
+    station's publisher puts them, :mod:`shared.sample_batching`)."""
+    return sum(
+        1 for n in range(newest - BATCH_SAMPLES + 1, newest + 1) if n % EVENT_EVERY_TICKS == 0
+    )
 
 
 def batch_ids(run_id: int, newest_ns: int) -> list[int]:
@@ -208,13 +224,14 @@ def generate(endpoint: str, station_files: list[str], seconds: float, per_sample
                     if per_sample:
                         station.put[channels.SAMPLES.topic](station.samples[n] % (run_id, now_ns))
                         station.published += 1
+                        if n % EVENT_EVERY_TICKS == 0:  # alone, as a line-placed station
+                            station.put[channels.EVENTS.topic]((station.events % run_id).encode())
+                            intensity = (station.intensity % run_id).encode()
+                            station.put[channels.INTENSITY.topic](intensity)
                     elif n % BATCH_SAMPLES == BATCH_SAMPLES - 1:
-                        batch = station.batch(n // BATCH_SAMPLES, run_id, now_ns)
+                        batch = station.batch(n // BATCH_SAMPLES, run_id, now_ns, events_in(n))
                         station.put[channels.SAMPLE_BATCHES.topic](batch)
                         station.published += BATCH_SAMPLES
-                    if n % EVENT_EVERY_TICKS == 0:
-                        station.put[channels.EVENTS.topic](station.events % run_id)
-                        station.put[channels.INTENSITY.topic](station.intensity % run_id)
                     if tick % 1000 == 0:
                         station.bus(now_ns)
                         station.put[channels.PREDICTOR.topic](station.predictor)

@@ -9,8 +9,9 @@ Run on demand (not collected by pytest)::
 A real :class:`~services.recorder.service.RecorderService` (its zenoh session
 peer-only, listening on nothing) is handed, every simulated 5 ms, what N edge
 stations publish toward the line in that time (``bench_line.py``'s generator:
-a ``SampleBatch`` every 10 ms, 1 s runs 0.2 s apart, an event and its
-intensity every 25 ms, tool states, a decision and a summary per run, bus and
+a ``SampleBatch`` every 10 ms with the events, one every 25 ms, and their
+intensities found in it, 1 s runs 0.2 s apart, tool states, a decision and a
+summary per run, bus and
 predictor statistics every second), stamped with a simulated clock, and ticks
 as its worker does (flush every half flush interval). No sleeping: the figure
 is CPU per sample (``time.process_time``: every thread of the process, Rerun's
@@ -42,10 +43,10 @@ from shared.service_skeleton import ServiceSkeleton  # noqa: E402
 from shared.zenoh_session import zenoh_config  # noqa: E402
 from tests.benchmarks.bench_line import (  # noqa: E402
     BATCH_SAMPLES,
-    EVENT_EVERY_TICKS,
     RUN_PAUSE_TICKS,
     RUN_SAMPLES,
     StationPayloads,
+    events_in,
     run_rows,
 )
 from tests.system.station_files import write_station  # noqa: E402
@@ -72,11 +73,8 @@ def line_load(
                         (key[channels.TOOL.topic], station.tool(run_id, "running", now_ns))
                     )
                 if n < RUN_SAMPLES and n % BATCH_SAMPLES == BATCH_SAMPLES - 1:
-                    batch = station.batch(n // BATCH_SAMPLES, run_id, now_ns)
+                    batch = station.batch(n // BATCH_SAMPLES, run_id, now_ns, events_in(n))
                     pending.append((key[channels.SAMPLE_BATCHES.topic], batch))
-                if n < RUN_SAMPLES and n % EVENT_EVERY_TICKS == 0:
-                    pending.append((key[channels.EVENTS.topic], station.events % run_id))
-                    pending.append((key[channels.INTENSITY.topic], station.intensity % run_id))
                 if n == RUN_SAMPLES:
                     pending.append((key[channels.TOOL.topic], station.tool(run_id, "done", now_ns)))
                     pending.append((key[channels.DECISION.topic], station.decision % run_id))

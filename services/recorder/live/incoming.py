@@ -23,14 +23,14 @@ at most 64) is filed under :data:`OTHER_STATION`, raw.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, NamedTuple
 
 from shared import channels, keys
 from shared.codec import decoder
 from shared.errors import InputError
 from shared.message_fields import STATION_ID
-from shared.messages import Sample, SampleBatch
+from shared.messages import Intensity, Sample, SampleBatch, StickSlipEvent
 from shared.sensor_range import CONTRACT_RANGE, SensorRange
 
 #: how far ahead of its arrival a message's own time may be: the clocks of two hosts of
@@ -152,8 +152,8 @@ _BATCH = channels.SAMPLE_BATCHES.schema_name
 
 
 def _check_batch(batch: SampleBatch, arrival_ns: int, sensors: SensorRange) -> None:
-    """Each sample of a batch as :func:`classify` checks a sample that came alone: one bad
-    sample refuses the batch (recorded raw, byte for byte, on its own channel)."""
+    """Each sample, event and intensity of a batch as :func:`classify` checks one that came
+    alone: one bad one refuses the batch (recorded raw, byte for byte, on its own channel)."""
     latest_ns = arrival_ns + _MAX_AHEAD_NS
     for index, sample in enumerate(batch.samples):
         try:
@@ -164,6 +164,19 @@ def _check_batch(batch: SampleBatch, arrival_ns: int, sensors: SensorRange) -> N
             _check_measured(sample, sensors)
         except InputError as err:
             raise InputError(f"samples[{index}]: {err}") from None
+    found: tuple[tuple[str, Sequence[StickSlipEvent | Intensity]], ...] = (
+        ("events", batch.events),
+        ("intensities", batch.intensities),
+    )
+    for name, messages in found:
+        for index, message in enumerate(messages):
+            if message.station != batch.station:
+                problem = f"it names station {message.station!r}, in a batch of its own"
+            elif not 0 <= message.time_ns <= latest_ns:
+                problem = _time_problem(message.time_ns, arrival_ns)
+            else:
+                continue
+            raise InputError(f"{name}[{index}]: {problem}")
 
 
 def _check_measured(sample: Sample, sensors: SensorRange) -> None:

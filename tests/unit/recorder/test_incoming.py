@@ -15,7 +15,14 @@ from typing import Any
 from services.recorder.live.incoming import MAX_AHEAD_S, OTHER_STATION, classify
 from shared import channels
 from shared.codec import encode, to_dict
-from shared.messages import RunSummary, Sample, SampleBatch, StickSlipEvent, ToolState
+from shared.messages import (
+    Intensity,
+    RunSummary,
+    Sample,
+    SampleBatch,
+    StickSlipEvent,
+    ToolState,
+)
 
 T_NS = 1_700_000_000_000_000_000
 SAMPLE = Sample("st4", 9, 33, T_NS + 5, 80.0, 12.5, None)
@@ -87,3 +94,28 @@ def test_a_batch_is_refused_for_its_first_bad_sample_named_by_index() -> None:
         assert received.message is None and not received.decodable
         assert received.problem is not None
         assert received.problem.startswith(f"samples[3]: {problem}"), received.problem
+
+
+def test_a_batch_is_refused_for_an_event_or_intensity_not_its_own_or_ahead() -> None:
+    """The events and intensities a batch carries are checked as those that came alone."""
+    key = channels.SAMPLE_BATCHES.key("st4")
+    samples = [dataclasses.replace(SAMPLE, sequence=n, time_ns=T_NS + n) for n in range(3)]
+    event = StickSlipEvent(
+        "st4", 9, 1, T_NS + 2, 0.002, 80.0, None, None, None, None, None, None, None, None,
+        None, 0.5, 0.5,
+    )  # fmt: skip
+    figures = Intensity("st4", 9, T_NS + 2, 0.5, 0.5)
+    good = SampleBatch("st4", T_NS + 9, samples, [event], [figures])
+    received = classify(key, encode(good), T_NS + 99)
+    assert received.decodable and received.message == good
+    ahead_ns = T_NS + 99 + (MAX_AHEAD_S + 1) * 1_000_000_000
+    bad = {
+        "events[0]: it names station 'st5'": dataclasses.replace(good, events=[
+            dataclasses.replace(event, station="st5")]),
+        f"intensities[0]: its time is {MAX_AHEAD_S + 1} s ahead": dataclasses.replace(
+            good, intensities=[dataclasses.replace(figures, time_ns=ahead_ns)]),
+    }  # fmt: skip
+    for problem, batch in bad.items():
+        received = classify(key, encode(batch), T_NS + 99)
+        assert received.message is None and received.problem is not None
+        assert received.problem.startswith(problem), received.problem

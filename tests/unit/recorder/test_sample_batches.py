@@ -32,13 +32,22 @@ from services.recorder.mcap_files.mcap_sink import RAW_ENCODING
 from shared import channels
 from shared.codec import decode, encode
 from shared.config import LoadedStation, load_station
-from shared.messages import BusStats, RecorderStats, Sample, SampleBatch, ToolState
+from shared.messages import (
+    BusStats,
+    Intensity,
+    RecorderStats,
+    Sample,
+    SampleBatch,
+    StickSlipEvent,
+    ToolState,
+)
 from shared.queued_publisher import QueuedPublisher
 from tests.live_recorder import RunningRecorder, publish, wait_until, write_station_file
 
 RUN = 11
 SAMPLES = 400
 MS_NS = 1_000_000
+EVENT_EVERY = 25
 
 
 @pytest.fixture
@@ -56,21 +65,38 @@ def recorder(station: LoadedStation, tmp_path: Path, endpoint: str) -> Iterator[
         running.finish()
 
 
+def found_at(station: str, index: int, sample: Sample) -> list[tuple[str, Any]]:
+    """The event the edge predictor finds at ``sample`` and its intensity, as it publishes
+    them (right after the sample)."""
+    intensity = 0.1 * index
+    event = StickSlipEvent(
+        station, RUN, index, sample.time_ns, sample.time_s or 0.0, sample.torque_nm, None, None,
+        None, None, None, None, None, None, None, intensity, intensity * (index + 1) / 2,
+    )  # fmt: skip
+    figures = Intensity(station, RUN, sample.time_ns, intensity, event.process_intensity)
+    return [(channels.EVENTS.topic, event), (channels.INTENSITY.topic, figures)]
+
+
 def run_of(station: str, t0_ns: int) -> list[tuple[str, Any]]:
-    """A run as its acquisition publishes it: running, samples 1 ms apart, done."""
-    samples = [
-        (
-            channels.SAMPLES.topic,
-            Sample(station, RUN, n, t0_ns + n * MS_NS, 5.0 + n, 0.2 * n, 1e4 + n, n / 1e3),
-        )
-        for n in range(SAMPLES)
+    """A run as its edge station publishes it: running, samples 1 ms apart with an event and
+    its intensity every 25 samples, done."""
+    published: list[tuple[str, Any]] = [
+        (channels.TOOL.topic, ToolState(station, RUN, 7, 1, "running", t0_ns))
     ]
+    for n in range(SAMPLES):
+        sample = Sample(station, RUN, n, t0_ns + n * MS_NS, 5.0 + n, 0.2 * n, 1e4 + n, n / 1e3)
+        published.append((channels.SAMPLES.topic, sample))
+        if n % EVENT_EVERY == EVENT_EVERY - 1:
+            published += found_at(station, n // EVENT_EVERY + 1, sample)
     ended_ns = t0_ns + SAMPLES * MS_NS
-    return [
-        (channels.TOOL.topic, ToolState(station, RUN, 7, 1, "running", t0_ns)),
-        *samples,
-        (channels.TOOL.topic, ToolState(station, RUN, 7, 1, "done", ended_ns)),
-    ]
+    return [*published, (channels.TOOL.topic, ToolState(station, RUN, 7, 1, "done", ended_ns))]
+
+
+def by_topic(messages: list[dict[str, Any]]) -> dict[str, list[dict[str, Any]]]:
+    grouped: dict[str, list[dict[str, Any]]] = {}
+    for message in messages:
+        grouped.setdefault(message["topic"].split("/", 2)[2], []).append(message)
+    return grouped
 
 
 def read_messages(path: Path) -> list[dict[str, Any]]:
@@ -101,6 +127,13 @@ def test_batches_are_recorded_exactly_as_samples_that_came_alone(
 ) -> None:
     t0_ns = time.time_ns() - 2 * SAMPLES * MS_NS  # stamped as a live station stamps
     alone = publish(publisher_session, run_of("st1", t0_ns))
+    heard: list[tuple[str, bytes]] = []
+    listeners = [
+        publisher_session.declare_subscriber(
+            channel.key("st2"), lambda s: heard.append((str(s.key_expr), s.payload.to_bytes()))
+        )
+        for channel in (channels.SAMPLE_BATCHES, channels.EVENTS)
+    ]
     batched = QueuedPublisher(publisher_session, "st2", batch_samples=True)
     for topic, message in run_of("st2", t0_ns):
         batched.publish(message)
@@ -108,6 +141,18 @@ def test_batches_are_recorded_exactly_as_samples_that_came_alone(
             time.sleep(0.0002)  # a live station's pace, roughly: batches of several samples
     batched.close()
     assert batched.failed == batched.dropped == 0
+
+    def events_heard() -> tuple[int, int]:
+        """(events in batches, events alone) heard on zenoh so far."""
+        batches = [decode(SampleBatch, p) for k, p in list(heard) if "batches" in k]
+        alone = sum(k.endswith("/events") for k, _ in list(heard))
+        return sum(len(b.events) for b in batches), alone
+
+    wait_until(lambda: sum(events_heard()) == SAMPLES // EVENT_EVERY, "every event on zenoh")
+    in_batches, events_alone = events_heard()
+    assert in_batches > events_alone  # most ride in a batch; the rest came just after one
+    for listener in listeners:
+        listener.undeclare()
     wait_until(lambda: recorder.service.recorder.messages == 2 * alone, "both runs recorded")
     recorder.finish()
 
@@ -116,12 +161,21 @@ def test_batches_are_recorded_exactly_as_samples_that_came_alone(
     assert f"_run{RUN}_" in file1.name and f"_run{RUN}_" in file2.name  # one file, the run's
     first, second = read_messages(file1), read_messages(file2)
     assert len(first) == len(second) == alone  # one MCAP message per sample, none twice
-    for one, two in zip(first, second, strict=True):
-        assert two["topic"] == one["topic"].replace("st1", "st2")
-        assert two["data"] == one["data"].replace(b'"st1"', b'"st2"')
-        assert (two["encoding"], two["schema"]) == (one["encoding"], one["schema"])
-        assert (two["sequence"], two["publish_time"]) == (one["sequence"], one["publish_time"])
-    samples = [m for m in second if m["topic"] == "boltwatch/st2/samples"]
+    # channel for channel the same messages in the same order (across channels, a batch's
+    # events are filed after its samples: after the sample each was found at, as alone)
+    alone_by_topic, batched_by_topic = by_topic(first), by_topic(second)
+    assert set(batched_by_topic) == {"tool", "samples", "events", "intensity"}
+    for topic, ones in alone_by_topic.items():
+        for one, two in zip(ones, batched_by_topic[topic], strict=True):
+            assert two["topic"] == one["topic"].replace("st1", "st2")
+            assert two["data"] == one["data"].replace(b'"st1"', b'"st2"')
+            assert (two["encoding"], two["schema"]) == (one["encoding"], one["schema"])
+            assert (two["sequence"], two["publish_time"]) == (one["sequence"], one["publish_time"])
+    filed_at = {(m["topic"], m["publish_time"]): i for i, m in enumerate(second)}
+    for event in batched_by_topic["events"]:
+        peak_sample = filed_at[("boltwatch/st2/samples", event["publish_time"])]
+        assert filed_at[("boltwatch/st2/events", event["publish_time"])] > peak_sample
+    samples = batched_by_topic["samples"]
     assert [m["sequence"] for m in samples] == list(range(SAMPLES))
     assert {m["schema"][0] for m in samples} == {"boltwatch.Sample"}
     # log times: each sample's arrival, 1 ms apart as on the CAN bus, never before its time
@@ -230,3 +284,33 @@ def received_batch(payload: bytes, batch: SampleBatch) -> Received:
         arrival_ns,
         batch.time_ns,
     )
+
+
+def test_a_batch_with_events_gives_its_samples_as_written_and_its_events_alone() -> None:
+    batch = batch_of("st1", 10)
+    found = [*found_at("st1", 1, batch.samples[4]), *found_at("st1", 2, batch.samples[9])]
+    events = [message for topic, message in found if topic == channels.EVENTS.topic]
+    intensities = [message for topic, message in found if topic == channels.INTENSITY.topic]
+    full = dataclasses.replace(batch, events=events, intensities=intensities)
+    payload = encode(full)
+    assert sample_texts(payload, full) == [encode(s) for s in batch.samples]
+    filed = BatchSamples().found(received_batch(payload, full))
+    assert [(r.key, r.schema_name, r.payload, r.publish_time_ns) for r in filed] == [
+        (channel.key("st1"), channel.schema_name, encode(m), m.time_ns)
+        for channel, m in [(channels.EVENTS, e) for e in events]
+        + [(channels.INTENSITY, i) for i in intensities]
+    ]
+    arrival_ns = received_batch(payload, full).log_time_ns
+    assert {r.log_time_ns for r in filed} == {arrival_ns}
+
+
+def test_a_second_samples_key_after_the_events_is_encoded_again() -> None:
+    """Behind the events, a second ``samples`` key (plain or spelled with an escape) is the
+    list the decoder keeps: the first list's pieces are not the samples."""
+    first, *rest = batch_of("st1", 3).samples
+    one = encode(SampleBatch("st1", first.time_ns, [first, first]))
+    for name in (b'"samples"', b'"sampl\\u0065s"'):
+        twice = one[:-1] + b"," + name + b":" + TypeAdapter(list[Sample]).dump_json(rest) + b"}"
+        batch = decode(SampleBatch, twice)
+        assert batch.samples == rest
+        assert sample_texts(twice, batch) is None
