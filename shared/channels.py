@@ -15,14 +15,15 @@ topic              publisher             message, when
 =================  ====================  ===========================================
 ``samples``        acquisition           :class:`Sample`, one per 1 kHz sample (placement
                    (openprotocol)        line: what the line's predictor decides on)
-``sample_batches`` acquisition           :class:`SampleBatch`, every 10 ms (placement
-                   (openprotocol)        edge: what the line records)
+``sample_batches`` acquisition           :class:`SampleBatch`, every 50 ms (placement
+                   (openprotocol)        edge: what the line records), with the
+                                         events and intensities found in it
 ``tool``           acquisition           :class:`ToolState`, on every change
                    (openprotocol)
 ``bus``            acquisition           :class:`BusStats`, once a second
-``events``         predictor             :class:`StickSlipEvent`, one per event
-                   (openprotocol)
-``intensity``      predictor             :class:`Intensity`, one per event
+``events``         predictor             :class:`StickSlipEvent`, one per event (placement
+                   (openprotocol)        edge: only when no batch is in progress)
+``intensity``      predictor             :class:`Intensity`, one per event (the same)
                    (openprotocol)
 ``decision``       predictor             :class:`StopDecision`, at most one per run
                    (openprotocol)        (a bridge's: advisory, the controller stopped)

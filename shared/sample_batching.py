@@ -27,8 +27,11 @@ import time
 
 from shared.messages import Intensity, Sample, SampleBatch, StickSlipEvent
 
-#: the longest a sample waits for its batch, seconds (100 batches a second at 1 kHz)
-BATCH_PERIOD_S = 0.010
+#: the longest a sample waits for its batch, seconds (20 batches a second at 1 kHz): each
+#: message costs the line's router and recorder about as much as 5 samples in a batch do,
+#: and 50 ms is still live to a person watching (bench_line.py, 50 stations: 10 ms 12.4 µs
+#: of recorder CPU a sample, 25 ms 10.2, 50 ms 9.4)
+BATCH_PERIOD_S = 0.050
 #: the most samples in one batch (a burst after a stall); about 7 KB, far below 64 KiB
 MAX_BATCH_SAMPLES = 50
 

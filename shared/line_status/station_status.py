@@ -225,7 +225,7 @@ class StatusCollector:
                 # 1 kHz: count only; the latest is decoded once, at report time.
                 seen.samples += 1
                 seen.last_sample = payload
-            elif topic == channels.SAMPLE_BATCHES.topic:  # an edge station's, 100 a second
+            elif topic == channels.SAMPLE_BATCHES.topic:  # an edge station's, 20 a second
                 batch = decode(SampleBatch, payload)
                 if batch.samples:
                     seen.samples += len(batch.samples)

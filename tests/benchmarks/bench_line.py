@@ -12,7 +12,7 @@ udp_multicast CAN bus; the stop path is measured as in ``bench_stop_path.py``
 (the deciding sample's CAN receive time -> the StopCommand heard on the bus).
 The N other stations are one generator process publishing exactly what an edge
 station publishes toward the line, at its rates, pre-encoded so the generator
-stays cheap: a ``SampleBatch`` of 10 samples every 10 ms (1 s runs, 0.2 s
+stays cheap: a ``SampleBatch`` of 50 samples every 50 ms (1 s runs, 0.2 s
 apart) with the stick-slip events (one every 25 ms) and their intensities
 found in it, ``ToolState`` running/done around each run, a decision and a
 summary per run, ``BusStats`` (with
@@ -70,7 +70,7 @@ from tests.unit.predictor.synthetic import staircase  # noqa: E402
 REAL_STATION = "st1"
 START_TIMEOUT_S = 120.0
 RUN_SAMPLES = 1000  # 1 s runs at 1 kHz
-BATCH_SAMPLES = 10  # every 10 ms
+BATCH_SAMPLES = 50  # every 50 ms (shared.sample_batching.BATCH_PERIOD_S)
 RUN_PAUSE_TICKS = 200  # 0.2 s between runs
 EVENT_EVERY_TICKS = 25
 RUN_MARK = 987_654_321  # stands for the run id in pre-encoded messages

@@ -9,7 +9,7 @@ Run on demand (not collected by pytest)::
 A real :class:`~services.recorder.service.RecorderService` (its zenoh session
 peer-only, listening on nothing) is handed, every simulated 5 ms, what N edge
 stations publish toward the line in that time (``bench_line.py``'s generator:
-a ``SampleBatch`` every 10 ms with the events, one every 25 ms, and their
+a ``SampleBatch`` every 50 ms with the events, one every 25 ms, and their
 intensities found in it, 1 s runs 0.2 s apart, tool states, a decision and a
 summary per run, bus and
 predictor statistics every second), stamped with a simulated clock, and ticks

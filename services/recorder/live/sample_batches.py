@@ -33,7 +33,7 @@ from shared.messages import SampleBatch
 
 SAMPLE = channels.SAMPLES.schema_name
 EVENTS, INTENSITY = channels.EVENTS, channels.INTENSITY
-#: the most a sample's log time is put before its batch's arrival: a batch spans 10 ms,
+#: the most a sample's log time is put before its batch's arrival: a batch spans 50 ms,
 #: one gathered over a stall of the station's publisher at most a second of log time
 MAX_SPREAD_NS = 1_000_000_000
 
