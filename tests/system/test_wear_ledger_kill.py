@@ -53,7 +53,7 @@ WRITER = textwrap.dedent(
             -2.5, 3, None, run_id * 0.25, 1000, run_id * 10**10, run_id * 10**10 + 2 * 10**9,
         )
         counted = watch.on_summary(summary, run_id)
-        print(f"{'counted' if counted is not None else 'repeated'} {run_id}", flush=True)
+        print(f"{'counted' if counted else 'repeated'} {run_id}", flush=True)
         run_id += 1
     """
 )

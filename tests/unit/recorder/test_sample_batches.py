@@ -47,7 +47,9 @@ from tests.live_recorder import RunningRecorder, publish, wait_until, write_stat
 RUN = 11
 SAMPLES = 400
 MS_NS = 1_000_000
-EVENT_EVERY = 25
+#: an event every 20 samples: one in five lands on a batch's 50th sample, the batch goes
+#: full with it and the event goes alone after it; the others ride in a batch
+EVENT_EVERY = 20
 
 
 @pytest.fixture
@@ -79,7 +81,7 @@ def found_at(station: str, index: int, sample: Sample) -> list[tuple[str, Any]]:
 
 def run_of(station: str, t0_ns: int) -> list[tuple[str, Any]]:
     """A run as its edge station publishes it: running, samples 1 ms apart with an event and
-    its intensity every 25 samples, done."""
+    its intensity every EVENT_EVERY samples, done."""
     published: list[tuple[str, Any]] = [
         (channels.TOOL.topic, ToolState(station, RUN, 7, 1, "running", t0_ns))
     ]
