@@ -154,29 +154,23 @@ _BATCH = channels.SAMPLE_BATCHES.schema_name
 def _check_batch(batch: SampleBatch, arrival_ns: int, sensors: SensorRange) -> None:
     """Each sample, event and intensity of a batch as :func:`classify` checks one that came
     alone: one bad one refuses the batch (recorded raw, byte for byte, on its own channel)."""
-    latest_ns = arrival_ns + _MAX_AHEAD_NS
-    for index, sample in enumerate(batch.samples):
-        try:
-            if sample.station != batch.station:
-                raise InputError(f"it names station {sample.station!r}, in a batch of its own")
-            if not 0 <= sample.time_ns <= latest_ns:
-                raise InputError(_time_problem(sample.time_ns, arrival_ns))
-            _check_measured(sample, sensors)
-        except InputError as err:
-            raise InputError(f"samples[{index}]: {err}") from None
-    found: tuple[tuple[str, Sequence[StickSlipEvent | Intensity]], ...] = (
+    parts: tuple[tuple[str, Sequence[Sample | StickSlipEvent | Intensity]], ...] = (
+        ("samples", batch.samples),
         ("events", batch.events),
         ("intensities", batch.intensities),
     )
-    for name, messages in found:
+    latest_ns = arrival_ns + _MAX_AHEAD_NS
+    for name, messages in parts:
         for index, message in enumerate(messages):
-            if message.station != batch.station:
-                problem = f"it names station {message.station!r}, in a batch of its own"
-            elif not 0 <= message.time_ns <= latest_ns:
-                problem = _time_problem(message.time_ns, arrival_ns)
-            else:
-                continue
-            raise InputError(f"{name}[{index}]: {problem}")
+            try:
+                if message.station != batch.station:
+                    raise InputError(f"it names station {message.station!r}, in a batch of its own")
+                if not 0 <= message.time_ns <= latest_ns:
+                    raise InputError(_time_problem(message.time_ns, arrival_ns))
+                if type(message) is Sample:
+                    _check_measured(message, sensors)
+            except InputError as err:
+                raise InputError(f"{name}[{index}]: {err}") from None
 
 
 def _check_measured(sample: Sample, sensors: SensorRange) -> None:
