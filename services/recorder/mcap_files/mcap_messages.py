@@ -38,8 +38,6 @@ LOG = logging.getLogger(__name__)
 
 #: opcode, record length, channel id, sequence, log time, publish time (MCAP spec, Message)
 _RECORD = struct.Struct("<BQHIQQ")
-#: bytes of a message record before its data
-RECORD_HEADER_BYTES = _RECORD.size
 _MESSAGE_OPCODE = 0x05
 _FIXED_BYTES = 2 + 4 + 8 + 8
 
@@ -95,14 +93,14 @@ class MessageAppender:
 
     def add(self, channel_id: int, rows: Sequence[MessageRow]) -> int:
         """Append ``rows`` in order, what ``add_message`` would write for each of them; the
-        bytes of their data."""
+        bytes of their records (header and data)."""
         if not rows:
             return 0
         chunk = self._chunk
         if chunk is None:
             for sequence, log_ns, publish_ns, data in rows:
                 self._writer.add_message(channel_id, log_ns, data, publish_ns, sequence)
-            return sum(len(row[3]) for row in rows)
+            return sum(len(row[3]) for row in rows) + _RECORD.size * len(rows)
         # the chunk's buffer is replaced at each chunk's end: looked up per batch
         buffer = chunk.record_writer._buffer
         offset = start = buffer.tell()
@@ -138,4 +136,4 @@ class MessageAppender:
         indices[channel_id].records.extend(index)
         chunk.num_messages += len(rows)
         self._finalize()
-        return offset - start - len(rows) * RECORD_HEADER_BYTES
+        return offset - start

@@ -37,11 +37,7 @@ from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 
 from services.recorder.live.incoming import Received
-from services.recorder.mcap_files.mcap_messages import (
-    RECORD_HEADER_BYTES,
-    MessageAppender,
-    MessageRow,
-)
+from services.recorder.mcap_files.mcap_messages import MessageAppender, MessageRow
 from services.recorder.mcap_files.recording_reader import RecordingScan
 from shared import channels
 from shared.codec import json_schema
@@ -141,9 +137,8 @@ class McapSink:
 
     def _append(self, channel_id: int, rows: list[MessageRow]) -> None:
         """Write ``rows`` on the channel and count them (messages, bytes not yet flushed)."""
-        data_bytes = self._messages.add(channel_id, rows)
+        self._unflushed_bytes += self._messages.add(channel_id, rows)
         self.messages += len(rows)
-        self._unflushed_bytes += data_bytes + RECORD_HEADER_BYTES * len(rows)
         self.last_write_ns = rows[-1][1]
 
     @property
