@@ -231,6 +231,8 @@ def one_run(
                     endpoint,
                     "--seconds",
                     str(seconds),
+                    # a line predictor decides on each sample: its stations publish them alone
+                    *([] if variant in RECORDER_VARIANTS else ["--per-sample"]),
                     *map(str, paths),
                 ],
                 cwd=REPO,
