@@ -23,6 +23,7 @@ from shared.messages import (
     StickSlipEvent,
     ToolState,
 )
+from tests.fuzz.payloads import template
 
 T_NS = 1_700_000_000_000_000_000
 SAMPLE = Sample("st4", 9, 33, T_NS + 5, 80.0, 12.5, None)
@@ -100,11 +101,8 @@ def test_a_batch_is_refused_for_an_event_or_intensity_not_its_own_or_ahead() -> 
     """The events and intensities a batch carries are checked as those that came alone."""
     key = channels.SAMPLE_BATCHES.key("st4")
     samples = [dataclasses.replace(SAMPLE, sequence=n, time_ns=T_NS + n) for n in range(3)]
-    event = StickSlipEvent(
-        "st4", 9, 1, T_NS + 2, 0.002, 80.0, None, None, None, None, None, None, None, None,
-        None, 0.5, 0.5,
-    )  # fmt: skip
-    figures = Intensity("st4", 9, T_NS + 2, 0.5, 0.5)
+    event: StickSlipEvent = template("events", "st4", T_NS + 2, 9)
+    figures: Intensity = template("intensity", "st4", T_NS + 2, 9)
     good = SampleBatch("st4", T_NS + 9, samples, [event], [figures])
     received = classify(key, encode(good), T_NS + 99)
     assert received.decodable and received.message == good

@@ -38,10 +38,10 @@ from shared.messages import (
     RecorderStats,
     Sample,
     SampleBatch,
-    StickSlipEvent,
     ToolState,
 )
 from shared.queued_publisher import QueuedPublisher
+from tests.fuzz.payloads import template
 from tests.live_recorder import RunningRecorder, publish, wait_until, write_station_file
 
 RUN = 11
@@ -71,10 +71,14 @@ def found_at(station: str, index: int, sample: Sample) -> list[tuple[str, Any]]:
     """The event the edge predictor finds at ``sample`` and its intensity, as it publishes
     them (right after the sample)."""
     intensity = 0.1 * index
-    event = StickSlipEvent(
-        station, RUN, index, sample.time_ns, sample.time_s or 0.0, sample.torque_nm, None, None,
-        None, None, None, None, None, None, None, intensity, intensity * (index + 1) / 2,
-    )  # fmt: skip
+    event = dataclasses.replace(
+        template("events", station, sample.time_ns, RUN),
+        index=index,
+        time_s=sample.time_s or 0.0,
+        peak_torque_nm=sample.torque_nm,
+        intensity=intensity,
+        process_intensity=intensity * (index + 1) / 2,
+    )
     figures = Intensity(station, RUN, sample.time_ns, intensity, event.process_intensity)
     return [(channels.EVENTS.topic, event), (channels.INTENSITY.topic, figures)]
 

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 from shared.messages import Intensity, Sample, StickSlipEvent
 from shared.sample_batching import BATCH_PERIOD_S, MAX_BATCH_SAMPLES, SampleBatching
+from tests.fuzz.payloads import template
 
 T0_NS = 1_700_000_000_000_000_000
 MS_NS = 1_000_000
@@ -14,10 +17,8 @@ def sample(run_id: int, n: int) -> Sample:
 
 
 def event(run_id: int, index: int) -> StickSlipEvent:
-    return StickSlipEvent(
-        "st1", run_id, index, T0_NS + index * MS_NS, 0.001 * index, 50.0, None, None, None,
-        None, None, None, None, None, None, 0.5, 0.5 * index,
-    )  # fmt: skip
+    found: StickSlipEvent = template("events", "st1", T0_NS + index * MS_NS, run_id)
+    return dataclasses.replace(found, index=index)
 
 
 def test_a_batch_goes_when_due_full_or_at_a_new_run() -> None:
