@@ -12,10 +12,12 @@ samples:
 - verdict: the controller's ``result`` (``OK`` / ``NOK``); where it wrote
   neither, the figures judged against their windows decide (as for a live run);
 - final torque: the last step's ``TF Torque`` actual (else the actual of its
-  torque monitoring functions), judged against the window of its monitoring
-  functions: ``MF TorqueMin`` nominal to ``MF(s) TorqueMax`` nominal;
+  torque monitoring functions, else of a function named ``Torque`` alone: a
+  final value with no function, as a bridge gives a result fetched by id),
+  judged against the window of its monitoring functions: ``MF TorqueMin``
+  nominal to ``MF(s) TorqueMax`` nominal;
 - final angle: the last step's angle (the actual of ``MF AngleMin`` /
-  ``MF(s) AngleMax`` / ``TF Angle``: the controller counts it in the step),
+  ``MF(s) AngleMax`` / ``TF Angle`` / ``Angle``: the controller counts it in the step),
   judged against ``MF AngleMin`` to ``MF(s) AngleMax``;
 - preload: not measured by the controller, not judged;
 - steps: each step's name, the tightening function that ended it (``TF ...``)
@@ -115,8 +117,10 @@ def _figure(step: ControllerStep | None, quantity: str, tightening: str) -> Judg
     low = monitors.get(f"{quantity}Min")
     high = monitors.get(f"{quantity}Max")
     ends = next((f for f in step.functions if f.name == tightening), None)
+    alone = next((f for f in step.functions if f.name == quantity), None)
     value = next(
-        (f.actual for f in (ends, low, high) if f is not None and f.actual is not None), None
+        (f.actual for f in (ends, low, high, alone) if f is not None and f.actual is not None),
+        None,
     )
     return judge(
         value,

@@ -183,3 +183,17 @@ class BridgeStats:
     last_error: str | None  # the newest fault, in one line; None: none since start
     # results published without their curves (0900 never came within the bridge's timeout)
     results_without_traces: Count = 0
+    # curves refused: no time step, or samples that agree with their result read no way
+    traces_refused: Count = 0
+    # tightening ids the controller could not give (fetch failed or refused, too far back)
+    results_given_up: Count = 0
+    # the controller's ids started again (reset, replaced, wrapped): new run id epochs
+    epochs: Count = 0
+    # controller time stamps no clock holds (before 2000, a day ahead): replaced by arrival
+    clock_refused: Count = 0
+    # how the controller's 0900 samples read right ("big-endian, scaling as declared"); None:
+    # not known yet
+    trace_reading: ControllerText | None = None
+    # the alarm active on the controller as the bridge last heard (0071, 0074, 0076); None:
+    # none active, or not heard
+    active_alarm: ControllerAlarm | None = None

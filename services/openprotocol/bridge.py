@@ -1,28 +1,33 @@
 """The bridge's work: keep a session with the controller, turn what it says into the line's.
 
 One thread (the service's work thread) owns the link: connect, start the
-session (:mod:`.controller_session`), subscribe, fill the gap since the last
-tightening published, then read what the controller pushes until the link
-ends or the service stops; then connect again after a pause that doubles from
-``reconnect_min_s`` up to ``reconnect_max_s`` (back to the minimum after a
-session that started).
+session (:mod:`.controller_session`), subscribe, catch up with what the
+controller made since the last tightening published, then read what it
+pushes until the link ends or the service stops; then connect again after a
+pause that doubles from ``reconnect_min_s`` up to ``reconnect_max_s`` (back
+to the minimum after a session that started).
 
-After every (re)connect: 0064 id 0 asks the newest result (0065); every id
-after the watermark up to it is fetched (0064 per id, 0065; :mod:`.pending_tightenings`)
-and published once, in id order, before newer live ones. Each 0061 is
-acknowledged (0062) as soon as it is read, before anything else is done with
-it (a controller re-sends an unacknowledged result three times, then drops the
-link). A 0061 the codec refuses is acknowledged too, then 0064 id 0 asks the
-newest result and the gap up to it is fetched by id: the refused result
-comes back as a 0065 even when it was the last one. A controller whose
-newest id is below the watermark, or that names itself differently, starts
-a new epoch (:mod:`.published_ids`).
+Catching up, after every (re)connect: 0064 id 0 asks the newest result
+(0065); every id after the watermark up to it is fetched (0064 per id) and
+published once, in id order, before newer live ones. 0064 is asked at the
+highest revision both sides know (one lower on error 97). Before that, the
+controller is checked for a new **epoch** (its ids started again: reset,
+replaced): it has no result though some were published (0004 error 15 for id
+0), its newest id is below the watermark, or its result at the watermark is
+not the one published (:attr:`ResultFigures.key`); so is a controller that
+names itself differently in 0002, and a live 0061 whose id was published
+with another key (ids that wrapped after 9999999999).
 
-Each tightening goes out through the station's queued publisher as a CAN
-station's services publish a run (:mod:`.tightening_messages`); the
-watermark is written after its last message was put (on the publisher's
-thread). Tool data (0041) goes on ``tool_data``, alarms (0071, 0074, 0076) on
-``alarms`` (:mod:`.controller_reports`).
+Each 0061 is acknowledged (0062) as soon as it is read, before anything else
+is done with it (a controller re-sends an unacknowledged result, then drops
+the link). A 0061 the codec refuses is acknowledged too, then the catch-up
+runs again: the refused result comes back as a 0065 by id. One message that
+cannot be used (refused by the codec, a curve with no time step, a value no
+clock or float holds) costs that message, counted and logged once per kind,
+never the bridge.
+
+Tightenings go out through :mod:`.tightening_flow`; tool data (0041) on
+``tool_data``, alarms (0071, 0074, 0076) on ``alarms`` (:mod:`.controller_reports`).
 """
 
 from __future__ import annotations
@@ -37,16 +42,20 @@ from typing import Any
 from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.controller_link import ControllerLink, LinkLostError
 from services.openprotocol.controller_reports import ControllerReports
-from services.openprotocol.controller_session import ControllerSession, RefusedFrame
-from services.openprotocol.pending_tightenings import PendingTightenings
-from services.openprotocol.published_ids import BridgePosition, read_position, write_position
-from services.openprotocol.result_reading import read_curve, read_result
-from services.openprotocol.tightening_messages import tightening_messages
+from services.openprotocol.controller_session import (
+    ControllerSession,
+    RefusedFrame,
+    SessionStoppedError,
+)
+from services.openprotocol.pending_tightenings import Take
+from services.openprotocol.published_ids import BridgePosition
+from services.openprotocol.result_reading import CurveRefusedError, read_curve, read_result
+from services.openprotocol.tightening_flow import TighteningFlow
 from shared.config import LoadedStation
 from shared.config.openprotocol import OpenProtocolSection
-from shared.message_fields import INT64_MAX
-from shared.openprotocol.codec import KNOWN_MIDS
+from shared.openprotocol.codec import KNOWN_MIDS, SUPPORTED_REVISIONS
 from shared.openprotocol.dialect import Dialect
+from shared.openprotocol.errors import OpenProtocolError
 from shared.openprotocol.results import (
     LastTighteningResult,
     OldResultRequest,
@@ -67,6 +76,8 @@ POLL_S = 0.05
 OLD_RESULT = 65
 #: 0004 error code: tightening id not found (0064 id 0 on a controller with no result yet)
 NOT_FOUND = 15
+#: what one message that cannot be used raises (beyond the codec's own refusal)
+UNUSABLE = (OpenProtocolError, CurveRefusedError, ValueError, OverflowError, ArithmeticError)
 
 
 class OpenProtocolBridge:
@@ -85,26 +96,36 @@ class OpenProtocolBridge:
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         """``after_published(f)``: call ``f`` once what is published so far was put."""
-        self._station = station
         self._section = section
         self._publish = publish
-        self._after_published = after_published
-        self._replay = replay
-        self._position_file = position_file
         self._counts = counts
-        self._clock = clock
         self._dialect = Dialect(
             header_fill="space" if section.header_fill == "spaces" else "zero",
-            trace_byte_order=section.trace_byte_order,
+            trace_byte_order="little" if section.trace_byte_order == "little" else "big",
         )
-        self.position = read_position(position_file)
-        self._pending = PendingTightenings(self.position.watermark, section.traces, trace_timeout_s)
+        self._flow = TighteningFlow(
+            station,
+            section,
+            publish,
+            after_published,
+            replay,
+            position_file,
+            trace_timeout_s,
+            counts,
+            clock,
+        )
         self._reports = ControllerReports(
             station.station_id, station.config.station.tool_id, section.timezone
         )
         self._session: ControllerSession | None = None
-        #: a pushed 0061 was refused: ask the newest result (its id shows the gap)
+        #: a pushed 0061 was refused: catch up again (its id comes back by 0064)
         self._ask_newest = False
+        #: the 0065 revision the controller answers on this link (asked from the highest)
+        self._old_result_revision = max(SUPPORTED_REVISIONS[OLD_RESULT])
+
+    @property
+    def position(self) -> BridgePosition:
+        return self._flow.position
 
     # -- the link's life -----------------------------------------------------------------
 
@@ -115,18 +136,23 @@ class OpenProtocolBridge:
         while not stop.is_set():
             try:
                 with ControllerLink(
-                    section.host,
-                    section.port,
-                    2.0 * section.keep_alive_s,
-                    KNOWN_MIDS,
+                    section.host, section.port, 2.0 * section.keep_alive_s, KNOWN_MIDS
                 ) as link:
                     session = ControllerSession(
-                        link, self._counts, section.keep_alive_s, self._dialect, self._pushed
+                        link,
+                        self._counts,
+                        section.keep_alive_s,
+                        self._dialect,
+                        self._pushed,
+                        stop,
                     )
                     self._session = session
-                    self._start(session)
-                    pause_s = section.reconnect_min_s
-                    self._serve(session, stop)
+                    try:
+                        self._start(session)
+                        pause_s = section.reconnect_min_s
+                        self._serve(session, stop)
+                    except SessionStoppedError:
+                        pass
                     session.stop()
                     return
             except LinkLostError as err:
@@ -145,29 +171,30 @@ class OpenProtocolBridge:
         session.start()
         self._counts.connects += 1
         self._counts.connected = True
+        flow = self._flow
         name = session.controller_name
-        if self.position.controller_name and name != self.position.controller_name:
-            self._new_epoch(
-                f"the controller is now {name!r}, was {self.position.controller_name!r}"
-            )
+        if flow.controller_name and name != flow.controller_name:
+            flow.new_epoch(f"the controller is now {name!r}, was {flow.controller_name!r}", name)
+        flow.controller_name = name
         section = self._section
         revision = session.subscribe(
-            lambda rev: ResultSubscribe(revision=rev), 60, section.result_revision
+            lambda rev: ResultSubscribe(revision=rev), section.result_revision, required=True
         )
         if revision is None:
             raise LinkLostError("the controller refused the result subscription (MID 0060)")
         self._counts.result_revision = revision
+        self._old_result_revision = max(SUPPORTED_REVISIONS[OLD_RESULT])
         if section.traces:
-            session.subscribe(_trace_subscription, 8, 1)
+            session.subscribe(_trace_subscription, 1)
         self._reports.subscribe(session, self._publish, self._counts)
-        self._fill_from_newest(session)
+        self._catch_up(session)
         LOG.info(
             "connected to %s (%s): results at revision %d, traces %s; watermark %d",
             self._counts.controller,
             name or "unnamed",
             revision,
             "on" if section.traces else "off",
-            self._pending.watermark,
+            flow.watermark,
         )
 
     def _serve(self, session: ControllerSession, stop: threading.Event) -> None:
@@ -177,9 +204,9 @@ class OpenProtocolBridge:
             session.poll(POLL_S)
             if self._ask_newest:
                 self._ask_newest = False
-                self._fill_from_newest(session)
+                self._catch_up(session)
             self._fill(session)
-            self._publish_ready()
+            self._flow.publish_ready()
             # tool data again after each tightening (its counters moved) and every minute:
             # a recorder that was not listening at the connect gets it all the same
             now_s = time.monotonic()
@@ -187,158 +214,149 @@ class OpenProtocolBridge:
                 self._reports.ask_tool_data(session)
                 tool_data_asked_s, results_at_ask = now_s, self._counts.results
 
-    # -- filling the gap -----------------------------------------------------------------
+    # -- catching up ---------------------------------------------------------------------
 
-    def _fill_from_newest(self, session: ControllerSession) -> None:
-        reply = session.request(
-            OldResultRequest(tightening_id=0), {OLD_RESULT}, expected_errors=(NOT_FOUND,)
-        )
-        if isinstance(reply, CommandError):  # no result yet on the controller
+    def _catch_up(self, session: ControllerSession) -> None:
+        """The newest result, a new epoch if the controller's ids started again, the gap."""
+        flow = self._flow
+        reply = self._old_result(session, 0)
+        if isinstance(reply, CommandError):
+            if reply.error_code == NOT_FOUND and flow.watermark > 0:
+                # no newest result: reset, unless it gives the published one (a controller
+                # that does not take id 0 for its newest)
+                known = flow.known_key(flow.watermark)
+                at_watermark = self._figures(self._old_result(session, flow.watermark))
+                if at_watermark is None or (known is not None and at_watermark.key != known):
+                    flow.new_epoch(
+                        f"it has no result, though tightening {flow.watermark} was published",
+                        flow.controller_name,
+                    )
             return
-        if isinstance(reply, RefusedFrame):
-            return  # counted; the next live result shows the gap
-        newest = reply.tightening_id
-        if newest < self._pending.watermark:
-            self._new_epoch(
-                f"its newest tightening id {newest} is below the last published "
-                f"{self._pending.watermark}"
-            )
-        self._take_result(reply, filled=True, repeat_expected=True)
-        self._pending.controller_newest(newest)
+        newest = self._figures(reply)
+        if newest is None:
+            return  # not answered, or refused (counted): the next live result shows the gap
+        why = self._epoch_ended(session, newest)
+        if why is not None:
+            flow.new_epoch(why, flow.controller_name)
+        flow.take_result(newest, newest_asked=True)
+        flow.controller_newest(newest.tightening_id)
         self._fill(session)
-        self._publish_ready()
+        flow.publish_ready()
+
+    def _epoch_ended(self, session: ControllerSession, newest: Any) -> str | None:
+        """Why the controller's ids started again since the watermark, or None."""
+        watermark = self._flow.watermark
+        if newest.tightening_id < watermark:
+            return (
+                f"its newest tightening id {newest.tightening_id} is below the last "
+                f"published {watermark}"
+            )
+        known = self._flow.known_key(watermark)
+        if watermark == 0 or known is None:
+            return None
+        at_watermark = newest
+        if newest.tightening_id > watermark:
+            at_watermark = self._figures(self._old_result(session, watermark))
+        if at_watermark is None:
+            LOG.info(
+                "%s no longer gives tightening %d: its ids are taken to go on",
+                self._counts.controller,
+                watermark,
+            )
+            return None
+        if at_watermark.key != known:
+            return (
+                f"its tightening {watermark} is not the one published "
+                f"({at_watermark.key} where {known} was)"
+            )
+        return None
 
     def _fill(self, session: ControllerSession) -> None:
-        for tightening_id in self._pending.missing():
-            reply = session.request(OldResultRequest(tightening_id=tightening_id), {OLD_RESULT})
-            if isinstance(reply, OldTighteningResult) and reply.tightening_id == tightening_id:
-                self._take_result(reply, filled=True)
+        for tightening_id in self._flow.missing():
+            reply = self._old_result(session, tightening_id)
+            figures = self._figures(reply)
+            if figures is not None and figures.tightening_id == tightening_id:
+                self._flow.take_result(figures)
             else:
                 why = (
                     f"error {reply.error_code}"
                     if isinstance(reply, CommandError)
-                    else "its answer was refused"
+                    else "its answer was refused or did not come"
                 )
-                self._counts.fault(
-                    "refused value", f"tightening {tightening_id} cannot be fetched ({why})"
-                )
-                self._pending.give_up(tightening_id)
-            self._publish_ready()
+                self._flow.give_up(tightening_id, why)
+            self._flow.publish_ready()
 
-    def _new_epoch(self, why: str) -> None:
-        name = self._session.controller_name if self._session is not None else ""
-        self.position = self.position.new_epoch(name)
-        self._pending = PendingTightenings(
-            0, self._pending.wait_for_curves, self._pending.trace_timeout_s
+    def _old_result(self, session: ControllerSession, tightening_id: int) -> Any:
+        """0064 for ``tightening_id`` (0: the newest) at the highest revision the controller
+        answers: its 0065, a 0004, or None (no answer, or a refused one)."""
+        revision, reply = session.request_highest(
+            lambda rev: OldResultRequest(tightening_id=tightening_id, revision=rev),
+            {OLD_RESULT},
+            self._old_result_revision,
+            expected_errors=(NOT_FOUND,),
         )
-        LOG.warning(
-            "a new controller epoch (%s): its tightenings get run ids after %d",
-            why,
-            self.position.run_id_offset,
-        )
-        self._write_position(self.position)
+        self._old_result_revision = revision
+        return None if isinstance(reply, RefusedFrame) else reply
+
+    def _figures(self, reply: Any) -> Any:
+        """A 0065's figures (filled); None for anything else or a value that cannot be used."""
+        if not isinstance(reply, OldTighteningResult):
+            return None
+        try:
+            return read_result(reply, self._section.timezone, True, time.time_ns())
+        except UNUSABLE as err:
+            self._unusable(reply, err)
+            return None
 
     # -- what the controller pushes ------------------------------------------------------
 
     def _pushed(self, message: Any) -> None:
+        try:
+            self._take_pushed(message)
+        except UNUSABLE as err:
+            self._unusable(message, err)
+
+    def _take_pushed(self, message: Any) -> None:
         session = self._session
         if isinstance(message, LastTighteningResult):
             if session is not None:
                 session.send(ResultAcknowledge())  # at once: it would be sent again
-            self._take_result(message, filled=False)
+            self._live_result(message)
         elif isinstance(message, RefusedFrame):
-            if message.frame.mid == 61 and session is not None:
+            if session is not None and message.frame.mid == LastTighteningResult.MID:
                 session.send(ResultAcknowledge())  # not sent again: fetched by id instead
                 self._ask_newest = True  # the newest id shows the gap, the last one too
+            elif session is not None and message.frame.mid == TraceCurve.MID:
+                session.send(CommandAccepted(mid=TraceCurve.MID))
         elif isinstance(message, TraceCurve):
             if session is not None:
-                session.send(CommandAccepted(mid=900))  # the acknowledge of a pushed 0900
-            self._take_curve(message)
+                session.send(CommandAccepted(mid=TraceCurve.MID))  # a pushed 0900's receipt
+            try:
+                curve, clock_ok = read_curve(message, self._section.timezone, time.time_ns())
+            except (CurveRefusedError, OpenProtocolError) as err:
+                self._counts.traces_refused += 1
+                self._counts.fault("trace", f"curve refused: {err}")
+                return
+            if curve is not None:
+                self._flow.take_curve(curve, clock_ok)
         elif session is not None:
             self._reports.pushed(message, session, self._publish, self._counts)
 
-    def _take_result(self, message: Any, filled: bool, repeat_expected: bool = False) -> None:
-        """``repeat_expected``: the newest result asked after a connect (published already,
-        most often): not a repeat of the controller's."""
-        figures = read_result(message, self._section.timezone, filled)
-        if not self._pending.result(figures, self._clock()):
-            if repeat_expected:
-                return
-            self._counts.repeated_results += 1
-            LOG.info(
-                "tightening %d again: acknowledged, not published again", figures.tightening_id
+    def _live_result(self, message: LastTighteningResult) -> None:
+        figures = read_result(message, self._section.timezone, False, time.time_ns())
+        flow = self._flow
+        if flow.take_result(figures) is Take.CONFLICT:
+            flow.new_epoch(
+                f"tightening {figures.tightening_id} came with other values than the one "
+                "published under its id: the controller's ids started again",
+                flow.controller_name,
             )
+            flow.take_result(figures)
 
-    def _take_curve(self, message: TraceCurve) -> None:
-        curve = read_curve(message, self._section.timezone)
-        if curve is None:
-            return  # a trace type the bridge does not use
-        if not self._pending.curve(curve, self._clock()):
-            self._counts.traces_without_result += 1
-
-    # -- publishing ----------------------------------------------------------------------
-
-    def _publish_ready(self) -> None:
-        now = self._clock()
-        expired = self._pending.expired_curves(now)
-        if expired:
-            self._counts.traces_without_result += expired
-            self._counts.fault("trace", f"{expired} curve(s) whose result never came: dropped")
-        for tightening in self._pending.ready(now):
-            result = tightening.result
-            run_id = self.position.run_id(result.tightening_id)
-            if run_id > INT64_MAX:
-                self._counts.refused_values += 1
-                self._counts.fault("run id", f"run id {run_id} does not fit 64 bits: not published")
-            else:
-                self._publish_tightening(tightening, run_id)
-            self.position = BridgePosition(
-                self._pending.watermark, self.position.run_id_offset, self._controller_name()
-            )
-            self._write_position(self.position)
-
-    def _publish_tightening(self, tightening: Any, run_id: int) -> None:
-        result = tightening.result
-        station = self._station
-        try:
-            program_name = station.config.program(result.program_id).name
-        except KeyError:
-            program_name = ""
-        messages = tightening_messages(
-            station.station_id,
-            station.config.station.tool_id,
-            run_id,
-            tightening,
-            self._replay,
-            program_name,
-        )
-        for message in messages:
-            self._publish(message)
-        counts = self._counts
-        counts.results += 1
-        counts.results_filled += int(result.filled)
-        curves = int(tightening.torque is not None) + int(tightening.angle is not None)
-        counts.traces += curves
-        if self._section.traces and not result.filled and not tightening.complete:
-            counts.results_without_traces += 1
-            counts.fault(
-                "trace", f"tightening {result.tightening_id}: published without its curves"
-            )
-        counts.last_tightening_id = result.tightening_id
-
-    def _write_position(self, position: BridgePosition) -> None:
-        path = self._position_file
-
-        def write() -> None:
-            try:
-                write_position(path, position)
-            except OSError as err:
-                self._counts.fault("link", f"{path}: cannot be written: {err.strerror}")
-
-        self._after_published(write)
-
-    def _controller_name(self) -> str:
-        return self._session.controller_name if self._session is not None else ""
+    def _unusable(self, message: Any, err: Exception) -> None:
+        mid = getattr(message, "MID", 0)
+        self._counts.refused_values += 1
+        self._counts.fault("refused value", f"MID {mid:04d} cannot be used: {err}: ignored")
 
 
 def _trace_subscription(revision: int) -> DataSubscribe:

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from shared.log_limit import RateLimitedLog
-from shared.messages import BridgeStats
+from shared.messages import BridgeStats, ControllerAlarm
 from shared.tightening_judgement import cut_text
 
 LOG = logging.getLogger(__name__)
@@ -29,6 +29,9 @@ FAULT_KINDS = (
     "link",
     "trace",
     "run id",
+    "repeat",
+    "epoch",
+    "clock",
 )
 
 
@@ -56,11 +59,21 @@ class BridgeCounts:
     controller_errors: int = 0
     last_tightening_id: int | None = None
     last_error: str | None = None
+    traces_refused: int = 0
+    results_given_up: int = 0
+    epochs: int = 0
+    clock_refused: int = 0
+    trace_reading: str | None = None
+    active_alarm: ControllerAlarm | None = None
     _logs: dict[str, RateLimitedLog] = field(default_factory=dict)
 
     def fault(self, kind: str, text: str, level: int = logging.WARNING) -> None:
         """Log a fault of ``kind`` (rate-limited per kind) and keep it as the last error."""
         self.last_error = cut_text(text)
+        self.note(kind, text, level)
+
+    def note(self, kind: str, text: str, level: int = logging.INFO) -> None:
+        """Log what is no fault (a repeat the controller sent) once per kind, rate-limited."""
         log = self._logs.get(kind)
         if log is None:
             log = self._logs[kind] = RateLimitedLog(LOG, level)
@@ -89,4 +102,10 @@ class BridgeCounts:
             last_tightening_id=self.last_tightening_id,
             last_error=self.last_error,
             results_without_traces=self.results_without_traces,
+            traces_refused=self.traces_refused,
+            results_given_up=self.results_given_up,
+            epochs=self.epochs,
+            clock_refused=self.clock_refused,
+            trace_reading=self.trace_reading,
+            active_alarm=self.active_alarm,
         )

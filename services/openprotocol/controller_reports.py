@@ -1,14 +1,19 @@
 """What a controller says besides its tightenings: its tool (0041) and its alarms (0071-0076).
 
-- tool data: asked (0040) after every connect, after each tightening and every
-  minute (a recorder that was not listening at the connect gets it); the 0041
-  becomes boltwatch's :class:`~shared.messages.ToolData` on ``tool_data`` (the station file's tool
+- tool data: asked (0040, at the highest revision the controller answers: rev
+  2 carries the count since service, the tool type) after every connect, after
+  each tightening and every minute (a recorder that was not listening at the
+  connect gets it); the 0041 becomes boltwatch's
+  :class:`~shared.messages.ToolData` on ``tool_data`` (the station file's tool
   id, the controller's serials, counters, calibration and service dates), which
   the wear ledger keeps beside the station's tool;
 - alarms: subscribed (0070) after every connect; 0071 (raised), 0074
   (acknowledged on the controller) and 0076 (the alarm status, sent on
   subscription) each become a :class:`~shared.messages.ControllerAlarm` on
-  ``alarms`` and are acknowledged (0072, 0075, 0077) at once.
+  ``alarms`` and are acknowledged (0072, 0075, 0077) at once. The alarm active
+  now (the last 0071 or active 0076, until a 0074 of its code or an inactive
+  0076) is kept in the bridge's counters, so ``status`` knows it whenever it
+  asks, not only when it heard the alarm.
 
 A date the controller gives that no clock holds is left out (None) and
 counted as a refused value, never a refused message.
@@ -33,11 +38,15 @@ from shared.openprotocol.alarms import (
     AlarmStatusAck,
     AlarmSubscribe,
 )
+from shared.openprotocol.codec import SUPPORTED_REVISIONS
 from shared.openprotocol.timestamps import timestamp_ns
 from shared.openprotocol.tool_data import ToolData as ControllerToolData
 from shared.openprotocol.tool_data import ToolDataRequest
 
 TOOL_DATA_MID = 41
+#: the highest revisions asked: 0070 (0071 at rev 2 carries the alarm's text), 0040
+HIGHEST_ALARMS = max(SUPPORTED_REVISIONS[AlarmSubscribe.MID])
+HIGHEST_TOOL = max(SUPPORTED_REVISIONS[ToolDataRequest.MID])
 
 
 class ControllerReports:
@@ -47,19 +56,24 @@ class ControllerReports:
         self._station = station
         self._tool_id = tool_id
         self._zone = zoneinfo.ZoneInfo(timezone)
+        self._tool_data_revision = 1
 
     def subscribe(
         self, session: Any, publish: Callable[[object], None], counts: BridgeCounts
     ) -> None:
-        """0070 (alarms) and 0040 (tool data) after a session started."""
-        session.subscribe(lambda revision: AlarmSubscribe(revision=revision), 70, 2)
-        reply = session.request(ToolDataRequest(), {TOOL_DATA_MID})
+        """0070 (alarms) and 0040 (tool data, at the highest revision the controller
+        answers) after a session started."""
+        counts.active_alarm = None  # the 0076 that answers 0070 says it again
+        session.subscribe(lambda revision: AlarmSubscribe(revision=revision), HIGHEST_ALARMS)
+        self._tool_data_revision, reply = session.request_highest(
+            lambda revision: ToolDataRequest(revision=revision), {TOOL_DATA_MID}, HIGHEST_TOOL
+        )
         if isinstance(reply, ControllerToolData):
             publish(self.tool_data(reply, time.time_ns(), counts))
 
     def ask_tool_data(self, session: Any) -> None:
         """0040 without waiting: the 0041 comes as a pushed message (:meth:`pushed`)."""
-        session.send(ToolDataRequest())
+        session.send(ToolDataRequest(revision=self._tool_data_revision))
 
     def pushed(
         self,
@@ -74,15 +88,21 @@ class ControllerReports:
             publish(self.tool_data(message, now_ns, counts))
         elif isinstance(message, Alarm):
             session.send(AlarmAcknowledge())
-            publish(self._alarm(message, "raised", True, message.alarm_text or "", now_ns, counts))
+            alarm = self._alarm(message, "raised", True, message.alarm_text or "", now_ns, counts)
+            counts.active_alarm = alarm
+            publish(alarm)
         elif isinstance(message, AlarmAcknowledgedOnController):
             session.send(AlarmAcknowledgedOnControllerAck())
+            code = message.error_code.strip()
+            active = counts.active_alarm
+            if active is not None and active.error_code == code:
+                counts.active_alarm = None
             publish(
                 ControllerAlarm(
                     station=self._station,
                     time_ns=now_ns,
                     received_ns=now_ns,
-                    error_code=message.error_code.strip(),
+                    error_code=code,
                     kind="acknowledged",
                     active=False,
                     controller_ready=None,
@@ -92,7 +112,9 @@ class ControllerReports:
             )
         elif isinstance(message, AlarmStatus):
             session.send(AlarmStatusAck())
-            publish(self._alarm(message, "status", message.alarm_active, "", now_ns, counts))
+            alarm = self._alarm(message, "status", message.alarm_active, "", now_ns, counts)
+            counts.active_alarm = alarm if alarm.active else None
+            publish(alarm)
         else:
             counts.fault("bad message", f"MID {getattr(message, 'MID', '?')} not expected: ignored")
 

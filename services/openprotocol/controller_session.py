@@ -5,31 +5,34 @@ The integrator's side of the public specification, on one
 
 - start: 0001 at the highest 0002 revision the codec implements, one lower on
   each 0004 error 97 (revision unsupported) down to 1; 0002 starts the session;
-- subscriptions: 0060 at ``result_revision`` (one lower on error 97), 0008 for
-  0900 traces when asked, 0070 alarms; each answered by 0005 (or 0004: counted,
-  and the session goes on without that subscription, except 0060);
-- asking: :meth:`request` writes a message and reads until its answer (the
-  reply MID, or a 0004/0005 naming the MID asked); what the controller pushes
-  meanwhile (0061, 0900, 0071...) goes to ``on_push`` as it comes;
+- asking: :meth:`request` writes a message and reads until its answer (a reply
+  MID, or a 0004/0005 naming the MID asked: for 0008/0009 the specification's
+  0005 names the MID subscribed for, and some controllers name 0008 itself, so
+  either answers); :meth:`request_highest` asks from a highest revision down,
+  one lower on error 97 (an expected answer: neither a fault nor a controller
+  error). What the controller pushes meanwhile (0061, 0900, 0071...) goes to
+  ``on_push`` in the order it came, also what shared a TCP read with the answer;
+- an answer that does not come: for a request the session cannot go on
+  without (0001, 0060) the link is dead (:class:`LinkLostError`); for any
+  other it is counted and logged, and the session goes on without it;
 - keep-alive: a 9999 at least every ``keep_alive_s``; the controller may
   mirror it or not. Once it has mirrored one, a controller silent for
-  :data:`DEAD_AFTER_KEEP_ALIVES` keep-alive periods is a dead link; an answer
-  that does not come within that time is one too (:class:`LinkLostError`);
+  :data:`DEAD_AFTER_KEEP_ALIVES` keep-alive periods is a dead link;
 - a frame the codec refuses (:class:`OpenProtocolError`) is counted and logged
-  (``bad_messages`` for its shape: a length that does not fit its fields;
-  ``refused_values`` for a field out of range) and the session goes on; a
-  refused 0061 is still acknowledged (0062 names no id), so the controller
-  does not re-send it and drop the link: the bridge fetches the id later
-  (0064) and counts it again if refused again;
-- stop: 0003.
+  (``bad_messages`` for its shape, ``refused_values`` for a field) and pushed
+  as a :class:`RefusedFrame`; the session goes on;
+- stop: the service's ``stop`` event ends any wait within :data:`READ_SLICE_S`
+  (:class:`SessionStoppedError`), then 0003.
 """
 
 from __future__ import annotations
 
 import contextlib
 import logging
+import threading
 import time
-from collections.abc import Callable
+from collections import deque
+from collections.abc import Callable, Collection
 from typing import Any
 
 from services.openprotocol.bridge_counts import BridgeCounts
@@ -50,15 +53,19 @@ from shared.openprotocol.session import (
 LOG = logging.getLogger(__name__)
 
 #: a controller that mirrors keep-alives and is silent this many periods is gone; an answer
-#: that does not come within as long ends the link too
+#: the session cannot go on without that does not come within as long ends the link too
 DEAD_AFTER_KEEP_ALIVES = 2.0
 #: 0004 error code: the MID revision is not supported
 REVISION_UNSUPPORTED = 97
-#: MIDs answered by a 0004/0005 naming them, or by a reply MID of their own
-RESULT_ACKNOWLEDGE_MID = 62
+#: the longest one read waits while an answer is awaited (the stop event is looked at between)
+READ_SLICE_S = 0.1
 
 #: where what the controller pushes goes (a decoded message or a RefusedFrame)
 Push = Callable[[Any], None]
+
+
+class SessionStoppedError(Exception):
+    """The service is stopping: the session ends where it is (not a fault)."""
 
 
 class RefusedFrame:
@@ -79,6 +86,7 @@ class ControllerSession:
         keep_alive_s: float,
         dialect: Dialect,
         on_push: Push,
+        stop: threading.Event | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self._link = link
@@ -86,6 +94,7 @@ class ControllerSession:
         self._keep_alive_s = keep_alive_s
         self._dialect = dialect
         self._on_push = on_push
+        self._stop = stop if stop is not None else threading.Event()
         self._clock = clock
         self.dead_after_s = DEAD_AFTER_KEEP_ALIVES * keep_alive_s
         now = clock()
@@ -95,6 +104,8 @@ class ControllerSession:
         self.controller_name = ""
         self._garbage_seen = 0  # the link's reader counts since the link started
         self._bad_frames_seen = 0
+        #: messages read with an answer and not handled yet (they came after it)
+        self._unread: deque[Any] = deque()
 
     # -- writing -----------------------------------------------------------------------
 
@@ -113,47 +124,98 @@ class ControllerSession:
 
     def start(self) -> CommunicationStartAck:
         """0001 -> 0002 at the highest revision the controller takes."""
-        for revision in sorted(SUPPORTED_REVISIONS[2], reverse=True):
-            reply = self.request(CommunicationStart(revision=revision), {2})
-            if isinstance(reply, CommunicationStartAck):
-                self.controller_name = reply.controller_name.strip()
-                return reply
-            if isinstance(reply, CommandError) and reply.error_code != REVISION_UNSUPPORTED:
-                raise LinkLostError(f"the controller refused MID 0001: error {reply.error_code}")
+        highest = max(SUPPORTED_REVISIONS[CommunicationStart.MID])
+        reply = self.request_highest(
+            lambda revision: CommunicationStart(revision=revision), {2}, highest, required=True
+        )[1]
+        if isinstance(reply, CommunicationStartAck):
+            self.controller_name = reply.controller_name.strip()
+            return reply
+        if isinstance(reply, CommandError) and reply.error_code != REVISION_UNSUPPORTED:
+            raise LinkLostError(f"the controller refused MID 0001: error {reply.error_code}")
         raise LinkLostError("the controller takes no revision of MID 0001 this bridge implements")
 
-    def subscribe(self, make: Callable[[int], Any], mid: int, highest: int) -> int | None:
-        """Subscribe with ``make(revision)`` from ``highest`` down (error 97: one lower);
-        the revision accepted, or None (a refusal other than 97, counted)."""
+    def subscribe(
+        self, make: Callable[[int], Any], highest: int, *, required: bool = False
+    ) -> int | None:
+        """Subscribe with ``make(revision)`` from ``highest`` down; the revision accepted, or
+        None (refused: counted; not answered: counted, or LinkLostError when ``required``)."""
+        revision, reply = self.request_highest(make, set(), highest, required=required)
+        return revision if isinstance(reply, CommandAccepted) else None
+
+    def request_highest(
+        self,
+        make: Callable[[int], Any],
+        replies: set[int],
+        highest: int,
+        *,
+        required: bool = False,
+        expected_errors: Collection[int] = (),
+    ) -> tuple[int, Any]:
+        """Ask ``make(revision)`` from the highest revision implemented up to ``highest``
+        down, one lower on error 97; the revision last asked and its answer (None: none came).
+
+        A 0004 other than 97 (and not in ``expected_errors``) is counted and logged."""
+        mid = int(make(1).MID)
         revisions = sorted(
-            (revision for revision in SUPPORTED_REVISIONS.get(mid, (1,)) if revision <= highest),
-            reverse=True,
-        )
+            (r for r in SUPPORTED_REVISIONS.get(mid, (1,)) if r <= highest), reverse=True
+        ) or [1]
+        reply: Any = None
         for revision in revisions:
-            reply = self.request(make(revision), set())
-            if isinstance(reply, CommandAccepted):
-                return revision
-            if isinstance(reply, CommandError) and reply.error_code != REVISION_UNSUPPORTED:
+            reply = self.request(
+                make(revision),
+                replies,
+                expected_errors=(REVISION_UNSUPPORTED, *expected_errors),
+                required=required,
+            )
+            if isinstance(reply, CommandError) and reply.error_code == REVISION_UNSUPPORTED:
+                LOG.info(
+                    "%s takes no MID %04d rev %d: asking rev %d",
+                    self._counts.controller,
+                    mid,
+                    revision,
+                    revision - 1,
+                )
+                continue
+            if isinstance(reply, CommandError) and reply.error_code not in expected_errors:
                 self._counts.fault(
                     "controller error",
                     f"the controller refused MID {mid:04d} rev {revision}: error "
-                    f"{reply.error_code}",
+                    f"{reply.error_code} ({reply.error_name})",
                 )
-                return None
-        return None
+            return revision, reply
+        self._counts.fault(
+            "controller error",
+            f"the controller takes no revision of MID {mid:04d} up to {highest}",
+        )
+        return revisions[-1], reply
 
     def request(
-        self, message: Any, replies: set[int], expected_errors: tuple[int, ...] = ()
+        self,
+        message: Any,
+        replies: set[int],
+        expected_errors: Collection[int] = (),
+        *,
+        required: bool = True,
     ) -> Any:
         """Write ``message``; its answer: a message of a MID in ``replies``, or the 0004 /
         0005 naming its MID (a 0004 is counted unless its code is in ``expected_errors``).
-        What comes meanwhile is pushed. LinkLostError when none comes."""
+
+        What comes meanwhile is pushed. No answer within the dead-link time:
+        LinkLostError when ``required``, else None (counted and logged)."""
         asked = _mid_of(message)
+        naming = {asked, *_subscribed_mid(message)}
         self.send(message)
         deadline = self._clock() + self.dead_after_s
         while True:
-            for decoded in self._receive(deadline - self._clock()):
-                if _answers(decoded, asked, replies):
+            if self._stop.is_set():
+                raise SessionStoppedError
+            messages = self._take_unread() or self._receive(
+                min(READ_SLICE_S, deadline - self._clock())
+            )
+            for index, decoded in enumerate(messages):
+                if _answers(decoded, naming, replies):
+                    self._unread.extendleft(reversed(messages[index + 1 :]))
                     if (
                         isinstance(decoded, CommandError)
                         and decoded.error_code not in expected_errors
@@ -162,11 +224,15 @@ class ControllerSession:
                     return decoded
                 self._push(decoded)
             if self._clock() >= deadline:
-                raise LinkLostError(f"no answer to MID {asked:04d} within {self.dead_after_s:g} s")
+                why = f"no answer to MID {asked:04d} within {self.dead_after_s:g} s"
+                if required:
+                    raise LinkLostError(why)
+                self._counts.fault("controller error", f"{why}: going on without it")
+                return None
 
     def poll(self, timeout_s: float) -> None:
         """Read for up to ``timeout_s``; push what comes; keep-alive; notice silence."""
-        for decoded in self._receive(timeout_s):
+        for decoded in self._take_unread() or self._receive(timeout_s):
             self._push(decoded)
         if self._mirrors and self._clock() - self._heard > self.dead_after_s:
             raise LinkLostError(f"the controller has been silent for {self.dead_after_s:g} s")
@@ -177,6 +243,11 @@ class ControllerSession:
             self.send(CommunicationStop())
 
     # -- reading -----------------------------------------------------------------------
+
+    def _take_unread(self) -> list[Any]:
+        messages = list(self._unread)
+        self._unread.clear()
+        return messages
 
     def _receive(self, timeout_s: float) -> list[Any]:
         self.keep_alive()
@@ -237,11 +308,18 @@ def _mid_of(message: Any) -> int:
     return int(message.MID)
 
 
-def _answers(message: Any, asked: int, replies: set[int]) -> bool:
+def _subscribed_mid(message: Any) -> tuple[int, ...]:
+    """The data MID a 0008/0009 subscribes to (its 0005/0004 may name it), else none."""
+    if _mid_of(message) in (8, 9):
+        return (int(message.mid),)
+    return ()
+
+
+def _answers(message: Any, naming: set[int], replies: set[int]) -> bool:
     if isinstance(message, UnknownMessage):
         return False
     if isinstance(message, CommandError | CommandAccepted):
-        return int(message.mid) == asked
+        return int(message.mid) in naming
     if isinstance(message, RefusedFrame):  # the answer came, and was refused
         return message.frame.mid in replies
     return _mid_of(message) in replies

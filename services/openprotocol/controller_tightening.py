@@ -40,17 +40,29 @@ class ResultFigures:
     strategy: str  # "" when the revision carries none
     revision: int  # of the message it came in
     filled: bool  # fetched with 0064 (not pushed live)
+    #: what tells this result from another of the same id: the controller's time stamp,
+    #: pset, torque, angle, verdict and part, as it wrote them (0061 and 0065 alike)
+    key: str = ""
+    #: the controller's time stamp was one no clock holds (before 2000, or ahead of the
+    #: bridge's): ``time_ns`` is when the bridge received it instead
+    clock_refused: bool = False
 
 
 @dataclass(frozen=True, slots=True)
 class Curve:
-    """One 0900 trace: samples at the controller's own timing."""
+    """One 0900 trace: samples at the controller's own timing.
+
+    ``values`` are read as the 0900 declares them (big-endian, its scaling);
+    ``sample_bytes`` and ``coefficient`` keep what came, so that the samples
+    can be read another way (:mod:`.curve_check`)."""
 
     tightening_id: int
     kind: str  # "torque" or "angle"
     start_ns: int  # the controller's time stamp of the trace's first sample
     time_step_s: float
     values: tuple[float, ...]  # in the trace's unit: Nm, deg
+    sample_bytes: bytes = b""  # the samples as they came, 2 bytes each
+    coefficient: float = 1.0  # value = raw sample * coefficient, as the 0900 declares it
 
     def time_ns(self, index: int) -> int:
         return self.start_ns + round(index * self.time_step_s * 1e9)

@@ -6,9 +6,14 @@ line gets each tightening once, in tightening-id order, so that the
 a restarted bridge needs to know. Here, pure (no socket, no zenoh; the clock
 is passed in, monotonic seconds):
 
-- a result whose id is at or below the watermark, or pending already, is a
-  **repeat** (the controller sent it again): acknowledged by the caller,
-  counted, not published;
+- a result is told apart by its id and its **key** (time stamp, pset, torque,
+  angle, verdict and part as the controller wrote them: :attr:`ResultFigures.key`).
+  The same id with the same key is a **repeat** (the controller sent it
+  again): acknowledged by the caller, counted, not published. An id at or
+  below the watermark whose key is another, or not known, is a **conflict**:
+  the controller's ids wrapped or started again (the caller starts a new
+  epoch). The keys of the last :data:`KEYS_KEPT` published ids are kept (and
+  saved with the watermark), the pending ones' too;
 - a result is **ready** when it is the next id (watermark + 1) and its torque
   and angle curves are here, or traces are not subscribed, or it was fetched
   (0065: no curve comes for an old result), or its curves have not come
@@ -17,25 +22,41 @@ is passed in, monotonic seconds):
   bridge that was stopped) are **missing**: the caller fetches each with 0064;
   one the controller cannot give (0004: unknown id; a refused 0065) is given
   up (counted by the caller) and the watermark passes it;
-- at most :data:`MAX_FILL` ids are fetched after one gap: a controller keeps a
-  bounded store of results, and a bridge coming back after weeks should not
-  ask for every tightening since; older ids are given up, logged;
+- at most :data:`MAX_FILL` missing ids are fetched after one gap (a controller
+  keeps a bounded store of results; a bridge back after weeks should not ask
+  for every tightening since): older missing ids are given up, logged. A
+  result that is here already is never given up, however many came at once;
+- :meth:`drain` hands out every pending result in id order, gaps given up
+  (before a new epoch: nothing of the old one is left behind);
 - a curve whose result was published already, or whose result has not come
   within ``trace_timeout_s``, is dropped and counted (``traces_without_result``).
 """
 
 from __future__ import annotations
 
+import bisect
+import enum
 import logging
-from collections.abc import Iterator
+from collections import OrderedDict
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, replace
 
 from services.openprotocol.controller_tightening import Curve, ResultFigures, Tightening
 
 LOG = logging.getLogger(__name__)
 
-#: the most ids fetched to fill one gap (older ones are given up, logged)
+#: the most missing ids fetched to fill one gap (older ones are given up, logged)
 MAX_FILL = 1000
+#: how many published ids keep their key (to tell a repeat from a wrapped or restarted id)
+KEYS_KEPT = 100
+
+
+class Take(enum.Enum):
+    """What a result was to :meth:`PendingTightenings.result`."""
+
+    NEW = "new"  # taken: it will be published
+    REPEAT = "repeat"  # the same id and key as one published or pending
+    CONFLICT = "conflict"  # an id published already, with another (or an unknown) key
 
 
 @dataclass
@@ -52,25 +73,45 @@ class PendingTightenings:
     #: the newest id the controller has (0064 id 0 -> 0065); 0: unknown
     newest: int = 0
     given_up: int = 0  # ids given up (fetch failed, refused, beyond MAX_FILL)
+    #: keys of the ids published last, oldest first (at most KEYS_KEPT)
+    published_keys: OrderedDict[int, str] = field(default_factory=OrderedDict)
     _results: dict[int, _Waiting] = field(default_factory=dict)
     _curves: dict[int, tuple[dict[str, Curve], float]] = field(default_factory=dict)
     _done: set[int] = field(default_factory=set)
+    #: every id below it that is not here is given up (a gap beyond MAX_FILL)
+    _floor: int = 0
+
+    @classmethod
+    def resume(
+        cls,
+        watermark: int,
+        keys: Mapping[int, str],
+        wait_for_curves: bool,
+        trace_timeout_s: float,
+    ) -> PendingTightenings:
+        """Where a bridge was: its watermark and the keys of the ids it published last."""
+        kept = OrderedDict(sorted((i, k) for i, k in keys.items() if i <= watermark))
+        return cls(watermark, wait_for_curves, trace_timeout_s, published_keys=kept)
 
     # -- in ---------------------------------------------------------------------------
 
-    def result(self, figures: ResultFigures, now_s: float) -> bool:
-        """Take a result; False when it is a repeat (published or pending already)."""
+    def result(self, figures: ResultFigures, now_s: float) -> Take:
+        """Take a result: NEW, a REPEAT (not taken), or a CONFLICT (not taken)."""
         tightening_id = figures.tightening_id
-        if tightening_id <= self.watermark or tightening_id in self._results:
-            return False
-        if tightening_id in self._done:
-            return False
+        waiting = self._results.get(tightening_id)
+        if waiting is not None:
+            return Take.REPEAT if waiting.tightening.result.key == figures.key else Take.CONFLICT
+        if tightening_id <= self.watermark or tightening_id in self._done:
+            known = self.published_keys.get(tightening_id)
+            return Take.REPEAT if known == figures.key else Take.CONFLICT
+        if tightening_id < self._floor:
+            self.given_up -= 1  # it was given up with its gap, and came after all
         curves, _ = self._curves.pop(tightening_id, ({}, now_s))
         self._results[tightening_id] = _Waiting(
             Tightening(figures, curves.get("torque"), curves.get("angle")), now_s
         )
         self.newest = max(self.newest, tightening_id)
-        return True
+        return Take.NEW
 
     def curve(self, curve: Curve, now_s: float) -> bool:
         """Take a curve; False when its result is gone already (dropped)."""
@@ -97,22 +138,20 @@ class PendingTightenings:
     def missing(self) -> list[int]:
         """Ids to fetch, oldest first: after the watermark, up to the newest known, that
         are neither pending nor given up. Beyond :data:`MAX_FILL` the oldest are given up."""
-        first = self.watermark + 1
-        if self.newest - first + 1 > MAX_FILL:
-            skipped = self.newest - MAX_FILL - first + 1
+        first = max(self.watermark + 1, self._floor)
+        known = sorted(i for i in (*self._results, *self._done) if i >= first)
+        if self._missing_from(first, known) > MAX_FILL:
+            start = self._fill_start(first, known)
+            below = bisect.bisect_left(known, start)
+            self.given_up += start - first - below  # the known ones were counted, or are here
             LOG.error(
                 "ids %d to %d are more than %d results back: not fetched, given up",
                 first,
-                first + skipped - 1,
+                start - 1,
                 MAX_FILL,
             )
-            # in one step, not id by id: a first connect may find ids counting from billions
-            self.watermark = first + skipped - 1
-            passed = {done for done in self._done if done <= self.watermark}
-            self.given_up += skipped - len(passed)  # those were given up (counted) already
-            self._done -= passed
+            self._floor = first = start
             self._advance()
-            first = self.watermark + 1
         return [
             tightening_id
             for tightening_id in range(first, self.newest + 1)
@@ -123,6 +162,8 @@ class PendingTightenings:
         """The controller cannot give ``tightening_id``: the watermark passes it."""
         if tightening_id <= self.watermark or tightening_id in self._done:
             return
+        if tightening_id < self._floor and tightening_id not in self._results:
+            return  # given up (counted) with the gap below the floor
         self.given_up += 1
         self._done.add(tightening_id)
         self._advance()
@@ -142,10 +183,18 @@ class PendingTightenings:
                 or waited
             ):
                 return
-            del self._results[self.watermark + 1]
-            self.watermark += 1
-            self._advance()
-            yield tightening
+            yield self._pass(tightening)
+
+    def drain(self) -> Iterator[Tightening]:
+        """Every pending result in id order, whatever it waits for; the ids between are
+        given up (counted)."""
+        for tightening_id in sorted(self._results):
+            first = max(self.watermark + 1, self._floor)
+            done = sum(1 for i in self._done if first <= i < tightening_id)
+            self.given_up += max(0, tightening_id - first) - done
+            self._done = {i for i in self._done if i > tightening_id}
+            self.watermark = tightening_id - 1
+            yield self._pass(self._results[tightening_id].tightening)
 
     def expired_curves(self, now_s: float) -> int:
         """Drop the curves whose result has not come within the timeout; how many."""
@@ -162,7 +211,47 @@ class PendingTightenings:
     def waiting_results(self) -> int:
         return len(self._results)
 
+    # -- pieces -----------------------------------------------------------------------
+
+    def _pass(self, tightening: Tightening) -> Tightening:
+        """``tightening`` (the next id) is handed out: the watermark moves past it."""
+        tightening_id = tightening.result.tightening_id
+        del self._results[tightening_id]
+        self.watermark = tightening_id
+        self.published_keys[tightening_id] = tightening.result.key
+        while len(self.published_keys) > KEYS_KEPT:
+            self.published_keys.popitem(last=False)
+        self._advance()
+        return tightening
+
+    def _missing_from(self, start: int, known: list[int]) -> int:
+        """How many ids from ``start`` to the newest are neither pending nor given up."""
+        if start > self.newest:
+            return 0
+        return self.newest - start + 1 - (len(known) - bisect.bisect_left(known, start))
+
+    def _fill_start(self, first: int, known: list[int]) -> int:
+        """The highest id from which exactly MAX_FILL ids are missing up to the newest."""
+        low, high = first, self.newest  # missing_from(low) > MAX_FILL >= missing_from(newest)
+        while low < high:
+            middle = (low + high + 1) // 2
+            if self._missing_from(middle, known) >= MAX_FILL:
+                low = middle
+            else:
+                high = middle - 1
+        return low
+
     def _advance(self) -> None:
-        while self.watermark + 1 in self._done:
-            self._done.discard(self.watermark + 1)
-            self.watermark += 1
+        """Move the watermark past the ids given up (one by one, or below the floor in one
+        step up to the next result that is here)."""
+        while True:
+            following = self.watermark + 1
+            if following in self._done:
+                self._done.discard(following)
+                self.watermark = following
+            elif following < self._floor and following not in self._results:
+                here = (i for i in self._results if i > self.watermark)
+                self.watermark = min([self._floor, *here]) - 1
+                self._done = {i for i in self._done if i > self.watermark}
+            else:
+                return

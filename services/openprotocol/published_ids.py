@@ -15,10 +15,18 @@ the put and the write publishes that one tightening again when it comes back
 (its run id is the same, so the wear ledger and ``up`` count it once); killed
 before the put, it fetches it again. Nothing is lost either way.
 
-A controller whose ids went backwards (it was reset or replaced: its newest
-id is below the watermark), or that names itself differently in MID 0002, is
-a new **epoch** of the station's controller: its tightening ids start again,
-so its runs get run ids past every run id published before
+The file also keeps the **keys** of the ids published last (time stamp,
+pset, torque, angle, verdict, part as the controller wrote them), so that a
+result sent again is told from another result under the same id, and the
+reading of the controller's 0900 samples that agreed with its results
+(:mod:`.curve_check`).
+
+A controller whose ids started again is a new **epoch** of the station's
+controller (:mod:`.bridge` tells when: it has no result though some were
+published, its newest id is below the watermark, its result at the watermark
+is another one, an id at or below the watermark comes with another key: reset,
+replaced, or wrapped after 9999999999; or it names itself differently in MID
+0002): its runs get run ids past every run id published before
 (``run_id = run_id_offset + tightening_id``; the offset is the last run id
 published), and none of them is taken for one published already. The
 tightening id of each result stays the controller's own.
@@ -31,7 +39,8 @@ import json
 import logging
 import os
 import tempfile
-from dataclasses import asdict, dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 
 LOG = logging.getLogger(__name__)
@@ -47,6 +56,10 @@ class BridgePosition:
     run_id_offset: int = 0
     #: the controller's name from MID 0002 when the watermark was written ("" unknown)
     controller_name: str = ""
+    #: the keys of the ids published last, by id (:attr:`ResultFigures.key`)
+    keys: Mapping[int, str] = field(default_factory=dict)
+    #: how the controller's 0900 samples read right (``Reading.text``); "" not known yet
+    trace_reading: str = ""
 
     def run_id(self, tightening_id: int) -> int:
         return self.run_id_offset + tightening_id
@@ -73,6 +86,8 @@ def read_position(path: Path) -> BridgePosition:
             watermark=_count(document, "watermark"),
             run_id_offset=_count(document, "run_id_offset"),
             controller_name=str(document.get("controller_name", "")),
+            keys=_keys(document),
+            trace_reading=str(document.get("trace_reading", "")),
         )
     except FileNotFoundError:
         return BridgePosition()
@@ -89,7 +104,7 @@ def write_position(path: Path, position: BridgePosition) -> None:
     handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=folder)
     try:
         with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            json.dump(asdict(position), stream)
+            json.dump(_document(position), stream)
             stream.flush()
             os.fsync(stream.fileno())
         os.replace(temporary, path)
@@ -102,6 +117,23 @@ def write_position(path: Path, position: BridgePosition) -> None:
         os.fsync(directory)
     finally:
         os.close(directory)
+
+
+def _document(position: BridgePosition) -> dict[str, object]:
+    return {
+        "watermark": position.watermark,
+        "run_id_offset": position.run_id_offset,
+        "controller_name": position.controller_name,
+        "keys": {str(tightening_id): key for tightening_id, key in position.keys.items()},
+        "trace_reading": position.trace_reading,
+    }
+
+
+def _keys(document: dict[str, object]) -> dict[int, str]:
+    keys = document.get("keys", {})
+    if not isinstance(keys, dict):
+        raise ValueError(f"keys: expected an object, got {keys!r}")
+    return {int(tightening_id): str(key) for tightening_id, key in keys.items()}
 
 
 def _count(document: dict[str, object], key: str) -> int:

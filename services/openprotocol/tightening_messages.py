@@ -134,7 +134,9 @@ def controller_message(
     them: ``TF Torque`` (target, final torque) or, on an angle strategy without
     a torque target, ``TF Angle``; ``MF TorqueMin`` / ``MF TorqueMax`` /
     ``MF AngleMin`` / ``MF AngleMax`` (the limits, each with the final value)
-    where the controller gave a window. The batch: its counter as ``batch_ok``,
+    where the controller gave a window; ``Torque`` / ``Angle`` (no nominal)
+    for a final value no function above carries (a result fetched by id: 0065
+    gives no targets or limits). The batch: its counter as ``batch_ok``,
     its size as ``batch_max_ok`` (a batch is done when that many are OK).
     """
     verdict = "OK" if result.ok else "NOK"
@@ -151,6 +153,9 @@ def controller_message(
     ):
         if limit is not None:
             functions.append(ControllerFunction(name, limit, value))
+    for quantity, value in (("Torque", result.torque_nm), ("Angle", result.angle_deg)):
+        if not any(function.name.split()[-1].startswith(quantity) for function in functions):
+            functions.append(ControllerFunction(quantity, None, value))  # a final value alone
     step = ControllerStep(
         name=result.strategy or STEP_NAME,
         result=verdict,

@@ -7,7 +7,9 @@ as an integrator and publishes what the controller says on the station's
 channels. The section is optional; where it is, ``host`` is required and
 every other key has a default. Where the public layouts leave room or real
 controllers differ, a key says which form this controller uses
-(``trace_byte_order``, ``header_fill``).
+(``trace_byte_order``, ``header_fill``). A simulated controller
+(``[rig.openprotocol]``) writes its 0900 samples in ``trace_byte_order``
+(big for ``auto``).
 
 ``[rig.openprotocol]`` (:class:`RigOpenProtocolSection`) is the other side:
 how the simulated controller of ``services/rig`` behaves toward a bridge
@@ -88,8 +90,10 @@ class OpenProtocolSection(StrictModel):
         le=999,
         description="highest revision of MID 0061 to ask for (lower ones on error 97)",
     )
-    trace_byte_order: Literal["big", "little"] = Field(
-        default="big", description="byte order of MID 0900 samples"
+    trace_byte_order: Literal["auto", "big", "little"] = Field(
+        default="auto",
+        description="byte order of MID 0900 samples; auto: the one whose curves agree with "
+        "their results (big tried first), found once and kept",
     )
     header_fill: Literal["spaces", "zeros"] = Field(
         default="spaces", description="how the controller fills unused header fields"

@@ -34,13 +34,14 @@ samples counted in the length or not.
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import math
 import struct
 from dataclasses import dataclass
 from typing import ClassVar, Final, Self
 
-from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect
+from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect, TraceByteOrder
 from shared.openprotocol.errors import OpenProtocolError
 from shared.openprotocol.timestamps import parse_timestamp
 
@@ -181,6 +182,14 @@ class TraceCurve:
     transducer_type: int = 0
     pid_fields: tuple[VariableField, ...] = ()
     revision: int = 1
+    #: the samples as they came (2 bytes each; empty for a curve built, not read)
+    sample_bytes: bytes = dataclasses.field(default=b"", compare=False, repr=False)
+
+    def read_samples(self, byte_order: TraceByteOrder, factor: float) -> tuple[float, ...]:
+        """The samples as they came, read in ``byte_order`` times ``factor``."""
+        order = ">" if byte_order == "big" else "<"
+        raw = struct.unpack(f"{order}{len(self.sample_bytes) // 2}h", self.sample_bytes)
+        return tuple(value * factor for value in raw)
 
     @classmethod
     def build(
@@ -260,6 +269,7 @@ class TraceCurve:
             transducer_type=transducer_type,
             pid_fields=pid_fields,
             revision=revision,
+            sample_bytes=bytes(rest),
         )
 
     def to_data(self, revision: int, dialect: Dialect = DEFAULT_DIALECT) -> bytes:

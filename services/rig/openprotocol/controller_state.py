@@ -82,7 +82,7 @@ class ControllerState:
         self.identity = ControllerIdentity(station_id, tool_id, zoneinfo.ZoneInfo(section.timezone))
         self.dialect = Dialect(
             header_fill="space" if section.header_fill == "spaces" else "zero",
-            trace_byte_order=section.trace_byte_order,
+            trace_byte_order="little" if section.trace_byte_order == "little" else "big",
         )
         self._program = program
         started = started or dt.date.today()

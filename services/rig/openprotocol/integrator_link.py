@@ -15,6 +15,9 @@ What it answers, as real controllers do:
 - 0060 / 0008 (of MID 0900) / 0070 -> 0005, or 0004: 97 (revision), 9 / 71 /
   11 (already subscribed), 73 (0008 of a MID other than 0900), 74 (0900 at a
   revision the codec lacks); 0063 / 0009 / 0073 -> 0005 or 0004 10 / 72 / 12.
+  The 0005 of a 0008 / 0009 names the MID subscribed for (0900), as the
+  specification words it ("MID 0005 Command accepted with the MID subscribed
+  for"); the 0004 of a refused one names 0008 / 0009.
   After 0070 the alarm status (0076) follows.
 - 0061 pushed to a result subscriber, one at a time: the next waits for the
   0062 of the one before (queued, newest last, never more than the store
@@ -253,7 +256,7 @@ class IntegratorLink:
             self._refuse(frame.mid, ErrorCode.SUBSCRIPTION_MISSING)
             return
         self.trace_revision = None
-        self._accept(frame.mid)
+        self._accept(message.mid)  # "accepted with the MID subscribed for", as for 0008
 
     def _tool_data(self, _message: object, frame: Frame, _now: float) -> None:
         self._send(self._state.tool_data(frame.revision))
@@ -301,7 +304,7 @@ class IntegratorLink:
             return
         self.trace_revision = message.wanted_revision
         self.trace_types = tuple(kind for kind in asked if kind in TRACE_TYPES)
-        self._accept(frame.mid)
+        self._accept(message.mid)  # the specification: "accepted with the MID subscribed for"
 
     def _old_result(self, message: object, frame: Frame, _now: float) -> None:
         assert isinstance(message, OldResultRequest)

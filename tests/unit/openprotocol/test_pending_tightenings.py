@@ -5,7 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 
 from services.openprotocol.controller_tightening import Curve, ResultFigures
-from services.openprotocol.pending_tightenings import MAX_FILL, PendingTightenings
+from services.openprotocol.pending_tightenings import (
+    KEYS_KEPT,
+    MAX_FILL,
+    PendingTightenings,
+    Take,
+)
 from services.openprotocol.published_ids import (
     BridgePosition,
     read_position,
@@ -13,7 +18,13 @@ from services.openprotocol.published_ids import (
 )
 
 
-def figures(tightening_id: int, filled: bool = False) -> ResultFigures:
+def key(tightening_id: int, time: str = "2026-11-24:10:00:00") -> str:
+    return f"{time}|1|200.00|50|1|VIN{tightening_id}"
+
+
+def figures(
+    tightening_id: int, filled: bool = False, time: str = "2026-11-24:10:00:00"
+) -> ResultFigures:
     return ResultFigures(
         tightening_id=tightening_id,
         program_id=1,
@@ -33,6 +44,7 @@ def figures(tightening_id: int, filled: bool = False) -> ResultFigures:
         strategy="",
         revision=2,
         filled=filled,
+        key=key(tightening_id, time),
     )
 
 
@@ -43,7 +55,7 @@ def curve(tightening_id: int, kind: str) -> Curve:
 def test_a_result_waits_for_both_curves_which_may_come_before_or_after_it() -> None:
     pending = PendingTightenings(watermark=4, wait_for_curves=True, trace_timeout_s=3.0)
     assert pending.curve(curve(5, "torque"), 0.0)
-    assert pending.result(figures(5), 0.1)
+    assert pending.result(figures(5), 0.1) is Take.NEW
     assert list(pending.ready(0.2)) == []
     assert pending.curve(curve(5, "angle"), 0.3)
     (tightening,) = pending.ready(0.3)
@@ -64,10 +76,10 @@ def test_a_result_whose_curves_never_come_goes_without_them_after_the_timeout() 
 
 
 def test_repeats_are_refused_and_order_is_kept_across_a_gap() -> None:
-    pending = PendingTightenings(watermark=10, wait_for_curves=False, trace_timeout_s=3.0)
-    assert not pending.result(figures(10), 0.0), "at the watermark: published already"
-    assert pending.result(figures(14), 0.0)
-    assert not pending.result(figures(14), 0.0), "pending already"
+    pending = PendingTightenings.resume(10, {10: key(10)}, False, 3.0)
+    assert pending.result(figures(10), 0.0) is Take.REPEAT, "at the watermark: published"
+    assert pending.result(figures(14), 0.0) is Take.NEW
+    assert pending.result(figures(14), 0.0) is Take.REPEAT, "pending already"
     assert list(pending.ready(0.0)) == [], "11 to 13 come first"
     assert pending.missing() == [11, 12, 13]
     pending.result(figures(11, filled=True), 0.0)
@@ -115,3 +127,52 @@ def test_a_new_epoch_gives_run_ids_after_every_one_published() -> None:
     assert epoch == BridgePosition(0, 41, "b")
     assert epoch.run_id(1) == 42
     assert epoch.new_epoch("c").run_id(1) == 42, "an epoch without a tightening moves nothing"
+
+
+def test_an_id_published_with_another_key_or_none_kept_is_a_conflict_not_a_repeat() -> None:
+    """A controller whose ids wrapped or started again sends ids published already."""
+    pending = PendingTightenings.resume(10, {9: key(9), 10: key(10)}, False, 3.0)
+    assert pending.result(figures(9), 0.0) is Take.REPEAT
+    assert pending.result(figures(9, time="2026-11-25:08:00:00"), 0.0) is Take.CONFLICT
+    assert pending.result(figures(1), 0.0) is Take.CONFLICT, "no key kept for id 1"
+    assert pending.result(figures(11), 0.0) is Take.NEW
+    assert pending.result(figures(11, time="2026-11-25:08:00:00"), 0.0) is Take.CONFLICT
+
+
+def test_published_keys_are_bounded_and_kept_in_id_order() -> None:
+    pending = PendingTightenings(watermark=0, wait_for_curves=False, trace_timeout_s=3.0)
+    for tightening_id in range(1, KEYS_KEPT + 21):
+        assert pending.result(figures(tightening_id), 0.0) is Take.NEW
+    assert len(list(pending.ready(0.0))) == KEYS_KEPT + 20
+    assert list(pending.published_keys) == list(range(21, KEYS_KEPT + 21))
+
+
+def test_a_flood_of_results_is_never_given_up_however_many_came() -> None:
+    """3000 results pushed as fast as the link takes them, their curves still to come:
+    every one is here, none is fetched or given up, all go out once, in order."""
+    pending = PendingTightenings(watermark=0, wait_for_curves=True, trace_timeout_s=3.0)
+    for tightening_id in range(1, 3001):
+        assert pending.result(figures(tightening_id), 0.0) is Take.NEW
+        assert pending.missing() == []
+    assert pending.given_up == 0
+    assert [t.result.tightening_id for t in pending.ready(3.0)] == list(range(1, 3001))
+
+
+def test_a_gap_beyond_the_bound_never_passes_a_result_that_is_here() -> None:
+    pending = PendingTightenings(watermark=0, wait_for_curves=False, trace_timeout_s=3.0)
+    pending.result(figures(5), 0.0)  # here, far below the newest
+    pending.controller_newest(MAX_FILL + 500)
+    assert pending.missing() == list(range(501, MAX_FILL + 501))
+    assert pending.watermark == 4, "ids 1 to 4 given up, 5 is here"
+    assert [t.result.tightening_id for t in pending.ready(0.0)] == [5]
+    assert pending.watermark == 500
+    assert pending.given_up == 499
+
+
+def test_drain_hands_out_what_is_pending_in_id_order_and_gives_the_gaps_up() -> None:
+    pending = PendingTightenings(watermark=2, wait_for_curves=True, trace_timeout_s=3.0)
+    for tightening_id in (7, 4, 5):
+        pending.result(figures(tightening_id), 0.0)
+    assert [t.result.tightening_id for t in pending.drain()] == [4, 5, 7]
+    assert pending.watermark == 7 and pending.given_up == 2  # 3 and 6
+    assert pending.waiting_results() == 0

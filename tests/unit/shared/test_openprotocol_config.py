@@ -45,7 +45,7 @@ def test_the_shipped_example_loads_with_its_stated_defaults(tmp_path: Path) -> N
     assert (bridge.port, bridge.keep_alive_s, bridge.result_revision) == (4545, 10.0, 2)
     assert (bridge.reconnect_min_s, bridge.reconnect_max_s) == (1.0, 30.0)
     assert (bridge.trace_byte_order, bridge.header_fill, bridge.timezone) == (
-        "big",
+        "auto",
         "spaces",
         "UTC",
     )
@@ -92,7 +92,7 @@ def test_a_controller_time_zone_by_its_iana_name(tmp_path: Path) -> None:
         ),
         (
             'host = "h"\ntrace_byte_order = "middle"',
-            "openprotocol.trace_byte_order: Input should be 'big' or 'little'",
+            "openprotocol.trace_byte_order: Input should be 'auto', 'big' or 'little'",
         ),
         (
             'host = "h"\nheader_fill = "nul"',

@@ -15,6 +15,7 @@ from shared.config import load_station
 from shared.openprotocol.codec import WireMessage, decode, encode
 from shared.openprotocol.framing import Frame, FrameReader, frame_bytes
 from shared.openprotocol.session import CommandAccepted, CommandError
+from shared.openprotocol.subscriptions import DataSubscribe
 from tests.live_recorder import free_port
 from tests.paths import CONFIG, STATION_FILE
 
@@ -148,9 +149,12 @@ class RawIntegrator:
         return self.receive()
 
     def accepted(self, message: WireMessage, revision: int | None = None) -> None:
+        """The 0005 of ``message``: naming its MID, or for 0008 / 0009 the MID subscribed
+        for (the specification's "accepted with the MID subscribed for")."""
         answer = self.request(message, revision)
         assert isinstance(answer, CommandAccepted), answer
-        assert answer.mid == message.MID, answer
+        named = message.mid if isinstance(message, DataSubscribe) else message.MID
+        assert answer.mid == named, answer
 
     def refused(self, message: WireMessage, revision: int | None = None) -> CommandError:
         answer = self.request(message, revision)
