@@ -90,6 +90,10 @@ def bridge_line(stats: BridgeStats) -> str:
         "controller errors": stats.controller_errors,
         "curves without result": stats.traces_without_result,
         "results without curves": stats.results_without_traces,
+        "curves refused": stats.traces_refused,
+        "results given up": stats.results_given_up,
+        "new controller epochs": stats.epochs,
+        "controller times refused": stats.clock_refused,
     }
     noted = ", ".join(f"{count} {name}" for name, count in faults.items() if count)
     return (

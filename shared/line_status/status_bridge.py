@@ -4,13 +4,14 @@ From the latest :class:`~shared.messages.BridgeStats` on
 ``boltwatch/<st>/openprotocol`` (once a second from ``boltwatch serve
 openprotocol``): whether the controller link is up, to which ``host:port``,
 the revision of MID 0061 in use, the results published and the last
-tightening id, and the bridge's fault counters that are not zero (link
-drops, results filled after a reconnect, repeated results, garbage bytes,
-bad messages, refused values, controller errors, traces without result);
-from :class:`~shared.messages.ControllerAlarm` on ``boltwatch/<st>/alarms``:
-the newest alarm still active (each error code's latest word counts; a
-status saying no alarm is active clears them all). A station without a
-bridge shows none of these lines. Collected by
+tightening id, how its 0900 samples read, and the bridge's counters that are
+not zero (:data:`FAULTS`); the alarm active on the controller: the one the
+bridge's latest stats carry (it keeps the controller's alarm state, whether
+or not status heard the alarm), or, without stats in the window, the newest
+still active of the :class:`~shared.messages.ControllerAlarm` heard on
+``boltwatch/<st>/alarms`` (each error code's latest word counts; a status
+saying no alarm is active clears them all). A station without a bridge shows
+none of these lines. Collected by
 :mod:`shared.line_status.station_status`, printed by :mod:`services.cli.station_status_text`.
 """
 
@@ -37,6 +38,11 @@ FAULTS = (
     ("bad_messages", "bad messages"),
     ("refused_values", "refused values"),
     ("controller_errors", "controller errors"),
+    ("results_without_traces", "results without curves"),
+    ("traces_refused", "curves refused"),
+    ("results_given_up", "results given up"),
+    ("epochs", "new controller epochs"),
+    ("clock_refused", "controller times refused"),
 )
 
 
@@ -85,6 +91,7 @@ class BridgeStatus:
     last_error: str | None
     age_s: float | None  # since the latest BridgeStats was received; None: none (alarms only)
     alarm: ActiveAlarm | None  # the newest active alarm
+    trace_reading: str | None = None  # how the controller's 0900 samples read right
 
 
 def bridge_status(seen: BridgeSeen, now_ns: int) -> BridgeStatus | None:
@@ -92,8 +99,11 @@ def bridge_status(seen: BridgeSeen, now_ns: int) -> BridgeStatus | None:
     stats = seen.stats
     if stats is None and not seen.alarms:
         return None
-    active = [alarm for alarm in seen.alarms.values() if alarm.active]
-    newest = max(active, key=lambda alarm: alarm.time_ns) if active else None
+    if stats is not None:
+        newest = stats.active_alarm
+    else:
+        active = [alarm for alarm in seen.alarms.values() if alarm.active]
+        newest = max(active, key=lambda alarm: alarm.time_ns) if active else None
     alarm = None
     if newest is not None:
         alarm = ActiveAlarm(
@@ -117,6 +127,7 @@ def bridge_status(seen: BridgeSeen, now_ns: int) -> BridgeStatus | None:
         last_error=stats.last_error,
         age_s=round((now_ns - seen.stats_received_ns) / _NS, 3),
         alarm=alarm,
+        trace_reading=stats.trace_reading,
     )
 
 
@@ -141,6 +152,8 @@ def _link_text(status: BridgeStatus) -> str:
         f"{link} {status.controller}, MID 0061 revision {revision}, {status.results} results, "
         f"last tightening {last} ({status.connects} connects, {status.age_s:.1f} s ago)"
     )
+    if status.trace_reading:
+        text += f"; curves read {status.trace_reading}"
     if status.last_error:
         text += f"; last error: {status.last_error}"
     return text
