@@ -7,7 +7,10 @@ no parameter ids::
 
 The 0008 header revision is 0008's own; the revision of the data MID asked is
 the second field (OpenProtocolInterpreter ``Mid0008.cs``). The controller
-answers 0005 (command accepted, data "0008") or 0004.
+answers 0005 (command accepted, data "0008") or 0004. Reading also takes data
+that stops after the wanted revision (no extra data length field) as no extra
+data: node-open-protocol's test ``test/0008.spec.js`` "parser rev 1 without
+extraData" reads "0900001" so; writing always gives the length ("00").
 
 **Acknowledging a pushed 0900**: the integrator answers each 0900 with 0005
 command accepted whose data is "0900" (:class:`~.session.CommandAccepted`
@@ -33,6 +36,7 @@ from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect
 from shared.openprotocol.errors import OpenProtocolError
 from shared.openprotocol.fields import Spec, decode_fields, encode_fields
 
+_NO_LENGTH = 7  # subscription MID and wanted revision only
 _HEAD = (
     Spec("mid", "subscription mid", 4, low=1),
     Spec("wanted_revision", "wanted revision", 3, low=1),
@@ -56,6 +60,8 @@ class DataSubscribe:
 
     @classmethod
     def from_data(cls, data: bytes, revision: int, dialect: Dialect = DEFAULT_DIALECT) -> Self:
+        if len(data) == _NO_LENGTH:
+            data += b"00"  # node-open-protocol's "0900001": no extra data length, no extra data
         values = decode_fields(data, _HEAD, cls.MID, revision)
         extra_length = values.pop("extra_length")
         assert isinstance(extra_length, int)
