@@ -7,6 +7,8 @@ source), each naming where it comes from. For every example:
 - it decodes, and the values the source states come out (``expect``);
 - unless ``roundtrip = false`` (the entry says why: a header or padding variant
   that ``encode`` does not write), ``encode`` gives the same bytes back;
+- a 0900 subscription (0008) asks the trace types the source states
+  (``trace_types``);
 - an example of a revision the codec does not implement is refused naming the
   revision (``refused = "revision"``), and one with content the codec refuses
   (``refused = "<field>"``) names that field: both are listed, not hidden.
@@ -31,12 +33,13 @@ from shared.openprotocol.codec import KNOWN_MIDS, UnknownMessage, decode, encode
 from shared.openprotocol.dialect import Dialect
 from shared.openprotocol.errors import OpenProtocolError
 from shared.openprotocol.framing import Frame, FrameReader, frame_bytes
+from shared.openprotocol.subscriptions import DataSubscribe, trace_types_of
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[3] / "data" / "openprotocol" / "examples"
 SENDERS = {"controller", "integrator"}
 ENTRY_KEYS = {
     "id", "source", "mid", "revision", "sender", "wire", "tail_hex", "data", "expect",
-    "refused", "roundtrip", "variant", "header_fill", "trace_byte_order", "note",
+    "refused", "roundtrip", "variant", "header_fill", "trace_byte_order", "trace_types", "note",
 }  # fmt: skip
 
 
@@ -52,17 +55,19 @@ class Example:
     expect: dict[str, Any] = field(default_factory=dict)
     refused: str | None = None
     roundtrip: bool = True
+    trace_types: tuple[int, ...] | None = None
 
 
 def _example(entry: dict[str, Any], file: str) -> Example:
     unknown = set(entry) - ENTRY_KEYS
     assert not unknown, f"{file} {entry.get('id')}: unknown keys {unknown}"
     assert ("wire" in entry) != ("data" in entry), f"{file} {entry['id']}: wire or data"
+    tail = bytes.fromhex(entry.get("tail_hex", ""))
     if "data" in entry:
-        frame = Frame(mid=entry["mid"], revision=entry["revision"], data=entry["data"].encode())
-        wire = frame_bytes(frame)
+        data = entry["data"].encode("latin-1") + tail
+        wire = frame_bytes(Frame(mid=entry["mid"], revision=entry["revision"], data=data))
     else:
-        wire = entry["wire"].encode("latin-1") + bytes.fromhex(entry.get("tail_hex", ""))
+        wire = entry["wire"].encode("latin-1") + tail
     assert entry["sender"] in SENDERS, f"{file} {entry['id']}: sender"
     assert entry.get("roundtrip", True) or entry.get("variant"), f"{entry['id']}: say why"
     dialect = Dialect(
@@ -82,6 +87,7 @@ def _example(entry: dict[str, Any], file: str) -> Example:
         expect=entry.get("expect", {}),
         refused=entry.get("refused"),
         roundtrip=entry.get("roundtrip", True) and "refused" not in entry,
+        trace_types=tuple(entry["trace_types"]) if "trace_types" in entry else None,
     )
 
 
@@ -96,6 +102,7 @@ def _load() -> list[Example]:
 EXAMPLES = _load()
 DECODED = [e for e in EXAMPLES if e.refused is None]
 ROUND_TRIPS = [e for e in DECODED if e.roundtrip]
+TRACE_SUBSCRIPTIONS = [e for e in DECODED if e.trace_types is not None]
 REFUSED_REVISIONS = [e for e in EXAMPLES if e.refused == "revision"]
 REFUSED_CONTENT = [e for e in EXAMPLES if e.refused not in (None, "revision")]
 
@@ -158,6 +165,13 @@ def test_encodes_back_to_the_same_bytes(example: Example) -> None:
     assert not isinstance(message, UnknownMessage)
     wire = encode(message, revision=frame.revision, dialect=example.dialect, no_ack=frame.no_ack)
     assert wire == example.wire, example.source
+
+
+@pytest.mark.parametrize("example", TRACE_SUBSCRIPTIONS, ids=_ids(TRACE_SUBSCRIPTIONS))
+def test_a_0900_subscription_asks_the_trace_types_the_source_states(example: Example) -> None:
+    message = decode(_frame(example), dialect=example.dialect)
+    assert isinstance(message, DataSubscribe)
+    assert trace_types_of(message.extra_data) == example.trace_types, example.source
 
 
 @pytest.mark.parametrize("example", REFUSED_REVISIONS, ids=_ids(REFUSED_REVISIONS))
