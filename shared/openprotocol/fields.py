@@ -13,7 +13,11 @@ Kinds:
   "001234" is 12.34 Nm), read as float;
 - ``flag``: one digit 0/1, read as bool;
 - ``enum``: digits read as the ``enum`` IntEnum given; other values refused;
-- ``text``: characters (latin-1), trailing spaces stripped on reading;
+- ``text``: characters (latin-1), written left-aligned (padded with spaces at
+  the end); spaces stripped at both ends on reading: controllers also pad on
+  the left (OpenProtocolInterpreter's test ``TestMid0061.Mid0061Revision2``
+  carries the tool serial "      C0761275", ``TestMid0076.Mid0076Revision2``
+  the error code " E851"; node-open-protocol trims both ends of every text);
 - ``timestamp``: ``YYYY-MM-DD:HH:MM:SS`` kept as text, checked to exist.
 
 Data longer than the layout is tolerated (fields of a later revision); shorter
@@ -123,7 +127,7 @@ def _in_range(spec: Spec, number: int, shown: str) -> int:
 
 def _read(spec: Spec, text: str) -> object:
     if spec.kind == "text":
-        return text.rstrip(" ")
+        return text.strip(" ")
     if spec.kind == "timestamp":
         parse_timestamp(text)
         return text

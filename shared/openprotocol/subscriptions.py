@@ -7,20 +7,38 @@ no parameter ids::
 
 The 0008 header revision is 0008's own; the revision of the data MID asked is
 the second field (OpenProtocolInterpreter ``Mid0008.cs``). The controller
-answers 0005 (command accepted, data "0008") or 0004.
+answers 0005 (command accepted, data "0008") or 0004. Reading also takes data
+that stops after the wanted revision (no extra data length field) as no extra
+data: node-open-protocol's test ``test/0008.spec.js`` "parser rev 1 without
+extraData" reads "0900001" so; writing always gives the length ("00").
 
 **Acknowledging a pushed 0900**: the integrator answers each 0900 with 0005
 command accepted whose data is "0900" (:class:`~.session.CommandAccepted`
-with ``mid=900``), as node-open-protocol's 0900 serializer does; there is no
-0900-specific acknowledge MID. A subscription with the header no-ack flag
+with ``mid=900``), as the 0900 serializer of the node-open-protocol-v2 fork
+(diwakrZha, ``src/mid/0900.js``, test "Serializer acknowledgment") does and as
+the specification's 5.27.1 answers 0900 ("MID 0005 Command accepted"); there
+is no 0900-specific acknowledge MID. A subscription with the header no-ack flag
 asks for none.
 
-**0900 extra data** (:func:`trace_extra_data`), as node-open-protocol sends
-it (the only public reading found): result data id to start from (10 digits,
-0 = new results only), a time stamp (19 characters, zeros = none), the number
-of trace types (3 digits) and each trace type (3 digits: 001 angle, 002
-torque, 003 current...), e.g. 29 zeros + "003001002003" for angle, torque
-and current.
+**0900 extra data** (:func:`trace_extra_data`, :func:`trace_types_of`), the
+specification's Table 158 (Open Protocol 2.8.0, 5.27.1.1)::
+
+    send alternative (1: 0 new data only, 1 from an index, 2 from a time stamp,
+    3 between two indexes, 4 between two Unix times)
+    | alternatives 0-2: time stamp (19) | index (10)
+    | alternatives 3-4: first (10) | last (10)
+    | number of trace types (2) | trace type (3) per type: 001 angle, 002 torque...
+
+Fields not used are zeros (the table) or spaces (the specification's own
+example: "0", 29 spaces, "01001", extra data length 35, for angle only); both
+are read. Bytes after the trace types are ignored: the example of 5.2.7, which
+node-open-protocol's ``test/0008.spec.js`` quotes, ends its 39 bytes with one
+more "0". Written: zeros, e.g. 30 zeros + "03001002003" for angle, torque and
+current, as the node-open-protocol-v2 fork (diwakrZha) sends it from
+``src/mid/0900.js``. An earlier reading here (result id (10) | time stamp (19)
+| number of types (3)) gave the same bytes for new data only and the
+specification's types, but refused the example's spaces and put a start index
+where the send alternative belongs.
 """
 
 from __future__ import annotations
@@ -33,6 +51,7 @@ from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect
 from shared.openprotocol.errors import OpenProtocolError
 from shared.openprotocol.fields import Spec, decode_fields, encode_fields
 
+_NO_LENGTH = 7  # subscription MID and wanted revision only
 _HEAD = (
     Spec("mid", "subscription mid", 4, low=1),
     Spec("wanted_revision", "wanted revision", 3, low=1),
@@ -56,6 +75,8 @@ class DataSubscribe:
 
     @classmethod
     def from_data(cls, data: bytes, revision: int, dialect: Dialect = DEFAULT_DIALECT) -> Self:
+        if len(data) == _NO_LENGTH:
+            data += b"00"  # node-open-protocol's "0900001": no extra data length, no extra data
         values = decode_fields(data, _HEAD, cls.MID, revision)
         extra_length = values.pop("extra_length")
         assert isinstance(extra_length, int)
@@ -90,24 +111,37 @@ class DataUnsubscribe(DataSubscribe):
     MID: ClassVar[int] = 9
 
 
+_SEND_NEW, _SEND_FROM_INDEX = 0, 1
+_TYPES_AT = {0: 30, 1: 30, 2: 30, 3: 21, 4: 21}  # where the number of trace types starts
+
+
 def trace_extra_data(trace_types: Sequence[int], *, from_result_id: int = 0) -> str:
-    """The 0008 extra data asking 0900 curves of ``trace_types`` (1 angle, 2 torque, ...)."""
+    """The 0008 extra data asking 0900 curves of ``trace_types`` (1 angle, 2 torque, ...).
+
+    ``from_result_id`` 0: new results only (send alternative 0); else the
+    stored results from that index on (send alternative 1).
+    """
     if not 0 <= from_result_id < 10**10:
         raise OpenProtocolError(8, "extra data", f"result id {from_result_id} is not 10 digits")
-    if not 1 <= len(trace_types) <= 999 or not all(0 < t < 1000 for t in trace_types):
-        why = f"trace types {list(trace_types)} are not 1 to 999 numbers of 1..999"
+    if not 1 <= len(trace_types) <= 99 or not all(0 < t < 1000 for t in trace_types):
+        why = f"trace types {list(trace_types)} are not 1 to 99 numbers of 1..999"
         raise OpenProtocolError(8, "extra data", why)
+    send = _SEND_FROM_INDEX if from_result_id else _SEND_NEW
     kinds = "".join(f"{t:03d}" for t in trace_types)
-    return f"{from_result_id:010d}{'0' * 19}{len(trace_types):03d}{kinds}"
+    return f"{send}{'0' * 19}{from_result_id:010d}{len(trace_types):02d}{kinds}"
 
 
 def trace_types_of(extra_data: str) -> tuple[int, ...]:
     """The trace types a 0900 subscription's extra data asks (see :func:`trace_extra_data`)."""
-    count_text = extra_data[29:32]
-    if not count_text.isdigit():
+    send = extra_data[:1]
+    if not send.isdigit() or int(send) not in _TYPES_AT:
+        raise OpenProtocolError(8, "extra data", f"'{send}' is not a send alternative (0..4)")
+    at = _TYPES_AT[int(send)]
+    count_text = extra_data[at : at + 2]
+    if len(count_text) != 2 or not count_text.isdigit():
         raise OpenProtocolError(8, "extra data", f"'{count_text}' is not a number of trace types")
     count = int(count_text)
-    kinds = extra_data[32 : 32 + 3 * count]
+    kinds = extra_data[at + 2 : at + 2 + 3 * count]
     if len(kinds) != 3 * count or not kinds.isdigit():
         raise OpenProtocolError(8, "extra data", f"'{kinds}' is not {count} trace types")
     return tuple(int(kinds[i : i + 3]) for i in range(0, len(kinds), 3))

@@ -17,12 +17,21 @@ Samples are signed 16-bit integers; a parameter data field gives their
 scaling: PID 02214 "coefficient", value = raw * coefficient, or PID 02213,
 value = raw / divisor. Time units: 200 s, 201 min, 202 ms, 203 h.
 
-Sources: node-open-protocol (``src/mid/0900.js``, ``helpers.js``
-``processTraceSamples``), OpenProtocolInterpreter's 0900 (commit 7bcd0a4) and
-the Rust crate (``messages/tightening_result.rs``, ``types/trace.rs``). They
-agree on the layout above and on big-endian samples; they disagree on the
-sign: node and OpenProtocolInterpreter read signed 16-bit, the Rust crate
-unsigned. Signed is taken (a loosening or a rebound gives negative torque).
+Sources: the specification (Open Protocol 2.8.0, 5.27.1, Table 157: the layout
+above, a NUL before the samples, "divide by PID 02213 or multiply by PID
+02214"; its example's first samples are the bytes 0x01 0x02, 0x02 0x04, i.e.
+big-endian), node-open-protocol (the diwakrZha v2 fork's ``src/mid/0900.js``
+and ``helpers.js`` ``processTraceSamples``), OpenProtocolInterpreter's 0900
+(commit 7bcd0a4, never merged) and the Rust crate (``messages/
+tightening_result.rs``, ``types/trace.rs``). They agree on the layout and on
+big-endian samples; they disagree on the sign, which the specification does
+not state: the node fork reads signed 16-bit, OpenProtocolInterpreter's
+commit (``(short)hi << 8 | lo`` into a float: no sign extension) and the Rust
+crate (``u16``) unsigned. Signed is taken: a loosening or a rebound gives
+negative torque, and the node fork's ``src/MID0900_example.json``, a curve of
+a real controller parsed by it, has raw samples -1, 3, 9, 15... at coefficient 0.001417
+(read unsigned, the -1 would be 92.9 Nm before the rundown). No public example gives
+the bytes of a whole real 0900 (see tests/data/openprotocol/examples).
 Trace types (Rust crate ``TraceType``): 1 angle, 2 torque, 3 current,
 4 gradient, 5 stroke, 6 force.
 

@@ -129,7 +129,7 @@ def test_trace_subscription_refuses_impossible_requests() -> None:
     with pytest.raises(OpenProtocolError) as refused:
         trace_extra_data([])
     assert str(refused.value) == (
-        "MID 0008, field 'extra data': trace types [] are not 1 to 999 numbers of 1..999"
+        "MID 0008, field 'extra data': trace types [] are not 1 to 99 numbers of 1..999"
     )
 
 

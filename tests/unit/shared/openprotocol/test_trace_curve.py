@@ -90,9 +90,13 @@ def test_several_pid_and_resolution_fields_are_kept() -> None:
     assert trace.time_step_s == 0.0005
 
 
-def test_the_0900_subscription_asks_trace_types_from_a_result_id() -> None:
+def test_the_0900_subscription_asks_trace_types_new_or_from_a_result_id() -> None:
     extra = trace_extra_data([TraceType.ANGLE, TraceType.TORQUE, TraceType.CURRENT])
-    assert extra == "0" * 29 + "003001002003"
+    assert extra == "0" + "0" * 19 + "0" * 10 + "03" + "001002003"  # send alternative 0
     assert trace_types_of(extra) == (1, 2, 3)
+    from_345 = trace_extra_data([TraceType.TORQUE], from_result_id=345)
+    assert from_345 == "1" + "0" * 19 + "0000000345" + "01" + "002"  # send alternative 1
+    assert trace_types_of(from_345) == (2,)
+    assert trace_types_of("3" + "0000000001" + "0000000009" + "01001") == (1,)
     subscribe = DataSubscribe(mid=900, wanted_revision=1, extra_data=extra)
     assert encode(subscribe) == b"00700008001         090000141" + extra.encode() + b"\x00"
