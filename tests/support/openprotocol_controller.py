@@ -24,9 +24,11 @@ boltwatch's own codec. The behaviour, by section:
   `max_tool_revision`).
 - 5.2.7 / 5.27.1: MID 0008 for MID 0900 is answered by MID 0005 "with the MID subscribed
   for" (`accept_names="subscribed"`, data 0900) or, as some controllers do, naming MID 0008
-  (`"subscribing"`); errors 73 (MID other than 0900), 74 (revision), 71, 78, 01. Then every
-  tightening with curves pushes one MID 0900 per subscribed trace type; the integrator
-  acknowledges each with MID 0005 naming 0900. MID 0009 unsubscribes.
+  (`"subscribing"`); errors 73 (a MID it does not push), 74 (revision), 71, 78, 01. Then
+  every tightening with curves pushes one MID 0900 per subscribed trace type; the integrator
+  acknowledges each with MID 0005 naming 0900. MID 0009 unsubscribes (72 if not subscribed).
+  As 3.9.4 says the generic subscription substitutes MID 0060 and 0070, MID 0008 for MID
+  0061 or 0071 subscribes to those too.
 - 5.28.1: MID 9999 is mirrored (`mirror_keep_alive`); a link on which nothing is heard for
   `link_timeout_s` (15 s in the specification) is closed.
 - 5.2.4: any other MID: MID 0004 error 99; a revision field that is not digits: error 97.
@@ -318,40 +320,59 @@ class SpecController(ControllerCore):
         return subscribed_mid if self.accept_names == "subscribed" else m.mid
 
     def _on_generic_subscribe(self, link: Link, m: Message) -> None:
+        """MID 0008: MID 0900, or MID 0061 / 0071 in place of MID 0060 / 0070 (3.9.4)."""
         parsed = self._generic(link, m)
         if parsed is None:
             return
         mid, revision, extra = parsed
         named = self._named(m, mid)
-        if mid != TRACE_MID:
+        highest = {
+            61: self.max_result_revision,
+            71: self.max_alarm_revision,
+            TRACE_MID: self.max_trace_revision,
+        }
+        if mid not in highest:
             self._error(link, named, Error.SUBSCRIBED_MID_UNSUPPORTED)
-        elif revision > self.max_trace_revision:
+            return
+        if revision > highest[mid]:
             self._error(link, named, Error.SUBSCRIBED_MID_REVISION_UNSUPPORTED)
-        elif TRACE_MID in self.subscriptions:
+            return
+        if mid in self.subscriptions:
             self._error(link, named, Error.SUBSCRIPTION_EXISTS)
-        else:
+            return
+        if mid == TRACE_MID:
             types = trace_subscription(extra)
             if isinstance(types, Error):
                 self._error(link, named, types)
                 return
-            self.subscriptions[TRACE_MID] = revision
             link.trace_types = types
-            self._accept_command(link, named)
+        link.result_no_ack = m.no_ack if mid == 61 else link.result_no_ack
+        self.subscriptions[mid] = revision
+        self._accept_command(link, named)
+        if mid == 71:
+            self._send(link, 76, msg.alarm_status(self.alarm, revision, time.time()), revision)
 
     def _on_generic_unsubscribe(self, link: Link, m: Message) -> None:
+        """MID 0009: the subscribed MID's subscription ends (for MID 0900, per trace type)."""
         parsed = self._generic(link, m)
         if parsed is None:
             return
         mid, _, extra = parsed
         named = self._named(m, mid)
-        if mid != TRACE_MID or TRACE_MID not in self.subscriptions:
+        if mid not in self.subscriptions:
             self._error(link, named, Error.SUBSCRIPTION_MISSING)
             return
-        left = trace_unsubscription(extra, link.trace_types)
-        if isinstance(left, Error):
-            self._error(link, named, left)
-            return
-        link.trace_types = left
-        if not left:
-            del self.subscriptions[TRACE_MID]
+        if mid == TRACE_MID:
+            left = trace_unsubscription(extra, link.trace_types)
+            if isinstance(left, Error):
+                self._error(link, named, left)
+                return
+            link.trace_types = left
+            if left:
+                self._accept_command(link, named)
+                return
+        del self.subscriptions[mid]
+        if mid == 61:
+            link.results_due.clear()
+            link.in_flight = None
         self._accept_command(link, named)

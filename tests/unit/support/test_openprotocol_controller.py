@@ -392,3 +392,28 @@ def test_the_controller_reads_any_split_of_the_integrators_stream(
     assert client.closed()
     assert controller.link_ends == ["unreadable stream"]
     assert controller.protocol_errors == ["unreadable length b'00x0'"]
+
+
+def test_generic_subscriptions_stand_for_0060_and_end_with_0009(
+    controller: SpecController,
+) -> None:
+    client = Client(controller.port)
+    client.start()
+    client.send(8, "0061002000")
+    assert client.expect(5)[20:24] == b"0061"
+    controller.tighten()
+    assert len(client.expect(61)) == 385  # revision 2, as the MID 0008 asked
+    client.send(62)
+    client.send(8, "0900001" + "38" + "0" + " " * 29 + "02001002")
+    client.expect(5)
+    client.send(9, "0900001" + "05" + "01001")
+    assert client.expect(5)[20:24] == b"0900"
+    assert controller.wait_for(lambda: controller.subscriptions == {61: 2, 900: 1})
+    client.send(9, "0061001000")
+    client.expect(5)
+    controller.tighten()
+    assert len(client.expect(900)) > 600 and client.silent()  # the torque trace, no result
+    client.send(9, "0900001" + "05" + "01001")
+    assert client.expect(4)[20:26] == b"090072"
+    client.send(8, "0061003000")
+    assert client.expect(4)[20:26] == b"006174"
