@@ -1,0 +1,1 @@
+"""Tests of the test support: doubles that speak real protocols."""
