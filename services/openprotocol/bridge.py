@@ -176,6 +176,8 @@ class OpenProtocolBridge:
         if flow.controller_name and name != flow.controller_name:
             flow.new_epoch(f"the controller is now {name!r}, was {flow.controller_name!r}", name)
         flow.controller_name = name
+        self._old_result_revision = max(SUPPORTED_REVISIONS[OLD_RESULT])
+        newest = self._newest_of_this_epoch(session)  # before any subscription: nothing live
         section = self._section
         revision = session.subscribe(
             lambda rev: ResultSubscribe(revision=rev), section.result_revision, required=True
@@ -183,11 +185,13 @@ class OpenProtocolBridge:
         if revision is None:
             raise LinkLostError("the controller refused the result subscription (MID 0060)")
         self._counts.result_revision = revision
-        self._old_result_revision = max(SUPPORTED_REVISIONS[OLD_RESULT])
         if section.traces:
             session.subscribe(_trace_subscription, 1)
         self._reports.subscribe(session, self._publish, self._counts)
-        self._catch_up(session)
+        if newest is not None:
+            self._take_newest(newest)
+        self._fill(session)
+        flow.publish_ready()
         LOG.info(
             "connected to %s (%s): results at revision %d, traces %s; watermark %d",
             self._counts.controller,
@@ -216,8 +220,9 @@ class OpenProtocolBridge:
 
     # -- catching up ---------------------------------------------------------------------
 
-    def _catch_up(self, session: ControllerSession) -> None:
-        """The newest result, a new epoch if the controller's ids started again, the gap."""
+    def _newest_of_this_epoch(self, session: ControllerSession) -> Any:
+        """The controller's newest result (0064 id 0), after a new epoch is started if its
+        ids started again since the watermark; None: it has none, or it was not given."""
         flow = self._flow
         reply = self._old_result(session, 0)
         if isinstance(reply, CommandError):
@@ -231,17 +236,33 @@ class OpenProtocolBridge:
                         f"it has no result, though tightening {flow.watermark} was published",
                         flow.controller_name,
                     )
-            return
+            return None
         newest = self._figures(reply)
+        if newest is not None:
+            why = self._epoch_ended(session, newest)
+            if why is not None:
+                flow.new_epoch(why, flow.controller_name)
+        return newest
+
+    def _catch_up(self, session: ControllerSession) -> None:
+        """The newest result and the gap up to it (a pushed 0061 was refused)."""
+        newest = self._figures(self._old_result(session, 0))
         if newest is None:
-            return  # not answered, or refused (counted): the next live result shows the gap
-        why = self._epoch_ended(session, newest)
-        if why is not None:
-            flow.new_epoch(why, flow.controller_name)
-        flow.take_result(newest, newest_asked=True)
-        flow.controller_newest(newest.tightening_id)
+            return  # not answered, refused or none (counted): the next live result shows it
+        self._take_newest(newest)
         self._fill(session)
-        flow.publish_ready()
+        self._flow.publish_ready()
+
+    def _take_newest(self, newest: Any) -> None:
+        flow = self._flow
+        if flow.take_result(newest) is Take.CONFLICT:
+            flow.new_epoch(
+                f"its newest tightening {newest.tightening_id} is not the one published under "
+                "its id",
+                flow.controller_name,
+            )
+            flow.take_result(newest)
+        flow.controller_newest(newest.tightening_id)
 
     def _epoch_ended(self, session: ControllerSession, newest: Any) -> str | None:
         """Why the controller's ids started again since the watermark, or None."""

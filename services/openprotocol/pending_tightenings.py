@@ -9,8 +9,15 @@ is passed in, monotonic seconds):
 - a result is told apart by its id and its **key** (time stamp, pset, torque,
   angle, verdict and part as the controller wrote them: :attr:`ResultFigures.key`).
   The same id with the same key is a **repeat** (the controller sent it
-  again): acknowledged by the caller, counted, not published. An id at or
-  below the watermark whose key is another, or not known, is a **conflict**:
+  again; so is an id whose key is not kept but comes after the oldest one
+  kept, or when none is kept): acknowledged by the caller, counted, not
+  published; unless the one
+  taken first was fetched by id while the controller pushed it live (a
+  tightening made during a catch-up): then the live one takes its place if it
+  is still pending (it carries the limits and targets a 0065 lacks), and it is
+  no repeat of the controller's. An id at or
+  below the watermark whose key is another, or older than every key kept, is a
+  **conflict**:
   the controller's ids wrapped or started again (the caller starts a new
   epoch). The keys of the last :data:`KEYS_KEPT` published ids are kept (and
   saved with the watermark), the pending ones' too;
@@ -55,7 +62,8 @@ class Take(enum.Enum):
     """What a result was to :meth:`PendingTightenings.result`."""
 
     NEW = "new"  # taken: it will be published
-    REPEAT = "repeat"  # the same id and key as one published or pending
+    REPEAT = "repeat"  # the same id and key as one published or pending: sent again
+    FETCHED = "fetched"  # a live result of one fetched by id already (0065): no repeat
     CONFLICT = "conflict"  # an id published already, with another (or an unknown) key
 
 
@@ -80,6 +88,8 @@ class PendingTightenings:
     _done: set[int] = field(default_factory=set)
     #: every id below it that is not here is given up (a gap beyond MAX_FILL)
     _floor: int = 0
+    #: the ids taken from a 0065 last (a live 0061 of one of them is no repeat)
+    _fetched: OrderedDict[int, None] = field(default_factory=OrderedDict)
 
     @classmethod
     def resume(
@@ -100,12 +110,27 @@ class PendingTightenings:
         tightening_id = figures.tightening_id
         waiting = self._results.get(tightening_id)
         if waiting is not None:
-            return Take.REPEAT if waiting.tightening.result.key == figures.key else Take.CONFLICT
+            earlier = waiting.tightening.result
+            if earlier.key != figures.key:
+                return Take.CONFLICT
+            if earlier.filled and not figures.filled:  # the live one carries limits, targets
+                waiting.tightening = replace(waiting.tightening, result=figures)
+                return Take.FETCHED
+            return Take.REPEAT
         if tightening_id <= self.watermark or tightening_id in self._done:
             known = self.published_keys.get(tightening_id)
-            return Take.REPEAT if known == figures.key else Take.CONFLICT
+            if known is None and self._below_the_keys(tightening_id):
+                return Take.CONFLICT  # long before every id whose key is kept: ids restarted
+            if known is not None and known != figures.key:
+                return Take.CONFLICT
+            fetched = tightening_id in self._fetched and not figures.filled
+            return Take.FETCHED if fetched else Take.REPEAT
         if tightening_id < self._floor:
             self.given_up -= 1  # it was given up with its gap, and came after all
+        if figures.filled:
+            self._fetched[tightening_id] = None
+            while len(self._fetched) > KEYS_KEPT:
+                self._fetched.popitem(last=False)
         curves, _ = self._curves.pop(tightening_id, ({}, now_s))
         self._results[tightening_id] = _Waiting(
             Tightening(figures, curves.get("torque"), curves.get("angle")), now_s
@@ -223,6 +248,11 @@ class PendingTightenings:
             self.published_keys.popitem(last=False)
         self._advance()
         return tightening
+
+    def _below_the_keys(self, tightening_id: int) -> bool:
+        """Before every id whose key is kept (none kept, as in a file from before keys: we
+        cannot tell, and take it for a repeat: never a tightening published twice)."""
+        return bool(self.published_keys) and tightening_id < next(iter(self.published_keys))
 
     def _missing_from(self, start: int, known: list[int]) -> int:
         """How many ids from ``start`` to the newest are neither pending nor given up."""

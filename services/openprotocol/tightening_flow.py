@@ -80,9 +80,9 @@ class TighteningFlow:
 
     # -- in -----------------------------------------------------------------------------
 
-    def take_result(self, figures: ResultFigures, *, newest_asked: bool = False) -> Take:
-        """Take a result; a repeat is counted (``newest_asked``: the newest result asked
-        after a connect, published already most often: not the controller's repeat)."""
+    def take_result(self, figures: ResultFigures) -> Take:
+        """Take a result; a repeat the controller sent is counted (a result fetched by id
+        that is here already, or published, is the bridge's own asking, not a repeat)."""
         if figures.clock_refused:
             self._counts.clock_refused += 1
             self._counts.fault(
@@ -91,7 +91,7 @@ class TighteningFlow:
                 "clock holds: the time it was received is taken",
             )
         take = self._pending.result(figures, self._clock())
-        if take is Take.REPEAT and not newest_asked:
+        if take is Take.REPEAT and not figures.filled:
             self._counts.repeated_results += 1
             self._counts.note(
                 "repeat",

@@ -59,6 +59,9 @@ from tests.support.openprotocol_results import (
 from tests.support.openprotocol_traces import make_curves
 from tests.support.openprotocol_wire import Message, frame, hundredths, parameters, whole
 
+#: the largest tightening id (10 digits); the next one is 1
+MAX_TIGHTENING_ID = 9_999_999_999
+
 
 class SpecController(ControllerCore):
     """The controller: a background thread serving 127.0.0.1:`port`. See the module text.
@@ -105,7 +108,8 @@ class SpecController(ControllerCore):
 
         def store() -> int:
             result = replaced(draft, tightening_id=self._next_id)
-            self._next_id += 1
+            # the tightening id is 10 digits: after 9999999999 the counter wraps to 1
+            self._next_id = 1 if self._next_id >= MAX_TIGHTENING_ID else self._next_id + 1
             self.results[result.tightening_id] = result
             while len(self.results) > self.results_kept:
                 oldest = next(iter(self.results))
@@ -132,6 +136,14 @@ class SpecController(ControllerCore):
                 self.curves.clear()
 
         self._call(reset)
+
+    def count_from(self, next_id: int) -> None:
+        """The next tightening gets `next_id`, the link staying up (e.g. just before a wrap)."""
+
+        def set_counter() -> None:
+            self._next_id = next_id
+
+        self._call(set_counter)
 
     def drop(self) -> None:
         """Cut the TCP link now, without a word."""

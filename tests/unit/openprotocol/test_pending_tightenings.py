@@ -134,7 +134,10 @@ def test_an_id_published_with_another_key_or_none_kept_is_a_conflict_not_a_repea
     pending = PendingTightenings.resume(10, {9: key(9), 10: key(10)}, False, 3.0)
     assert pending.result(figures(9), 0.0) is Take.REPEAT
     assert pending.result(figures(9, time="2026-11-25:08:00:00"), 0.0) is Take.CONFLICT
-    assert pending.result(figures(1), 0.0) is Take.CONFLICT, "no key kept for id 1"
+    assert pending.result(figures(1), 0.0) is Take.CONFLICT, "older than every key kept"
+    assert pending.result(figures(10, filled=True), 0.0) is Take.REPEAT
+    upgraded = PendingTightenings.resume(10, {}, False, 3.0)  # a file from before keys
+    assert upgraded.result(figures(3), 0.0) is Take.REPEAT, "cannot tell: never twice"
     assert pending.result(figures(11), 0.0) is Take.NEW
     assert pending.result(figures(11, time="2026-11-25:08:00:00"), 0.0) is Take.CONFLICT
 
@@ -176,3 +179,16 @@ def test_drain_hands_out_what_is_pending_in_id_order_and_gives_the_gaps_up() -> 
     assert [t.result.tightening_id for t in pending.drain()] == [4, 5, 7]
     assert pending.watermark == 7 and pending.given_up == 2  # 3 and 6
     assert pending.waiting_results() == 0
+
+
+def test_a_live_result_of_one_fetched_by_id_is_no_repeat_and_takes_its_place() -> None:
+    """A tightening made while the bridge caught up: fetched by id (0065, no limits) and
+    pushed live (0061) too."""
+    pending = PendingTightenings(watermark=0, wait_for_curves=False, trace_timeout_s=3.0)
+    assert pending.result(figures(2, filled=True), 0.0) is Take.NEW
+    assert pending.result(figures(2), 0.0) is Take.FETCHED
+    assert pending.result(figures(2), 0.0) is Take.REPEAT, "the live one, sent again"
+    assert pending.result(figures(1, filled=True), 0.0) is Take.NEW
+    first, second = pending.ready(0.0)
+    assert first.result.filled and not second.result.filled
+    assert pending.result(figures(1), 0.0) is Take.FETCHED, "published from its 0065"
