@@ -20,6 +20,9 @@ import zenoh
 
 from tests.live_recorder import wait_until
 from tests.support.openprotocol_controller import SpecController
+from tests.support.openprotocol_core import AcceptNames
+from tests.support.openprotocol_link import WriteMode
+from tests.support.openprotocol_traces import ByteOrder, Scaling
 from tests.unit.openprotocol.bridge_harness import Heard, RunningBridge, bridge_station_file
 
 TIGHTENINGS = 10
@@ -108,7 +111,7 @@ def assert_as_the_controller_said(results: list[Any], controller: SpecController
     ],
 )
 def test_ten_tightenings_are_recorded_once_with_the_controllers_values_and_curves(
-    line_of: Any, accept_names: str, write_mode: str
+    line_of: Any, accept_names: AcceptNames, write_mode: WriteMode
 ) -> None:
     """Before: a 0005 naming 0900 was never taken for the answer to 0008, the link dropped
     and started again for ever, and no tightening was published; messages that shared a
@@ -198,7 +201,7 @@ def test_a_controller_restarted_with_ids_from_1_loses_nothing(
     [("little", "coefficient"), ("big", "divisor"), ("little", "divisor")],
 )
 def test_curves_in_either_byte_order_and_scaling_are_read_right(
-    line_of: Any, byte_order: str, scaling: str
+    line_of: Any, byte_order: ByteOrder, scaling: Scaling
 ) -> None:
     """Before: little-endian samples were read big-endian, a 25 Nm tightening peaked at
     322 Nm, nothing was counted, and the wear ledger took thousands of times the intensity."""
