@@ -34,7 +34,9 @@ is passed in, monotonic seconds):
   for every tightening since): older missing ids are given up, logged. A
   result that is here already is never given up, however many came at once;
 - :meth:`drain` hands out every pending result in id order, gaps given up
-  (before a new epoch: nothing of the old one is left behind);
+  (before a new epoch: nothing of the old one is left behind); the new epoch
+  keeps the old one's keys, so that a controller that kept its old results
+  under the ids now used again never has one of them published a second time;
 - a curve whose result was published already, or whose result has not come
   within ``trace_timeout_s``, is dropped and counted (``traces_without_result``).
 """
@@ -83,6 +85,10 @@ class PendingTightenings:
     given_up: int = 0  # ids given up (fetch failed, refused, beyond MAX_FILL)
     #: keys of the ids published last, oldest first (at most KEYS_KEPT)
     published_keys: OrderedDict[int, str] = field(default_factory=OrderedDict)
+    #: the keys of the epoch before: a result of one of them is never published again
+    previous_keys: dict[int, str] = field(default_factory=dict)
+    #: False: resumed from a file that kept no keys (an id published cannot be told apart)
+    keys_complete: bool = True
     _results: dict[int, _Waiting] = field(default_factory=dict)
     _curves: dict[int, tuple[dict[str, Curve], float]] = field(default_factory=dict)
     _done: set[int] = field(default_factory=set)
@@ -98,16 +104,32 @@ class PendingTightenings:
         keys: Mapping[int, str],
         wait_for_curves: bool,
         trace_timeout_s: float,
+        previous_keys: Mapping[int, str] | None = None,
     ) -> PendingTightenings:
-        """Where a bridge was: its watermark and the keys of the ids it published last."""
+        """Where a bridge was: its watermark and the keys of the ids it published last
+        (``previous_keys``: the last ones of the epoch before, never published again)."""
         kept = OrderedDict(sorted((i, k) for i, k in keys.items() if i <= watermark))
-        return cls(watermark, wait_for_curves, trace_timeout_s, published_keys=kept)
+        return cls(
+            watermark,
+            wait_for_curves,
+            trace_timeout_s,
+            published_keys=kept,
+            previous_keys=dict(previous_keys or {}),
+            keys_complete=bool(kept) or watermark == 0,
+        )
 
     # -- in ---------------------------------------------------------------------------
 
     def result(self, figures: ResultFigures, now_s: float) -> Take:
         """Take a result: NEW, a REPEAT (not taken), or a CONFLICT (not taken)."""
         tightening_id = figures.tightening_id
+        if self.previous_keys.get(tightening_id) == figures.key:
+            # of the epoch before (a controller that kept its results): never again, and
+            # not missing from this one
+            if tightening_id > self.watermark and tightening_id not in self._results:
+                self._done.add(tightening_id)
+                self._advance()
+            return Take.REPEAT
         waiting = self._results.get(tightening_id)
         if waiting is not None:
             earlier = waiting.tightening.result
@@ -250,9 +272,11 @@ class PendingTightenings:
         return tightening
 
     def _below_the_keys(self, tightening_id: int) -> bool:
-        """Before every id whose key is kept (none kept, as in a file from before keys: we
-        cannot tell, and take it for a repeat: never a tightening published twice)."""
-        return bool(self.published_keys) and tightening_id < next(iter(self.published_keys))
+        """Before every id whose key is kept, or none kept. Resumed from a file that kept no
+        keys, it cannot tell: a repeat (never a tightening published twice)."""
+        if not self.keys_complete:
+            return False
+        return not self.published_keys or tightening_id < next(iter(self.published_keys))
 
     def _missing_from(self, start: int, known: list[int]) -> int:
         """How many ids from ``start`` to the newest are neither pending nor given up."""

@@ -131,8 +131,12 @@ class TighteningFlow:
         self._given_up_before += self._pending.given_up
         self.position = self._current_position().new_epoch(controller_name)
         self.controller_name = controller_name
-        self._pending = PendingTightenings(
-            0, self._pending.wait_for_curves, self._pending.trace_timeout_s
+        self._pending = PendingTightenings.resume(
+            0,
+            {},
+            self._pending.wait_for_curves,
+            self._pending.trace_timeout_s,
+            previous_keys=self._pending.published_keys,
         )
         self._reading = None
         self._counts.trace_reading = None

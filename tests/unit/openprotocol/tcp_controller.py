@@ -65,6 +65,7 @@ class TcpController:
     result_revision: int = 2
     mirror: bool = True
     port: int = 0  # 0: any free port
+    timestamp: str = TIMESTAMP  # of every result and curve (the controller's clock)
     next_id: int = 1
     results: dict[int, StoredResult] = field(default_factory=dict)
     acks: int = 0
@@ -304,8 +305,8 @@ class TcpController:
             angle_final_target_deg=0,
             angle_deg=int(stored.angle[-1]),
             tightening_id=stored.tightening_id,
-            timestamp=TIMESTAMP,
-            pset_changed=TIMESTAMP,
+            timestamp=self.timestamp,
+            pset_changed=self.timestamp,
             revision=revision,
             **extra,  # type: ignore[arg-type]
         )
@@ -322,14 +323,14 @@ class TcpController:
             angle_status=1,  # type: ignore[arg-type]
             torque_nm=stored.torque[-1],
             angle_deg=int(stored.angle[-1]),
-            timestamp=TIMESTAMP,
+            timestamp=self.timestamp,
         )
 
     def _curve(self, stored: StoredResult, kind: TraceType) -> TraceCurve:
         values = stored.torque if kind == TraceType.TORQUE else stored.angle
         return TraceCurve.build(
             result_id=stored.tightening_id,
-            timestamp=TIMESTAMP,
+            timestamp=self.timestamp,
             trace_type=int(kind),
             unit=1 if kind == TraceType.TORQUE else 50,
             samples=values,

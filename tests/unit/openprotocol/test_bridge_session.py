@@ -179,7 +179,8 @@ def test_a_controller_whose_ids_start_again_gets_run_ids_after_the_last(
     finally:
         bridge.finish()
         first.close()
-    replaced = TcpController(port=first.port)  # reset: its ids start at 1 again
+    # reset: its ids start at 1 again, its clock goes on
+    replaced = TcpController(port=first.port, timestamp="2026-11-24:11:00:00")
     replaced.tighten(push=False)
     bridge = RunningBridge(station_file, feeding)
     try:
