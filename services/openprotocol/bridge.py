@@ -42,7 +42,7 @@ from services.openprotocol.pending_tightenings import PendingTightenings
 from services.openprotocol.published_ids import BridgePosition, read_position, write_position
 from services.openprotocol.result_reading import read_curve, read_result
 from services.openprotocol.tightening_messages import tightening_messages
-from shared.config import LoadedStation
+from shared.config import AnyStation
 from shared.config.openprotocol import OpenProtocolSection
 from shared.message_fields import INT64_MAX
 from shared.openprotocol.codec import KNOWN_MIDS
@@ -74,7 +74,7 @@ class OpenProtocolBridge:
 
     def __init__(
         self,
-        station: LoadedStation,
+        station: AnyStation,
         section: OpenProtocolSection,
         publish: Callable[[object], None],
         after_published: Callable[[Callable[[], None]], None],
