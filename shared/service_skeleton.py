@@ -45,7 +45,7 @@ import zenoh
 
 from shared import keys
 from shared.channels import Channel
-from shared.config.station import ZenohSection
+from shared.config.common_sections import ZenohSection
 from shared.service_runtime import ServiceRunner
 from shared.zenoh_session import open_from, open_session
 

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import zenoh
 
-from shared.config.station import ENDPOINT_EXPECTED, ZenohSection
+from shared.config.common_sections import ENDPOINT_EXPECTED, ZenohSection
 from shared.errors import ConfigError, TransportError
 
 LOG = logging.getLogger(__name__)

@@ -20,7 +20,7 @@ import zenoh
 from services.recorder.service import RecorderService
 from shared import keys
 from shared.codec import encode
-from shared.config import LoadedStation, toml_writer
+from shared.config import AnyStation, ControllerStation, LoadedStation, toml_writer
 from shared.service_skeleton import ServiceSkeleton
 from tests.paths import STATION_FILE
 
@@ -66,8 +66,8 @@ def publish(session: zenoh.Session, items: Sequence[tuple[str, Any]], station: s
 class RunningRecorder:
     """A RecorderService working in a thread of this process, as ServiceRunner runs it."""
 
-    def __init__(self, loaded: LoadedStation | Sequence[LoadedStation]) -> None:
-        first = loaded if isinstance(loaded, LoadedStation) else loaded[0]
+    def __init__(self, loaded: AnyStation | Sequence[AnyStation]) -> None:
+        first = loaded if isinstance(loaded, LoadedStation | ControllerStation) else loaded[0]
         self.skeleton = ServiceSkeleton("recorder")
         self.session = self.skeleton.open_session(first.config.zenoh)
         self.service = RecorderService(loaded, self.skeleton)

@@ -88,9 +88,9 @@ def recordings_folder(args: argparse.Namespace) -> Path:
     if args.recordings is not None:
         folder: Path = args.recordings
         return folder
-    from shared.config import load_station
+    from shared.config import load_any_station
 
-    return load_station(args.config).recordings_folder
+    return load_any_station(args.config).recordings_folder
 
 
 def check_png_target(path: Path, what: str) -> None:

@@ -27,11 +27,11 @@ def router_client(config: Path, connect: str | None) -> tuple[str, zenoh.Config]
 
 
 def _router_of(config: Path) -> tuple[str, zenoh.Config]:
-    from shared.config import load_station
+    from shared.config import load_any_station
     from shared.errors import ConfigError
     from shared.zenoh_session import client_config
 
-    section = load_station(config).config.zenoh
+    section = load_any_station(config).config.zenoh
     if not section.connect:
         raise ConfigError(
             f"{config}: zenoh.connect is empty (a peer that only listens); "

@@ -18,7 +18,7 @@ from services.recorder.overlay.overlay_alignment import parse_alignment
 from services.recorder.overlay.overlay_plot import save_figure
 from services.recorder.overlay.overlay_run import OverlayRun, find_run_files, read_overlay_run
 from services.recorder.overlay.overlay_series import build_overlay
-from shared.config import LoadedStation
+from shared.config import AnyStation
 
 DEFAULT_TARGET = Path("overlay.png")
 
@@ -28,7 +28,7 @@ class RunFinder:
 
     def __init__(self, station_file: Path) -> None:
         self.station_file = station_file
-        self._station: LoadedStation | None = None
+        self._station: AnyStation | None = None
 
     def run(self, name: str) -> OverlayRun:
         path = Path(name)
@@ -38,11 +38,11 @@ class RunFinder:
             return read_overlay_run(name, files, int(name))
         return read_overlay_run(name, [path])
 
-    def _loaded(self) -> LoadedStation:
+    def _loaded(self) -> AnyStation:
         if self._station is None:
-            from shared.config import load_station
+            from shared.config import load_any_station
 
-            self._station = load_station(self.station_file)
+            self._station = load_any_station(self.station_file)
         return self._station
 
 

@@ -3,7 +3,9 @@
 One block per station, one line per figure, labels in a column; what each
 figure means is said in :mod:`shared.line_status.station_status`, which collects
 them. A figure that did not arrive in the listening window is a ``-`` and a
-short guess why, so that an empty line never reads as "all is well".
+short guess why, so that an empty line never reads as "all is well". A bridge
+station (a controller's, ``kind`` "bridge") has no bus or predictor line unless
+their stats came: it runs neither.
 """
 
 from __future__ import annotations
@@ -39,6 +41,8 @@ def format_report(report: StatusReport) -> str:
 
 
 _LABEL = 14
+#: how a service of :attr:`StationStatus.services` reads where its key is terse
+SERVICE_WORDS = {"controller": "controller link"}
 
 
 def _station_lines(status: StationStatus) -> list[str]:
@@ -46,7 +50,8 @@ def _station_lines(status: StationStatus) -> list[str]:
         return f"  {label:<{_LABEL}}{text}"
 
     services = ", ".join(
-        f"{name} {'up' if alive else 'DOWN'}" for name, alive in status.services.items()
+        f"{SERVICE_WORDS.get(name, name)} {'up' if alive else 'DOWN'}"
+        for name, alive in status.services.items()
     )
     rate = f"{status.samples_per_s:.0f} received"
     if status.bus_samples_per_s is not None:
@@ -55,19 +60,27 @@ def _station_lines(status: StationStatus) -> list[str]:
         f"station {status.station}",
         line("services", services),
         line("samples/s", rate),
-        line("bus", _bus_text(status.bus)),
+        *_unless_bridge(status, status.bus, line("bus", _bus_text(status.bus))),
         line("last run", _run_text(status.last_run)),
         line("last decision", _decision_text(status.last_decision)),
         line("last summary", _summary_text(status.last_summary)),
         line("last result", result_text(status.last_result)),
         line("quality alert", quality_text(status.quality_alert)),
-        line("predictor", _predictor_text(status.predictor)),
+        *_unless_bridge(
+            status, status.predictor, line("predictor", _predictor_text(status.predictor))
+        ),
         line("recorder", _recorder_text(status.recorder)),
         *(line(label, text) for label, text in bridge_lines(status.bridge)),
     ]
     if status.unreadable_messages:
         out.append(line("unreadable", f"{status.unreadable_messages} messages"))
     return out
+
+
+def _unless_bridge(status: StationStatus, figure: object, text: str) -> list[str]:
+    """``text``, except on a bridge station that did not send ``figure``: it runs no
+    acquisition or predictor, so their missing stats say nothing."""
+    return [] if status.kind == "bridge" and figure is None else [text]
 
 
 def _bus_text(bus: BusHealth | None) -> str:

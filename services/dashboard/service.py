@@ -20,7 +20,7 @@ from aiohttp import web
 from services.dashboard.board_feed import BoardFeed
 from services.dashboard.line_board import LineBoard, StationSetting
 from services.dashboard.web_app import Listeners, make_app
-from shared.config import load_line
+from shared.config import load_any_line
 from shared.zenoh_session import open_session
 
 LOG = logging.getLogger(__name__)
@@ -30,7 +30,7 @@ SHUTDOWN_TIMEOUT_S = 2.0
 
 
 def main(args: argparse.Namespace) -> int:
-    stations = load_line(args.config)
+    stations = load_any_line(args.config)
     settings = [
         StationSetting(station.station_id, station.config.recorder.wear_service_threshold)
         for station in stations

@@ -51,7 +51,7 @@ from services.openprotocol.pending_tightenings import Take
 from services.openprotocol.published_ids import BridgePosition
 from services.openprotocol.result_reading import CurveRefusedError, read_curve, read_result
 from services.openprotocol.tightening_flow import TighteningFlow
-from shared.config import LoadedStation
+from shared.config import AnyStation
 from shared.config.openprotocol import OpenProtocolSection
 from shared.openprotocol.codec import KNOWN_MIDS, SUPPORTED_REVISIONS
 from shared.openprotocol.dialect import Dialect
@@ -85,7 +85,7 @@ class OpenProtocolBridge:
 
     def __init__(
         self,
-        station: LoadedStation,
+        station: AnyStation,
         section: OpenProtocolSection,
         publish: Callable[[object], None],
         after_published: Callable[[Callable[[], None]], None],

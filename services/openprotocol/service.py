@@ -23,7 +23,7 @@ import threading
 from services.openprotocol.bridge import OpenProtocolBridge
 from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.published_ids import position_path
-from shared.config import load_station
+from shared.config import load_any_station
 from shared.errors import ConfigError
 from shared.queued_publisher import QueuedPublisher
 from shared.service_skeleton import ServiceSkeleton, Stop
@@ -33,7 +33,7 @@ LOG = logging.getLogger(__name__)
 
 
 def main(args: argparse.Namespace, replay: RunReplay) -> int:
-    station = load_station(args.config)
+    station = load_any_station(args.config)
     section = station.config.openprotocol
     if section is None:
         raise ConfigError(

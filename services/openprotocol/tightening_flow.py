@@ -28,7 +28,7 @@ from services.openprotocol.curve_check import Reading, check_curves, readings
 from services.openprotocol.pending_tightenings import PendingTightenings, Take
 from services.openprotocol.published_ids import BridgePosition, read_position, write_position
 from services.openprotocol.tightening_messages import tightening_messages
-from shared.config import LoadedStation
+from shared.config import AnyStation
 from shared.config.openprotocol import OpenProtocolSection
 from shared.message_fields import INT64_MAX
 from shared.stopped_run import RunReplay
@@ -41,7 +41,7 @@ class TighteningFlow:
 
     def __init__(
         self,
-        station: LoadedStation,
+        station: AnyStation,
         section: OpenProtocolSection,
         publish: Callable[[object], None],
         after_published: Callable[[Callable[[], None]], None],

@@ -10,8 +10,10 @@ constants and ``[predictor]`` section. Out, per station: ``events`` and ``intens
 per stick-slip event, ``decision`` (REAL_TIME priority, express, blocking
 congestion control: a stop must never be dropped), ``results`` and ``runs`` per
 run. One liveliness token ``boltwatch/<st>/health/predictor`` per served station; a
-station that already has a predictor on the line is refused at start-up, so
-two predictors never both decide for one station.
+station whose acquisition decides (``[predictor] placement = "edge"``, the
+default) is refused at once, from its file, and a station that already has
+a predictor on the line is refused at start-up, so two predictors never both
+decide for one station (:mod:`services.predictor.station_refusal`).
 
 No payload stops the service: what does not decode (bad JSON, nested too
 deeply, too large, a wrong type, a value out of its bounds or an id wider
@@ -35,7 +37,10 @@ from services.predictor.active_run import Outgoing
 from services.predictor.served_station import ServedStation
 from services.predictor.station_counts import StationCounts
 from services.predictor.station_inbox import Inbox, InboxFactory, StationInbox
-from services.predictor.station_refusal import refuse_stations_served_elsewhere
+from services.predictor.station_refusal import (
+    refuse_edge_stations,
+    refuse_stations_served_elsewhere,
+)
 from services.predictor.station_runs import StationRuns
 from shared import channels, codec, keys
 from shared.config import LoadedStation, load_line
@@ -213,6 +218,7 @@ def main(args: argparse.Namespace) -> int:
     # (measured with bench_line_inbox.py, variant callback-rx1; figures in the README).
     use_one_receive_thread()
     stations = load_line(args.config)
+    refuse_edge_stations(stations)  # an edge station's acquisition decides: refused at once
     with ServiceSkeleton("predictor") as skeleton:
         skeleton.open_session(stations[0].config.zenoh)
         service = PredictorService(skeleton, stations)

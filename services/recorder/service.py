@@ -60,7 +60,7 @@ from services.recorder.wear.wear_ledger import WearLedger, ledger_path
 from services.recorder.wear.wear_watch import WearWatch
 from shared import channels, keys
 from shared.codec import encode
-from shared.config import LoadedStation, load_line
+from shared.config import AnyStation, ControllerStation, LoadedStation, load_any_line
 from shared.errors import ConfigError
 from shared.message_fields import MAX_TEXT_CHARS
 from shared.messages import QualityAlert, RecorderStats, WearAlert
@@ -84,7 +84,7 @@ _SAMPLE = channels.SAMPLES.schema_name
 _BATCH = channels.SAMPLE_BATCHES.schema_name
 
 
-def limits_of(loaded: LoadedStation) -> FileLimits:
+def limits_of(loaded: AnyStation) -> FileLimits:
     section = loaded.config.recorder
     return FileLimits(
         flush_interval_ns=round(section.flush_interval_s * 1e9),
@@ -93,9 +93,10 @@ def limits_of(loaded: LoadedStation) -> FileLimits:
     )
 
 
-def served_stations(loaded: LoadedStation | Sequence[LoadedStation]) -> list[LoadedStation]:
-    """The station files of one recorder; ConfigError when their [recorder] sections differ."""
-    stations = [loaded] if isinstance(loaded, LoadedStation) else list(loaded)
+def served_stations(loaded: AnyStation | Sequence[AnyStation]) -> list[AnyStation]:
+    """The station files of one recorder (CAN or controller stations); ConfigError when their
+    [recorder] sections differ."""
+    stations = [loaded] if isinstance(loaded, LoadedStation | ControllerStation) else list(loaded)
     if not stations:
         raise ConfigError("the recorder needs at least one station file")
     first = stations[0]
@@ -120,7 +121,7 @@ class RecorderService:
 
     def __init__(
         self,
-        loaded: LoadedStation | Sequence[LoadedStation],
+        loaded: AnyStation | Sequence[AnyStation],
         skeleton: ServiceSkeleton,
         rerun_files: bool = True,
         rerun_live_url: str | None = None,
@@ -383,7 +384,7 @@ def start_foxglove(args: argparse.Namespace, station_ids: Sequence[str]) -> Foxg
 
 
 def main(args: argparse.Namespace) -> int:
-    loaded = load_line(args.config)  # serve recorder: one or more files, always a list
+    loaded = load_any_line(args.config)  # serve recorder: one or more files, always a list
     served_stations(loaded)  # bad combinations fail before zenoh is opened
     loaded[0].make_recordings_folder()  # and a folder that can never be made
     view_only = getattr(args, "view_only", False)

@@ -1,9 +1,12 @@
 """Station and joint configuration: TOML files, validated once at start-up.
 
-Load with :func:`load_station` (which also loads the joint it names) or
+Load with :func:`load_station` (a CAN station; it also loads the joint it
+names), :func:`load_any_station` (a CAN or a controller station) or
 :func:`load_joint`; pass the result down, never re-read it.
 
-- :mod:`.station` (the station file), :mod:`.program_windows` (a program's
+- :mod:`.station` (the CAN station file), :mod:`.controller_station` (a station
+  whose tool an Open Protocol controller drives), :mod:`.station_kinds` (either
+  kind), :mod:`.common_sections` (what both have), :mod:`.program_windows` (a program's
   windows: where a run must end to be OK), :mod:`.openprotocol` (a controller that
   speaks Open Protocol, and the simulated one's side), :mod:`.quality` (when the
   recorder raises a quality alert), :mod:`.joint` (the joint file),
@@ -12,8 +15,13 @@ Load with :func:`load_station` (which also loads the joint it names) or
   :mod:`.toml_writer` (the files boltwatch derives from others)
 """
 
+from shared.config.controller_station import (
+    ControllerProgram,
+    ControllerStation,
+    ControllerStationConfig,
+)
 from shared.config.joint import JointConfig, load_joint
-from shared.config.line import derive_stations, derived_ids, load_line
+from shared.config.line import derive_stations, derived_ids, load_any_line, load_line
 from shared.config.station import (
     LoadedStation,
     PredictorSection,
@@ -22,8 +30,13 @@ from shared.config.station import (
     StationConfig,
     load_station,
 )
+from shared.config.station_kinds import AnyStation, load_any_station
 
 __all__ = [
+    "AnyStation",
+    "ControllerProgram",
+    "ControllerStation",
+    "ControllerStationConfig",
     "JointConfig",
     "LoadedStation",
     "PredictorSection",
@@ -32,6 +45,8 @@ __all__ = [
     "StationConfig",
     "derive_stations",
     "derived_ids",
+    "load_any_line",
+    "load_any_station",
     "load_joint",
     "load_line",
     "load_station",

@@ -2,7 +2,9 @@
 
 Line services (predictor, recorder) take several station files; they must
 agree on where the line's zenoh router is and name each station once
-(:func:`load_line`). ``boltwatch up --stations N`` derives N isolated
+(:func:`load_line`: CAN stations, for the predictor and ``up``;
+:func:`load_any_line`: either kind, for the recorder, the dashboard and
+``health``). ``boltwatch up --stations N`` derives N isolated
 simulated stations from one station file (:func:`derive_stations`):
 
 - ids: the base id's trailing number counts up (``st1`` -> ``st1, st2, ...``;
@@ -21,20 +23,24 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from shared.config.loading import read_toml, resolve_relative
 from shared.config.station import LoadedStation, load_station
+from shared.config.station_kinds import AnyStation, load_any_station
 from shared.config.toml_writer import dumps
 from shared.errors import ConfigError
 
 MAX_PORT = 65535
 MAX_TOOL_ID = 65535
 
+#: a loaded station, of one kind or of either
+StationT = TypeVar("StationT", bound=AnyStation)
 
-def stations_by_id(stations: Sequence[LoadedStation]) -> dict[str, LoadedStation]:
+
+def stations_by_id(stations: Sequence[StationT]) -> dict[str, StationT]:
     """Station id -> its file; ConfigError naming both files when an id repeats."""
-    seen: dict[str, LoadedStation] = {}
+    seen: dict[str, StationT] = {}
     for station in stations:
         twin = seen.get(station.station_id)
         if twin is not None:
@@ -47,14 +53,25 @@ def stations_by_id(stations: Sequence[LoadedStation]) -> dict[str, LoadedStation
 
 
 def load_line(paths: Sequence[Path]) -> list[LoadedStation]:
-    """Load every station file of a line service; one station id per file, one router.
+    """Load every CAN station file of a line service; one station id per file, one router.
 
     Two files with the same station id, or with different ``[zenoh]`` sections
     (a line process has one zenoh session), are a ConfigError naming both files.
     """
     if not paths:
         raise ConfigError("no station file given")
-    stations = [load_station(Path(path)) for path in paths]
+    return _one_line([load_station(Path(path)) for path in paths])
+
+
+def load_any_line(paths: Sequence[Path]) -> list[AnyStation]:
+    """:func:`load_line` for stations of either kind (CAN or controller)."""
+    if not paths:
+        raise ConfigError("no station file given")
+    return _one_line([load_any_station(Path(path)) for path in paths])
+
+
+def _one_line(stations: list[StationT]) -> list[StationT]:
+    """``stations``, each id once and all on one router; else ConfigError naming both files."""
     first = stations[0]
     stations_by_id(stations)
     for station in stations:

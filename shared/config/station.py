@@ -1,47 +1,44 @@
-"""The station file: one tightening station and everything its services need.
+"""The CAN station file: one tightening station whose tool boltwatch reads over CAN.
 
 All services of a station read the same file (``config/station.toml`` for the
 embedded simulated station). Paths inside it (``station.joint``, ``can.dbc``,
-``recorder.folder``) are relative to the file itself.
+``recorder.folder``) are relative to the file itself. The rig (the simulated
+tool, also as an Open Protocol controller: ``serve rig --controller
+openprotocol``), the acquisition, the predictor, ``simulate`` and ``predict``
+need this kind: a joint, programs with motor speed and hard limits, a DBC.
+A station whose tool a controller drives (``[openprotocol]`` without
+``[can]``) has a file of its own kind (:mod:`shared.config.controller_station`);
+:func:`load_station` refuses it, naming what the command needs.
 """
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Any, Literal
 
-from pydantic import AfterValidator, Field, ValidationInfo, field_validator, model_validator
+from pydantic import Field, model_validator
 
 from shared.can_database import StationDatabase
+from shared.config.common_sections import (
+    RecorderSection,
+    StationIdentity,
+    ZenohSection,
+    make_recordings_folder,
+    recordings_folder,
+)
+from shared.config.controller_station import is_controller_station
 from shared.config.joint import JointConfig, load_joint
 from shared.config.loading import StrictModel, read_toml, resolve_relative, validate
 from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
 from shared.config.program_windows import ProgramWindows
 from shared.config.quality import QualitySection
 from shared.errors import CanDatabaseError, ConfigError
-from shared.folders import FolderError, make_folder
 from shared.sensor_range import SensorRange
 
-StationId = str
 
-#: a zenoh endpoint: ``<protocol>/<address>[?<metadata>][#<config>]``
-ENDPOINT_FORM = re.compile(r"[A-Za-z0-9_-]+/[^?#\s]+(\?[^#\s]*)?(#\S*)?")
-ENDPOINT_EXPECTED = "expected <protocol>/<address>:<port>, e.g. tcp/127.0.0.1:7447"
+class StationSection(StationIdentity):
+    """``[station]`` of a CAN station: its identity, the joint its tool tightens, its sensors."""
 
-
-def _endpoint(text: str) -> str:
-    if not ENDPOINT_FORM.fullmatch(text):
-        raise ValueError(f"not a zenoh endpoint: {ENDPOINT_EXPECTED}")
-    return text
-
-
-Endpoint = Annotated[str, AfterValidator(_endpoint)]
-
-
-class StationSection(StrictModel):
-    id: StationId = Field(pattern=r"^[A-Za-z0-9_-]{1,64}$", description="key-expression safe")
-    tool_id: int = Field(ge=0, le=65535, description="the tool's id on the CAN bus (ToolStatus)")
     joint: Path = Field(description="joint file, relative to this station file")
     has_force_sensor: bool = Field(
         default=True, description="false: no JointSensors on the bus, torque-only prediction"
@@ -59,68 +56,6 @@ class CanSection(StrictModel):
         if self.port is not None and self.interface != "udp_multicast":
             raise ValueError("port applies only to interface = 'udp_multicast'")
         return self
-
-
-class ZenohSection(StrictModel):
-    """How a service joins the line: its router, reconnection, and TLS (see README, Security)."""
-
-    mode: Literal["peer", "client"] = "client"
-    connect: list[Endpoint] = Field(default_factory=list, description="e.g. tcp/127.0.0.1:7447")
-    listen: list[Endpoint] = Field(default_factory=list)
-    connect_timeout_s: float | None = Field(
-        default=None,
-        gt=0,
-        description="how long a service waits for its router at start; none: for ever",
-    )
-    reconnect_period_max_s: float = Field(
-        default=2.0,
-        gt=0,
-        le=60,
-        description="longest pause between two attempts to reach a lost router (never gives up)",
-    )
-    tls_root_ca: Path | None = Field(
-        default=None, description="CA certificate (PEM) of the line, relative to this station file"
-    )
-    tls_cert: Path | None = Field(
-        default=None, description="this service's certificate (PEM), for mutual TLS"
-    )
-    tls_key: Path | None = Field(default=None, description="its private key (PEM)")
-
-    @field_validator("tls_root_ca", "tls_cert", "tls_key")
-    @classmethod
-    def _readable_file(cls, path: Path | None, info: ValidationInfo) -> Path | None:
-        """Resolve against the station file and fail now, not at the first TLS handshake."""
-        if path is None:
-            return None
-        source = (info.context or {}).get("source")
-        resolved = resolve_relative(path, Path(source)) if source is not None else path
-        try:
-            with resolved.open("rb") as handle:
-                handle.read(1)
-        except OSError as err:
-            raise ValueError(f"cannot read {resolved}: {err.strerror}") from err
-        return resolved
-
-    @model_validator(mode="after")
-    def _has_somewhere_to_go(self) -> ZenohSection:
-        if not self.connect and not self.listen:
-            raise ValueError("give connect or listen endpoints (multicast scouting is off)")
-        return self
-
-    @model_validator(mode="after")
-    def _tls_is_complete(self) -> ZenohSection:
-        if (self.tls_cert is None) != (self.tls_key is None):
-            raise ValueError("give tls_cert and tls_key together (mutual TLS needs both)")
-        uses_tls = any(e.startswith("tls/") for e in [*self.connect, *self.listen])
-        if uses_tls and self.tls_root_ca is None:
-            raise ValueError("tls/ endpoints need tls_root_ca (the CA that signed the router)")
-        if not uses_tls and (self.tls_root_ca or self.tls_cert):
-            raise ValueError("tls_* keys are set but no endpoint is tls/ (e.g. tls/host:7447)")
-        return self
-
-    @property
-    def uses_tls(self) -> bool:
-        return self.tls_root_ca is not None
 
 
 class Program(ProgramWindows):
@@ -227,18 +162,6 @@ class RigSection(StrictModel):
     )
 
 
-class RecorderSection(StrictModel):
-    folder: Path = Field(description="relative to this station file")
-    flush_interval_s: float = Field(default=1.0, gt=0, le=60)
-    max_file_bytes: int = Field(default=256 * 1024 * 1024, ge=1024 * 1024)
-    max_file_duration_s: float = Field(default=600.0, gt=0)
-    wear_service_threshold: float | None = Field(
-        default=None,
-        gt=0,
-        description="intensity since last service (eq. 69) at which the recorder alerts",
-    )
-
-
 class StationConfig(StrictModel):
     station: StationSection
     can: CanSection
@@ -305,26 +228,37 @@ class LoadedStation:
 
     @property
     def recordings_folder(self) -> Path:
-        return resolve_relative(self.config.recorder.folder, self.path)
+        return recordings_folder(self.path, self.config.recorder)
 
     def make_recordings_folder(self) -> Path:
-        """The recordings folder, made if missing; ConfigError (file, key, why) if it cannot be.
-
-        Called at a service's start: a folder that can never be made is a
-        configuration error, while a disk that fails later is a fault the
-        recorder rides out (README, "Faults").
-        """
-        folder = self.recordings_folder
-        try:
-            return make_folder(folder)
-        except FolderError as err:
-            raise ConfigError(f"{self.path}: recorder.folder: {folder}: {err}") from err
+        """The recordings folder, made if missing; ConfigError (file, key, why) if it cannot be."""
+        return make_recordings_folder(self.path, self.config.recorder)
 
 
 def load_station(path: Path) -> LoadedStation:
-    """Load a station file and the joint file it names; every error names file and key."""
+    """Load a CAN station file and the joint file it names; every error names file and key.
+
+    A controller station's file (``[openprotocol]`` without ``[can]``) is a
+    ConfigError saying what the command needs: the services of a CAN station
+    (rig, acquisition, predictor) and ``simulate`` / ``predict`` need a joint,
+    a DBC and programs with motor and limits. Whatever the kind:
+    :func:`shared.config.station_kinds.load_any_station`.
+    """
     path = Path(path)
-    config = validate(StationConfig, read_toml(path), path)
+    data = read_toml(path)
+    if is_controller_station(data):
+        raise ConfigError(
+            f"{path}: can: a controller station ([openprotocol] without [can]) has no CAN bus, "
+            "joint or motor; this needs a CAN station's file ([can], station.joint, programs "
+            "with motor speed and hard limits, e.g. config/station.toml). A controller "
+            f"station runs its bridge: boltwatch serve openprotocol --config {path}"
+        )
+    return can_station(path, data)
+
+
+def can_station(path: Path, data: dict[str, Any]) -> LoadedStation:
+    """The CAN station of ``path`` from its TOML ``data``: validated, its joints and DBC read."""
+    config = validate(StationConfig, data, path)
     joint_path = resolve_relative(config.station.joint, path)
     if not joint_path.is_file():
         raise ConfigError(f"{path}: station.joint: file not found: {joint_path}")

@@ -10,7 +10,7 @@ printed by :mod:`services.cli.station_status_text` (for a person) or
 
 Per station:
 
-- services alive: the liveliness tokens ``boltwatch/<st>/health/<service>``;
+- services alive: the tokens ``boltwatch/<st>/health/<service>``, its own first;
 - sample rate: samples received per second over the window (one per Sample
   message of a line-placed station, every sample of an edge station's
   SampleBatch), and, when
@@ -32,8 +32,8 @@ Per station:
 - predictor: the latest PredictorStats (``boltwatch/<st>/predictor``, once a
   second): payloads it refused, samples its core could not use, samples of
   no running run, runs whose end never arrived;
-- a controller bridge's link, faults and newest active alarm, for a station
-  with one (:mod:`shared.line_status.status_bridge`);
+- a controller bridge's link, faults and newest active alarm, and its services
+  (``kind`` "bridge"), for a station with one (:mod:`shared.line_status.status_bridge`);
 - the newest active quality alert of the recorder (a program's Cpk or NOKs,
   :mod:`shared.line_status.status_quality_alert`).
 """
@@ -48,7 +48,13 @@ from shared import channels, keys
 from shared.codec import decode
 from shared.errors import InputError
 from shared.line_status.status_bridge import TOPICS as BRIDGE_TOPICS
-from shared.line_status.status_bridge import BridgeSeen, BridgeStatus, bridge_status
+from shared.line_status.status_bridge import (
+    BridgeSeen,
+    BridgeStatus,
+    bridge_status,
+    is_bridge_station,
+    station_services,
+)
 from shared.line_status.status_bus import BusHealth, bus_health, bus_rate
 from shared.line_status.status_last_result import LastResult, last_result
 from shared.line_status.status_quality_alert import TOPIC as QUALITY_TOPIC
@@ -69,7 +75,7 @@ from shared.messages import (
     ToolState,
 )
 
-#: The services of a station, in display order; others are shown if alive.
+#: The services of a CAN station, in display order; others are shown if alive.
 KNOWN_SERVICES = ("acquisition", "predictor", "recorder", "rig")
 
 _NS = 1_000_000_000
@@ -182,6 +188,7 @@ class StationStatus:
     last_result: LastResult | None = None  # None: no TighteningResult in the window
     bridge: BridgeStatus | None = None  # None: no controller bridge spoke in the window
     quality_alert: ActiveQualityAlert | None = None  # None: none active in the window
+    kind: str = "can"  # "bridge": a controller bridge's station (services: its own)
 
 
 @dataclass(frozen=True)
@@ -262,8 +269,7 @@ class StatusCollector:
 
 
 def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationStatus:
-    services = {service: service in seen.services for service in KNOWN_SERVICES}
-    services.update(dict.fromkeys(sorted(seen.services - set(KNOWN_SERVICES)), True))
+    services = station_services(seen.services, seen.bridge, KNOWN_SERVICES)
     last_sample = _decode_sample(seen.last_sample)
     unreadable = seen.unreadable + (1 if seen.last_sample and last_sample is None else 0)
     return StationStatus(
@@ -281,6 +287,7 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
         last_result=last_result(seen.result, now_ns),
         bridge=bridge_status(seen.bridge, now_ns),
         quality_alert=quality_alert(seen.quality, now_ns),
+        kind="bridge" if is_bridge_station(seen.services, seen.bridge) else "can",
     )
 
 

@@ -13,6 +13,12 @@ still active of the :class:`~shared.messages.ControllerAlarm` heard on
 saying no alarm is active clears them all). A station without a bridge shows
 none of these lines. Collected by
 :mod:`shared.line_status.station_status`, printed by :mod:`services.cli.station_status_text`.
+
+A bridge station (one whose bridge holds ``health/openprotocol`` or spoke on
+``openprotocol`` in the window) runs no acquisition, predictor or rig of its
+own: its services are :data:`BRIDGE_SERVICES`, the bridge, its link to the
+controller (``controller``: up while the latest BridgeStats says connected)
+and the recorder (:func:`station_services`).
 """
 
 from __future__ import annotations
@@ -27,6 +33,8 @@ _NS = 1_000_000_000
 
 #: the topics this module reads
 TOPICS = (channels.OPENPROTOCOL.topic, channels.ALARMS.topic)
+#: the services of a bridge station, in display order (``controller``: the bridge's link)
+BRIDGE_SERVICES = ("openprotocol", "controller", "recorder")
 
 #: fault counters of BridgeStats shown when not zero, with their words
 FAULTS = (
@@ -67,6 +75,28 @@ class BridgeSeen:
         latest = self.alarms.get(alarm.error_code)
         if latest is None or alarm.time_ns >= latest.time_ns:
             self.alarms[alarm.error_code] = alarm
+
+
+def is_bridge_station(alive: set[str], seen: BridgeSeen) -> bool:
+    """A station whose bridge holds its token or spoke in the window."""
+    return "openprotocol" in alive or seen.stats is not None
+
+
+def station_services(
+    alive: set[str], seen: BridgeSeen, can_services: tuple[str, ...]
+) -> dict[str, bool]:
+    """Service -> alive: the station's own services first (a bridge station's
+    :data:`BRIDGE_SERVICES`, else ``can_services``), each alive or not, then any other
+    service alive, by name."""
+    alive = set(alive)
+    known = can_services
+    if is_bridge_station(alive, seen):
+        known = BRIDGE_SERVICES
+        if seen.stats is not None and seen.stats.connected:
+            alive.add("controller")
+    services = {service: service in alive for service in known}
+    services.update(dict.fromkeys(sorted(alive - set(known)), True))
+    return services
 
 
 @dataclass(frozen=True)

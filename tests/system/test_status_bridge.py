@@ -1,7 +1,9 @@
 """``boltwatch status`` of a station with a controller bridge, as a real process against a
 real router: a fake bridge (a zenoh client session of the test) keeps publishing
 BridgeStats; status shows the link, the faults that are not zero, the last tightening id
-and the alarm active on the controller. As a real bridge does, the fake one publishes an
+and the alarm active on the controller, and the station's own services (the bridge, its
+controller link, the recorder), not a CAN station's acquisition, predictor and rig; a CAN
+station beside it is shown as ever. As a real bridge does, the fake one publishes an
 alarm message only when the alarm is raised (long before status listens): the active
 alarm comes with the bridge's stats, whatever status heard in its window."""
 
@@ -26,6 +28,7 @@ from tests.system.test_status_command import boltwatch, router  # noqa: F401  (t
 pytestmark = pytest.mark.system
 
 STATION = "op-st4"
+CAN_STATION = "can-st5"
 S_NS = 1_000_000_000
 
 
@@ -54,7 +57,10 @@ def test_status_shows_the_bridge_link_its_faults_and_the_newest_active_alarm(
 ) -> None:
     station_file = write_station(tmp_path, zenoh_port=int(router.rsplit(":", 1)[1]))
     session = open_from(zenoh_config("client", [router], connect_timeout_ms=5000))
-    token = session.liveliness().declare_token(keys.health_key(STATION, "openprotocol"))
+    tokens = [
+        session.liveliness().declare_token(keys.health_key(station, service))
+        for station, service in ((STATION, "openprotocol"), (CAN_STATION, "acquisition"))
+    ]
     stop = threading.Event()
 
     def publish() -> None:
@@ -71,13 +77,20 @@ def test_status_shows_the_bridge_link_its_faults_and_the_newest_active_alarm(
     finally:
         stop.set()
         thread.join(10)
-        token.undeclare()
+        for token in tokens:
+            token.undeclare()
         session.close()
 
     assert text.returncode == 0, text.stderr
     block = text.stdout.split(f"station {STATION}\n", 1)[1]
     lines = {line[:16].strip(): line[16:] for line in block.splitlines()}
-    assert "openprotocol up" in lines["services"]
+    assert lines["services"] == "openprotocol up, controller link DOWN, recorder DOWN"
+    assert "bus" not in lines and "predictor" not in lines  # it runs neither
+    can_block = text.stdout.split(f"station {CAN_STATION}\n", 1)[1].split("\n\n", 1)[0]
+    can_lines = {line[:16].strip(): line[16:] for line in can_block.splitlines()}
+    assert can_lines["services"] == "acquisition up, predictor DOWN, recorder DOWN, rig DOWN"
+    assert can_lines["bus"].startswith("- (no BusStats in the window: acquisition down?)")
+    assert can_lines["predictor"].startswith("- (no predictor stats in the window")
     assert lines["controller"].startswith(
         "NOT CONNECTED to 192.0.2.10:4545, MID 0061 revision 2, 4711 results, last tightening "
         "4711 (3 connects, "
@@ -94,7 +107,20 @@ def test_status_shows_the_bridge_link_its_faults_and_the_newest_active_alarm(
     assert lines["alarm"].endswith(": overheated (controller NOT ready, tool ready)")
 
     assert as_json.returncode == 0, as_json.stderr
-    bridge = json.loads(as_json.stdout)["stations"][STATION]["bridge"]
+    stations = json.loads(as_json.stdout)["stations"]
+    assert stations[STATION]["services"] == {
+        "openprotocol": True,
+        "controller": False,
+        "recorder": False,
+    }
+    assert (stations[STATION]["kind"], stations[CAN_STATION]["kind"]) == ("bridge", "can")
+    assert list(stations[CAN_STATION]["services"]) == [
+        "acquisition",
+        "predictor",
+        "recorder",
+        "rig",
+    ]
+    bridge = stations[STATION]["bridge"]
     assert (bridge["controller"], bridge["connected"], bridge["last_tightening_id"]) == (
         "192.0.2.10:4545",
         False,

@@ -44,11 +44,11 @@ def run(args: argparse.Namespace) -> int:
     import sys
 
     from shared import keys
-    from shared.config import load_line
+    from shared.config import load_any_line
     from shared.errors import ConfigError
     from shared.zenoh_session import client_config, open_from
 
-    stations = load_line(args.config)
+    stations = load_any_line(args.config)
     section = stations[0].config.zenoh
     connect = section.connect
     if not connect:

@@ -91,11 +91,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from services.recorder.quality.quality_report import write_report
     from services.recorder.quality.recorded_results import ResultFilter
-    from shared.config import load_station
+    from shared.config import load_any_station
 
     stations = []
     for path in args.config:
-        loaded = load_station(path)
+        loaded = load_any_station(path)
         stations.append((loaded.station_id, loaded.recordings_folder))
     rule = ResultFilter(
         stations=stations,

@@ -4,8 +4,10 @@ Each file carries (MCAP metadata records, string to string):
 
 ``station``   station id, tool id, station file, recorder software version
 ``run``       run id, tool id and program id as the tool reported them (run files)
-``program``   the program's parameters from the station file (run files)
-``joint``     the joint parameters (JointConfig, nested keys dotted)
+``program``   the program's parameters from the station file (run files; a
+              controller station's pset: its id, name and windows)
+``joint``     the joint parameters (JointConfig, nested keys dotted; a CAN
+              station's only: a controller station models no joint)
 
 One recorder serves several stations (``serve recorder --config A B ...``):
 each station's records come from its own station file. A station with no
@@ -21,7 +23,7 @@ import logging
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from shared.config import LoadedStation
+from shared.config import AnyStation, ControllerStation, LoadedStation
 from shared.config.line import stations_by_id
 
 LOG = logging.getLogger(__name__)
@@ -54,11 +56,12 @@ class FileMetadata:
 
     def __init__(
         self,
-        loaded: LoadedStation | Sequence[LoadedStation],
+        loaded: AnyStation | Sequence[AnyStation],
         extra: Mapping[str, Mapping[str, str]] | None = None,
         warn_unknown: bool = True,
     ) -> None:
-        self._stations = stations_by_id([loaded] if isinstance(loaded, LoadedStation) else loaded)
+        stations = [loaded] if isinstance(loaded, LoadedStation | ControllerStation) else loaded
+        self._stations = stations_by_id(stations)
         self._extra: Metadata = {name: dict(data) for name, data in (extra or {}).items()}
         self._version = software_version()
         self._warned: set[str] = set()
@@ -112,8 +115,9 @@ class FileMetadata:
         )
 
 
-def _configured(loaded: LoadedStation, program_id: int | None) -> Metadata:
-    """``program`` and ``joint`` records from the station's own file."""
+def _configured(loaded: AnyStation, program_id: int | None) -> Metadata:
+    """``program`` and ``joint`` records from the station's own file (a controller station
+    has no joint: its ``program`` is the pset's id, name and windows)."""
     records: Metadata = {}
     if program_id is not None:
         try:
@@ -122,6 +126,7 @@ def _configured(loaded: LoadedStation, program_id: int | None) -> Metadata:
             records["program"] = {"id": str(program_id), "error": "not in the station file"}
         else:
             records["program"] = flatten(program.model_dump(mode="json"))
-    joint = loaded.joint if program_id is None else loaded.joint_of(program_id)
-    records["joint"] = flatten(joint.model_dump(mode="json"))
+    if isinstance(loaded, LoadedStation):
+        joint = loaded.joint if program_id is None else loaded.joint_of(program_id)
+        records["joint"] = flatten(joint.model_dump(mode="json"))
     return records

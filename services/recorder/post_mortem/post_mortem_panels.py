@@ -22,6 +22,7 @@ from shared.model.slip_bounds import PAPER_PARTIAL_RELIEF
 
 HORIZON_COLORS = {1: "tab:red", 2: "tab:green", 3: "tab:blue"}  # as Figures 18, 22, 23
 BOUND_COLOR = "tab:orange"
+WINDOW_COLOR = "tab:green"  # a controller's window (its own, from its result)
 GRID_POINTS = 400
 SMALL = 8  # legend font size
 #: The one sign convention of the error panels (Figs. 22, 23), first line of their y labels.
@@ -85,11 +86,34 @@ def _decisions(ax: Any, run: RecordedRun) -> None:
 
 
 def _target(ax: Any, run: RecordedRun, key: str, scale: float = 1.0) -> None:
+    """The program's target from the file's ``program`` record; a controller's run: none
+    (that record is the station file's, not the controller's pset)."""
+    if run.controller is not None:
+        return
     try:
         value = float(run.metadata.get("program", {})[key]) * scale
     except (KeyError, ValueError):
         return
     ax.axhline(value, color="tab:purple", ls=":", lw=1.2, label=f"program target {value:g}")
+
+
+def _controller_torque(ax: Any, run: RecordedRun) -> None:
+    """A controller's run: its own torque window (shaded) and target (its result's)."""
+    marks = run.controller
+    if marks is None:
+        return
+    low, high = marks.torque_window_nm
+    if low is not None and high is not None:
+        ax.axhspan(low, high, color=WINDOW_COLOR, alpha=0.15,
+                   label=f"controller's torque window {low:g} to {high:g} Nm")  # fmt: skip
+    else:
+        for bound, side in ((low, "min"), (high, "max")):
+            if bound is not None:
+                ax.axhline(bound, color=WINDOW_COLOR, lw=1.2,
+                           label=f"controller's torque {side} {bound:g} Nm")  # fmt: skip
+    if marks.torque_target_nm is not None:
+        ax.axhline(marks.torque_target_nm, color="tab:purple", ls=":", lw=1.2,
+                   label=f"controller's target {marks.torque_target_nm:g} Nm")  # fmt: skip
 
 
 def _times(run: RecordedRun, events: Sequence[StickSlipEvent]) -> list[float]:
@@ -116,6 +140,7 @@ def draw_torque(ax: Any, run: RecordedRun, bounds: Bounds) -> None:
         ax.plot(bounds.trace_run_s, bounds.model.slip_torque_nm(t), color=BOUND_COLOR, lw=1.5,
                 ls="-.", label="T_min: end of the smallest slip (eqs. 10, 20)")  # fmt: skip
     _target(ax, run, "target_torque_nm")
+    _controller_torque(ax, run)
     _decisions(ax, run)
     extra = "" if bounds.model is not None else " (no analytical envelopes)"
     ax.set(title=f"Fig. 10 (top): torque with detected peaks{extra}", ylabel="torque T / Nm")

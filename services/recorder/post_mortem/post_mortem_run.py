@@ -14,6 +14,11 @@ Section 5.2, we anchor the two at the first plateau. The plateau F_1 is left
 when sticking breaks at the first peak, so t(F_1) (eqs. 16, 27 solved for t,
 :meth:`JointModel.time_at_force_s`) is the model time of that peak. Without
 force, the first peak torque anchors them instead (:meth:`time_at_torque_s`).
+
+A run a tool controller tightened (its recording holds the controller's
+result: :mod:`.controller_marks`) gets no model: the joint and program
+records of its file are the station file's, not what the controller
+tightened; the panels draw the controller's own windows and target instead.
 """
 
 from __future__ import annotations
@@ -27,11 +32,18 @@ from mcap.records import Message, Metadata
 
 from services.recorder.mcap_files.recording_reader import RecordingScan
 from services.recorder.mcap_files.trace_export import SAMPLE_SCHEMA
+from services.recorder.post_mortem.controller_marks import ControllerMarks
 from shared import channels
 from shared.codec import decode
 from shared.config.joint import JointConfig
 from shared.errors import InputError
-from shared.messages import Sample, StickSlipEvent, StopDecision
+from shared.messages import (
+    ControllerResult,
+    Sample,
+    StickSlipEvent,
+    StopDecision,
+    TighteningResult,
+)
 from shared.model import JointConstants, JointModel
 from shared.run_clock import RunClock
 
@@ -39,6 +51,13 @@ LOG = logging.getLogger(__name__)
 
 EVENT_SCHEMA = channels.EVENTS.schema_name
 DECISION_SCHEMA = channels.DECISION.schema_name
+RESULT_SCHEMA = channels.RESULTS.schema_name
+CONTROLLER_SCHEMA = channels.CONTROLLER.schema_name
+#: why a controller's run has no model (the caption says it)
+CONTROLLER_NO_MODEL = (
+    "a controller's run: the joint and program in its file are the station file's, "
+    "not what the controller tightened"
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,6 +87,7 @@ class RecordedRun:
     model_missing: str = ""  # why there is no model ("" when there is one)
     state: str = ""  # RecordingScan.describe() of the source: complete, or what was lost
     runs_in_file: list[int] = field(default_factory=list)  # every run with samples in the file
+    controller: ControllerMarks | None = None  # the controller's windows and target, if its run
 
     @property
     def t0_ns(self) -> int:
@@ -82,7 +102,7 @@ class RecordedRun:
         return any(s.force_n is not None for s in self.samples)
 
     def model(self) -> JointModel | None:
-        if self.joint is None or self.motor_speed_rad_s is None:
+        if self.controller is not None or self.joint is None or self.motor_speed_rad_s is None:
             return None
         return JointModel(JointConstants.of(self.joint), self.motor_speed_rad_s)
 
@@ -112,6 +132,15 @@ def read_run(source: Path, run_id: int | None = None) -> RecordedRun:
     samples: list[Sample] = []
     events: list[StickSlipEvent] = []
     decisions: list[StopDecision] = []
+    results: list[TighteningResult] = []
+    controllers: list[ControllerResult] = []
+    kept: dict[str, tuple[type, list[Any]]] = {
+        SAMPLE_SCHEMA: (Sample, samples),
+        EVENT_SCHEMA: (StickSlipEvent, events),
+        DECISION_SCHEMA: (StopDecision, decisions),
+        RESULT_SCHEMA: (TighteningResult, results),
+        CONTROLLER_SCHEMA: (ControllerResult, controllers),
+    }
     undecodable = 0
     for record in scan.records():
         if isinstance(record, Metadata):
@@ -121,15 +150,12 @@ def read_run(source: Path, run_id: int | None = None) -> RecordedRun:
             continue
         channel = scan.channels.get(record.channel_id)
         schema = scan.schemas.get(channel.schema_id) if channel is not None else None
-        if schema is None:
+        wanted = kept.get(schema.name) if schema is not None else None
+        if wanted is None:
             continue
+        message_type, messages = wanted
         try:
-            if schema.name == SAMPLE_SCHEMA:
-                samples.append(decode(Sample, record.data))
-            elif schema.name == EVENT_SCHEMA:
-                events.append(decode(StickSlipEvent, record.data))
-            elif schema.name == DECISION_SCHEMA:
-                decisions.append(decode(StopDecision, record.data))
+            messages.append(decode(message_type, record.data))
         except InputError:
             undecodable += 1
     if undecodable:
@@ -151,6 +177,12 @@ def read_run(source: Path, run_id: int | None = None) -> RecordedRun:
         runs_in_file=sorted(counts),
     )
     run.joint, run.motor_speed_rad_s, run.model_missing = _model_inputs(metadata)
+    run.controller = ControllerMarks.of(
+        next((r for r in reversed(results) if r.run_id == run_id), None),
+        next((c for c in reversed(controllers) if c.run_id == run_id), None),
+    )
+    if run.controller is not None:
+        run.model_missing = CONTROLLER_NO_MODEL
     return run
 
 

@@ -14,8 +14,11 @@ With the joint (``joint`` metadata) and the motor speed (``program``) in the
 file, the analytical envelopes (Figure 10), bounds (eqs. 21-26) and K bands
 (eqs. 34-39) are drawn, at model time = run time + a shift anchored at the
 first plateau (:class:`~services.recorder.post_mortem.post_mortem_run.ModelClock`); the
-caption says so, and says when they are missing. matplotlib (Agg) is
-imported inside the functions: nothing at import time.
+caption says so, and says when they are missing. A run a tool controller
+tightened (:mod:`.controller_marks`) is drawn against the controller's own
+torque window and target instead, from its result; never the station file's
+program or the model of its joint. matplotlib (Agg) is imported inside the
+functions: nothing at import time.
 """
 
 from __future__ import annotations
@@ -74,6 +77,12 @@ def _caption(run: RecordedRun, bounds: Bounds) -> str:
         f"{run.source.name}: run {run.run_id}, {len(run.samples)} samples, "
         f"{len(run.events)} stick-slip events{force}{state}"
     )
+    if run.controller is not None:
+        return (
+            f"{first}\nA controller's run (its result: {run.controller.source}): drawn against "
+            f"its own {run.controller.describe()}.\nNo analytical bounds "
+            f"({run.model_missing}): measured values only."
+        )
     if bounds.model is None or bounds.clock is None:
         why = run.model_missing or "no event to anchor model time"
         return f"{first}\nNo analytical bounds ({why}): measured values only."

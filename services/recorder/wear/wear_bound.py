@@ -32,8 +32,9 @@ I_process 1.1e6) is about 2000 times below its bound of 41 × (320 Nm)² ×
 500 Hz = 2.1e9; the real CS351 runs are listed in the README. What it
 catches: a negative, infinite or NaN intensity, and any figure no tool could
 have taken (a forged 1e15, or 9e11 from random frames on a 320 Nm tool).
-A station the recorder has no file for is bounded by its sensor range and
-its own duration only: a loose bound; the answer to forged messages is TLS
+A station the recorder has no file for, and a controller station (its
+psets carry no limits: the controller keeps them), are bounded by the
+sensor range and the run's own duration only: a loose bound; the answer to forged messages is TLS
 and access control (README, Security).
 """
 
@@ -43,7 +44,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from shared.config import LoadedStation
+from shared.config import AnyStation, LoadedStation
 from shared.errors import InputError
 from shared.messages import RunSummary
 from shared.run_clock import RunClock
@@ -151,7 +152,7 @@ def refusal(summary: RunSummary, limits: RunLimits) -> str | None:
 class StationLimits:
     """The limits of each run from the station files a recorder serves."""
 
-    def __init__(self, stations: Sequence[LoadedStation]) -> None:
+    def __init__(self, stations: Sequence[AnyStation]) -> None:
         self._stations = {station.station_id: station for station in stations}
 
     def of(self, summary: RunSummary) -> RunLimits:
@@ -165,6 +166,12 @@ class StationLimits:
                 f"no station file for {summary.station}: the contract DBC's torque range",
             )
         sensor_top = torque_top_nm(station.sensor_range)
+        if not isinstance(station, LoadedStation):  # a controller's psets carry no limits
+            return RunLimits(
+                sensor_top,
+                None,
+                f"{station.path.name} is a controller station: the contract's torque range",
+            )
         try:
             program = station.config.program(summary.program_id)
         except KeyError:

@@ -192,7 +192,10 @@ def test_an_endpoint_zenoh_cannot_parse_is_named(
 def test_zenoh_errors_lose_their_rust_source_locations(
     workspace: Workspace, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    line = fails_with(["serve", "predictor", "--config", "station.toml"], capsys)
+    line_placed = workspace.path / "line-station.toml"  # a line predictor's station
+    text = (workspace.path / "station.toml").read_text()
+    line_placed.write_text(text.replace("[predictor]\n", '[predictor]\nplacement = "line"\n'))
+    line = fails_with(["serve", "predictor", "--config", "line-station.toml"], capsys)
     assert "no zenoh router at tcp/127.0.0.1:" in line and line.endswith("Timeout!")
     line = fails_with(["serve", "router", "--access-control", "empty.toml"], capsys)
     assert line.endswith(

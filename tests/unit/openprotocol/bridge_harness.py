@@ -22,7 +22,7 @@ from services.openprotocol.published_ids import position_path
 from services.predictor.advisory_replay import replay_run
 from shared import channels, keys
 from shared.codec import decode
-from shared.config import load_station, toml_writer
+from shared.config import load_any_station, toml_writer
 from shared.messages import SampleBatch
 from shared.queued_publisher import QueuedPublisher
 from tests.live_recorder import write_station_file
@@ -79,7 +79,7 @@ class RunningBridge:
     """The bridge of a station file, working in a thread until :meth:`finish`."""
 
     def __init__(self, station_file: Path, session: zenoh.Session, trace_timeout_s: float = 1.0):
-        station = load_station(station_file)
+        station = load_any_station(station_file)
         section = station.config.openprotocol
         assert section is not None
         self.counts = BridgeCounts(station.station_id, f"{section.host}:{section.port}")

@@ -43,10 +43,11 @@ TIMESTAMP = "2026-11-24:10:00:00"
 SAMPLES = 400
 
 
-def torque_curve(samples: int = SAMPLES) -> tuple[float, ...]:
-    """A ramp to 200 Nm with a few stick-slip drops."""
+def torque_curve(samples: int = SAMPLES, peak_nm: float = 200.0) -> tuple[float, ...]:
+    """A ramp to ``peak_nm`` (200 Nm) with a few stick-slip drops of 3 % of it."""
+    drop = 0.03 * peak_nm
     return tuple(
-        round(200.0 * i / samples - (6.0 if i % 50 > 42 else 0.0), 1) for i in range(samples)
+        round(peak_nm * i / samples - (drop if i % 50 > 42 else 0.0), 1) for i in range(samples)
     )
 
 
@@ -72,6 +73,9 @@ class TcpController:
     connections: int = 0
     stops: int = 0
     keep_alives: int = 0
+    #: the pset's final torque target and window (MID 0061), and where its curves end
+    torque_target_nm: float = 200.0
+    torque_window_nm: tuple[float, float] = (180.0, 240.0)
 
     def __post_init__(self) -> None:
         self._server = socket.create_server(("127.0.0.1", self.port))
@@ -103,7 +107,7 @@ class TcpController:
             self.next_id += 1
             stored = StoredResult(
                 tightening_id,
-                torque_curve(),
+                torque_curve(peak_nm=self.torque_target_nm),
                 tuple(round(0.1 * i, 1) for i in range(SAMPLES)),
                 ok,
             )
@@ -296,9 +300,9 @@ class TcpController:
             batch_status=1,  # type: ignore[arg-type]
             torque_status=1,  # type: ignore[arg-type]
             angle_status=1,  # type: ignore[arg-type]
-            torque_min_nm=180.0,
-            torque_max_nm=240.0,
-            torque_final_target_nm=200.0,
+            torque_min_nm=self.torque_window_nm[0],
+            torque_max_nm=self.torque_window_nm[1],
+            torque_final_target_nm=self.torque_target_nm,
             torque_nm=stored.torque[-1],
             angle_min_deg=0,
             angle_max_deg=90,

@@ -1,0 +1,142 @@
+"""What every station file holds, whatever drives its tool: its identity, router and recordings.
+
+A station file is one of two kinds (:mod:`shared.config.station_kinds`): a CAN
+station (:mod:`shared.config.station`: ``[can]``, a joint, programs with motor
+and hard limits) or a controller station (:mod:`shared.config.controller_station`:
+``[openprotocol]``, no ``[can]``). Both have the sections here, read the same
+way: ``[station]`` ``id`` and ``tool_id``, ``[zenoh]`` (the line's router,
+reconnection, TLS) and ``[recorder]`` (where the recordings go). Paths are
+relative to the station file.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import AfterValidator, Field, ValidationInfo, field_validator, model_validator
+
+from shared.config.loading import StrictModel, resolve_relative
+from shared.errors import ConfigError
+from shared.folders import FolderError, make_folder
+
+StationId = str
+
+#: a zenoh endpoint: ``<protocol>/<address>[?<metadata>][#<config>]``
+ENDPOINT_FORM = re.compile(r"[A-Za-z0-9_-]+/[^?#\s]+(\?[^#\s]*)?(#\S*)?")
+ENDPOINT_EXPECTED = "expected <protocol>/<address>:<port>, e.g. tcp/127.0.0.1:7447"
+
+
+def _endpoint(text: str) -> str:
+    if not ENDPOINT_FORM.fullmatch(text):
+        raise ValueError(f"not a zenoh endpoint: {ENDPOINT_EXPECTED}")
+    return text
+
+
+Endpoint = Annotated[str, AfterValidator(_endpoint)]
+
+
+class StationIdentity(StrictModel):
+    """``[station]`` keys of every station: its id on the line, its tool's id."""
+
+    id: StationId = Field(pattern=r"^[A-Za-z0-9_-]{1,64}$", description="key-expression safe")
+    tool_id: int = Field(
+        ge=0,
+        le=65535,
+        description="the tool's id: in ToolStatus on CAN; the id a controller station's "
+        "runs and wear are counted under",
+    )
+
+
+class ZenohSection(StrictModel):
+    """How a service joins the line: its router, reconnection, and TLS (see README, Security)."""
+
+    mode: Literal["peer", "client"] = "client"
+    connect: list[Endpoint] = Field(default_factory=list, description="e.g. tcp/127.0.0.1:7447")
+    listen: list[Endpoint] = Field(default_factory=list)
+    connect_timeout_s: float | None = Field(
+        default=None,
+        gt=0,
+        description="how long a service waits for its router at start; none: for ever",
+    )
+    reconnect_period_max_s: float = Field(
+        default=2.0,
+        gt=0,
+        le=60,
+        description="longest pause between two attempts to reach a lost router (never gives up)",
+    )
+    tls_root_ca: Path | None = Field(
+        default=None, description="CA certificate (PEM) of the line, relative to this station file"
+    )
+    tls_cert: Path | None = Field(
+        default=None, description="this service's certificate (PEM), for mutual TLS"
+    )
+    tls_key: Path | None = Field(default=None, description="its private key (PEM)")
+
+    @field_validator("tls_root_ca", "tls_cert", "tls_key")
+    @classmethod
+    def _readable_file(cls, path: Path | None, info: ValidationInfo) -> Path | None:
+        """Resolve against the station file and fail now, not at the first TLS handshake."""
+        if path is None:
+            return None
+        source = (info.context or {}).get("source")
+        resolved = resolve_relative(path, Path(source)) if source is not None else path
+        try:
+            with resolved.open("rb") as handle:
+                handle.read(1)
+        except OSError as err:
+            raise ValueError(f"cannot read {resolved}: {err.strerror}") from err
+        return resolved
+
+    @model_validator(mode="after")
+    def _has_somewhere_to_go(self) -> ZenohSection:
+        if not self.connect and not self.listen:
+            raise ValueError("give connect or listen endpoints (multicast scouting is off)")
+        return self
+
+    @model_validator(mode="after")
+    def _tls_is_complete(self) -> ZenohSection:
+        if (self.tls_cert is None) != (self.tls_key is None):
+            raise ValueError("give tls_cert and tls_key together (mutual TLS needs both)")
+        uses_tls = any(e.startswith("tls/") for e in [*self.connect, *self.listen])
+        if uses_tls and self.tls_root_ca is None:
+            raise ValueError("tls/ endpoints need tls_root_ca (the CA that signed the router)")
+        if not uses_tls and (self.tls_root_ca or self.tls_cert):
+            raise ValueError("tls_* keys are set but no endpoint is tls/ (e.g. tls/host:7447)")
+        return self
+
+    @property
+    def uses_tls(self) -> bool:
+        return self.tls_root_ca is not None
+
+
+class RecorderSection(StrictModel):
+    folder: Path = Field(description="relative to this station file")
+    flush_interval_s: float = Field(default=1.0, gt=0, le=60)
+    max_file_bytes: int = Field(default=256 * 1024 * 1024, ge=1024 * 1024)
+    max_file_duration_s: float = Field(default=600.0, gt=0)
+    wear_service_threshold: float | None = Field(
+        default=None,
+        gt=0,
+        description="intensity since last service (eq. 69) at which the recorder alerts",
+    )
+
+
+def recordings_folder(station_file: Path, section: RecorderSection) -> Path:
+    """``recorder.folder`` resolved against the station file."""
+    return resolve_relative(section.folder, station_file)
+
+
+def make_recordings_folder(station_file: Path, section: RecorderSection) -> Path:
+    """The recordings folder, made if missing; ConfigError (file, key, why) if it cannot be.
+
+    Called at a service's start: a folder that can never be made is a
+    configuration error, while a disk that fails later is a fault the
+    recorder rides out (README, "Faults").
+    """
+    folder = recordings_folder(station_file, section)
+    try:
+        return make_folder(folder)
+    except FolderError as err:
+        raise ConfigError(f"{station_file}: recorder.folder: {folder}: {err}") from err
