@@ -47,7 +47,6 @@ from services.openprotocol.controller_session import (
     RefusedFrame,
     SessionStoppedError,
 )
-from services.openprotocol.pending_tightenings import Take
 from services.openprotocol.published_ids import BridgePosition
 from services.openprotocol.result_reading import CurveRefusedError, read_curve, read_result
 from services.openprotocol.tightening_flow import TighteningFlow
@@ -254,15 +253,8 @@ class OpenProtocolBridge:
         self._flow.publish_ready()
 
     def _take_newest(self, newest: Any) -> None:
-        flow = self._flow
-        if flow.take_result(newest) is Take.CONFLICT:
-            flow.new_epoch(
-                f"its newest tightening {newest.tightening_id} is not the one published under "
-                "its id",
-                flow.controller_name,
-            )
-            flow.take_result(newest)
-        flow.controller_newest(newest.tightening_id)
+        self._flow.take_result(newest)
+        self._flow.controller_newest(newest.tightening_id)
 
     def _epoch_ended(self, session: ControllerSession, newest: Any) -> str | None:
         """Why the controller's ids started again since the watermark, or None."""
@@ -364,15 +356,7 @@ class OpenProtocolBridge:
             self._reports.pushed(message, session, self._publish, self._counts)
 
     def _live_result(self, message: LastTighteningResult) -> None:
-        figures = read_result(message, self._section.timezone, False, time.time_ns())
-        flow = self._flow
-        if flow.take_result(figures) is Take.CONFLICT:
-            flow.new_epoch(
-                f"tightening {figures.tightening_id} came with other values than the one "
-                "published under its id: the controller's ids started again",
-                flow.controller_name,
-            )
-            flow.take_result(figures)
+        self._flow.take_result(read_result(message, self._section.timezone, False, time.time_ns()))
 
     def _unusable(self, message: Any, err: Exception) -> None:
         mid = getattr(message, "MID", 0)

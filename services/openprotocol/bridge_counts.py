@@ -9,6 +9,7 @@ shows the counters that are not zero.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from collections.abc import Callable
@@ -80,32 +81,12 @@ class BridgeCounts:
         log("%s", text)
 
     def stats(self, clock_ns: Callable[[], int] = time.time_ns) -> BridgeStats:
-        return BridgeStats(
-            station=self.station,
-            time_ns=clock_ns(),
-            started_ns=self.started_ns,
-            controller=self.controller,
-            connected=self.connected,
-            result_revision=self.result_revision,
-            connects=self.connects,
-            link_drops=self.link_drops,
-            keep_alives_sent=self.keep_alives_sent,
-            results=self.results,
-            results_filled=self.results_filled,
-            repeated_results=self.repeated_results,
-            traces=self.traces,
-            traces_without_result=self.traces_without_result,
-            garbage_bytes=self.garbage_bytes,
-            bad_messages=self.bad_messages,
-            refused_values=self.refused_values,
-            controller_errors=self.controller_errors,
-            last_tightening_id=self.last_tightening_id,
-            last_error=self.last_error,
-            results_without_traces=self.results_without_traces,
-            traces_refused=self.traces_refused,
-            results_given_up=self.results_given_up,
-            epochs=self.epochs,
-            clock_refused=self.clock_refused,
-            trace_reading=self.trace_reading,
-            active_alarm=self.active_alarm,
-        )
+        """The counters as the message, each field of :class:`BridgeStats` by its name here."""
+        values = {name: getattr(self, name) for name in _STATS_FIELDS}
+        return BridgeStats(time_ns=clock_ns(), **values)
+
+
+#: the fields of BridgeStats these counters give (all but the time it is sent)
+_STATS_FIELDS = tuple(
+    field.name for field in dataclasses.fields(BridgeStats) if field.name != "time_ns"
+)

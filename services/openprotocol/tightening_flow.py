@@ -82,7 +82,8 @@ class TighteningFlow:
 
     def take_result(self, figures: ResultFigures) -> Take:
         """Take a result; a repeat the controller sent is counted (a result fetched by id
-        that is here already, or published, is the bridge's own asking, not a repeat)."""
+        that is here already, or published, is the bridge's own asking, not a repeat); an
+        id published with other values starts a new epoch, in which it is taken."""
         if figures.clock_refused:
             self._counts.clock_refused += 1
             self._counts.fault(
@@ -91,6 +92,13 @@ class TighteningFlow:
                 "clock holds: the time it was received is taken",
             )
         take = self._pending.result(figures, self._clock())
+        if take is Take.CONFLICT:
+            self.new_epoch(
+                f"tightening {figures.tightening_id} came with other values than the one "
+                "published under its id: the controller's ids started again",
+                self.controller_name,
+            )
+            take = self._pending.result(figures, self._clock())
         if take is Take.REPEAT and not figures.filled:
             self._counts.repeated_results += 1
             self._counts.note(

@@ -12,8 +12,9 @@ relative to the station file.
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Literal, Protocol, TypeVar
 
 from pydantic import AfterValidator, Field, ValidationInfo, field_validator, model_validator
 
@@ -140,3 +141,29 @@ def make_recordings_folder(station_file: Path, section: RecorderSection) -> Path
         return make_folder(folder)
     except FolderError as err:
         raise ConfigError(f"{station_file}: recorder.folder: {folder}: {err}") from err
+
+
+class _Numbered(Protocol):
+    @property
+    def id(self) -> int: ...
+
+
+Numbered = TypeVar("Numbered", bound=_Numbered)
+
+
+def check_unique_ids(programs: Sequence[_Numbered], what: str) -> None:
+    """ValueError when two of ``programs`` share an id (``what``: "program", "pset")."""
+    ids = [program.id for program in programs]
+    if len(ids) != len(set(ids)):
+        raise ValueError(f"{what} ids must be unique (got {ids})")
+
+
+def find_program(
+    programs: Sequence[Numbered], program_id: int, station_id: str, what: str
+) -> Numbered:
+    """The one of ``programs`` with ``program_id``; KeyError names the known ids."""
+    for program in programs:
+        if program.id == program_id:
+            return program
+    known = ", ".join(str(program.id) for program in programs) or "none"
+    raise KeyError(f"no {what} {program_id} in station {station_id} (known: {known})")

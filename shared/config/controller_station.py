@@ -54,6 +54,8 @@ from shared.config.common_sections import (
     RecorderSection,
     StationIdentity,
     ZenohSection,
+    check_unique_ids,
+    find_program,
     make_recordings_folder,
     recordings_folder,
 )
@@ -134,18 +136,12 @@ class ControllerStationConfig(StrictModel):
 
     @model_validator(mode="after")
     def _program_ids_unique(self) -> ControllerStationConfig:
-        ids = [program.id for program in self.programs]
-        if len(ids) != len(set(ids)):
-            raise ValueError(f"pset ids must be unique (got {ids})")
+        check_unique_ids(self.programs, "pset")
         return self
 
     def program(self, program_id: int) -> ControllerProgram:
         """The pset with ``program_id``; KeyError names the known ids."""
-        for program in self.programs:
-            if program.id == program_id:
-                return program
-        known = ", ".join(str(program.id) for program in self.programs) or "none"
-        raise KeyError(f"no pset {program_id} in station {self.station.id} (known: {known})")
+        return find_program(self.programs, program_id, self.station.id, "pset")
 
 
 class ControllerStation:

@@ -23,6 +23,8 @@ from shared.config.common_sections import (
     RecorderSection,
     StationIdentity,
     ZenohSection,
+    check_unique_ids,
+    find_program,
     make_recordings_folder,
     recordings_folder,
 )
@@ -177,18 +179,12 @@ class StationConfig(StrictModel):
 
     @model_validator(mode="after")
     def _program_ids_unique(self) -> StationConfig:
-        ids = [program.id for program in self.programs]
-        if len(ids) != len(set(ids)):
-            raise ValueError(f"program ids must be unique (got {ids})")
+        check_unique_ids(self.programs, "program")
         return self
 
     def program(self, program_id: int) -> Program:
         """The program with ``program_id``; KeyError names the known ids."""
-        for program in self.programs:
-            if program.id == program_id:
-                return program
-        known = ", ".join(str(program.id) for program in self.programs)
-        raise KeyError(f"no program {program_id} in station {self.station.id} (known: {known})")
+        return find_program(self.programs, program_id, self.station.id, "program")
 
 
 class LoadedStation:
