@@ -131,7 +131,7 @@ class ControllerReports:
             last_service_ns=self._date(message.last_service, counts),
             calibration_value_nm=message.calibration_value_nm,
             tool_type=None if message.tool_type is None else str(message.tool_type),
-            tool_model=None,
+            tool_model=(message.tool_model or "").strip() or None,
             controller_software=(message.controller_software_version or "").strip() or None,
         )
 

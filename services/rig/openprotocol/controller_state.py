@@ -16,16 +16,18 @@ reads its settings and writes through it.
   it stays active until the next run that ends without a limit, which clears
   it (0074, "acknowledged on the controller"); 0076 after each 0070 says
   whether one is active;
-- tool data (0041): serial ``SIM-<tool id>``, the tightenings of this
-  controller process (also the count since service), the configured last
-  calibration and service dates (default: the day the controller started),
-  calibration value = the program's hard torque limit.
+- tool data (0041, revisions 1 to 5): serial ``SIM-<tool id>``, the
+  tightenings of this controller process (also the count since service), the
+  configured last calibration and service dates (default: the day the
+  controller started), calibration value and max torque = the program's hard
+  torque limit, full speed = its motor speed, model ``BW-SIM``.
 """
 
 from __future__ import annotations
 
 import datetime as dt
 import logging
+import math
 import threading
 import zoneinfo
 
@@ -61,6 +63,7 @@ ALARM_CODES: dict[StopSource, tuple[str, str]] = {
 }
 SUPPLIER_CODE = "BWS"
 SOFTWARE_VERSION = "boltwatch-sim 1"
+TOOL_MODEL = "BW-SIM"
 
 
 class ControllerState:
@@ -151,8 +154,17 @@ class ControllerState:
             motor_size=0 if second else None,
             open_end_data="000" if second else None,
             controller_software_version=SOFTWARE_VERSION if second else None,
+            max_torque_nm=self._program.max_torque_nm if revision >= 3 else None,
+            gear_ratio=1.0 if revision >= 3 else None,
+            full_speed_rpm=self._full_speed_rpm() if revision >= 3 else None,
+            primary_tool=1 if revision >= 4 else None,
+            tool_model=TOOL_MODEL if revision >= 5 else None,
             revision=revision,
         )
+
+    def _full_speed_rpm(self) -> float:
+        """The program's motor speed (rad/s) in revolutions a minute, as 0041 rev 3 has it."""
+        return round(self._program.motor_speed_rad_s * 60.0 / (2.0 * math.pi), 2)
 
     def alarm_status(self, revision: int) -> AlarmStatus:
         alarm = self.alarm

@@ -138,7 +138,10 @@ def test_ten_tightenings_are_recorded_once_with_the_controllers_values_and_curve
         assert counts.controller_errors == 0 and counts.repeated_results == 0
         assert counts.trace_reading == "big-endian, scaling as declared"
         assert set(controller.delivered_ids) >= set(range(1, TIGHTENINGS + 1))
-        assert controller.tool_data_revisions[0] == 2, "0040 at the highest revision known"
+        assert controller.tool_data_revisions[0] == 5, "0040 at the highest revision known"
+        tool = line.heard.of("tool_data")[0]
+        assert tool.tool_model == controller.identity.tool_model
+        assert tool.tightenings_since_service is not None and tool.tool_type == "4"
 
 
 def test_results_fetched_by_id_after_a_restart_keep_their_values(line_of: Any) -> None:

@@ -68,12 +68,31 @@ EXAMPLES: list[WireMessage] = [
         mid=900, wanted_revision=1, extra_data=subscriptions.trace_extra_data([1, 2])
     ),
     subscriptions.DataUnsubscribe(mid=900, extra_data=""),
-    tool_data.ToolDataRequest(revision=1),
-    tool_data.ToolDataRequest(revision=2),
+    *(tool_data.ToolDataRequest(revision=revision) for revision in range(1, 6)),
     tool_data.ToolData(
         tool_serial="B0412345", tightenings=0, last_calibration=TIME, controller_serial=""
     ),
     TOOL_DATA_2,
+    dataclasses.replace(
+        TOOL_DATA_2, max_torque_nm=60.0, gear_ratio=1.25, full_speed_rpm=1200.0, revision=3
+    ),
+    dataclasses.replace(
+        TOOL_DATA_2,
+        max_torque_nm=60.0,
+        gear_ratio=1.25,
+        full_speed_rpm=1200.0,
+        primary_tool=1,
+        revision=4,
+    ),
+    dataclasses.replace(
+        TOOL_DATA_2,
+        max_torque_nm=0.0,
+        gear_ratio=0.0,
+        full_speed_rpm=9999.99,
+        primary_tool=99,
+        tool_model="STB34",
+        revision=5,
+    ),
     results.ResultSubscribe(revision=1),
     results.ResultSubscribe(revision=2),
     LAST_RESULT_1,
