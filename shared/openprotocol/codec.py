@@ -5,7 +5,9 @@
   revision not implemented or malformed content raises
   :class:`~shared.openprotocol.errors.OpenProtocolError` (``field ==
   "revision"`` for the former: a controller answers it with 0004 error 97).
-- :func:`encode` ``(message) -> bytes``: the whole message on the wire.
+- :func:`encode` ``(message) -> bytes``: the whole message on the wire (a NUL
+  ends it, but for a message with binary data, 0900: the specification's
+  2.2.4, "no NUL character is sent after the binary data").
 - :data:`SUPPORTED_REVISIONS`: the revisions implemented per MID, lowest
   first, so an integrator can ask the highest and fall back, and a controller
   can refuse the others.
@@ -29,7 +31,7 @@ from shared.openprotocol.alarms import (
 )
 from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect
 from shared.openprotocol.errors import OpenProtocolError
-from shared.openprotocol.framing import Frame, HeaderFill, frame_bytes
+from shared.openprotocol.framing import BINARY_MIDS, Frame, HeaderFill, frame_bytes
 from shared.openprotocol.results import (
     LastTighteningResult,
     OldResultRequest,
@@ -151,4 +153,6 @@ def encode(
     _check_revision(message.MID, revision)
     data = message.to_data(revision, dialect)
     frame = Frame(mid=message.MID, revision=revision, no_ack=no_ack, data=data)
-    return frame_bytes(frame, fill=fill, terminator=dialect.nul_terminator)
+    # the specification (2.2.4): "no NUL character is sent after the binary data"
+    terminator = dialect.nul_terminator and message.MID not in BINARY_MIDS
+    return frame_bytes(frame, fill=fill, terminator=terminator)

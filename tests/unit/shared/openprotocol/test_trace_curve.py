@@ -22,7 +22,9 @@ ASCII_PART = (
 )  # fmt: skip
 BIG = b"\x00\x64\xff\xce\x04\xd2"
 LITTLE = b"\x64\x00\xce\xff\xd2\x04"
-TRACE_WIRE = b"01170900001         " + ASCII_PART + b"\x00" + BIG + b"\x00"
+# the specification (2.2.4): the length counts the ASCII part's NUL and the samples, and "no
+# NUL character is sent after the binary data"
+TRACE_WIRE = b"01170900001         " + ASCII_PART + b"\x00" + BIG
 
 
 def _trace(data: bytes, dialect: Dialect = DEFAULT_DIALECT) -> TraceCurve:
@@ -33,6 +35,8 @@ def _trace(data: bytes, dialect: Dialect = DEFAULT_DIALECT) -> TraceCurve:
 
 def test_golden_0900_decodes_to_samples_in_their_unit_and_the_step_in_seconds() -> None:
     (frame,) = FrameReader().feed(TRACE_WIRE)
+    (with_nul,) = FrameReader().feed(TRACE_WIRE + b"\x00")  # as some controllers send it
+    assert with_nul == frame
     trace = decode(frame)
     assert isinstance(trace, TraceCurve)
     assert (trace.result_id, trace.timestamp) == (345, "2024-06-01:07:31:02")
@@ -58,7 +62,7 @@ def test_the_nul_before_the_samples_may_be_missing_or_a_nul_after_them_counted()
     assert _trace(ASCII_PART + BIG) == expected
     assert _trace(ASCII_PART + b"\x00" + BIG + b"\x00") == expected
     without = encode(expected, dialect=Dialect(trace_nul_separator=False))
-    assert without == b"01160900001         " + ASCII_PART + BIG + b"\x00"
+    assert without == b"01160900001         " + ASCII_PART + BIG
 
 
 def test_a_divisor_parameter_divides() -> None:
@@ -66,7 +70,7 @@ def test_a_divisor_parameter_divides() -> None:
     trace = _trace(divided + b"\x00" + BIG)
     assert trace.samples == pytest.approx((1.0, -0.5, 12.34))
     assert trace.coefficient == 0.01
-    assert encode(trace)[20:-1] == divided + b"\x00" + BIG
+    assert encode(trace)[20:] == divided + b"\x00" + BIG
 
 
 def test_build_makes_a_curve_that_reads_back() -> None:
