@@ -18,10 +18,10 @@ from typing import Any
 import zenoh
 
 from services.recorder.service import RecorderService
-from shared import keys
-from shared.codec import encode
 from shared.config import AnyStation, ControllerStation, LoadedStation, toml_writer
-from shared.service_skeleton import ServiceSkeleton
+from shared.contract import keys
+from shared.contract.codec import encode
+from shared.runtime.service_skeleton import ServiceSkeleton
 from tests.paths import STATION_FILE
 
 WAIT_S = 10.0  # upper bound on waits for zenoh; tests never assert on time

@@ -63,7 +63,7 @@ identity() {
 }
 
 identity router router
-# the generator reads the channel table (shared/channels.py), which needs the project's
+# the generator reads the channel table (shared/contract/channels.py), which needs the project's
 # packages: the checkout's .venv (make run makes it) unless PYTHON names another
 python=${PYTHON:-python3}
 [ -n "${PYTHON:-}" ] || [ ! -x "$repo/.venv/bin/python" ] || python="$repo/.venv/bin/python"

@@ -47,12 +47,10 @@ from services.acquisition.frame_decoder import (
     ToolStatusFrame,
 )
 from services.acquisition.pairing import AssembledSample, SampleAssembler
-from shared import codec
-from shared.can_database import SAMPLE_RATE_HZ, StationDatabase
-from shared.errors import InputError
-from shared.log_limit import RateLimitedLog
-from shared.message_fields import can_id_bounds
-from shared.messages import (
+from shared.contract import codec
+from shared.contract.can_database import SAMPLE_RATE_HZ, StationDatabase
+from shared.contract.message_fields import can_id_bounds
+from shared.contract.messages import (
     BusStats,
     Sample,
     StopDecision,
@@ -61,6 +59,8 @@ from shared.messages import (
     ToolRunState,
     ToolState,
 )
+from shared.errors import InputError
+from shared.runtime.log_limit import RateLimitedLog
 
 LOG = logging.getLogger(__name__)
 

@@ -10,7 +10,7 @@ joins the two (services never import each other).
 
 Both calls run on the CAN thread between two frames: they must not wait
 (no blocking I/O, no lock another thread holds for long). What they publish
-goes through a queue (:mod:`shared.queued_publisher`).
+goes through a queue (:mod:`shared.runtime.queued_publisher`).
 """
 
 from __future__ import annotations
@@ -19,8 +19,8 @@ from collections.abc import Callable
 from typing import Protocol
 
 from shared.config import LoadedStation
-from shared.messages import Sample, StopDecision, ToolState
-from shared.service_skeleton import ServiceSkeleton
+from shared.contract.messages import Sample, StopDecision, ToolState
+from shared.runtime.service_skeleton import ServiceSkeleton
 
 
 class Decider(Protocol):

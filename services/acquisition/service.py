@@ -14,7 +14,7 @@ Where the decision runs is the station file's ``[predictor] placement``:
   bad payload is counted in ``BusStats.bad_decisions``, never raised into
   zenoh).
 
-The CAN thread runs under ``SCHED_FIFO`` where allowed (:mod:`shared.realtime`)
+The CAN thread runs under ``SCHED_FIFO`` where allowed (:mod:`shared.runtime.realtime`)
 and never waits on zenoh: samples, run states, bus counters and the
 predictor's messages go through the station's queued publisher.
 """
@@ -32,14 +32,14 @@ import zenoh
 from services.acquisition.acquisition import Acquisition
 from services.acquisition.decider import DeciderFactory
 from services.acquisition.zenoh_outlet import ZenohOutlet
-from shared import channels
-from shared.can_bus import open_bus
-from shared.can_database import StationDatabase
 from shared.config import load_station
+from shared.contract import channels
+from shared.contract.can_database import StationDatabase
 from shared.errors import ConfigError
-from shared.queued_publisher import QueuedPublisher
-from shared.realtime import STOP_PATH_PRIORITY, use_realtime_priority
-from shared.service_skeleton import ServiceSkeleton, Stop
+from shared.runtime.can_bus import open_bus
+from shared.runtime.queued_publisher import QueuedPublisher
+from shared.runtime.realtime import STOP_PATH_PRIORITY, use_realtime_priority
+from shared.runtime.service_skeleton import ServiceSkeleton, Stop
 
 LOG = logging.getLogger(__name__)
 

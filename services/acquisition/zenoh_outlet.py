@@ -1,6 +1,6 @@
 """Publish the acquisition's output on zenoh (``samples``, ``tool``, ``bus``).
 
-Through the station's :class:`~shared.queued_publisher.QueuedPublisher`:
+Through the station's :class:`~shared.runtime.queued_publisher.QueuedPublisher`:
 the CAN thread only queues (it is the stop path), a thread of the
 publisher's own encodes and puts, in order. An edge station's publisher
 sends the samples in batches on ``sample_batches`` (the line only records
@@ -10,7 +10,7 @@ While the session has no router (it restarts, the network is cut) zenoh has
 nowhere to send a sample: it is lost. The outlet counts those samples
 (``unsent_samples``, reported in BusStats) and logs each outage once when it
 starts and once, with its length and its count, when it ends. The check on
-the 1 kHz path is one attribute read (:class:`~shared.zenoh_session.RouterLink`).
+the 1 kHz path is one attribute read (:class:`~shared.runtime.zenoh_session.RouterLink`).
 """
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ import logging
 
 import zenoh
 
-from shared.messages import BusStats, Sample, ToolState
-from shared.queued_publisher import QueuedPublisher
-from shared.zenoh_session import RouterLink
+from shared.contract.messages import BusStats, Sample, ToolState
+from shared.runtime.queued_publisher import QueuedPublisher
+from shared.runtime.zenoh_session import RouterLink
 
 LOG = logging.getLogger(__name__)
 

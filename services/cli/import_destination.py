@@ -13,26 +13,26 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from shared import folders
+from shared import files
 from shared.errors import InputError
 
 if TYPE_CHECKING:
-    from services.recorder.controller_import.controller_run import ControllerRun
-    from services.recorder.rerun_files.rerun_sink import RerunOptions
+    from shared.offline.controller_import.controller_run import ControllerRun
+    from shared.recordings.rerun.rerun_sink import RerunOptions
 
 
 def make_folder(folder: Path, what: str) -> Path:
     """``folder``, made if missing; InputError naming it, what it is for, and why not."""
     try:
-        return folders.make_folder(folder)
-    except folders.FolderError as err:
+        return files.make_folder(folder)
+    except files.FolderError as err:
         raise InputError(f"{folder}: {what}: {err}") from err
 
 
 def write_csv_whole(target: Path, rows: Iterable[tuple[float, float, float, float | None]]) -> int:
-    """:func:`shared.trace.write_trace` under a temporary name, renamed when complete."""
-    from services.recorder.controller_import.import_files import remove_temporary, temporary_path
-    from shared.trace import write_trace
+    """:func:`shared.contract.trace.write_trace` under a temporary name, renamed when complete."""
+    from shared.contract.trace import write_trace
+    from shared.offline.controller_import.import_files import remove_temporary, temporary_path
 
     temporary = temporary_path(target)
     try:
@@ -56,8 +56,8 @@ class CsvWriter:
 
     def write(self, run: ControllerRun) -> bool:
         """Write the run's trace; True (a CSV is always written, over an older one)."""
-        from services.recorder.controller_import.controller_import import RunNotWrittenError
         from services.recorder.live.recorder import describe_os_error
+        from shared.offline.controller_import.controller_import import RunNotWrittenError
 
         target = self.folder / f"{run.source.stem}.csv"
         rows = zip(run.run_time_s, run.torque_nm, run.angle_deg, [None] * len(run), strict=True)
@@ -79,21 +79,21 @@ class RecordingsWriter:
     """Each run into the recordings folder, with its predictor replay and wear-ledger count."""
 
     def __init__(self, folder: Path, station: str, rerun: bool) -> None:
-        from services.recorder.wear.wear_ledger import WearLedger, ledger_path
+        from shared.wear.wear_ledger import WearLedger, ledger_path
 
         self.folder = folder
         self._station = station
         self._options: RerunOptions | None = None
         if rerun:
-            from services.recorder.rerun_files.rerun_sink import RerunOptions
+            from shared.recordings.rerun.rerun_sink import RerunOptions
 
             self._options = RerunOptions()
         self._ledger = WearLedger(ledger_path(folder))
 
     def write(self, run: ControllerRun) -> bool:
         """Import the run; True when written now, False when it was already there."""
-        from services.cli.controller_replay import replay_run
-        from services.recorder.controller_import.controller_import import import_run
+        from shared.offline.controller_import.controller_import import import_run
+        from shared.offline.controller_import.controller_replay import replay_run
 
         replay = replay_run(self._station, run)
         imported = import_run(run, self.folder, self._station, self._options, replay, self._ledger)

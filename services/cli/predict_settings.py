@@ -16,10 +16,10 @@ import dataclasses
 import math
 from pathlib import Path
 
-from services.predictor.core import DEFAULT_WINDOW_SAMPLES, PredictorSettings
+from shared.contract.sensor_range import SensorRange
 from shared.errors import BoltwatchError, InputError
 from shared.model import JointConstants
-from shared.sensor_range import SensorRange
+from shared.stickslip import DEFAULT_WINDOW_SAMPLES, PredictorSettings
 
 
 def predict_settings(
@@ -103,7 +103,7 @@ def _joint_constants(path: Path) -> JointConstants:
 
 
 def _dbc_range(path: Path) -> SensorRange:
-    from shared.can_database import StationDatabase
+    from shared.contract.can_database import StationDatabase
 
     try:
         return SensorRange.of_database(StationDatabase(path))

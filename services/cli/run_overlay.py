@@ -3,7 +3,7 @@
 A RUN is a run id (all digits, and no file of that name): its MCAP files are
 found in the ``--config`` station's recordings folder; anything else is the
 path of an MCAP file. The runs are read, aligned and drawn by
-:mod:`services.recorder.overlay`; a run that never reaches the alignment
+:mod:`shared.offline.overlay`; a run that never reaches the alignment
 point is drawn unaligned, with a warning line naming it.
 """
 
@@ -14,11 +14,11 @@ import sys
 from pathlib import Path
 
 from services.cli.command_options import check_png_target
-from services.recorder.overlay.overlay_alignment import parse_alignment
-from services.recorder.overlay.overlay_plot import save_figure
-from services.recorder.overlay.overlay_run import OverlayRun, find_run_files, read_overlay_run
-from services.recorder.overlay.overlay_series import build_overlay
 from shared.config import AnyStation
+from shared.offline.overlay.overlay_alignment import parse_alignment
+from shared.offline.overlay.overlay_plot import save_figure
+from shared.offline.overlay.overlay_run import OverlayRun, find_run_files, read_overlay_run
+from shared.offline.overlay.overlay_series import build_overlay
 
 DEFAULT_TARGET = Path("overlay.png")
 

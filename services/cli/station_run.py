@@ -30,12 +30,12 @@ import zenoh
 from services.cli import run_table
 from services.cli.run_tally import RunTally
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
-from shared import channels, keys
-from shared.codec import decode
 from shared.config import LoadedStation, Program
+from shared.contract import channels, keys
+from shared.contract.codec import decode
+from shared.contract.messages import BridgeStats, BusStats, RunSummary, TighteningResult, ToolState
 from shared.errors import BoltwatchError, TransportError
-from shared.messages import BridgeStats, BusStats, RunSummary, TighteningResult, ToolState
-from shared.zenoh_session import open_from, zenoh_config
+from shared.runtime.zenoh_session import open_from, zenoh_config
 
 LOG = logging.getLogger(__name__)
 

@@ -7,7 +7,7 @@ recording holds everything). Each service logs to its own file. Processes
 that can stop at the same time (the rigs of a line, its acquisitions) are
 stopped as a group: signalled together, then waited for. Should the supervisor
 itself be killed outright, each service gets SIGTERM from the kernel
-(:mod:`shared.supervisor_link`) and stops as it would on Ctrl-C.
+(:mod:`shared.runtime.supervisor_link`) and stops as it would on Ctrl-C.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from shared.supervisor_link import supervisor_environment
+from shared.runtime.supervisor_link import supervisor_environment
 
 LOG = logging.getLogger(__name__)
 

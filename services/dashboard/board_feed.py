@@ -22,7 +22,7 @@ from collections.abc import Callable
 import zenoh
 
 from services.dashboard.line_board import WINDOW_S, LineBoard
-from shared import keys
+from shared.contract import keys
 from shared.errors import InputError
 
 LOG = logging.getLogger(__name__)

@@ -15,7 +15,7 @@ What ``boltwatch status`` collects is reused, not copied
 
 Beside them, what status does not keep: the last :data:`HISTORY` results and
 stop reasons of each station, the alerts of every alert channel of
-:mod:`shared.channels` (a topic ending in ``alert``: the recorder's
+:mod:`shared.contract.channels` (a topic ending in ``alert``: the recorder's
 ``wear/alert`` and ``quality/alert``, and any other a service adds, shown by its fields), and the
 wear of each tool from the recorder's ``wear`` queryable against the
 station's ``recorder.wear_service_threshold``.
@@ -29,12 +29,12 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
-from shared import channels, keys
-from shared.codec import decode
+from shared.contract import channels, keys
+from shared.contract.codec import decode
+from shared.contract.messages import RunSummary, TighteningResult
 from shared.errors import InputError
 from shared.line_status.station_status import KNOWN_SERVICES, StationStatus, StatusCollector
 from shared.line_status.status_last_result import last_result
-from shared.messages import RunSummary, TighteningResult
 
 #: results, stop reasons and alerts kept per station
 HISTORY = 10

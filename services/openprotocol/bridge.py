@@ -65,7 +65,7 @@ from shared.openprotocol.results import (
 from shared.openprotocol.session import CommandAccepted, CommandError
 from shared.openprotocol.subscriptions import DataSubscribe, trace_extra_data
 from shared.openprotocol.traces import TraceCurve, TraceType
-from shared.stopped_run import RunReplay
+from shared.stickslip.stopped_run import RunReplay
 
 LOG = logging.getLogger(__name__)
 

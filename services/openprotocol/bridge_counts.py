@@ -3,7 +3,7 @@
 Written by the link thread only; read once a second by the stats thread (a
 torn read of two counters is one second old at worst, never wrong for long).
 A fault of the link or of a message is counted here and logged once per kind
-(:class:`~shared.log_limit.RateLimitedLog`), never raised: ``boltwatch status``
+(:class:`~shared.runtime.log_limit.RateLimitedLog`), never raised: ``boltwatch status``
 shows the counters that are not zero.
 """
 
@@ -15,9 +15,9 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from shared.log_limit import RateLimitedLog
-from shared.messages import BridgeStats, ControllerAlarm
-from shared.tightening_judgement import cut_text
+from shared.contract.messages import BridgeStats, ControllerAlarm
+from shared.quality.verdict import cut_text
+from shared.runtime.log_limit import RateLimitedLog
 
 LOG = logging.getLogger(__name__)
 
@@ -38,7 +38,7 @@ FAULT_KINDS = (
 
 @dataclass
 class BridgeCounts:
-    """The counters of :class:`~shared.messages.BridgeStats` and the link's state."""
+    """The counters of :class:`~shared.contract.messages.BridgeStats` and the link's state."""
 
     station: str
     controller: str  # "host:port"

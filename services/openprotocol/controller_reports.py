@@ -4,12 +4,12 @@
   2 carries the count since service, the tool type) after every connect, after
   each tightening and every minute (a recorder that was not listening at the
   connect gets it); the 0041 becomes boltwatch's
-  :class:`~shared.messages.ToolData` on ``tool_data`` (the station file's tool
+  :class:`~shared.contract.messages.ToolData` on ``tool_data`` (the station file's tool
   id, the controller's serials, counters, calibration and service dates), which
   the wear ledger keeps beside the station's tool;
 - alarms: subscribed (0070) after every connect; 0071 (raised), 0074
   (acknowledged on the controller) and 0076 (the alarm status, sent on
-  subscription) each become a :class:`~shared.messages.ControllerAlarm` on
+  subscription) each become a :class:`~shared.contract.messages.ControllerAlarm` on
   ``alarms`` and are acknowledged (0072, 0075, 0077) at once. The alarm active
   now (the last 0071 or active 0076, until a 0074 of its code or an inactive
   0076) is kept in the bridge's counters, so ``status`` knows it whenever it
@@ -27,8 +27,8 @@ from collections.abc import Callable
 from typing import Any
 
 from services.openprotocol.bridge_counts import BridgeCounts
-from shared.messages import ControllerAlarm
-from shared.messages import ToolData as LineToolData
+from shared.contract.messages import ControllerAlarm
+from shared.contract.messages import ToolData as LineToolData
 from shared.openprotocol.alarms import (
     Alarm,
     AlarmAcknowledge,

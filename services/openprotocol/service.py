@@ -6,7 +6,7 @@ declares ``boltwatch/<station>/health/openprotocol``, and runs the bridge
 (:mod:`.bridge`) in the work thread. Everything goes out through the station's
 queued publisher with samples in batches (as an edge station's acquisition
 sends them: nothing on the line decides on a controller's samples); the
-counters (:class:`~shared.messages.BridgeStats`) once a second from a timer of
+counters (:class:`~shared.contract.messages.BridgeStats`) once a second from a timer of
 their own. On stop: the session ends with 0003, the last counters go out, the
 queue is flushed, the token undeclared.
 
@@ -25,9 +25,9 @@ from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.published_ids import position_path
 from shared.config import load_any_station
 from shared.errors import ConfigError
-from shared.queued_publisher import QueuedPublisher
-from shared.service_skeleton import ServiceSkeleton, Stop
-from shared.stopped_run import RunReplay
+from shared.runtime.queued_publisher import QueuedPublisher
+from shared.runtime.service_skeleton import ServiceSkeleton, Stop
+from shared.stickslip.stopped_run import RunReplay
 
 LOG = logging.getLogger(__name__)
 

@@ -30,8 +30,8 @@ from services.openprotocol.published_ids import BridgePosition, read_position, w
 from services.openprotocol.tightening_messages import tightening_messages
 from shared.config import AnyStation
 from shared.config.openprotocol import OpenProtocolSection
-from shared.message_fields import INT64_MAX
-from shared.stopped_run import RunReplay
+from shared.contract.message_fields import INT64_MAX
+from shared.stickslip.stopped_run import RunReplay
 
 LOG = logging.getLogger(__name__)
 

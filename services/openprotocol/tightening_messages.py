@@ -20,7 +20,7 @@ too):
 5. ``controller``: the controller's own result (:class:`ControllerResult`, one
    step made of its torque and angle limits, targets and finals);
 6. ``results``: the :class:`TighteningResult` made from it
-   (:func:`shared.controller_judgement.controller_result`, source
+   (:func:`shared.quality.controller_result.controller_result`, source
    ``controller``);
 7. ``runs``: the replay's :class:`RunSummary` (stop reason None).
 """
@@ -31,15 +31,15 @@ import math
 from typing import Any
 
 from services.openprotocol.controller_tightening import ResultFigures, Tightening
-from shared.controller_judgement import controller_result
-from shared.messages import (
+from shared.contract.messages import (
     ControllerFunction,
     ControllerResult,
     ControllerStep,
     Sample,
     ToolState,
 )
-from shared.stopped_run import RunReplay, StoppedRun
+from shared.quality.controller_result import controller_result
+from shared.stickslip.stopped_run import RunReplay, StoppedRun
 
 #: the name of the one step a bridge's ControllerResult has (Open Protocol gives no steps)
 STEP_NAME = "Tightening"
@@ -130,7 +130,7 @@ def controller_message(
 ) -> ControllerResult:
     """The controller's own result: its verdict, part, batch, and one step of its figures.
 
-    The step's functions, named as :mod:`shared.controller_judgement` reads
+    The step's functions, named as :mod:`shared.quality.controller_result` reads
     them: ``TF Torque`` (target, final torque) or, on an angle strategy without
     a torque target, ``TF Angle``; ``MF TorqueMin`` / ``MF TorqueMax`` /
     ``MF AngleMin`` / ``MF AngleMax`` (the limits, each with the final value)

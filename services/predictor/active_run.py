@@ -1,7 +1,7 @@
 """One tightening run as the live service sees it: a core plus the run's bookkeeping.
 
-Turns the core's plain outputs into :mod:`shared.messages` (events,
-intensity, decision: :mod:`services.predictor.run_messages`) and, at the
+Turns the core's plain outputs into :mod:`shared.contract.messages` (events,
+intensity, decision: :mod:`shared.stickslip.run_messages`) and, at the
 end, the run's :class:`RunSummary`.
 Pure: the wall-clock time of a decision is passed in by the caller.
 """
@@ -10,10 +10,8 @@ from __future__ import annotations
 
 import math
 
-from services.predictor.core import CoreDecision, EventFigures, PredictorCore, PredictorSettings
-from services.predictor.run_messages import decision_message, event_messages
 from shared.config import Program
-from shared.messages import (
+from shared.contract.messages import (
     Intensity,
     RunSummary,
     Sample,
@@ -21,7 +19,9 @@ from shared.messages import (
     StopDecision,
     ToolState,
 )
-from shared.run_clock import RunClock
+from shared.contract.run_clock import RunClock
+from shared.stickslip import CoreDecision, EventFigures, PredictorCore, PredictorSettings
+from shared.stickslip.run_messages import decision_message, event_messages
 
 Outgoing = StickSlipEvent | Intensity | StopDecision
 

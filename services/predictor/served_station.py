@@ -11,13 +11,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from services.predictor.core import PredictorSettings
-from shared import codec
-from shared.can_database import StationDatabase
 from shared.config import LoadedStation, Program
-from shared.message_fields import can_id_bounds
-from shared.messages import Sample, ToolState
+from shared.contract import codec
+from shared.contract.can_database import StationDatabase
+from shared.contract.message_fields import can_id_bounds
+from shared.contract.messages import Sample, ToolState
 from shared.model import JointConstants
+from shared.stickslip import PredictorSettings
 
 
 class ServedStation:

@@ -19,7 +19,7 @@ No payload stops the service: what does not decode (bad JSON, nested too
 deeply, too large, a wrong type, a value out of its bounds or an id wider
 than the station's CAN signal) or names another station is counted as a bad
 payload and logged once, then at most every 10 s. What it counted goes out
-per station once a second as :class:`~shared.messages.PredictorStats` on
+per station once a second as :class:`~shared.contract.messages.PredictorStats` on
 ``boltwatch/<st>/predictor`` (:mod:`services.predictor.station_counts`).
 """
 
@@ -42,14 +42,14 @@ from services.predictor.station_refusal import (
     refuse_stations_served_elsewhere,
 )
 from services.predictor.station_runs import StationRuns
-from shared import channels, codec, keys
 from shared.config import LoadedStation, load_line
 from shared.config.line import stations_by_id
+from shared.contract import channels, codec, keys
+from shared.contract.messages import Sample, StopDecision, ToolState
 from shared.errors import InputError
-from shared.log_limit import RateLimitedLog
-from shared.messages import Sample, StopDecision, ToolState
-from shared.receive_threads import use_one_receive_thread
-from shared.service_skeleton import ServiceSkeleton, Stop
+from shared.runtime.log_limit import RateLimitedLog
+from shared.runtime.receive_threads import use_one_receive_thread
+from shared.runtime.service_skeleton import ServiceSkeleton, Stop
 
 LOG = logging.getLogger(__name__)
 

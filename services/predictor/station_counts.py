@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from services.predictor.core.input_guard import InputReport
-from shared.messages import PredictorStats
+from shared.contract.messages import PredictorStats
+from shared.stickslip.input_guard import InputReport
 
 
 @dataclass

@@ -14,7 +14,7 @@ subscriber (``FifoChannel`` + ``recv()``, or ``indirect=True``) was measured
 too and is wrong: a run's ``tool`` and ``samples`` then race each other.
 
 Each callback first keeps its receive thread's Python thread state
-(:func:`shared.receive_threads.keep_thread_state`; the inbox variants are
+(:func:`shared.runtime.receive_threads.keep_thread_state`; the inbox variants are
 measured side by side in ``tests/benchmarks/bench_line_inbox.py``, figures in
 the README).
 
@@ -39,8 +39,8 @@ from typing import Protocol
 
 import zenoh
 
-from shared import channels, keys
-from shared.receive_threads import keep_thread_state
+from shared.contract import channels, keys
+from shared.runtime.receive_threads import keep_thread_state
 
 #: (served station id, topic, payload) -> None; called one message at a time
 Handler = Callable[[str, str, bytes], None]

@@ -25,8 +25,8 @@ from collections.abc import Iterable, Sequence
 
 import zenoh
 
-from shared import keys
 from shared.config import LoadedStation
+from shared.contract import keys
 from shared.errors import ConfigError
 
 

@@ -6,7 +6,7 @@ callback keeps each
 message, the service's worker thread files them in batches every
 :data:`TAKE_INTERVAL_S`). The worker also flushes files every half flush
 interval, even when the line is quiet, and once a second publishes
-:class:`~shared.messages.RecorderStats` per station. On SIGTERM the
+:class:`~shared.contract.messages.RecorderStats` per station. On SIGTERM the
 subscriber is undeclared, what it received is filed and every file
 finished, so it is readable without recovery.
 
@@ -20,12 +20,12 @@ others (no other line's sample crosses to this line for it). No payload
 stops it: what it refuses (:mod:`services.recorder.live.incoming`) is recorded
 raw and counted in the station's ``RecorderStats.bad_payloads``. Every
 TighteningResult it files feeds the quality alert
-(:mod:`services.recorder.quality.quality_watch`, on ``quality/alert``), every
+(:mod:`services.recorder.quality_watch`, on ``quality/alert``), every
 RunSummary the wear ledger (``wear/alert``); a view-only recorder keeps neither.
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
-(:class:`services.recorder.rerun_files.rerun_sink.RerunLive`); ``--foxglove-port`` serves
+(:class:`shared.recordings.rerun.rerun_sink.RerunLive`); ``--foxglove-port`` serves
 every message it files as a Foxglove WebSocket too
 (:class:`services.recorder.foxglove_live.foxglove_server.FoxgloveLive`). ``--view-only`` makes a
 second recorder a live view beside the line's one: it keeps no wear ledger,
@@ -47,28 +47,28 @@ from typing import TYPE_CHECKING
 
 import zenoh
 
-from services.recorder.live.file_metadata import FileMetadata
 from services.recorder.live.incoming import OTHER_STATION, Received, classify
 from services.recorder.live.line_inbox import LineInbox, Message
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.recorder_health import RecorderHealth
 from services.recorder.live.run_files import FileLimits
 from services.recorder.live.sample_batches import BatchSamples
-from services.recorder.quality.quality_watch import QualityWatch
-from services.recorder.wear.wear_bound import StationLimits
-from services.recorder.wear.wear_ledger import WearLedger, ledger_path
-from services.recorder.wear.wear_watch import WearWatch
-from shared import channels, keys
-from shared.codec import encode
+from services.recorder.quality_watch import QualityWatch
+from services.recorder.wear_watch import WearWatch
 from shared.config import AnyStation, ControllerStation, LoadedStation, load_any_line
+from shared.contract import channels, keys
+from shared.contract.codec import encode
+from shared.contract.message_fields import MAX_TEXT_CHARS
+from shared.contract.messages import QualityAlert, RecorderStats, WearAlert
 from shared.errors import ConfigError
-from shared.message_fields import MAX_TEXT_CHARS
-from shared.messages import QualityAlert, RecorderStats, WearAlert
-from shared.service_skeleton import ServiceSkeleton, Stop
+from shared.recordings.file_metadata import FileMetadata
+from shared.runtime.service_skeleton import ServiceSkeleton, Stop
+from shared.wear.wear_bound import StationLimits
+from shared.wear.wear_ledger import WearLedger, ledger_path
 
 if TYPE_CHECKING:
     from services.recorder.foxglove_live.foxglove_server import FoxgloveLive
-    from services.recorder.rerun_files.rerun_sink import RerunLive, RerunOptions
+    from shared.recordings.rerun.rerun_sink import RerunLive, RerunOptions
 
 LOG = logging.getLogger(__name__)
 
@@ -342,7 +342,7 @@ def rerun_options(write_files: bool, live_url: str | None) -> RerunOptions | Non
     if not write_files and live_url is None:
         return None
     try:
-        from services.recorder.rerun_files.rerun_sink import LIVE_BATCH_SAMPLES, RerunOptions
+        from shared.recordings.rerun.rerun_sink import LIVE_BATCH_SAMPLES, RerunOptions
     except ImportError:
         LOG.exception("Rerun is unusable; recording MCAP only")
         return None
@@ -357,7 +357,7 @@ def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
     if not (web or getattr(args, "rerun_serve", False)):
         return None
     try:
-        from services.recorder.rerun_files.rerun_sink import RerunLive
+        from shared.recordings.rerun.rerun_sink import RerunLive
 
         return RerunLive(args.rerun_port, args.rerun_web_port if web else None)
     except Exception:

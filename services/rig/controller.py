@@ -23,7 +23,7 @@ import logging
 
 from services.rig.physics import Measurement, TighteningPhysics
 from shared.config.station import Program
-from shared.messages import ToolRunState
+from shared.contract.messages import ToolRunState
 
 LOG = logging.getLogger(__name__)
 

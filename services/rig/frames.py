@@ -2,7 +2,7 @@
 
 The tool controller sends ToolSensors and ToolStatus, the force sensor node
 JointSensors; both listen for StopCommand. Ids, layout and scaling come from
-:class:`~shared.can_database.StationDatabase`, never from this file. A
+:class:`~shared.contract.can_database.StationDatabase`, never from this file. A
 reading beyond what its signal can carry is sent at the end of the range, as
 a real transducer saturates at full scale (the predictor counts it as
 ``saturated``); the station file's limits are checked against the range at
@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import can
 
-from shared.can_database import COUNTER_MODULO, StationDatabase
-from shared.messages import ToolRunState
-from shared.sensor_range import SensorRange
+from shared.contract.can_database import COUNTER_MODULO, StationDatabase
+from shared.contract.messages import ToolRunState
+from shared.contract.sensor_range import SensorRange
 
 
 class RigFrames:

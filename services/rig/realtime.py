@@ -26,8 +26,8 @@ from services.rig.controller import RunController, StopSource
 from services.rig.frames import RigFrames
 from services.rig.physics import TighteningPhysics
 from shared.config.station import Program, RigSection
+from shared.contract.messages import ToolRunState
 from shared.errors import TransportError
-from shared.messages import ToolRunState
 from shared.model.stiffness import JointConstants
 
 LOG = logging.getLogger(__name__)

@@ -2,7 +2,7 @@
 
 Loads the station file once, opens the configured bus (closed on exit) and
 runs :class:`~services.rig.realtime.RealtimeRig` in the work thread of its
-:class:`~shared.service_skeleton.ServiceSkeleton`: ``--runs N`` exits 0
+:class:`~shared.runtime.service_skeleton.ServiceSkeleton`: ``--runs N`` exits 0
 after N runs, otherwise it runs until SIGINT/SIGTERM (the loop looks at the
 stop flag every sample period, so no wake is needed).
 
@@ -23,13 +23,13 @@ import time
 from services.rig.frames import RigFrames
 from services.rig.realtime import RealtimeRig, ToolIdentity
 from services.rig.selection import choose_program, choose_seed
-from shared.can_bus import open_bus
-from shared.can_database import StationDatabase
 from shared.config import load_station
+from shared.contract.can_database import StationDatabase
 from shared.errors import ConfigError
 from shared.model.stiffness import JointConstants
-from shared.realtime import RIG_PRIORITY, use_realtime_priority
-from shared.service_skeleton import ServiceSkeleton
+from shared.runtime.can_bus import open_bus
+from shared.runtime.realtime import RIG_PRIORITY, use_realtime_priority
+from shared.runtime.service_skeleton import ServiceSkeleton
 
 LOG = logging.getLogger(__name__)
 

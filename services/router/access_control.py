@@ -16,7 +16,7 @@ may declare subscribers, queryables and liveliness tokens under
 - ``<st>-openprotocol`` may put what an Open Protocol bridge publishes for its
   station (``boltwatch serve openprotocol``: the run's samples, tool states,
   the advisory predictor's keys, the controller's result, tool data, alarms and
-  its own stats; :func:`shared.channels.topics_of` ``("openprotocol")``),
+  its own stats; :func:`shared.contract.channels.topics_of` ``("openprotocol")``),
 - ``line-recorder`` may put ``boltwatch/<st>/recorder`` and ``wear/**``.
 
 No one else may put a station's decision; in a plant of several lines the
@@ -44,7 +44,7 @@ import sys
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from shared import channels, keys
+from shared.contract import channels, keys
 
 ACQUISITION_TOPICS = channels.topics_of("acquisition")
 PREDICTOR_TOPICS = channels.topics_of("predictor")

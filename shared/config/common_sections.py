@@ -20,7 +20,7 @@ from pydantic import AfterValidator, Field, ValidationInfo, field_validator, mod
 
 from shared.config.loading import StrictModel, resolve_relative
 from shared.errors import ConfigError
-from shared.folders import FolderError, make_folder
+from shared.files import FolderError, make_folder
 
 StationId = str
 

@@ -36,7 +36,7 @@ recordings, status); its windows are kept with each run's recording (the
 the verdict, the windows and the target of a result are the controller's
 (MID 0061), and ``boltwatch inspect`` draws those.
 
-**Sensor range**: the contract's (:data:`shared.sensor_range.CONTRACT_RANGE`,
+**Sensor range**: the contract's (:data:`shared.contract.sensor_range.CONTRACT_RANGE`,
 the range of ``config/can/station.dbc``: torque ±8388 Nm, angle ±83886 deg):
 a controller station has no DBC, and that range holds every tool a
 controller drives. The recorder refuses samples beyond it, the wear ledger
@@ -63,8 +63,8 @@ from shared.config.loading import StrictModel, read_toml, validate
 from shared.config.openprotocol import OpenProtocolSection
 from shared.config.program_windows import ProgramWindows
 from shared.config.quality import QualitySection
+from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
 from shared.errors import ConfigError
-from shared.sensor_range import CONTRACT_RANGE, SensorRange
 
 #: what a controller station's samples can hold (see the module docstring)
 CONTROLLER_RANGE: SensorRange = CONTRACT_RANGE

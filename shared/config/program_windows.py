@@ -6,7 +6,7 @@ A plant judges every tightening against windows: the final torque between
 ``force_min_n`` and ``force_max_n``. Each bound is optional: a figure with
 no bound is not judged, a figure with one bound is judged against that one.
 The run's ``TighteningResult`` says each figure's status (low / ok / high,
-or not judged) and the run's OK/NOK (:mod:`shared.tightening_judgement`).
+or not judged) and the run's OK/NOK (:mod:`shared.quality.verdict`).
 
 Refused at start, naming the file and the key (the validators below and
 :func:`shared.config.station.load_station`): a minimum not below its maximum, a minimum the
@@ -22,7 +22,7 @@ from __future__ import annotations
 from pydantic import Field, model_validator
 
 from shared.config.loading import StrictModel
-from shared.sensor_range import SensorRange
+from shared.contract.sensor_range import SensorRange
 
 #: (figure, its minimum's key, its maximum's key, the hard limit's key, unit)
 WINDOWS = (

@@ -1,7 +1,7 @@
 """The ``[quality]`` section of a station file: when the recorder raises a quality alert.
 
 Per (station, program) the recorder keeps the last ``window_runs`` results
-(:mod:`services.recorder.quality.quality_watch`) and alerts when
+(:mod:`services.recorder.quality_watch`) and alerts when
 
 - the rolling Cpk of a figure (torque, angle, preload) against the newest
   result's window falls below ``cpk_min`` (no Cpk before ``min_runs`` results

@@ -18,7 +18,6 @@ from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from shared.can_database import StationDatabase
 from shared.config.common_sections import (
     RecorderSection,
     StationIdentity,
@@ -34,8 +33,9 @@ from shared.config.loading import StrictModel, read_toml, resolve_relative, vali
 from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
 from shared.config.program_windows import ProgramWindows
 from shared.config.quality import QualitySection
+from shared.contract.can_database import StationDatabase
+from shared.contract.sensor_range import SensorRange
 from shared.errors import CanDatabaseError, ConfigError
-from shared.sensor_range import SensorRange
 
 
 class StationSection(StationIdentity):

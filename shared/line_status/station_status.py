@@ -44,8 +44,19 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-from shared import channels, keys
-from shared.codec import decode
+from shared.contract import channels, keys
+from shared.contract.codec import decode
+from shared.contract.messages import (
+    BusStats,
+    PredictorStats,
+    RecorderStats,
+    RunSummary,
+    Sample,
+    SampleBatch,
+    StopDecision,
+    TighteningResult,
+    ToolState,
+)
 from shared.errors import InputError
 from shared.line_status.status_bridge import TOPICS as BRIDGE_TOPICS
 from shared.line_status.status_bridge import (
@@ -62,17 +73,6 @@ from shared.line_status.status_quality_alert import (
     ActiveQualityAlert,
     QualitySeen,
     quality_alert,
-)
-from shared.messages import (
-    BusStats,
-    PredictorStats,
-    RecorderStats,
-    RunSummary,
-    Sample,
-    SampleBatch,
-    StopDecision,
-    TighteningResult,
-    ToolState,
 )
 
 #: The services of a CAN station, in display order; others are shown if alive.

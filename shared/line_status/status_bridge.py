@@ -1,6 +1,6 @@
 """What ``boltwatch status`` shows of a station's controller bridge: the link, faults, alarms.
 
-From the latest :class:`~shared.messages.BridgeStats` on
+From the latest :class:`~shared.contract.messages.BridgeStats` on
 ``boltwatch/<st>/openprotocol`` (once a second from ``boltwatch serve
 openprotocol``): whether the controller link is up, to which ``host:port``,
 the revision of MID 0061 in use, the results published and the last
@@ -8,7 +8,7 @@ tightening id, how its 0900 samples read, and the bridge's counters that are
 not zero (:data:`FAULTS`); the alarm active on the controller: the one the
 bridge's latest stats carry (it keeps the controller's alarm state, whether
 or not status heard the alarm), or, without stats in the window, the newest
-still active of the :class:`~shared.messages.ControllerAlarm` heard on
+still active of the :class:`~shared.contract.messages.ControllerAlarm` heard on
 ``boltwatch/<st>/alarms`` (each error code's latest word counts; a status
 saying no alarm is active clears them all). A station without a bridge shows
 none of these lines. Collected by
@@ -25,9 +25,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from shared import channels
-from shared.codec import decode
-from shared.messages import BridgeStats, ControllerAlarm
+from shared.contract import channels
+from shared.contract.codec import decode
+from shared.contract.messages import BridgeStats, ControllerAlarm
 
 _NS = 1_000_000_000
 

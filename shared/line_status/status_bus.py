@@ -1,7 +1,7 @@
 """The acquisition's bus as ``boltwatch status`` shows it: rate and faults from BusStats.
 
 Counters since the acquisition started, from the latest
-:class:`~shared.messages.BusStats` of the window; ``bad_frames`` =
+:class:`~shared.contract.messages.BusStats` of the window; ``bad_frames`` =
 wrong_length + decode_errors + error_frames + counter_faults (frames that
 were on our bus and unusable; foreign ``unknown_ids`` are not); the
 acquisition's own sample rate from the first and the latest BusStats (tells
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shared.messages import BusStats
+from shared.contract.messages import BusStats
 
 _NS = 1_000_000_000
 

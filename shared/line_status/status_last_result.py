@@ -1,6 +1,6 @@
 """The last tightening result ``boltwatch status`` heard of a station: its verdict and why.
 
-From the latest :class:`~shared.messages.TighteningResult` on
+From the latest :class:`~shared.contract.messages.TighteningResult` on
 ``boltwatch/<st>/results`` in the listening window (the live predictor's,
 or a controller's): the run, OK or NOK with its reasons, each final figure
 with its status, where it came from and how long ago the run ended.
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shared.messages import TighteningResult
+from shared.contract.messages import TighteningResult
 
 _NS = 1_000_000_000
 

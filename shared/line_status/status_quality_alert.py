@@ -1,6 +1,6 @@
 """The newest active quality alert ``boltwatch status`` heard of a station.
 
-From :class:`~shared.messages.QualityAlert` on ``boltwatch/<st>/quality/alert``
+From :class:`~shared.contract.messages.QualityAlert` on ``boltwatch/<st>/quality/alert``
 (put by the recorder when a program's rolling Cpk or its NOKs go out of
 bounds, and once more when they are back): each condition's (program, kind,
 figure) latest word counts; the newest of those still active is shown, with
@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from shared import channels
-from shared.codec import decode
-from shared.messages import QualityAlert
+from shared.contract import channels
+from shared.contract.codec import decode
+from shared.contract.messages import QualityAlert
 
 _NS = 1_000_000_000
 

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from services.predictor.core import PredictorCore, PredictorSettings, model_bands
+from shared.stickslip import PredictorCore, PredictorSettings, model_bands
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # run as a script: the repo root
 from tests.benchmarks.bench_predictor_accuracy import (

@@ -30,7 +30,7 @@ false events; "floor Nm" is the median floor the tracker had at the slips of
 the band, which stick-slip itself lifts when its kinks are most samples.
 
 Recall is printed per frequency band, which is what the docstring of
-services/predictor/core/settings.py quotes.
+shared/stickslip/settings.py quotes.
 """
 
 from __future__ import annotations
@@ -45,9 +45,9 @@ from pathlib import Path
 
 import numpy as np
 
-from services.predictor.core import EventFigures, PredictorCore, PredictorSettings
-from services.predictor.core.extremum_tracker import NOISE_FACTOR
 from shared.config import RigSection
+from shared.stickslip import EventFigures, PredictorCore, PredictorSettings
+from shared.stickslip.extremum_tracker import NOISE_FACTOR
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # run as a script: the repo root
 from tests.benchmarks.bench_predictor_accuracy import (

@@ -54,12 +54,12 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
 from services.cli.station_supervisor import stop_process  # noqa: E402
-from shared import channels, keys  # noqa: E402
-from shared.can_database import StationDatabase  # noqa: E402
-from shared.codec import decode, encode  # noqa: E402
 from shared.config import LoadedStation, derive_stations, load_station  # noqa: E402
-from shared.messages import BusStats, RecorderStats  # noqa: E402
-from shared.zenoh_session import zenoh_config  # noqa: E402
+from shared.contract import channels, keys  # noqa: E402
+from shared.contract.can_database import StationDatabase  # noqa: E402
+from shared.contract.codec import decode, encode  # noqa: E402
+from shared.contract.messages import BusStats, RecorderStats  # noqa: E402
+from shared.runtime.zenoh_session import zenoh_config  # noqa: E402
 from tests.benchmarks.bench_stop_path import serve_from  # noqa: E402
 from tests.benchmarks.line_station_runs import SHORT_PROGRAM, Heard, figures, tighten  # noqa: E402
 from tests.fuzz.payloads import template  # noqa: E402
@@ -70,7 +70,7 @@ from tests.unit.predictor.synthetic import staircase  # noqa: E402
 REAL_STATION = "st1"
 START_TIMEOUT_S = 120.0
 RUN_SAMPLES = 1000  # 1 s runs at 1 kHz
-BATCH_SAMPLES = 50  # every 50 ms (shared.sample_batching.BATCH_PERIOD_S)
+BATCH_SAMPLES = 50  # every 50 ms (shared.runtime.sample_batching.BATCH_PERIOD_S)
 RUN_PAUSE_TICKS = 200  # 0.2 s between runs
 EVENT_EVERY_TICKS = 25
 RUN_MARK = 987_654_321  # stands for the run id in pre-encoded messages
@@ -183,7 +183,7 @@ class Station(StationPayloads):
 def events_in(newest: int) -> int:
     """Events found in the batch whose newest sample is the run's ``newest``-th: an event every
     :data:`EVENT_EVERY_TICKS` samples, each riding in the batch in progress (as an edge
-    station's publisher puts them, :mod:`shared.sample_batching`)."""
+    station's publisher puts them, :mod:`shared.runtime.sample_batching`)."""
     return sum(
         1 for n in range(newest - BATCH_SAMPLES + 1, newest + 1) if n % EVENT_EVERY_TICKS == 0
     )

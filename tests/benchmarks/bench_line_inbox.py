@@ -59,13 +59,13 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
 from services.cli.station_supervisor import stop_process  # noqa: E402
 from services.predictor.service import PredictorService  # noqa: E402
 from services.predictor.station_inbox import Handler, Inbox, StationInbox  # noqa: E402
-from services.recorder.mcap_files.recording_reader import RecordingScan  # noqa: E402
-from shared import channels, keys  # noqa: E402
-from shared.codec import decode  # noqa: E402
 from shared.config import derive_stations, load_line  # noqa: E402
-from shared.messages import RunSummary  # noqa: E402
-from shared.service_skeleton import ServiceSkeleton  # noqa: E402
-from shared.zenoh_session import zenoh_config  # noqa: E402
+from shared.contract import channels, keys  # noqa: E402
+from shared.contract.codec import decode  # noqa: E402
+from shared.contract.messages import RunSummary  # noqa: E402
+from shared.recordings.mcap.recording_reader import RecordingScan  # noqa: E402
+from shared.runtime.service_skeleton import ServiceSkeleton  # noqa: E402
+from shared.runtime.zenoh_session import zenoh_config  # noqa: E402
 from tests.benchmarks.bench_line import cpu_s, wait_alive  # noqa: E402
 from tests.benchmarks.line_station_runs import SHORT_PROGRAM  # noqa: E402
 from tests.system.station_files import free_tcp_port, serve, write_station  # noqa: E402

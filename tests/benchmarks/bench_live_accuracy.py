@@ -61,22 +61,22 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
 from services.cli.station_supervisor import stop_process  # noqa: E402
-from services.predictor.core import CoreDecision, PredictorCore, PredictorSettings  # noqa: E402
-from services.predictor.trace_replay import replay  # noqa: E402
-from services.recorder.mcap_files.trace_export import export_trace  # noqa: E402
 from services.rig.frames import RigFrames  # noqa: E402
 from services.rig.realtime import RealtimeRig, ToolIdentity  # noqa: E402
-from shared import channels, keys  # noqa: E402
-from shared.can_bus import open_bus  # noqa: E402
-from shared.can_database import StationDatabase  # noqa: E402
-from shared.codec import decode  # noqa: E402
 from shared.config import load_station  # noqa: E402
 from shared.config.station import RigSection  # noqa: E402
-from shared.messages import RunSummary, StopDecision  # noqa: E402
+from shared.contract import channels, keys  # noqa: E402
+from shared.contract.can_database import StationDatabase  # noqa: E402
+from shared.contract.codec import decode  # noqa: E402
+from shared.contract.messages import RunSummary, StopDecision  # noqa: E402
+from shared.contract.trace import read_trace  # noqa: E402
 from shared.model import JointConstants  # noqa: E402
-from shared.realtime import RIG_PRIORITY, use_realtime_priority  # noqa: E402
-from shared.trace import read_trace  # noqa: E402
-from shared.zenoh_session import zenoh_config  # noqa: E402
+from shared.recordings.mcap.trace_export import export_trace  # noqa: E402
+from shared.runtime.can_bus import open_bus  # noqa: E402
+from shared.runtime.realtime import RIG_PRIORITY, use_realtime_priority  # noqa: E402
+from shared.runtime.zenoh_session import zenoh_config  # noqa: E402
+from shared.stickslip import CoreDecision, PredictorCore, PredictorSettings  # noqa: E402
+from shared.stickslip.trace_replay import replay  # noqa: E402
 from tests.benchmarks.bench_predictor_accuracy import (  # noqa: E402
     Joint,
     conventional,

@@ -37,7 +37,7 @@ Joints are classed by what the rig does near the target (true force within
 ±5 %): "stick-slip" when it sticks most of that time, else "smooth" (the
 screw never stops: above the critical speed there is no stick phase, and no
 plateau to choose). Plateau predictors compared: see
-services/predictor/core/regression.py.
+shared/stickslip/regression.py.
 """
 
 from __future__ import annotations
@@ -52,11 +52,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from services.predictor.core import PredictorCore, PredictorSettings
-from services.predictor.core.settings import PlateauMethod
 from services.rig.physics import Measurement, TighteningPhysics
 from shared.config import Program, RigSection
 from shared.model import JointConstants
+from shared.stickslip import PredictorCore, PredictorSettings
+from shared.stickslip.settings import PlateauMethod
 
 SETTLE_SAMPLES = 300
 LATENCY_SAMPLES = 1  # samples the motor still turns after the sample that triggered the stop

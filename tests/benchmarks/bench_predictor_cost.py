@@ -9,7 +9,7 @@ Goal: < 5 µs per sample (the 1 kHz budget is 1000 µs).
 Three modes on the same recordings: force (target out of reach, the
 streaming cost), torque-only with the target out of reach, and torque-only
 with the target at the run's highest torque, so that the torque halt plan
-(a grid search per event near the target, services/predictor/core/halt_planner.py)
+(a grid search per event near the target, shared/stickslip/halt_planner.py)
 runs on the last stretch of every run; a latched decision ends planning, so
 the target is crossed only at the very end.
 """
@@ -21,10 +21,10 @@ import math
 import statistics
 import time
 
-from services.predictor.core import PredictorCore, PredictorSettings
 from services.rig.physics import TighteningPhysics
 from shared.config import Program, RigSection
 from shared.model import JointConstants
+from shared.stickslip import PredictorCore, PredictorSettings
 
 #: a target no run reaches (an infinite one is refused, and would decide at once: every
 #: plateau is as far from it as the next)

@@ -37,10 +37,10 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
 import zenoh  # noqa: E402
 
 from services.recorder.service import RecorderService  # noqa: E402
-from shared import channels  # noqa: E402
 from shared.config import derive_stations, load_station  # noqa: E402
-from shared.service_skeleton import ServiceSkeleton  # noqa: E402
-from shared.zenoh_session import zenoh_config  # noqa: E402
+from shared.contract import channels  # noqa: E402
+from shared.runtime.service_skeleton import ServiceSkeleton  # noqa: E402
+from shared.runtime.zenoh_session import zenoh_config  # noqa: E402
 from tests.benchmarks.bench_line import (  # noqa: E402
     BATCH_SAMPLES,
     RUN_PAUSE_TICKS,

@@ -4,7 +4,7 @@ Run: ``.venv/bin/python tests/benchmarks/bench_recorder_memory.py [--runs 120]``
 (not collected by pytest). No zenoh: the recorder gets classified payloads on
 a simulated 1 kHz clock, 1700 samples a run (the paper's program), with and
 without the Rerun ``.rrd`` files, and prints the resident memory every 20
-runs. Before pooling Rerun streams (``services/recorder/rerun_files/rerun_streams.py``)
+runs. Before pooling Rerun streams (``shared/recordings/rerun/rerun_streams.py``)
 this showed +1.5 MiB per run with Rerun on.
 """
 
@@ -32,14 +32,14 @@ def rss_mib() -> float:
 
 
 def one_recorder(runs: int, rerun: bool) -> None:
-    from services.recorder.live.file_metadata import FileMetadata
     from services.recorder.live.incoming import classify
     from services.recorder.live.recorder import Recorder
     from services.recorder.live.run_files import FileLimits
-    from services.recorder.rerun_files.rerun_sink import RerunOptions
-    from shared.codec import encode
     from shared.config import load_station
-    from shared.messages import Sample, ToolState
+    from shared.contract.codec import encode
+    from shared.contract.messages import Sample, ToolState
+    from shared.recordings.file_metadata import FileMetadata
+    from shared.recordings.rerun.rerun_sink import RerunOptions
     from tests.live_recorder import write_station_file
 
     tmp = Path(tempfile.mkdtemp(prefix="boltwatch-memory-"))

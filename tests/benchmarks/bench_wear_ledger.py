@@ -24,9 +24,9 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from services.recorder.wear.wear_bound import CONTRACT_LIMITS  # noqa: E402
-from services.recorder.wear.wear_ledger import WearLedger  # noqa: E402
-from shared.messages import RunSummary  # noqa: E402
+from shared.contract.messages import RunSummary  # noqa: E402
+from shared.wear.wear_bound import CONTRACT_LIMITS  # noqa: E402
+from shared.wear.wear_ledger import WearLedger  # noqa: E402
 
 T0_NS = 1_700_000_000_000_000_000
 S_NS = 1_000_000_000

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import zenoh
 
-from shared import channels
-from shared.codec import decode
-from shared.messages import RunSummary, StickSlipEvent, StopDecision
+from shared.contract import channels
+from shared.contract.codec import decode
+from shared.contract.messages import RunSummary, StickSlipEvent, StopDecision
 from tests.system.can_injector import HeardStop
 from tests.system.station_files import serve
 

@@ -16,7 +16,7 @@ Two kinds, because the property checked differs:
   rules refuse them (the caller says which, from the field and the value).
 
 Which values a field refuses is read from its declared bounds
-(:mod:`shared.message_fields`), never from the decoder under test.
+(:mod:`shared.contract.message_fields`), never from the decoder under test.
 """
 
 from __future__ import annotations
@@ -31,9 +31,9 @@ from typing import Any
 
 from hypothesis import strategies as st
 
-from services.recorder.wear.wear_watch import WearAlert
-from shared.codec import MAX_PAYLOAD_BYTES, to_dict
-from shared.message_fields import (
+from services.recorder.wear_watch import WearAlert
+from shared.contract.codec import MAX_PAYLOAD_BYTES, to_dict
+from shared.contract.message_fields import (
     DEFAULT_FLOAT,
     DEFAULT_INT,
     DEFAULT_TEXT,
@@ -41,7 +41,7 @@ from shared.message_fields import (
     NumberRange,
     TextRange,
 )
-from shared.messages import (
+from shared.contract.messages import (
     BridgeStats,
     BusStats,
     ControllerAlarm,

@@ -35,15 +35,15 @@ from mcap.reader import make_reader
 from services.acquisition.acquisition import Acquisition
 from services.acquisition.service import decision_handler
 from services.predictor.service import PredictorService
-from services.recorder.mcap_files.mcap_sink import RAW_ENCODING
-from shared import channels, keys
-from shared.can_database import StationDatabase
-from shared.channels import CHANNELS
-from shared.codec import decode, encode
 from shared.config import load_line, load_station
-from shared.messages import BusStats, Sample, StopDecision, ToolState
-from shared.service_skeleton import ServiceSkeleton
-from shared.zenoh_session import zenoh_config
+from shared.contract import channels, keys
+from shared.contract.can_database import StationDatabase
+from shared.contract.channels import CHANNELS
+from shared.contract.codec import decode, encode
+from shared.contract.messages import BusStats, Sample, StopDecision, ToolState
+from shared.recordings.mcap.mcap_sink import RAW_ENCODING
+from shared.runtime.service_skeleton import ServiceSkeleton
+from shared.runtime.zenoh_session import zenoh_config
 from tests.fuzz.payloads import template
 from tests.live_recorder import (
     RunningRecorder,

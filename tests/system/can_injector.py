@@ -22,10 +22,10 @@ from types import TracebackType
 
 import can
 
-from shared.can_bus import open_bus
-from shared.can_database import COUNTER_MODULO, StationDatabase
 from shared.config.station import CanSection
-from shared.messages import ToolRunState
+from shared.contract.can_database import COUNTER_MODULO, StationDatabase
+from shared.contract.messages import ToolRunState
+from shared.runtime.can_bus import open_bus
 
 
 class CanInjector:

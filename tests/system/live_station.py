@@ -26,15 +26,15 @@ import can
 import zenoh
 
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
-from services.recorder.mcap_files.recording_reader import RecordingScan
-from shared import channels, keys
-from shared.can_bus import open_bus
-from shared.can_database import StationDatabase
-from shared.codec import decode
 from shared.config import LoadedStation, load_station
+from shared.contract import channels, keys
+from shared.contract.can_database import StationDatabase
+from shared.contract.codec import decode
+from shared.contract.messages import RunSummary, StopDecision, ToolRunState
 from shared.errors import TransportError
-from shared.messages import RunSummary, StopDecision, ToolRunState
-from shared.zenoh_session import open_from, zenoh_config
+from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.runtime.can_bus import open_bus
+from shared.runtime.zenoh_session import open_from, zenoh_config
 from tests.system.station_files import write_station
 
 STATION = "st1"

@@ -11,14 +11,14 @@ import json
 import sys
 from pathlib import Path
 
-from services.recorder.live.file_metadata import FileMetadata
 from services.recorder.live.incoming import Received, classify
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.run_files import FileLimits
-from services.recorder.mcap_files.recording_reader import RecordingScan
-from shared.codec import encode
 from shared.config import load_station
-from shared.messages import Sample, ToolState
+from shared.contract.codec import encode
+from shared.contract.messages import Sample, ToolState
+from shared.recordings.file_metadata import FileMetadata
+from shared.recordings.mcap.recording_reader import RecordingScan
 from tests.live_recorder import write_station_file
 
 MS = 1_000_000

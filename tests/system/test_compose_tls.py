@@ -33,12 +33,12 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
-from shared import channels, keys
-from shared.codec import decode
 from shared.config import load_station
+from shared.contract import channels, keys
+from shared.contract.codec import decode
+from shared.contract.messages import RunSummary, StopDecision
 from shared.errors import BoltwatchError
-from shared.messages import RunSummary, StopDecision
-from shared.zenoh_session import open_session
+from shared.runtime.zenoh_session import open_session
 from tests.compose_layout import (
     BASE_FILE,
     IDENTITY,

@@ -26,9 +26,9 @@ from pathlib import Path
 
 import pytest
 
-from shared import channels
-from shared.codec import decode
-from shared.messages import TighteningResult
+from shared.contract import channels
+from shared.contract.codec import decode
+from shared.contract.messages import TighteningResult
 from tests.live_recorder import free_port
 from tests.paths import REPO
 from tests.system.live_station import STATION, live_station

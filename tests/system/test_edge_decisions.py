@@ -16,12 +16,12 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
-from shared import channels, keys
-from shared.can_database import StationDatabase
-from shared.codec import encode
 from shared.config import load_station
-from shared.messages import StopDecision, ToolRunState
-from shared.zenoh_session import zenoh_config
+from shared.contract import channels, keys
+from shared.contract.can_database import StationDatabase
+from shared.contract.codec import encode
+from shared.contract.messages import StopDecision, ToolRunState
+from shared.runtime.zenoh_session import zenoh_config
 from tests.system.can_injector import CanInjector, Pacer, StopListener
 from tests.system.station_files import free_tcp_port, serve, write_station
 

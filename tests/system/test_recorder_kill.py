@@ -17,12 +17,12 @@ import pytest
 import zenoh
 from mcap.reader import make_reader
 
-from services.recorder.mcap_files.recording_reader import RecordingScan
-from services.recorder.mcap_files.recovery import recover
-from shared import channels
-from shared.codec import encode
-from shared.messages import Sample, ToolState
-from shared.zenoh_session import zenoh_config
+from shared.contract import channels
+from shared.contract.codec import encode
+from shared.contract.messages import Sample, ToolState
+from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.recordings.mcap.recovery import recover
+from shared.runtime.zenoh_session import zenoh_config
 from tests.live_recorder import (
     free_port,
     has_subscribers,

@@ -12,11 +12,11 @@ from pathlib import Path
 import pytest
 import zenoh
 
-from shared import channels, keys
-from shared.codec import encode
 from shared.config import load_station
-from shared.messages import JudgedFigure, TighteningResult, Verdict
-from shared.zenoh_session import open_from, zenoh_config
+from shared.contract import channels, keys
+from shared.contract.codec import encode
+from shared.contract.messages import JudgedFigure, TighteningResult, Verdict
+from shared.runtime.zenoh_session import open_from, zenoh_config
 from tests.live_recorder import RunningRecorder, has_subscribers, wait_until, write_station_file
 from tests.system.test_status_command import REPO, router  # noqa: F401  (the fixture)
 

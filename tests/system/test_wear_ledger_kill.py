@@ -24,9 +24,9 @@ from pathlib import Path
 
 import pytest
 
-from services.recorder.wear.wear_bound import CONTRACT_LIMITS
-from services.recorder.wear.wear_ledger import WearLedger
-from shared.messages import RunSummary
+from shared.contract.messages import RunSummary
+from shared.wear.wear_bound import CONTRACT_LIMITS
+from shared.wear.wear_ledger import WearLedger
 from tests.paths import REPO
 
 pytestmark = pytest.mark.system
@@ -40,9 +40,9 @@ S_NS = 1_000_000_000
 WRITER = textwrap.dedent(
     """
     import sys
-    from services.recorder.wear.wear_bound import CONTRACT_LIMITS
-    from services.recorder.wear.wear_watch import WearWatch
-    from shared.messages import RunSummary
+    from shared.wear.wear_bound import CONTRACT_LIMITS
+    from services.recorder.wear_watch import WearWatch
+    from shared.contract.messages import RunSummary
 
     path, first = sys.argv[1], int(sys.argv[2])
     watch = WearWatch(path, None, lambda alert: None, lambda summary: CONTRACT_LIMITS)

@@ -43,10 +43,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import sys
 
-    from shared import keys
     from shared.config import load_any_line
+    from shared.contract import keys
     from shared.errors import ConfigError
-    from shared.zenoh_session import client_config, open_from
+    from shared.runtime.zenoh_session import client_config, open_from
 
     stations = load_any_line(args.config)
     section = stations[0].config.zenoh

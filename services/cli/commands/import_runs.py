@@ -1,11 +1,11 @@
 """``boltwatch import CONTROLLER.json...``: real controller runs into the recordings.
 
 Reads the JSON runs a Bosch Rexroth CS351 controller exports (one file per
-run, see :mod:`services.recorder.controller_import.controller_run`) and writes each as a live
+run, see :mod:`shared.offline.controller_import.controller_run`) and writes each as a live
 recording would be: ``<recordings>/<station>/<YYYY-MM-DD>/<station>_run<id>_<HHMMSS>.mcap``
 (+ ``.rrd``), same channels, schemas and metadata, the controller's own
 timing kept, the controller's result on ``boltwatch/<st>/controller``, and
-the predictor's replay of the run (:mod:`services.cli.controller_replay`):
+the predictor's replay of the run (:mod:`shared.offline.controller_import.controller_replay`):
 its events, intensity, advisory decision and run summary. Each run is
 counted in the wear ledger under the controller's tool serial, once.
 ``--csv DIR`` writes offline trace CSVs instead (header
@@ -88,13 +88,10 @@ class Tally:
 
 def run(args: argparse.Namespace) -> int:
     from services.cli.import_destination import CsvWriter, RecordingsWriter, make_folder
-    from services.recorder.controller_import.controller_import import (
-        DEFAULT_STATION,
-        check_station_id,
-    )
-    from services.recorder.controller_import.controller_run import read_controller_run
-    from services.recorder.wear.wear_bound import RefusedSummaryError
     from shared.errors import BoltwatchError, InputError
+    from shared.offline.controller_import.controller_import import DEFAULT_STATION, check_station_id
+    from shared.offline.controller_import.controller_run import read_controller_run
+    from shared.wear.wear_bound import RefusedSummaryError
 
     tally = Tally(len(args.runs))
     writer: CsvWriter | RecordingsWriter

@@ -1,6 +1,6 @@
 """``boltwatch inspect RUN.mcap [--out RUN.png]``: a picture of a recorded run;
 ``boltwatch inspect RUN.mcap --rerun [--out RUN.rrd]``: its Rerun recording, made from
-the MCAP (:mod:`services.recorder.rerun_files.rrd_from_mcap`);
+the MCAP (:mod:`shared.recordings.rerun.rrd_from_mcap`);
 ``boltwatch inspect --overlay RUN... [--reference RUN] [--align POINT]``: several runs
 on one figure (:mod:`services.cli.run_overlay`)."""
 
@@ -97,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     if args.reference is not None or args.align != "start":
         option = "--reference" if args.reference is not None else "--align"
         raise InputError(f"{option} is an option of --overlay; give --overlay RUN... with it")
-    from services.recorder.post_mortem.run_plot import draw_run
+    from shared.offline.post_mortem.run_plot import draw_run
 
     target = args.out or args.recording.with_suffix(".png")
     check_png_target(target, "the report")
@@ -123,8 +123,8 @@ def _write_rrd(args: argparse.Namespace) -> int:
         )
     if target.exists():
         raise InputError(f"{target} exists (the recorder wrote it live?); give another --out")
-    from services.recorder.rerun_files.rerun_streams import BLUEPRINT_FILE
-    from services.recorder.rerun_files.rrd_from_mcap import rrd_from_mcap
+    from shared.recordings.rerun.rerun_streams import BLUEPRINT_FILE
+    from shared.recordings.rerun.rrd_from_mcap import rrd_from_mcap
 
     written = rrd_from_mcap(args.recording, target)
     if not written.scan.complete:

@@ -1,8 +1,8 @@
 """``boltwatch recover FILE [--out OUT]``: make a truncated recording readable again.
 
-``.mcap`` files are read record by record (:mod:`services.recorder.mcap_files.recovery`);
+``.mcap`` files are read record by record (:mod:`shared.recordings.mcap.recovery`);
 ``.rrd`` files are copied chunk by chunk by the ``rerun`` CLI of the wheel
-(:mod:`services.recorder.rerun_files.rrd_recovery`).
+(:mod:`shared.recordings.rerun.rrd_recovery`).
 """
 
 from __future__ import annotations
@@ -33,11 +33,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     if args.file.suffix == ".rrd":
-        from services.recorder.rerun_files.rrd_recovery import recover_rrd
+        from shared.recordings.rerun.rrd_recovery import recover_rrd
 
         print(recover_rrd(args.file, args.out).describe())
         return 0
-    from services.recorder.mcap_files.recovery import recover
+    from shared.recordings.mcap.recovery import recover
 
     print(recover(args.file, args.out).describe())
     return 0

@@ -79,8 +79,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from shared.logging_setup import setup_logging
-    from shared.supervisor_link import follow_supervisor
+    from shared.runtime.logging_setup import setup_logging
+    from shared.runtime.supervisor_link import follow_supervisor
 
     setup_logging(args.service, args.log_level)
     follow_supervisor()  # started by boltwatch up: stop when it dies
@@ -104,7 +104,7 @@ def _service_main(service: str) -> Callable[[argparse.Namespace], int]:
         return predictor_main
     if service == "openprotocol":  # the predictor replays each run after the fact
         from services.openprotocol.service import main as openprotocol_main
-        from services.predictor.advisory_replay import replay_run
+        from shared.stickslip.advisory_replay import replay_run
 
         return lambda args: openprotocol_main(args, replay=replay_run)
     if service == "recorder":

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from services.cli.command_options import DEFAULT_STATION_FILE
-from shared.option_types import seconds
+from shared.runtime.option_types import seconds
 
 if TYPE_CHECKING:
     import zenoh
@@ -87,7 +87,7 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
     import time
 
     from services.cli.router_client import open_client
-    from shared import keys
+    from shared.contract import keys
     from shared.line_status.station_status import StatusCollector
 
     session = open_client(endpoint, config)

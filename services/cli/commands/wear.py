@@ -9,7 +9,7 @@
 
 ``--plant`` asks every recorder of the plant (``boltwatch/*/wear`` through the
 router of the station file, or ``--connect``; the routers of a plant's lines
-are meshed) and merges their replies (:mod:`services.recorder.wear.wear_plant`). A
+are meshed) and merges their replies (:mod:`shared.wear.wear_plant`). A
 recorder that replies with an error is named on stderr, what the others said
 is printed, and the exit status is 2.
 
@@ -23,7 +23,7 @@ import argparse
 from pathlib import Path
 
 from services.cli.command_options import add_recordings_folder_options, recordings_folder
-from shared.option_types import int_in, seconds
+from shared.runtime.option_types import int_in, seconds
 
 NAME = "wear"
 HELP = "show the wear ledger per tool, record a tool's service, or replace a broken ledger"
@@ -88,9 +88,9 @@ def run(args: argparse.Namespace) -> int:
     import json
     import time
 
-    from services.recorder.wear.wear_ledger import WearLedger, ledger_path
-    from services.recorder.wear.wear_table import format_table
     from shared.errors import InputError
+    from shared.wear.wear_ledger import WearLedger, ledger_path
+    from shared.wear.wear_table import format_table
 
     if args.plant or args.connect is not None:
         return _plant(args)
@@ -115,8 +115,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _reset(args: argparse.Namespace, path: Path) -> int:
-    from services.recorder.wear.wear_reset import reset_ledger
     from shared.errors import InputError
+    from shared.wear.wear_reset import reset_ledger
 
     if args.tool is not None:
         raise InputError("reset takes no tool id: boltwatch wear reset [--recordings DIR]")
@@ -139,10 +139,10 @@ def _plant(args: argparse.Namespace) -> int:
     import sys
 
     from services.cli.router_client import open_client, router_client
-    from services.recorder.wear.wear_plant import WearReply, merge, parse_reply
-    from services.recorder.wear.wear_table import format_table
-    from shared import keys
+    from shared.contract import keys
     from shared.errors import InputError
+    from shared.wear.wear_plant import WearReply, merge, parse_reply
+    from shared.wear.wear_table import format_table
 
     if args.action is not None:
         raise InputError(

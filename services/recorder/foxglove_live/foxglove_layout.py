@@ -26,7 +26,7 @@ from typing import Any
 
 import foxglove.layouts as fl
 
-from shared import channels
+from shared.contract import channels
 
 DEFAULT_STATION = "st1"
 SHIPPED_LAYOUT = Path(__file__).resolve().parents[3] / "config/foxglove/boltwatch-layout.json"

@@ -3,7 +3,7 @@
 ``serve recorder --foxglove-port N`` (or ``--view-only`` beside the line's
 recorder) starts the ``foxglove-sdk``'s WebSocket server on
 ``--foxglove-host`` (default loopback) and advertises one channel per
-(station, channel of :mod:`shared.channels`) at once, so a client subscribes
+(station, channel of :mod:`shared.contract.channels`) at once, so a client subscribes
 before the first run starts. Each channel is the MCAP channel's twin: topic
 the zenoh key (``boltwatch/st1/samples``), message encoding ``json``, schema
 the codec's JSON schema (``jsonschema``) named ``boltwatch.<Type>``; a
@@ -11,7 +11,7 @@ layout made for the recordings works live, and the other way round.
 
 What is served is what the recorder files, as the MCAP holds it: the same
 payload bytes, the same log time, each sample of a
-:class:`~shared.messages.SampleBatch` as a sample of its own (the batch
+:class:`~shared.contract.messages.SampleBatch` as a sample of its own (the batch
 channel itself is not advertised). Payloads the recorder refused (recorded
 raw) and keys that are no channel are not served.
 
@@ -34,8 +34,8 @@ import foxglove
 from foxglove.websocket import WebSocketServer
 
 from services.recorder.live.incoming import Received
-from shared import channels
-from shared.codec import json_schema
+from shared.contract import channels
+from shared.contract.codec import json_schema
 
 LOG = logging.getLogger(__name__)
 
@@ -46,7 +46,7 @@ NOT_SERVED = frozenset({channels.SAMPLE_BATCHES.topic})
 
 
 def served_channels() -> list[channels.Channel[object]]:
-    """The channels of :mod:`shared.channels` a Foxglove client sees, per station."""
+    """The channels of :mod:`shared.contract.channels` a Foxglove client sees, per station."""
     return [channel for channel in channels.CHANNELS if channel.topic not in NOT_SERVED]
 
 

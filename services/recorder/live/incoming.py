@@ -1,14 +1,14 @@
 """What the recorder receives: one zenoh sample, classified and (when it is ours) decoded.
 
 A key ``boltwatch/<station>/<topic>`` whose topic is a channel
-(:mod:`shared.channels`) is decoded with :mod:`shared.codec`; anything else
-is kept as raw bytes. A :class:`~shared.messages.SampleBatch` is checked
+(:mod:`shared.contract.channels`) is decoded with :mod:`shared.contract.codec`; anything else
+is kept as raw bytes. A :class:`~shared.contract.messages.SampleBatch` is checked
 sample by sample as samples that came alone are (:mod:`.sample_batches` then
 files each sample as if it had). Nothing is dropped here: a payload that is refused is marked
 ``decodable=False`` (with the reason in ``problem``) and still recorded, byte
 for byte, on its key's raw channel, with its arrival as its publish time.
 Refused are payloads the decoder refuses (bad JSON, too large or nested too
-deeply, a wrong type, a value out of its bounds: :mod:`shared.message_fields`),
+deeply, a wrong type, a value out of its bounds: :mod:`shared.contract.message_fields`),
 a message naming another station than its key's (a wear ledger must not
 count it elsewhere), a message whose own time is negative or more than
 :data:`MAX_AHEAD_S` ahead of its arrival (no clock on the line is that far
@@ -26,12 +26,12 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, NamedTuple
 
-from shared import channels, keys
-from shared.codec import decoder
+from shared.contract import channels, keys
+from shared.contract.codec import decoder
+from shared.contract.message_fields import STATION_ID
+from shared.contract.messages import Intensity, Sample, SampleBatch, StickSlipEvent
+from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
 from shared.errors import InputError
-from shared.message_fields import STATION_ID
-from shared.messages import Intensity, Sample, SampleBatch, StickSlipEvent
-from shared.sensor_range import CONTRACT_RANGE, SensorRange
 
 #: how far ahead of its arrival a message's own time may be: the clocks of two hosts of
 #: a line differ by milliseconds with NTP; five minutes is a clock gone wrong or a forgery

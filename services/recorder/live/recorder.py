@@ -28,13 +28,13 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from services.recorder.live.file_metadata import FileMetadata
 from services.recorder.live.incoming import Received
 from services.recorder.live.run_files import FileLimits, StationFiles
-from shared.log_limit import RateLimitedLog
+from shared.recordings.file_metadata import FileMetadata
+from shared.runtime.log_limit import RateLimitedLog
 
 if TYPE_CHECKING:
-    from services.recorder.rerun_files.rerun_sink import RerunOptions
+    from shared.recordings.rerun.rerun_sink import RerunOptions
 
 LOG = logging.getLogger(__name__)
 

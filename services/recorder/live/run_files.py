@@ -33,13 +33,13 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from services.recorder.live.file_metadata import FileMetadata
 from services.recorder.live.incoming import Received
-from services.recorder.mcap_files.mcap_sink import McapSink
-from shared import channels
+from shared.contract import channels
+from shared.recordings.file_metadata import FileMetadata
+from shared.recordings.mcap.mcap_sink import McapSink
 
 if TYPE_CHECKING:  # rerun is imported only when .rrd files are wanted
-    from services.recorder.rerun_files.rerun_sink import RerunOptions, RerunSink
+    from shared.recordings.rerun.rerun_sink import RerunOptions, RerunSink
 
 LOG = logging.getLogger(__name__)
 
@@ -285,7 +285,7 @@ class StationFiles:
 
     def _open_rerun(self, path: Path, run_id: int, now_ns: int, options: RerunOptions) -> None:
         try:
-            from services.recorder.rerun_files.rerun_sink import open_rerun_sink
+            from shared.recordings.rerun.rerun_sink import open_rerun_sink
         except ImportError:
             LOG.exception("Rerun is unusable; recording MCAP only from now on")
             self._rerun = None

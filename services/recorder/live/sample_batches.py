@@ -1,8 +1,8 @@
 """A station's batch of samples, filed as the samples it holds, each as if it had come alone.
 
 An edge station sends its samples toward the line in batches
-(:class:`~shared.messages.SampleBatch` on ``boltwatch/<st>/sample_batches``,
-:mod:`shared.sample_batching`). The MCAP files stay as they were when each
+(:class:`~shared.contract.messages.SampleBatch` on ``boltwatch/<st>/sample_batches``,
+:mod:`shared.runtime.sample_batching`). The MCAP files stay as they were when each
 sample was a message of its own, so a Foxglove plot or a reader of the files
 sees no difference: each sample is one :class:`Received` on
 ``boltwatch/<st>/samples`` with the ``boltwatch.Sample`` schema, its own JSON
@@ -10,7 +10,7 @@ as payload, ``publish_time`` its ``time_ns`` and ``sequence`` its ``sequence``.
 The JSON is the station's own, cut out of the batch's payload when the batch
 is in the form the station's publisher writes (:func:`sample_texts`; a sample
 that came alone is recorded byte for byte too), and encoded again
-(:func:`shared.codec.encode`) otherwise.
+(:func:`shared.contract.codec.encode`) otherwise.
 
 ``log_time`` is the time the recorder received it. A batch arrives at once,
 so each sample's arrival is taken as the batch's arrival less how much older
@@ -27,9 +27,9 @@ time (:meth:`BatchSamples.found`; encoded again, as the station encoded them).
 from __future__ import annotations
 
 from services.recorder.live.incoming import Received
-from shared import channels
-from shared.codec import encode
-from shared.messages import SampleBatch
+from shared.contract import channels
+from shared.contract.codec import encode
+from shared.contract.messages import SampleBatch
 
 SAMPLE = channels.SAMPLES.schema_name
 EVENTS, INTENSITY = channels.EVENTS, channels.INTENSITY
@@ -84,7 +84,7 @@ class BatchSamples:
 def sample_texts(payload: bytes, batch: SampleBatch) -> list[bytes] | None:
     """The JSON of each sample of ``batch`` as it stands in ``payload``, the batch's JSON, when
     that is ``{"station":..,"time_ns":..,"samples":[{..},..,{..}]`` then ``}`` or the events
-    and intensities, written compact (as :func:`shared.codec.encode` writes it); None
+    and intensities, written compact (as :func:`shared.contract.codec.encode` writes it); None
     otherwise.
 
     Exact because ``batch`` decoded from ``payload``: a sample is a flat object

@@ -5,7 +5,7 @@ Loads the station file once, listens (a port that cannot be listened on is
 a ``TransportError``: one line, no traceback), holds the rig's liveliness token
 ``boltwatch/<station>/health/rig`` on a zenoh session from the station file
 as the CAN rig does, and runs :class:`~.simulated_controller.SimulatedController`
-in the work thread of its :class:`~shared.service_skeleton.ServiceSkeleton`:
+in the work thread of its :class:`~shared.runtime.service_skeleton.ServiceSkeleton`:
 ``--runs N`` ends (status 0) once an integrator has had all N tightenings
 (pushed and acknowledged, or fetched by id after it was away), otherwise it
 runs until SIGINT/SIGTERM.
@@ -21,7 +21,7 @@ from services.rig.openprotocol.tightening_counter import TighteningCounter
 from services.rig.selection import choose_program, choose_seed
 from shared.config import load_station
 from shared.errors import ConfigError
-from shared.service_skeleton import ServiceSkeleton, Stop
+from shared.runtime.service_skeleton import ServiceSkeleton, Stop
 
 LOG = logging.getLogger(__name__)
 

@@ -40,7 +40,7 @@ from services.rig.physics import TighteningPhysics
 from shared.config.openprotocol import RigOpenProtocolSection
 from shared.config.station import Program, RigSection
 from shared.model.stiffness import JointConstants
-from shared.tightening_judgement import judge
+from shared.quality.verdict import judge
 
 SAMPLE_PERIOD_S = 1e-3
 FigureStatus = Literal["low", "ok", "high"]

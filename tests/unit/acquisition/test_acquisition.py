@@ -10,9 +10,9 @@ import can
 import pytest
 
 from services.acquisition.acquisition import Acquisition
-from shared.can_database import StationDatabase
-from shared.codec import encode
-from shared.messages import BusStats, Sample, StopDecision, StopReason, ToolState
+from shared.contract.can_database import StationDatabase
+from shared.contract.codec import encode
+from shared.contract.messages import BusStats, Sample, StopDecision, StopReason, ToolState
 from tests.paths import DBC_FILE
 
 DATABASE = StationDatabase(DBC_FILE)

@@ -32,10 +32,10 @@ from pathlib import Path
 
 from services.cli.main import build_parser
 from services.recorder.live.incoming import classify
-from services.recorder.mcap_files.mcap_sink import McapSink
-from shared.codec import encode
-from shared.messages import Sample
-from shared.trace import write_trace
+from shared.contract.codec import encode
+from shared.contract.messages import Sample
+from shared.contract.trace import write_trace
+from shared.recordings.mcap.mcap_sink import McapSink
 from tests.paths import JOINT_5_2
 from tests.system.station_files import write_station
 

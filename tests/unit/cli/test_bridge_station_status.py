@@ -10,10 +10,10 @@ import json
 from dataclasses import replace
 
 from services.cli.station_status_text import format_report
-from shared import channels, keys
-from shared.codec import encode
+from shared.contract import channels, keys
+from shared.contract.codec import encode
+from shared.contract.messages import BridgeStats
 from shared.line_status.station_status import StatusCollector, to_json
-from shared.messages import BridgeStats
 from tests.fuzz.payloads import template
 
 S = 1_000_000_000

@@ -22,11 +22,11 @@ import pytest
 from mcap.reader import make_reader
 
 from services.cli.main import main
-from services.recorder.controller_import.controller_run import read_controller_run
-from services.recorder.wear.wear_ledger import WearLedger
-from shared.codec import json_schema
-from shared.messages import ControllerResult
-from shared.trace import read_trace
+from shared.contract.codec import json_schema
+from shared.contract.messages import ControllerResult
+from shared.contract.trace import read_trace
+from shared.offline.controller_import.controller_run import read_controller_run
+from shared.wear.wear_ledger import WearLedger
 from tests.paths import PROJECT_REAL_RUNS
 
 RUNS = sorted(PROJECT_REAL_RUNS.glob("Ch_*.json"))

@@ -6,10 +6,9 @@ import json
 from typing import Any
 
 from services.cli.station_status_text import format_report
-from shared import channels, keys
-from shared.codec import encode
-from shared.line_status.station_status import LastRun, StatusCollector, to_json
-from shared.messages import (
+from shared.contract import channels, keys
+from shared.contract.codec import encode
+from shared.contract.messages import (
     BusStats,
     PredictorStats,
     RecorderStats,
@@ -18,6 +17,7 @@ from shared.messages import (
     StopDecision,
     ToolState,
 )
+from shared.line_status.station_status import LastRun, StatusCollector, to_json
 
 S = 1_000_000_000
 T0 = 1_700_000_000 * S

@@ -9,10 +9,10 @@ import pytest
 
 from services.dashboard import line_board
 from services.dashboard.line_board import HISTORY, LineBoard, StationSetting
-from shared import channels, keys
-from shared.codec import encode
+from shared.contract import channels, keys
+from shared.contract.codec import encode
+from shared.contract.messages import QualityAlert, QualityFigure, WearAlert
 from shared.errors import InputError
-from shared.messages import QualityAlert, QualityFigure, WearAlert
 from tests.unit.cli.test_station_status import T0, S, summary
 
 

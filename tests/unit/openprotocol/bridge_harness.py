@@ -19,12 +19,12 @@ import zenoh
 from services.openprotocol.bridge import OpenProtocolBridge
 from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.published_ids import position_path
-from services.predictor.advisory_replay import replay_run
-from shared import channels, keys
-from shared.codec import decode
 from shared.config import load_any_station, toml_writer
-from shared.messages import SampleBatch
-from shared.queued_publisher import QueuedPublisher
+from shared.contract import channels, keys
+from shared.contract.codec import decode
+from shared.contract.messages import SampleBatch
+from shared.runtime.queued_publisher import QueuedPublisher
+from shared.stickslip.advisory_replay import replay_run
 from tests.live_recorder import write_station_file
 
 

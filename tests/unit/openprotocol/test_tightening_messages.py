@@ -6,8 +6,7 @@ import math
 
 from services.openprotocol.controller_tightening import Curve, Tightening
 from services.openprotocol.tightening_messages import tightening_messages
-from services.predictor.advisory_replay import replay_run
-from shared.messages import (
+from shared.contract.messages import (
     ControllerResult,
     Intensity,
     RunSummary,
@@ -17,6 +16,7 @@ from shared.messages import (
     TighteningResult,
     ToolState,
 )
+from shared.stickslip.advisory_replay import replay_run
 from tests.unit.openprotocol.test_pending_tightenings import figures
 
 START_NS = 1_700_000_000_000_000_000

@@ -14,8 +14,8 @@ from typing import Any
 
 import zenoh
 
-from shared import channels, codec, keys
-from shared.messages import Sample, StopReasonName, ToolState
+from shared.contract import channels, codec, keys
+from shared.contract.messages import Sample, StopReasonName, ToolState
 
 REPO = Path(__file__).resolve().parents[3]
 TARGET_N = 30_400.0

@@ -38,7 +38,7 @@ class SyntheticTrace:
         )
 
     def csv_rows(self) -> list[tuple[float, float, float, float | None]]:
-        """(time_s, torque_nm, angle_deg, force_n): the order of shared.trace.write_trace."""
+        """(time_s, torque_nm, angle_deg, force_n): the order of ``write_trace`` (the contract)."""
         return [(t, tq, a, f) for t, tq, f, a in self.rows()]
 
 

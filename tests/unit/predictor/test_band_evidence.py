@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import pytest
 
-from services.predictor.core.model_bands import MIN_STICK_SHARE, ModelBandCheck
 from shared.config import Program, RigSection
 from shared.model import JointConstants, expected_constant_bands
+from shared.stickslip.model_bands import MIN_STICK_SHARE, ModelBandCheck
 from tests.unit.predictor.test_model_bands import TRACE_JOINT, rig_decision
 
 SPEED_RAD_S = 0.5

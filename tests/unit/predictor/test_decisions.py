@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from services.predictor.core import CoreDecision, EventFigures, PredictorCore, PredictorSettings
+from shared.stickslip import CoreDecision, EventFigures, PredictorCore, PredictorSettings
 from tests.unit.predictor.synthetic import SyntheticTrace, smooth_ramp, staircase
 
 
@@ -192,14 +192,14 @@ def test_torque_target_stops_on_a_stick_ramp_at_the_target() -> None:
 
 
 def first_stop(policy: object, ramp: list[tuple[float, float]]) -> float | None:
-    from services.predictor.core.stop_policy import StopPolicy
+    from shared.stickslip.stop_policy import StopPolicy
 
     assert isinstance(policy, StopPolicy)
     return next((tq for t, tq in ramp if policy.on_sample(t, tq, None, 0.0) is not None), None)
 
 
 def test_a_halt_plan_moves_the_torque_stop_and_holds_one_phase_only() -> None:
-    from services.predictor.core.stop_policy import StopPolicy
+    from shared.stickslip.stop_policy import StopPolicy
 
     settings = PredictorSettings(target_torque_nm=100.0, has_force=False)
     ramp = [(i * 1e-3, 95.0 + 0.5 * i) for i in range(30)]
@@ -232,7 +232,7 @@ def test_a_halt_plan_moves_the_torque_stop_and_holds_one_phase_only() -> None:
 def test_a_halt_plan_never_aims_past_the_torque_limit() -> None:
     """A program whose limit sits within the plan's reach (target 100, limit 102): the plan
     is capped below the limit, so the stop is the planned one, never a limit fault."""
-    from services.predictor.core.stop_policy import StopPolicy
+    from shared.stickslip.stop_policy import StopPolicy
 
     settings = PredictorSettings(target_torque_nm=100.0, has_force=False, max_torque_nm=102.0)
     policy = StopPolicy(settings)

@@ -6,22 +6,12 @@ import math
 
 import pytest
 
-from services.predictor.core.event_figures import compute_figures, event_intensity, torque_mean_nm
-from services.predictor.core.force_history import ForceHistory
-from services.predictor.core.inclination_window import (
-    MAX_PASSED,
-    MIN_PASSED,
-    NO_FLIP,
-    InclinationWindow,
-)
-from services.predictor.core.regression import (
-    fit_line,
-    fit_parabola,
-    predict_periods,
-    predict_plateaus,
-)
-from services.predictor.core.scoring import PredictionScores
-from shared.messages import Prediction
+from shared.contract.messages import Prediction
+from shared.stickslip.event_figures import compute_figures, event_intensity, torque_mean_nm
+from shared.stickslip.force_history import ForceHistory
+from shared.stickslip.inclination_window import MAX_PASSED, MIN_PASSED, NO_FLIP, InclinationWindow
+from shared.stickslip.regression import fit_line, fit_parabola, predict_periods, predict_plateaus
+from shared.stickslip.scoring import PredictionScores
 
 
 def test_slope_sum_is_eq_46_over_the_window_pairs() -> None:

@@ -5,11 +5,11 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from services.predictor.core import EventFigures, PredictorCore, PredictorSettings
-from services.predictor.core.event_history import HISTORY, EventHistory
-from services.predictor.run_messages import event_messages, stick_slip_event
-from shared.messages import StickSlipEvent
-from shared.run_clock import RunClock
+from shared.contract.messages import StickSlipEvent
+from shared.contract.run_clock import RunClock
+from shared.stickslip import EventFigures, PredictorCore, PredictorSettings
+from shared.stickslip.event_history import HISTORY, EventHistory
+from shared.stickslip.run_messages import event_messages, stick_slip_event
 from tests.unit.predictor.synthetic import staircase
 
 CORE_ONLY = {"current_force_n", "detected_at_s"}  # what the core keeps and the wire does not

@@ -1,4 +1,4 @@
-"""The torque halt level of :mod:`services.predictor.core.halt_planner`, by hand."""
+"""The torque halt level of :mod:`shared.stickslip.halt_planner`, by hand."""
 
 from __future__ import annotations
 
@@ -6,12 +6,7 @@ import math
 
 import pytest
 
-from services.predictor.core.halt_planner import (
-    MIN_EVENTS,
-    HaltPlanner,
-    best_halt,
-    expected_error,
-)
+from shared.stickslip.halt_planner import MIN_EVENTS, HaltPlanner, best_halt, expected_error
 
 
 def phi(z: float) -> float:
@@ -79,7 +74,7 @@ def test_planner_ignores_implausible_input() -> None:
 def test_a_torque_target_at_a_slip_is_not_halted_into_the_slip() -> None:
     """The target is just above the peak of one stick phase: deciding on the peak sample
     (the ramp's projection reaches the target there) would halt inside the slip."""
-    from services.predictor.core import CoreDecision, PredictorCore, PredictorSettings
+    from shared.stickslip import CoreDecision, PredictorCore, PredictorSettings
     from tests.unit.predictor.synthetic import staircase
 
     clean = staircase()

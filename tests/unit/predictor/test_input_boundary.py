@@ -18,7 +18,7 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from services.predictor.core import CoreDecision, EventFigures, PredictorCore, PredictorSettings
+from shared.stickslip import CoreDecision, EventFigures, PredictorCore, PredictorSettings
 from tests.unit.predictor.synthetic import SyntheticTrace, staircase
 
 Row = tuple[float, float, float, float]  # time_s, torque_nm, force_n, angle_deg

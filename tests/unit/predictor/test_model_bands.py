@@ -9,12 +9,12 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
-from services.predictor.core import CoreDecision, PredictorCore, PredictorSettings
-from services.predictor.core.model_bands import MODEL_SLACK, ModelBandCheck
 from services.rig.physics import TighteningPhysics
 from shared.config import Program, RigSection
+from shared.contract.trace import write_trace
 from shared.model import JointConstants, expected_constant_bands
-from shared.trace import write_trace
+from shared.stickslip import CoreDecision, PredictorCore, PredictorSettings
+from shared.stickslip.model_bands import MODEL_SLACK, ModelBandCheck
 from tests.unit.predictor.synthetic import smooth_ramp, staircase
 from tests.unit.rig.rig_fixtures import constants as paper_constants
 from tests.unit.rig.rig_fixtures import paper_program, paper_rig

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from services.predictor.core.ramp_estimator import SPAN, RampEstimator
+from shared.stickslip.ramp_estimator import SPAN, RampEstimator
 
 
 def test_steady_ramp_is_projected_over_the_lead() -> None:

@@ -20,8 +20,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from services.predictor.core import CoreDecision, EventFigures, PredictorCore, PredictorSettings
-from services.recorder.controller_import.controller_run import read_controller_run
+from shared.offline.controller_import.controller_run import read_controller_run
+from shared.stickslip import CoreDecision, EventFigures, PredictorCore, PredictorSettings
 from tests.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 
 #: the share of a run's process intensity that events at or after its torque peak may carry

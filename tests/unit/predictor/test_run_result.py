@@ -9,10 +9,10 @@ from typing import Any
 
 import pytest
 
-from services.predictor.run_result import tightening_result
-from shared.codec import decode, encode
 from shared.config import Program
-from shared.messages import RunSummary, TighteningResult
+from shared.contract.codec import decode, encode
+from shared.contract.messages import RunSummary, TighteningResult
+from shared.quality.run_result import tightening_result
 
 WINDOWS = {
     "torque_min_nm": 180.0,

@@ -13,10 +13,9 @@ import pytest
 import zenoh
 
 from services.predictor.service import PredictorService
-from shared import channels, codec, keys
 from shared.config import LoadedStation
-from shared.errors import ConfigError
-from shared.messages import (
+from shared.contract import channels, codec, keys
+from shared.contract.messages import (
     Intensity,
     RunSummary,
     Sample,
@@ -24,8 +23,9 @@ from shared.messages import (
     StopDecision,
     TighteningResult,
 )
-from shared.service_skeleton import ServiceSkeleton
-from shared.zenoh_session import zenoh_config
+from shared.errors import ConfigError
+from shared.runtime.service_skeleton import ServiceSkeleton
+from shared.runtime.zenoh_session import zenoh_config
 from tests.unit.predictor.live_predictor import (
     PROGRAM_OF,
     START_NS,

@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from services.predictor.core import EventFigures, PredictorCore, PredictorSettings
+from shared.stickslip import EventFigures, PredictorCore, PredictorSettings
 from tests.unit.predictor.synthetic import staircase
 
 Row = tuple[float, float, float, float]  # time_s, torque_nm, force_n, angle_deg

@@ -1,12 +1,12 @@
-"""The order of the stop rules (services/predictor/core/stop_policy.py): the first that fires
+"""The order of the stop rules (shared/stickslip/stop_policy.py): the first that fires
 on a sample or an event is the run's one decision, whatever fires after it."""
 
 from __future__ import annotations
 
 import pytest
 
-from services.predictor.core import PredictorSettings
-from services.predictor.core.stop_policy import StopPolicy
+from shared.stickslip import PredictorSettings
+from shared.stickslip.stop_policy import StopPolicy
 
 SETTINGS = PredictorSettings(
     target_force_n=50_000.0,

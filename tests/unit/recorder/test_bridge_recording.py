@@ -14,19 +14,15 @@ import zenoh
 from mcap.reader import make_reader
 
 from services.cli.main import main
-from services.recorder.wear.wear_bound import CONTRACT_LIMITS as LIMITS
-from services.recorder.wear.wear_ledger import WearLedger, ledger_path
-from services.recorder.wear.wear_ledger_file import (
-    APPLICATION_ID,
-    LEDGER_VERSION,
-    BrokenLedgerError,
-)
-from services.recorder.wear.wear_ledger_file import COLUMNS as LEDGER_COLUMNS
-from services.recorder.wear.wear_plant import merge, parse_reply
-from shared import channels, keys
-from shared.codec import decode, json_schema
 from shared.config import LoadedStation
-from shared.messages import ControllerAlarm, RunSummary, ToolData, ToolState
+from shared.contract import channels, keys
+from shared.contract.codec import decode, json_schema
+from shared.contract.messages import ControllerAlarm, RunSummary, ToolData, ToolState
+from shared.wear.wear_bound import CONTRACT_LIMITS as LIMITS
+from shared.wear.wear_ledger import WearLedger, ledger_path
+from shared.wear.wear_ledger_file import APPLICATION_ID, LEDGER_VERSION, BrokenLedgerError
+from shared.wear.wear_ledger_file import COLUMNS as LEDGER_COLUMNS
+from shared.wear.wear_plant import merge, parse_reply
 from tests.fuzz.payloads import template
 from tests.live_recorder import RunningRecorder, publish, wait_until
 

@@ -26,13 +26,13 @@ import pytest
 import zenoh
 
 from services.cli.main import main
-from services.recorder.wear.wear_bound import CONTRACT_LIMITS
-from services.recorder.wear.wear_ledger import WearLedger
-from shared import channels
-from shared.codec import decode
 from shared.config import LoadedStation
-from shared.messages import RecorderStats, RunSummary, Sample, ToolState
-from shared.zenoh_session import zenoh_config
+from shared.contract import channels
+from shared.contract.codec import decode
+from shared.contract.messages import RecorderStats, RunSummary, Sample, ToolState
+from shared.runtime.zenoh_session import zenoh_config
+from shared.wear.wear_bound import CONTRACT_LIMITS
+from shared.wear.wear_ledger import WearLedger
 from tests.live_recorder import RunningRecorder, publish, wait_until
 from tests.paths import REPO
 

@@ -13,11 +13,11 @@ from mcap.reader import make_reader
 
 from services.cli.main import main
 from services.recorder.live.incoming import classify
-from services.recorder.mcap_files.mcap_sink import McapSink
-from services.recorder.mcap_files.recording_reader import RecordingScan
-from shared.codec import encode
-from shared.messages import Sample, ToolState
-from shared.trace import read_trace
+from shared.contract.codec import encode
+from shared.contract.messages import Sample, ToolState
+from shared.contract.trace import read_trace
+from shared.recordings.mcap.mcap_sink import McapSink
+from shared.recordings.mcap.recording_reader import RecordingScan
 
 T0_NS = 1_700_000_000_000_000_000
 SAMPLES = 3000

@@ -19,9 +19,9 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
-from services.recorder.mcap_files.mcap_sink import McapSink
-from services.recorder.mcap_files.recording_reader import RecordingScan
-from services.recorder.wear.wear_ledger import WearLedger
+from shared.recordings.mcap.mcap_sink import McapSink
+from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.wear.wear_ledger import WearLedger
 from tests.paths import PROJECT_REAL_RUNS, REPO
 
 CLASS_1 = [PROJECT_REAL_RUNS / "Ch_000001596334.json", PROJECT_REAL_RUNS / "Ch_000001596339.json"]

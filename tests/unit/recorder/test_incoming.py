@@ -13,9 +13,9 @@ import math
 from typing import Any
 
 from services.recorder.live.incoming import MAX_AHEAD_S, OTHER_STATION, classify
-from shared import channels
-from shared.codec import encode, to_dict
-from shared.messages import (
+from shared.contract import channels
+from shared.contract.codec import encode, to_dict
+from shared.contract.messages import (
     Intensity,
     RunSummary,
     Sample,

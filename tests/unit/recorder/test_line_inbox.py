@@ -8,7 +8,7 @@ import threading
 import zenoh
 
 from services.recorder.live.line_inbox import LineInbox, Message
-from shared import channels, keys
+from shared.contract import channels, keys
 from tests.live_recorder import has_subscribers, wait_until
 
 

@@ -11,13 +11,13 @@ import pytest
 from services.cli.main import main
 from services.recorder.live.incoming import classify
 from services.recorder.live.run_files import file_path
-from services.recorder.mcap_files.mcap_sink import McapSink
-from services.recorder.overlay.overlay_alignment import parse_alignment
-from services.recorder.overlay.overlay_plot import build_figure, run_colours
-from services.recorder.overlay.overlay_run import find_run_files, read_overlay_run
-from services.recorder.overlay.overlay_series import Overlay, build_overlay
-from shared.codec import encode
-from shared.messages import JudgedFigure, Sample, StickSlipEvent, TighteningResult
+from shared.contract.codec import encode
+from shared.contract.messages import JudgedFigure, Sample, StickSlipEvent, TighteningResult
+from shared.offline.overlay.overlay_alignment import parse_alignment
+from shared.offline.overlay.overlay_plot import build_figure, run_colours
+from shared.offline.overlay.overlay_run import find_run_files, read_overlay_run
+from shared.offline.overlay.overlay_series import Overlay, build_overlay
+from shared.recordings.mcap.mcap_sink import McapSink
 from tests.system.station_files import write_station
 
 T0_NS = 1_790_000_000_000_000_000

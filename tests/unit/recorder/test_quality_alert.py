@@ -13,10 +13,10 @@ import pytest
 import zenoh
 from mcap.reader import make_reader
 
-from shared import channels
-from shared.codec import decode, encode
 from shared.config import LoadedStation, load_station
-from shared.messages import JudgedFigure, QualityAlert, TighteningResult, Verdict
+from shared.contract import channels
+from shared.contract.codec import decode, encode
+from shared.contract.messages import JudgedFigure, QualityAlert, TighteningResult, Verdict
 from tests.live_recorder import (
     RunningRecorder,
     has_subscribers,

@@ -17,10 +17,10 @@ import pytest
 from services.cli.main import main
 from services.recorder.live.incoming import classify
 from services.recorder.live.run_files import file_path
-from services.recorder.mcap_files.mcap_sink import McapSink
-from services.recorder.quality.control_chart import c4, control_chart
-from shared.codec import encode
-from shared.messages import FigureStatus, JudgedFigure, RunSummary, TighteningResult
+from shared.contract.codec import encode
+from shared.contract.messages import FigureStatus, JudgedFigure, RunSummary, TighteningResult
+from shared.quality.control_chart import c4, control_chart
+from shared.recordings.mcap.mcap_sink import McapSink
 from tests.live_recorder import write_station_file
 
 DAY1_NS = int(datetime(2026, 3, 2, 8, 0, tzinfo=UTC).timestamp() * 1e9)

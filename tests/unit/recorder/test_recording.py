@@ -20,12 +20,11 @@ from mcap.reader import make_reader
 from mcap.records import Schema
 from mcap.well_known import MessageEncoding
 
-from services.recorder.mcap_files.mcap_sink import RAW_ENCODING, RAW_REASON
 from services.recorder.service import RecorderService
-from shared import channels, keys
-from shared.codec import encode, json_schema
 from shared.config import LoadedStation, load_station
-from shared.messages import (
+from shared.contract import channels, keys
+from shared.contract.codec import encode, json_schema
+from shared.contract.messages import (
     Intensity,
     RunSummary,
     Sample,
@@ -33,8 +32,9 @@ from shared.messages import (
     StopDecision,
     ToolState,
 )
-from shared.service_skeleton import ServiceSkeleton
-from shared.zenoh_session import zenoh_config
+from shared.recordings.mcap.mcap_sink import RAW_ENCODING, RAW_REASON
+from shared.runtime.service_skeleton import ServiceSkeleton
+from shared.runtime.zenoh_session import zenoh_config
 from tests.live_recorder import (
     RunningRecorder,
     has_subscribers,

@@ -10,12 +10,12 @@ import pytest
 from mcap.reader import make_reader
 
 from services.recorder.live.incoming import classify
-from services.recorder.mcap_files.mcap_sink import McapSink
-from services.recorder.mcap_files.recording_reader import RecordingScan
-from services.recorder.mcap_files.recovery import default_target, recover
-from shared.codec import encode
+from shared.contract.codec import encode
+from shared.contract.messages import Sample
 from shared.errors import InputError
-from shared.messages import Sample
+from shared.recordings.mcap.mcap_sink import McapSink
+from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.recordings.mcap.recovery import default_target, recover
 
 T0_NS = 1_700_000_000_000_000_000
 

@@ -20,11 +20,11 @@ import zenoh
 from mcap.reader import make_reader
 from test_recording import recorded_files  # type: ignore[import-not-found]
 
-from services.recorder.mcap_files.mcap_sink import RAW_ENCODING
-from shared import channels, keys
-from shared.codec import encode
 from shared.config import LoadedStation
-from shared.messages import RunSummary, Sample, StopDecision, ToolState
+from shared.contract import channels, keys
+from shared.contract.codec import encode
+from shared.contract.messages import RunSummary, Sample, StopDecision, ToolState
+from shared.recordings.mcap.mcap_sink import RAW_ENCODING
 from tests.live_recorder import RunningRecorder, publish, wait_until
 
 RUN = 7

@@ -8,16 +8,16 @@ from typing import Any
 import pytest
 
 from services.cli.main import main
-from services.recorder.live.file_metadata import flatten
 from services.recorder.live.incoming import classify
-from services.recorder.mcap_files.mcap_sink import McapSink
-from services.recorder.post_mortem.post_mortem_errors import prediction_errors
-from services.recorder.post_mortem.post_mortem_panels import plateau_bars
-from services.recorder.post_mortem.post_mortem_run import read_run
-from services.recorder.post_mortem.run_plot import build_figure
-from shared.codec import encode
 from shared.config.joint import load_joint
-from shared.messages import Prediction, Sample, StickSlipEvent, StopDecision
+from shared.contract.codec import encode
+from shared.contract.messages import Prediction, Sample, StickSlipEvent, StopDecision
+from shared.offline.post_mortem.post_mortem_errors import prediction_errors
+from shared.offline.post_mortem.post_mortem_panels import plateau_bars
+from shared.offline.post_mortem.post_mortem_run import read_run
+from shared.offline.post_mortem.run_plot import build_figure
+from shared.recordings.file_metadata import flatten
+from shared.recordings.mcap.mcap_sink import McapSink
 
 T0_NS = 1_700_000_000_000_000_000
 MS_NS = 1_000_000

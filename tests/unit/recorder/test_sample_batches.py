@@ -28,11 +28,10 @@ from pydantic import TypeAdapter
 
 from services.recorder.live.incoming import Received
 from services.recorder.live.sample_batches import BatchSamples, sample_texts
-from services.recorder.mcap_files.mcap_sink import RAW_ENCODING
-from shared import channels
-from shared.codec import decode, encode
 from shared.config import LoadedStation, load_station
-from shared.messages import (
+from shared.contract import channels
+from shared.contract.codec import decode, encode
+from shared.contract.messages import (
     BusStats,
     Intensity,
     RecorderStats,
@@ -40,7 +39,8 @@ from shared.messages import (
     SampleBatch,
     ToolState,
 )
-from shared.queued_publisher import QueuedPublisher
+from shared.recordings.mcap.mcap_sink import RAW_ENCODING
+from shared.runtime.queued_publisher import QueuedPublisher
 from tests.fuzz.payloads import template
 from tests.live_recorder import RunningRecorder, publish, wait_until, write_station_file
 

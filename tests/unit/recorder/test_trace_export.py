@@ -11,12 +11,12 @@ import pytest
 
 from services.cli.main import main
 from services.recorder.live.incoming import classify
-from services.recorder.mcap_files.mcap_sink import McapSink
-from services.recorder.mcap_files.trace_export import export_trace
-from shared.codec import encode
+from shared.contract.codec import encode
+from shared.contract.messages import Sample
+from shared.contract.trace import read_trace
 from shared.errors import InputError
-from shared.messages import Sample
-from shared.trace import read_trace
+from shared.recordings.mcap.mcap_sink import McapSink
+from shared.recordings.mcap.trace_export import export_trace
 
 T0_NS = 1_700_000_000_000_000_000
 MS_NS = 1_000_000

@@ -1,6 +1,6 @@
 """No message falsifies a figure: the wear ledger counts a run only within what its tool can take.
 
-The bound (services/recorder/wear/wear_bound.py): I_process ≤ (n_ss − 1) · T_lim² ·
+The bound (shared/wear/wear_bound.py): I_process ≤ (n_ss − 1) · T_lim² ·
 f_s/2, with T_lim the program's max_torque_nm, n_ss ≤ samples/2 and the
 samples within what the run's duration (and the program's max_time_s)
 carries at 1 kHz. The issue's probes (a negative intensity and 9e11 from
@@ -18,15 +18,10 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
-from services.recorder.wear.wear_bound import (
-    F_SS_MAX_HZ,
-    RefusedSummaryError,
-    StationLimits,
-    refusal,
-)
-from services.recorder.wear.wear_ledger import WearLedger
 from shared.config import load_station
-from shared.messages import RunSummary
+from shared.contract.messages import RunSummary
+from shared.wear.wear_bound import F_SS_MAX_HZ, RefusedSummaryError, StationLimits, refusal
+from shared.wear.wear_ledger import WearLedger
 from tests.live_recorder import write_station_file
 from tests.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 

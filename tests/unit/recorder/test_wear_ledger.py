@@ -8,10 +8,10 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
-from services.recorder.wear.wear_bound import CONTRACT_LIMITS as LIMITS
-from services.recorder.wear.wear_ledger import WearLedger, ledger_path
+from shared.contract.messages import RunSummary
 from shared.errors import InputError
-from shared.messages import RunSummary
+from shared.wear.wear_bound import CONTRACT_LIMITS as LIMITS
+from shared.wear.wear_ledger import WearLedger, ledger_path
 
 T0_NS = 1_700_000_000_000_000_000
 S_NS = 1_000_000_000

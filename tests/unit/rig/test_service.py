@@ -10,8 +10,8 @@ from pathlib import Path
 import can
 
 from services.rig import service
-from shared.can_database import StationDatabase
-from shared.messages import ToolRunState
+from shared.contract.can_database import StationDatabase
+from shared.contract.messages import ToolRunState
 
 from .rig_fixtures import STATION_FILE
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from services.cli.commands import simulate
+from shared.contract.trace import read_trace
 from shared.errors import ConfigError
-from shared.trace import read_trace
 
 from .rig_fixtures import STATION_FILE
 

@@ -12,7 +12,7 @@ from services.router.access_control import (
     PREDICTOR_TOPICS,
     line_access_control,
 )
-from shared import channels, keys
+from shared.contract import channels, keys
 from tests.access_rules import common_names, put_keys_granted
 from tests.paths import CONFIG
 

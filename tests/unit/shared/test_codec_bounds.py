@@ -1,6 +1,6 @@
 """Every field of every message is bounded: the decoders refuse the rest, the schemas say so.
 
-The bounds are declared once (shared/message_fields.py) and hold for both
+The bounds are declared once (shared/contract/message_fields.py) and hold for both
 decoders (``codec.decoder`` of flat messages, ``codec.decode`` of any), for
 payload size and nesting depth too; every refusal is an InputError naming
 the field, never another exception.
@@ -16,11 +16,10 @@ from collections.abc import Callable
 import jsonschema
 import pytest
 
-from shared import codec
-from shared.channels import CHANNELS, SCHEMA_TYPES
-from shared.errors import InputError
-from shared.message_fields import MAX_TEXT_CHARS
-from shared.messages import (
+from shared.contract import codec
+from shared.contract.channels import CHANNELS, SCHEMA_TYPES
+from shared.contract.message_fields import MAX_TEXT_CHARS
+from shared.contract.messages import (
     ControllerResult,
     RunSummary,
     Sample,
@@ -29,6 +28,7 @@ from shared.messages import (
     StopDecision,
     ToolState,
 )
+from shared.errors import InputError
 from tests.fuzz.payloads import refused_values, template
 
 NOW_NS = time.time_ns()

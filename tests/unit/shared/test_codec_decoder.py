@@ -12,9 +12,8 @@ import math
 
 import pytest
 
-from shared import codec
-from shared.errors import InputError
-from shared.messages import (
+from shared.contract import codec
+from shared.contract.messages import (
     BusStats,
     Prediction,
     RunSummary,
@@ -23,6 +22,7 @@ from shared.messages import (
     StopDecision,
     ToolState,
 )
+from shared.errors import InputError
 
 SAMPLE = Sample("st1", 7, 12, 1_700_000_000_000_000_123, 101.5, 33.25, 30_000.0)
 decode_sample = codec.decoder(Sample)

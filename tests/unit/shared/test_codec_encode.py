@@ -13,9 +13,9 @@ import math
 
 import pytest
 
-from shared import codec
+from shared.contract import codec
+from shared.contract.messages import Intensity, Prediction, Sample, StickSlipEvent
 from shared.errors import InputError
-from shared.messages import Intensity, Prediction, Sample, StickSlipEvent
 
 EVENT = StickSlipEvent(
     "st1", 5, 3, 17_000_000_000, 0.5, 120.5, 100.2, 20.3, 30_000.5, 500.2, 0.05, 20.0,

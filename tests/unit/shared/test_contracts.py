@@ -10,12 +10,11 @@ from typing import Any
 import jsonschema
 import pytest
 
-from shared import channels, keys
-from shared.can_database import CONTRACT, StationDatabase
-from shared.channels import SCHEMA_TYPES
-from shared.codec import decode, encode, json_schema
-from shared.errors import CanDatabaseError, InputError
-from shared.messages import (
+from shared.contract import channels, keys
+from shared.contract.can_database import CONTRACT, StationDatabase
+from shared.contract.channels import SCHEMA_TYPES
+from shared.contract.codec import decode, encode, json_schema
+from shared.contract.messages import (
     BusStats,
     ControllerFunction,
     ControllerResult,
@@ -30,6 +29,7 @@ from shared.messages import (
     ToolRunState,
     ToolState,
 )
+from shared.errors import CanDatabaseError, InputError
 from tests.paths import DBC_FILE
 
 EXAMPLES = [

@@ -19,8 +19,8 @@ from shared.config import (
     load_any_station,
     load_station,
 )
+from shared.contract.sensor_range import CONTRACT_RANGE
 from shared.errors import ConfigError
-from shared.sensor_range import CONTRACT_RANGE
 from tests.paths import CONFIG, STATION_FILE
 
 CONTROLLER_FILE = CONFIG / "controller-station.toml"

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from shared.can_database import StationDatabase
 from shared.config import load_station
-from shared.sensor_range import CONTRACT_RANGE, SensorRange
+from shared.contract.can_database import StationDatabase
+from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
 from tests.paths import DBC_FILE, STATION_FILE
 
 

@@ -13,10 +13,10 @@ from collections.abc import Iterator
 import pytest
 import zenoh
 
-from shared import channels, keys
+from shared.contract import channels, keys
 from shared.errors import BoltwatchError
-from shared.service_skeleton import ServiceSkeleton, Stop
-from shared.zenoh_session import zenoh_config
+from shared.runtime.service_skeleton import ServiceSkeleton, Stop
+from shared.runtime.zenoh_session import zenoh_config
 from tests.live_recorder import WAIT_S, free_port
 
 TOKEN_KEY = keys.health_key("st1", "tester")

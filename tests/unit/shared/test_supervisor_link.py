@@ -9,12 +9,12 @@ import subprocess
 import sys
 import time
 
-from shared.supervisor_link import SUPERVISOR_PID_ENV
+from shared.runtime.supervisor_link import SUPERVISOR_PID_ENV
 from tests.paths import REPO
 
 FOLLOWER = """
 import signal, sys, time
-from shared.supervisor_link import follow_supervisor
+from shared.runtime.supervisor_link import follow_supervisor
 signal.signal(signal.SIGTERM, lambda *_: sys.exit(15))
 follow_supervisor()
 print("following", flush=True)
@@ -23,7 +23,7 @@ time.sleep(60)
 
 SUPERVISOR = """
 import os, subprocess, sys, time
-from shared.supervisor_link import supervisor_environment
+from shared.runtime.supervisor_link import supervisor_environment
 child = subprocess.Popen([sys.executable, "-c", sys.argv[1]],
                          env={**os.environ, **supervisor_environment()}, start_new_session=True)
 print(child.pid, flush=True)

@@ -1,6 +1,6 @@
 """Bad CSV traces, for real files: one line naming the file, the line and what is wrong.
 
-``boltwatch predict`` reads traces through :func:`shared.trace.read_trace`; each bad
+``boltwatch predict`` reads traces through :func:`shared.contract.trace.read_trace`; each bad
 file ends it with exit status 2 and that one line on stderr.
 """
 
@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
+from shared.contract.trace import read_trace
 from shared.errors import InputError
-from shared.trace import read_trace
 
 GOOD = "time_s,torque_nm,angle_deg,force_n\n0.000,1.0,0.1,100.0\n0.001,1.5,0.2,\n"
 

@@ -1,0 +1,220 @@
+"""What flows on a line, in one place: every channel of boltwatch and its contract.
+
+A channel is a key below a station, ``boltwatch/<station>/<topic>``
+(:mod:`shared.contract.keys`), carrying one message type of :mod:`shared.contract.messages`,
+encoded as JSON by :mod:`shared.contract.codec` with the JSON schema the codec
+derives (the MCAP channel's schema, named ``boltwatch.<Type>``), put by one
+service with one set of zenoh options (priority, congestion control,
+express). Publishers are declared from here (:meth:`Channel.declare_publisher`);
+the recorder, ``boltwatch status``, the tests and the benchmarks look channels
+up here (:func:`by_topic`, :func:`of_message`, :data:`CHANNELS`). Adding a
+channel: its message type in :mod:`shared.contract.messages`, its row below.
+
+=================  ====================  ===========================================
+topic              publisher             message, when
+=================  ====================  ===========================================
+``samples``        acquisition           :class:`Sample`, one per 1 kHz sample (placement
+                   (openprotocol)        line: what the line's predictor decides on)
+``sample_batches`` acquisition           :class:`SampleBatch`, every 50 ms (placement
+                   (openprotocol)        edge: what the line records), with the
+                                         events and intensities found in it
+``tool``           acquisition           :class:`ToolState`, on every change
+                   (openprotocol)
+``bus``            acquisition           :class:`BusStats`, once a second
+``events``         predictor             :class:`StickSlipEvent`, one per event (placement
+                   (openprotocol)        edge: only when no batch is in progress)
+``intensity``      predictor             :class:`Intensity`, one per event (the same)
+                   (openprotocol)
+``decision``       predictor             :class:`StopDecision`, at most one per run
+                   (openprotocol)        (a bridge's: advisory, the controller stopped)
+``runs``           predictor             :class:`RunSummary`, one per run
+                   (openprotocol)
+``results``        predictor (import,    :class:`TighteningResult`, one per run, just
+                   openprotocol)         before its summary: OK/NOK against the windows
+``predictor``      predictor             :class:`PredictorStats`, once a second
+``recorder``       recorder              :class:`RecorderStats`, once a second
+``wear/alert``     recorder              :class:`WearAlert`, when a tool is due
+``quality/alert``  recorder              :class:`QualityAlert`, when a program's Cpk or
+                                         NOKs go out of bounds, and when back
+``controller``     import (openprotocol) :class:`ControllerResult`, one per run
+``tool_data``      openprotocol          :class:`ToolData`, when the controller says it
+``alarms``         openprotocol          :class:`ControllerAlarm`, per alarm message
+``openprotocol``   openprotocol          :class:`BridgeStats`, once a second
+=================  ====================  ===========================================
+
+In brackets: who else may put the channel (:attr:`Channel.also_by`). A
+controller bridge (``boltwatch serve openprotocol``, publisher
+``openprotocol``) stands for a CAN station's acquisition and predictor: it
+publishes what they would, from what its controller says.
+
+A station's samples go toward the line once, on one of the two sample
+channels: one message per sample where a line predictor decides on them
+(``[predictor] placement = "line"``), in batches otherwise (the decision is
+taken on the station; the line only records them).
+
+Not channels: ``health/<service>`` (liveliness tokens) and ``wear`` (the
+recorder's queryable of the wear ledger), in :mod:`shared.contract.keys`.
+
+Every channel is put with congestion control BLOCK: zenoh's default (DROP)
+lost events under load, silently, and loss is counted end to end. Samples
+and tool states share one priority, so a run's ``done`` never overtakes its
+samples; a decision is REAL_TIME. Samples, tool states and decisions are
+express (no batching in zenoh: latency counts). Sample batches are not: they
+are recorded, not decided on, and zenoh packs the batches of many stations
+into one frame toward the line's recorder (``bench_line.py`` at 50 stations:
+0.6 to 1.0 µs less of the recorder's CPU per sample, lag no worse).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Generic, TypeVar
+
+import zenoh
+
+from shared.contract import keys
+from shared.contract.messages import (
+    BridgeStats,
+    BusStats,
+    ControllerAlarm,
+    ControllerResult,
+    Intensity,
+    PredictorStats,
+    QualityAlert,
+    RecorderStats,
+    RunSummary,
+    Sample,
+    SampleBatch,
+    StickSlipEvent,
+    StopDecision,
+    TighteningResult,
+    ToolData,
+    ToolState,
+    WearAlert,
+)
+
+MessageT = TypeVar("MessageT")
+
+#: the encoding of every channel's payloads (MCAP's message encoding too)
+ENCODING = "json"
+
+
+@dataclass(frozen=True, slots=True)
+class Qos:
+    """How a channel is put (zenoh's options)."""
+
+    priority: zenoh.Priority = field(default_factory=lambda: zenoh.Priority.DATA)
+    express: bool = False  # no batching: latency counts
+    congestion_control: zenoh.CongestionControl = field(
+        default_factory=lambda: zenoh.CongestionControl.BLOCK
+    )
+
+    def options(self) -> dict[str, Any]:
+        """Keyword arguments of ``declare_publisher`` and ``put``."""
+        return {
+            "priority": self.priority,
+            "express": self.express,
+            "congestion_control": self.congestion_control,
+        }
+
+
+@dataclass(frozen=True, slots=True)
+class Channel(Generic[MessageT]):
+    """One channel: the topic below its station, its message type, who puts it, how."""
+
+    topic: str
+    message_type: type[MessageT]
+    #: the service that puts it (what the access control lets put it, per role)
+    publisher: str
+    qos: Qos = field(default_factory=Qos)
+    #: who else may put it, in the place of ``publisher`` (a controller bridge, an import)
+    also_by: tuple[str, ...] = ()
+    #: the registry name of its message type (``boltwatch.<Type>``): MCAP schema names
+    schema_name: str = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "schema_name", f"boltwatch.{self.message_type.__name__}")
+
+    @property
+    def publishers(self) -> tuple[str, ...]:
+        """Every service that may put it: ``publisher`` first, then ``also_by``."""
+        return (self.publisher, *self.also_by)
+
+    def key(self, station: str) -> str:
+        """``boltwatch/<station>/<topic>``."""
+        return keys.station_key(station, self.topic)
+
+    def declare_publisher(self, session: zenoh.Session, station: str) -> zenoh.Publisher:
+        """A publisher of this channel for ``station``, with the channel's options."""
+        return session.declare_publisher(self.key(station), **self.qos.options())
+
+
+#: what a controller bridge puts in the place of a CAN station's acquisition and predictor
+_BRIDGE = ("openprotocol",)
+
+SAMPLES = Channel("samples", Sample, "acquisition", Qos(express=True), _BRIDGE)
+SAMPLE_BATCHES = Channel("sample_batches", SampleBatch, "acquisition", Qos(), _BRIDGE)
+TOOL = Channel("tool", ToolState, "acquisition", Qos(express=True), _BRIDGE)
+BUS = Channel("bus", BusStats, "acquisition")
+EVENTS = Channel("events", StickSlipEvent, "predictor", also_by=_BRIDGE)
+INTENSITY = Channel("intensity", Intensity, "predictor", also_by=_BRIDGE)
+DECISION = Channel(
+    "decision",
+    StopDecision,
+    "predictor",
+    Qos(priority=zenoh.Priority.REAL_TIME, express=True),
+    _BRIDGE,
+)
+RUNS = Channel("runs", RunSummary, "predictor", also_by=_BRIDGE)
+RESULTS = Channel("results", TighteningResult, "predictor", also_by=("import", *_BRIDGE))
+PREDICTOR = Channel("predictor", PredictorStats, "predictor")
+RECORDER = Channel("recorder", RecorderStats, "recorder")
+WEAR_ALERT = Channel("wear/alert", WearAlert, "recorder")
+QUALITY_ALERT = Channel("quality/alert", QualityAlert, "recorder")
+CONTROLLER = Channel("controller", ControllerResult, "import", also_by=_BRIDGE)
+TOOL_DATA = Channel("tool_data", ToolData, "openprotocol")
+ALARMS = Channel("alarms", ControllerAlarm, "openprotocol")
+OPENPROTOCOL = Channel("openprotocol", BridgeStats, "openprotocol")
+
+#: every channel, in the order of the table above
+CHANNELS: tuple[Channel[Any], ...] = (
+    SAMPLES,
+    SAMPLE_BATCHES,
+    TOOL,
+    BUS,
+    EVENTS,
+    INTENSITY,
+    DECISION,
+    RUNS,
+    RESULTS,
+    PREDICTOR,
+    RECORDER,
+    WEAR_ALERT,
+    QUALITY_ALERT,
+    CONTROLLER,
+    TOOL_DATA,
+    ALARMS,
+    OPENPROTOCOL,
+)
+
+_BY_TOPIC: dict[str, Channel[Any]] = {channel.topic: channel for channel in CHANNELS}
+_BY_TYPE: dict[type, Channel[Any]] = {channel.message_type: channel for channel in CHANNELS}
+
+#: registry name -> message type of every channel (MCAP schema names)
+SCHEMA_TYPES: dict[str, type] = {channel.schema_name: channel.message_type for channel in CHANNELS}
+
+
+def by_topic(topic: str) -> Channel[Any] | None:
+    """The channel of a topic (the key below the station), None for any other key."""
+    return _BY_TOPIC.get(topic)
+
+
+def topics_of(publisher: str) -> tuple[str, ...]:
+    """The topics ``publisher`` puts, or may put (:attr:`Channel.also_by`), in the order of
+    :data:`CHANNELS`."""
+    return tuple(channel.topic for channel in CHANNELS if publisher in channel.publishers)
+
+
+def of_message(message: object) -> Channel[Any]:
+    """The channel a message is put on (KeyError for a type no channel carries)."""
+    return _BY_TYPE[type(message)]

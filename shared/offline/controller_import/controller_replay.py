@@ -1,0 +1,42 @@
+"""An imported controller run as the predictor's replay takes it (``boltwatch import``).
+
+The replay itself is the predictor's (:mod:`shared.stickslip.advisory_replay`,
+shared with the Open Protocol bridge); the recorder may not import the
+predictor, so the command line, which knows every service, turns a
+:class:`ControllerRun` into a :class:`~shared.stickslip.stopped_run.StoppedRun` here and
+hands the replay's messages to the recorder's import.
+
+A CS351 run's target is its last step's ``TF Torque`` nominal (the torque the
+controller tightened to), its reached torque the ``TF Torque`` actual (the
+highest torque measured where the last step has none).
+"""
+
+from __future__ import annotations
+
+from shared.offline.controller_import.controller_import import run_end_ns
+from shared.offline.controller_import.controller_run import ControllerRun
+from shared.stickslip.advisory_replay import replay_run as advisory_replay
+from shared.stickslip.stopped_run import PredictorReplay, StoppedRun
+
+
+def stopped_run(station: str, run: ControllerRun) -> StoppedRun:
+    """The run's samples, identity, torque target and final torque."""
+    return StoppedRun(
+        station=station,
+        run_id=run.run_id,
+        tool_id=run.tool_id,
+        program_id=run.program_id,
+        started_ns=run.started_ns,
+        ended_ns=run_end_ns(run),
+        times_ns=run.times_ns,
+        run_time_s=run.run_time_s,
+        torque_nm=run.torque_nm,
+        angle_deg=run.angle_deg,
+        target_torque_nm=run.final_torque_nominal_nm,
+        reached_torque_nm=run.final_torque_actual_nm,
+    )
+
+
+def replay_run(station: str, run: ControllerRun) -> PredictorReplay:
+    """The predictor's advisory replay of an imported run."""
+    return advisory_replay(stopped_run(station, run))

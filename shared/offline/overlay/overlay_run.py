@@ -1,0 +1,160 @@
+"""One recorded run for the overlay: its samples as arrays, its events and its result.
+
+A run is named on the command line by its id (looked up in a station's
+recordings folder, ``<folder>/<station>/<date>/<station>_run<id>_*.mcap``;
+a run the recorder split into parts is read from all of them) or by the path
+of an MCAP file (the run with the most samples in it). Damaged files are read
+as far as they go (:mod:`~shared.recordings.mcap.recording_reader`);
+``damage`` says what was lost.
+
+Run time is the sample's own clock (``Sample.time_s``, the tool's counter)
+when every sample has it, else the receive time (``time_ns``), counted from
+the run's first sample in both cases.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+from mcap.records import Message
+
+from shared.contract import channels
+from shared.contract.codec import decode
+from shared.contract.messages import Sample, StickSlipEvent, TighteningResult
+from shared.errors import InputError
+from shared.recordings.mcap.recording_reader import RecordingScan
+
+_SCHEMAS = {
+    channels.SAMPLES.schema_name: Sample,
+    channels.EVENTS.schema_name: StickSlipEvent,
+    channels.RESULTS.schema_name: TighteningResult,
+}
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.-]")  # as the recorder makes a station safe in file names
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True)
+class OverlayRun:
+    """One run's traces (arrays of equal length, in sample order) and what the file says."""
+
+    label: str  # how the command line named it (a run id or a path)
+    files: tuple[Path, ...]
+    run_id: int
+    time_s: FloatArray  # since the run's first sample
+    time_ns: npt.NDArray[np.int64]  # receive times, to find an event's sample
+    torque_nm: FloatArray
+    angle_deg: FloatArray
+    force_n: FloatArray | None  # None: no preload measured in this run (NaN: a lost sample)
+    events: tuple[StickSlipEvent, ...]
+    result: TighteningResult | None  # None: the recording has no result of this run
+    damage: str  # "" when every file was whole
+
+    @property
+    def verdict(self) -> str:
+        return self.result.result if self.result is not None else "no result"
+
+
+def find_run_files(folder: Path, station: str, run_id: int) -> list[Path]:
+    """The MCAP files of run ``run_id`` of ``station`` under the recordings ``folder``."""
+    safe = _UNSAFE.sub("_", station) or "_"
+    station_folder = folder / safe
+    files = sorted(
+        path for path in station_folder.glob(f"*/{safe}_run{run_id}_*.mcap") if path.is_file()
+    )
+    if not files:
+        raise InputError(
+            f"run {run_id}: not found, no {safe}_run{run_id}_*.mcap in the day folders of "
+            f"{station_folder} (station {station}'s recordings)"
+        )
+    return files
+
+
+def read_overlay_run(label: str, files: list[Path], run_id: int | None = None) -> OverlayRun:
+    """Run ``run_id`` of ``files`` (None: the run with the most samples in them)."""
+    samples: list[Sample] = []
+    events: list[StickSlipEvent] = []
+    results: list[TighteningResult] = []
+    damage: list[str] = []
+    for path in files:
+        scan = RecordingScan(path)
+        for record in scan.records():
+            if not isinstance(record, Message):
+                continue
+            channel = scan.channels.get(record.channel_id)
+            schema = scan.schemas.get(channel.schema_id) if channel is not None else None
+            message_type = _SCHEMAS.get(schema.name) if schema is not None else None
+            if message_type is None:
+                continue
+            try:
+                message: Sample | StickSlipEvent | TighteningResult = decode(
+                    message_type, record.data
+                )
+            except InputError:
+                continue  # what cannot be decoded is not drawn
+            if isinstance(message, Sample):
+                samples.append(message)
+            elif isinstance(message, StickSlipEvent):
+                events.append(message)
+            else:
+                results.append(message)
+        if not scan.complete:
+            damage.append(scan.describe())
+    run_id = _chosen_run(label, files, samples, run_id, damage)
+    own = [sample for sample in samples if sample.run_id == run_id]
+    own.sort(key=lambda sample: sample.sequence)
+    result = next((r for r in reversed(results) if r.run_id == run_id), None)
+    return OverlayRun(
+        label,
+        tuple(files),
+        run_id,
+        _run_time_s(own),
+        np.array([sample.time_ns for sample in own], dtype=np.int64),
+        np.array([sample.torque_nm for sample in own], dtype=np.float64),
+        np.array([sample.angle_deg for sample in own], dtype=np.float64),
+        _force_n(own),
+        tuple(sorted((e for e in events if e.run_id == run_id), key=lambda e: e.index)),
+        result,
+        "; ".join(damage),
+    )
+
+
+def _chosen_run(
+    label: str, files: list[Path], samples: list[Sample], run_id: int | None, damage: list[str]
+) -> int:
+    counts: dict[int, int] = {}
+    for sample in samples:
+        counts[sample.run_id] = counts.get(sample.run_id, 0) + 1
+    where = ", ".join(str(path) for path in files)
+    lost = f" ({'; '.join(damage)})" if damage else ""
+    if run_id is None:
+        if not counts:
+            raise InputError(f"{label}: no samples in {where}{lost}: nothing to draw")
+        return max(counts, key=counts.__getitem__)
+    if run_id not in counts:
+        others = f" (runs with samples there: {', '.join(map(str, sorted(counts)))})"
+        raise InputError(
+            f"run {run_id}: no samples in {where}{others if counts else ''}{lost}: nothing to draw"
+        )
+    return run_id
+
+
+def _run_time_s(samples: list[Sample]) -> FloatArray:
+    if samples and all(sample.time_s is not None for sample in samples):
+        clock = np.array([sample.time_s for sample in samples], dtype=np.float64)
+        return clock - clock[0]
+    times_ns = np.array([sample.time_ns for sample in samples], dtype=np.int64)
+    return (times_ns - times_ns[0]).astype(np.float64) / 1e9
+
+
+def _force_n(samples: list[Sample]) -> FloatArray | None:
+    if all(sample.force_n is None for sample in samples):
+        return None
+    return np.array(
+        [np.nan if sample.force_n is None else sample.force_n for sample in samples],
+        dtype=np.float64,
+    )

@@ -1,0 +1,73 @@
+"""``boltwatch report``'s work: results read, statistics per program, HTML and PNG written.
+
+Writes ``<out>/report.html`` (self-contained) and ``<out>/report.png`` (the
+same charts). No result in the range is an :class:`InputError` (one line,
+exit status 2), naming what was searched.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from shared.errors import InputError
+from shared.offline.report.recorded_results import ResultFilter, read_results
+from shared.offline.report.report_figure import build_figure, png_bytes
+from shared.offline.report.report_page import html_page
+from shared.quality.program_statistics import ProgramStatistics, program_statistics
+
+HTML_NAME = "report.html"
+PNG_NAME = "report.png"
+
+
+@dataclass(frozen=True, slots=True)
+class WrittenReport:
+    """What was written and from what."""
+
+    html_path: Path
+    png_path: Path
+    programs: list[ProgramStatistics]
+    files: int
+    results: int
+    damaged: list[str]
+
+
+def describe_scope(rule: ResultFilter, subgroup_size: int) -> list[str]:
+    """What the report covers, in words (the page's first lines, the error's text)."""
+    stations = ", ".join(f"{station} ({folder})" for station, folder in rule.stations)
+    since = rule.since.isoformat() if rule.since else "the first recording"
+    until = rule.until.isoformat() if rule.until else "now"
+    lines = [f"stations: {stations}", f"results that ended from {since} until {until} (UTC)"]
+    if rule.program_id is not None:
+        lines.append(f"program {rule.program_id} only")
+    if rule.tool_id is not None:
+        lines.append(f"tool {rule.tool_id} only")
+    lines.append(
+        f"control charts: consecutive subgroups of {subgroup_size} runs "
+        f"({'X̄/R' if subgroup_size <= 10 else 'X̄/s'}); σ, Cp, Cpk over every run (ddof=1)"
+    )
+    return lines
+
+
+def write_report(
+    rule: ResultFilter,
+    out: Path,
+    subgroup_size: int,
+    progress: Callable[[int, int], None] | None = None,
+) -> WrittenReport:
+    """Read, compute, draw and write; InputError when no result is in range."""
+    read = read_results(rule, progress)
+    if not read.results:
+        searched = "; ".join(describe_scope(rule, subgroup_size)[:-1])
+        raise InputError(f"no tightening results in range ({searched}; {read.files} files read)")
+    programs = program_statistics(read.results, subgroup_size, read.summaries)
+    title = f"boltwatch report: {', '.join(station for station, _ in rule.stations)}"
+    figure = build_figure(programs, title)
+    png = png_bytes(figure)
+    out.mkdir(parents=True, exist_ok=True)
+    png_path, html_path = out / PNG_NAME, out / HTML_NAME
+    png_path.write_bytes(png)
+    scope = [*describe_scope(rule, subgroup_size), f"{len(read.results)} results"]
+    html_path.write_text(html_page(programs, title, scope, png), encoding="utf-8")
+    return WrittenReport(html_path, png_path, programs, read.files, len(read.results), read.damaged)

@@ -1,0 +1,112 @@
+"""The tightening results (and run summaries) of a station's recordings in a time range.
+
+Reads ``<recordings>/<station>/<YYYY-MM-DD>/*.mcap`` (the layout of
+:mod:`services.recorder.live.run_files`, dates in UTC) for the days of the
+range, every complete message of channels ``results`` and ``runs``, damaged
+files as far as they go (:class:`RecordingScan`, a warning each). A result
+is kept when it ended (``time_ns``) inside the range and matches the
+program / tool asked for. The same result seen twice (a file and its
+``.recovered`` copy) counts once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from datetime import UTC, date, datetime, timedelta
+from pathlib import Path
+
+from shared.contract import channels
+from shared.contract.codec import decode
+from shared.contract.messages import RunSummary, TighteningResult
+from shared.recordings.mcap.recording_reader import RecordingScan
+
+#: progress is told every this many files (when there are more)
+PROGRESS_EVERY_FILES = 50
+
+
+@dataclass(frozen=True, slots=True)
+class ResultFilter:
+    """Which results a report is about: stations, a range of end times, a program, a tool."""
+
+    stations: Sequence[tuple[str, Path]]  # (station id, its recordings folder)
+    since: datetime | None = None  # UTC; None: from the first recording
+    until: datetime | None = None  # UTC, exclusive; None: up to now
+    program_id: int | None = None
+    tool_id: int | None = None
+
+    def keeps(self, result: TighteningResult) -> bool:
+        ended = datetime.fromtimestamp(result.time_ns / 1e9, UTC)
+        return (
+            (self.since is None or ended >= self.since)
+            and (self.until is None or ended < self.until)
+            and (self.program_id is None or result.program_id == self.program_id)
+            and (self.tool_id is None or result.tool_id == self.tool_id)
+        )
+
+
+@dataclass
+class RecordedResults:
+    """What was read: the results kept, the summaries of their runs, the files."""
+
+    results: list[TighteningResult] = field(default_factory=list)
+    #: (station, run id, tool id) -> its RunSummary (events per run when a result has none)
+    summaries: dict[tuple[str, int, int], RunSummary] = field(default_factory=dict)
+    files: int = 0
+    damaged: list[str] = field(default_factory=list)  # one line per damaged file
+
+
+def recording_files(station: str, folder: Path, rule: ResultFilter) -> list[Path]:
+    """The MCAP files of ``station`` under ``folder`` whose day folder may hold the range
+    (a day either side: a file opened before midnight holds runs that ended after it)."""
+    base = folder / station
+    if not base.is_dir():
+        return []
+    first: date | None = rule.since.date() - timedelta(days=1) if rule.since else None
+    last: date | None = rule.until.date() + timedelta(days=1) if rule.until else None
+    files: list[Path] = []
+    for day in sorted(base.iterdir()):
+        try:
+            day_date = date.fromisoformat(day.name)
+        except ValueError:
+            continue
+        if (first and day_date < first) or (last and day_date > last) or not day.is_dir():
+            continue
+        files.extend(sorted(day.glob("*.mcap")))
+    return files
+
+
+def read_results(
+    rule: ResultFilter, progress: Callable[[int, int], None] | None = None
+) -> RecordedResults:
+    """Every result that ``rule`` keeps, in the order the runs ended; ``progress(done,
+    total)`` is called every :data:`PROGRESS_EVERY_FILES` files and at the end."""
+    files = [
+        (station, path)
+        for station, folder in rule.stations
+        for path in recording_files(station, folder, rule)
+    ]
+    read = RecordedResults(files=len(files))
+    seen: set[tuple[str, int, int, int]] = set()
+    result_topic, runs_topic = channels.RESULTS.topic, channels.RUNS.topic
+    for done, (station, path) in enumerate(files, start=1):
+        scan = RecordingScan(path)
+        for _, channel, message in scan.messages():
+            topic = channel.topic.rsplit("/", 1)[-1]
+            if not channel.topic.startswith(f"boltwatch/{station}/"):
+                continue
+            if topic == result_topic:
+                result = decode(TighteningResult, message.data)
+                key = (result.station, result.run_id, result.tool_id, result.time_ns)
+                if key not in seen and rule.keeps(result):
+                    seen.add(key)
+                    read.results.append(result)
+            elif topic == runs_topic:
+                summary = decode(RunSummary, message.data)
+                read.summaries[(summary.station, summary.run_id, summary.tool_id)] = summary
+        if not scan.complete:
+            read.damaged.append(scan.describe())
+        if progress is not None and (done % PROGRESS_EVERY_FILES == 0 or done == len(files)):
+            progress(done, len(files))
+    read.results.sort(key=lambda result: (result.time_ns, result.station, result.run_id))
+    return read
