@@ -1,7 +1,9 @@
-"""Making a folder, and saying plainly why one cannot be made."""
+"""Folders and files: making a folder, and saying plainly why one cannot be made; an
+``OSError`` in one line that names its file."""
 
 from __future__ import annotations
 
+import errno
 from pathlib import Path
 
 from shared.errors import BoltwatchError
@@ -24,3 +26,10 @@ def make_folder(folder: Path) -> Path:
     except OSError as err:
         raise FolderError(f"cannot be made: {err.strerror}") from err
     return folder
+
+
+def describe_os_error(err: OSError, path: Path | None) -> str:
+    """``<file>: <errno text> (<ERRNO>)``, e.g. ``a.mcap: No space left on device (ENOSPC)``."""
+    where = err.filename if err.filename is not None else (path or "?")
+    code = errno.errorcode.get(err.errno, str(err.errno)) if err.errno is not None else "?"
+    return f"{where}: {err.strerror or err} ({code})"

@@ -56,7 +56,7 @@ class CsvWriter:
 
     def write(self, run: ControllerRun) -> bool:
         """Write the run's trace; True (a CSV is always written, over an older one)."""
-        from services.recorder.live.recorder import describe_os_error
+        from shared.files import describe_os_error
         from shared.offline.controller_import.controller_import import RunNotWrittenError
 
         target = self.folder / f"{run.source.stem}.csv"
@@ -93,14 +93,12 @@ class RecordingsWriter:
     def write(self, run: ControllerRun) -> bool:
         """Import the run; True when written now, False when it was already there."""
         from shared.offline.controller_import.controller_import import import_run
-        from shared.offline.controller_import.controller_replay import replay_run
 
-        replay = replay_run(self._station, run)
-        imported = import_run(run, self.folder, self._station, self._options, replay, self._ledger)
-        if imported.mcap is None:
+        imported = import_run(run, self.folder, self._station, self._options, self._ledger)
+        summary = imported.summary
+        if imported.mcap is None or summary is None:
             print(f"{run.source}: run {run.run_id} already in {imported.existing}, skipped")
             return False
-        summary = replay.summary
         extra = f" + {imported.rrd.name}" if imported.rrd is not None else ""
         replaced = "".join(f"; replaced the unfinished {path.name}" for path in imported.replaced)
         print(

@@ -20,7 +20,4 @@ predictor would (README, "Connecting an Open Protocol controller").
 - :mod:`.tightening_messages` (a tightening as a CAN station's messages of a run)
 - :mod:`.controller_reports` (tool data 0041 and alarms 0071-0076)
 - :mod:`.bridge_counts` (the counters of BridgeStats, faults logged once per kind)
-
-The predictor's after-the-fact replay of each tightening is injected by the
-command line (services never import each other).
 """

@@ -65,7 +65,6 @@ from shared.openprotocol.results import (
 from shared.openprotocol.session import CommandAccepted, CommandError
 from shared.openprotocol.subscriptions import DataSubscribe, trace_extra_data
 from shared.openprotocol.traces import TraceCurve, TraceType
-from shared.stickslip.stopped_run import RunReplay
 
 LOG = logging.getLogger(__name__)
 
@@ -88,7 +87,6 @@ class OpenProtocolBridge:
         section: OpenProtocolSection,
         publish: Callable[[object], None],
         after_published: Callable[[Callable[[], None]], None],
-        replay: RunReplay,
         position_file: Path,
         trace_timeout_s: float,
         counts: BridgeCounts,
@@ -107,7 +105,6 @@ class OpenProtocolBridge:
             section,
             publish,
             after_published,
-            replay,
             position_file,
             trace_timeout_s,
             counts,

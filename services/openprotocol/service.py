@@ -10,8 +10,8 @@ counters (:class:`~shared.contract.messages.BridgeStats`) once a second from a t
 their own. On stop: the session ends with 0003, the last counters go out, the
 queue is flushed, the token undeclared.
 
-The predictor's after-the-fact replay (``replay``) is the command line's to
-give: services never import each other.
+Each tightening is replayed through the stick-slip library after the fact
+(:mod:`shared.stickslip.advisory_replay`), as ``boltwatch import`` does.
 """
 
 from __future__ import annotations
@@ -27,12 +27,11 @@ from shared.config import load_any_station
 from shared.errors import ConfigError
 from shared.runtime.queued_publisher import QueuedPublisher
 from shared.runtime.service_skeleton import ServiceSkeleton, Stop
-from shared.stickslip.stopped_run import RunReplay
 
 LOG = logging.getLogger(__name__)
 
 
-def main(args: argparse.Namespace, replay: RunReplay) -> int:
+def main(args: argparse.Namespace) -> int:
     station = load_any_station(args.config)
     section = station.config.openprotocol
     if section is None:
@@ -52,7 +51,6 @@ def main(args: argparse.Namespace, replay: RunReplay) -> int:
             section,
             publisher.publish,
             publisher.call,
-            replay,
             position_path(recordings, station_id),
             args.trace_timeout_s,
             counts,

@@ -31,7 +31,6 @@ from services.openprotocol.tightening_messages import tightening_messages
 from shared.config import AnyStation
 from shared.config.openprotocol import OpenProtocolSection
 from shared.contract.message_fields import INT64_MAX
-from shared.stickslip.stopped_run import RunReplay
 
 LOG = logging.getLogger(__name__)
 
@@ -45,7 +44,6 @@ class TighteningFlow:
         section: OpenProtocolSection,
         publish: Callable[[object], None],
         after_published: Callable[[Callable[[], None]], None],
-        replay: RunReplay,
         position_file: Path,
         trace_timeout_s: float,
         counts: BridgeCounts,
@@ -56,7 +54,6 @@ class TighteningFlow:
         self._section = section
         self._publish = publish
         self._after_published = after_published
-        self._replay = replay
         self._position_file = position_file
         self._counts = counts
         self._clock = clock
@@ -190,7 +187,6 @@ class TighteningFlow:
             station.config.station.tool_id,
             run_id,
             tightening,
-            self._replay,
             program_name,
         ):
             self._publish(message)

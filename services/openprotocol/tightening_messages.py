@@ -13,7 +13,8 @@ too):
    (``force_n`` None). The station's queued publisher sends them in
    ``SampleBatch``es;
 3. after the sample that caused each, the predictor's after-the-fact outputs
-   (the injected replay: events, intensities, the decision marked advisory);
+   (:func:`shared.stickslip.advisory_replay.replay_run`: events, intensities,
+   the decision marked advisory);
 4. ``tool``: :class:`ToolState` done, 1 ns after the last sample (without
    samples: at the result's time stamp); ``stop_command`` None: the controller
    stopped its tool;
@@ -39,7 +40,8 @@ from shared.contract.messages import (
     ToolState,
 )
 from shared.quality.controller_result import controller_result
-from shared.stickslip.stopped_run import RunReplay, StoppedRun
+from shared.stickslip.advisory_replay import replay_run
+from shared.stickslip.stopped_run import StoppedRun
 
 #: the name of the one step a bridge's ControllerResult has (Open Protocol gives no steps)
 STEP_NAME = "Tightening"
@@ -95,12 +97,11 @@ def tightening_messages(
     tool_id: int,
     run_id: int,
     tightening: Tightening,
-    replay: RunReplay,
     program_name: str = "",
 ) -> list[Any]:
     """Every message of the tightening, in the order a CAN station publishes them."""
     run, samples = stopped_run(station, tool_id, run_id, tightening)
-    replayed = replay(run)
+    replayed = replay_run(run)
     result = tightening.result
     messages: list[Any] = [
         ToolState(station, run_id, tool_id, result.program_id, "running", run.started_ns)

@@ -17,7 +17,7 @@ the ``[recorder]`` settings (an error when the files disagree). A station
 with no file is not its station: in a plant each line's recorder records its
 own line's stations, and the subscription never asks the router for the
 others (no other line's sample crosses to this line for it). No payload
-stops it: what it refuses (:mod:`services.recorder.live.incoming`) is recorded
+stops it: what it refuses (:mod:`shared.recordings.received`) is recorded
 raw and counted in the station's ``RecorderStats.bad_payloads``. Every
 TighteningResult it files feeds the quality alert
 (:mod:`services.recorder.quality_watch`, on ``quality/alert``), every
@@ -47,7 +47,6 @@ from typing import TYPE_CHECKING
 
 import zenoh
 
-from services.recorder.live.incoming import OTHER_STATION, Received, classify
 from services.recorder.live.line_inbox import LineInbox, Message
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.recorder_health import RecorderHealth
@@ -62,6 +61,7 @@ from shared.contract.message_fields import MAX_TEXT_CHARS
 from shared.contract.messages import QualityAlert, RecorderStats, WearAlert
 from shared.errors import ConfigError
 from shared.recordings.file_metadata import FileMetadata
+from shared.recordings.received import OTHER_STATION, Received, classify
 from shared.runtime.service_skeleton import ServiceSkeleton, Stop
 from shared.wear.wear_bound import StationLimits
 from shared.wear.wear_ledger import WearLedger, ledger_path

@@ -5,9 +5,8 @@ bridge (a controller's live result and traces): both record a controller's
 run with the same predictor output as a live run. The core the live service
 and ``boltwatch predict`` run (:class:`~shared.stickslip.PredictorCore`)
 is fed every sample of the run, and its outputs become the same messages a
-live predictor publishes (:mod:`shared.stickslip.run_messages`). Neither
-the recorder nor the bridge may import the predictor, so the command line
-hands them :func:`replay_run` (a :data:`shared.stickslip.stopped_run.RunReplay`).
+live predictor publishes (:mod:`shared.stickslip.run_messages`): both call
+:func:`replay_run`.
 
 Settings: torque only (a controller measures no preload), the target is the
 controller's final torque target, and ``advisory=True``: the controller, not

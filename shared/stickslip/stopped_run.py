@@ -2,12 +2,9 @@
 
 A controller's run (imported from its file by ``boltwatch import``, or received
 live from it by the Open Protocol bridge) was stopped by the controller, not by
-boltwatch: the predictor can only replay it after the fact. Neither the
-recorder's import nor the bridge may import the predictor (services meet on
-zenoh only), so the command line, which knows every service, injects the
-replay (:data:`RunReplay`, implemented by
-``shared.stickslip.advisory_replay.replay_run``) into both; these are the
-types it takes and gives.
+boltwatch: the predictor can only replay it after the fact
+(:func:`shared.stickslip.advisory_replay.replay_run`); these are the types it
+takes and gives.
 
 - :class:`StoppedRun`: the run as the replay takes it: identity, samples on the
   controller's own clock, the controller's torque target and final torque;
@@ -18,7 +15,7 @@ types it takes and gives.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -61,7 +58,3 @@ class PredictorReplay:
     #: (index of the sample after which it was published, topic, message), in order
     outputs: list[tuple[int, str, Any]]
     summary: RunSummary
-
-
-#: the predictor's replay of a stopped run (injected by the command line)
-RunReplay = Callable[[StoppedRun], PredictorReplay]

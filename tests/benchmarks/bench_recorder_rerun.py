@@ -20,13 +20,13 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from services.recorder.live.incoming import Received, classify  # noqa: E402
 from services.recorder.live.recorder import Recorder  # noqa: E402
 from services.recorder.live.run_files import FileLimits  # noqa: E402
 from shared.config import load_station  # noqa: E402
 from shared.contract.codec import encode  # noqa: E402
 from shared.contract.messages import Sample, StickSlipEvent, ToolState  # noqa: E402
 from shared.recordings.file_metadata import FileMetadata  # noqa: E402
+from shared.recordings.received import Received, classify  # noqa: E402
 from shared.recordings.rerun.rerun_sink import RerunOptions, RerunSink  # noqa: E402
 from tests.live_recorder import write_station_file  # noqa: E402
 

@@ -22,7 +22,6 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from services.recorder.live.incoming import classify  # noqa: E402
 from services.recorder.live.recorder import Recorder  # noqa: E402
 from services.recorder.live.run_files import FileLimits  # noqa: E402
 from shared.config import load_station  # noqa: E402
@@ -30,6 +29,7 @@ from shared.contract.codec import encode  # noqa: E402
 from shared.contract.messages import Sample, ToolState  # noqa: E402
 from shared.recordings.file_metadata import FileMetadata  # noqa: E402
 from shared.recordings.mcap.mcap_sink import McapSink  # noqa: E402
+from shared.recordings.received import classify  # noqa: E402
 from tests.live_recorder import write_station_file  # noqa: E402
 
 SAMPLES = 60_000  # one minute at 1 kHz

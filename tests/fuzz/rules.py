@@ -25,7 +25,7 @@ from shared.contract import channels
 from shared.contract.sensor_range import CONTRACT_RANGE
 from tests.fuzz.payloads import as_json, dumps
 
-AHEAD_NS = 300 * 1_000_000_000  # services/recorder/live/incoming.py: MAX_AHEAD_S
+AHEAD_NS = 300 * 1_000_000_000  # shared/recordings/received.py: MAX_AHEAD_S
 HOUR_NS = 3_600_000_000_000
 RUN_ID_MAX = 2**32 - 1
 #: what the station's DBC carries (ToolStatus): the predictor narrows ids to it

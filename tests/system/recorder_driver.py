@@ -11,7 +11,6 @@ import json
 import sys
 from pathlib import Path
 
-from services.recorder.live.incoming import Received, classify
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.run_files import FileLimits
 from shared.config import load_station
@@ -19,6 +18,7 @@ from shared.contract.codec import encode
 from shared.contract.messages import Sample, ToolState
 from shared.recordings.file_metadata import FileMetadata
 from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.recordings.received import Received, classify
 from tests.live_recorder import write_station_file
 
 MS = 1_000_000

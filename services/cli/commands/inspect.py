@@ -114,9 +114,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _write_rrd(args: argparse.Namespace) -> int:
+    from shared.recordings.layout import rerun_path
+
     if args.run is not None or args.overlay is not None:
         raise InputError("--rerun writes the whole file's run; give no --run or --overlay with it")
-    target = args.out or args.recording.with_suffix(".rrd")
+    target = args.out or rerun_path(args.recording)
     if target.suffix.lower() != ".rrd":
         raise InputError(
             f"{target}: a Rerun recording is written as .rrd; give a path ending in .rrd"

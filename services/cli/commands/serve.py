@@ -102,11 +102,10 @@ def _service_main(service: str) -> Callable[[argparse.Namespace], int]:
         from services.predictor.service import main as predictor_main
 
         return predictor_main
-    if service == "openprotocol":  # the predictor replays each run after the fact
+    if service == "openprotocol":
         from services.openprotocol.service import main as openprotocol_main
-        from shared.stickslip.advisory_replay import replay_run
 
-        return lambda args: openprotocol_main(args, replay=replay_run)
+        return openprotocol_main
     if service == "recorder":
         from services.recorder.service import main as recorder_main
 

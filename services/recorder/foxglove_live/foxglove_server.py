@@ -33,9 +33,9 @@ from collections.abc import Iterable
 import foxglove
 from foxglove.websocket import WebSocketServer
 
-from services.recorder.live.incoming import Received
 from shared.contract import channels
 from shared.contract.codec import json_schema
+from shared.recordings.received import Received
 
 LOG = logging.getLogger(__name__)
 

@@ -21,16 +21,16 @@ reached the disk). ``write_errors``, ``last_write_error`` and
 
 from __future__ import annotations
 
-import errno
 import logging
 from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from services.recorder.live.incoming import Received
 from services.recorder.live.run_files import FileLimits, StationFiles
+from shared.files import describe_os_error
 from shared.recordings.file_metadata import FileMetadata
+from shared.recordings.received import Received
 from shared.runtime.log_limit import RateLimitedLog
 
 if TYPE_CHECKING:
@@ -40,13 +40,6 @@ LOG = logging.getLogger(__name__)
 
 RETRY_INTERVAL_NS = 3_000_000_000
 REMINDER_INTERVAL_NS = 10_000_000_000
-
-
-def describe_os_error(err: OSError, path: Path | None) -> str:
-    """``<file>: <errno text> (<ERRNO>)``, e.g. ``a.mcap: No space left on device (ENOSPC)``."""
-    where = err.filename if err.filename is not None else (path or "?")
-    code = errno.errorcode.get(err.errno, str(err.errno)) if err.errno is not None else "?"
-    return f"{where}: {err.strerror or err} ({code})"
 
 
 class Recorder:

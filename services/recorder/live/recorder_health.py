@@ -8,7 +8,7 @@ covers the samples since the previous report (about one second); a station
 that sent no samples has no lag (None), not zero.
 
 ``bad_payloads`` counts the payloads on a message key that the recorder
-refused (see :mod:`services.recorder.live.incoming`) and recorded raw.
+refused (see :mod:`shared.recordings.received`) and recorded raw.
 
 Write health (``write_errors``, ``last_error``, ``recording``) is read from
 the :class:`~services.recorder.live.recorder.Recorder`'s ``write_errors``,

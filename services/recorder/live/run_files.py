@@ -1,9 +1,4 @@
-"""The MCAP files of one station: one file per run, found by station, date and run.
-
-Layout (UTC)::
-
-    <recordings>/<station>/<YYYY-MM-DD>/<station>_run<run_id>_<HHMMSS>.mcap
-    <recordings>/<station>/<YYYY-MM-DD>/<station>_idle_<HHMMSS>.mcap      before the first run
+"""The MCAP files of one station: one file per run, named as :mod:`shared.recordings.layout` says.
 
 A run file is opened by the run's ``ToolState(state="running")`` and holds
 everything the station publishes until the next run starts, so the run's
@@ -25,25 +20,24 @@ the owner (:class:`~services.recorder.live.recorder.Recorder`) calls
 from __future__ import annotations
 
 import logging
-import re
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
-from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from services.recorder.live.incoming import Received
 from shared.contract import channels
 from shared.recordings.file_metadata import FileMetadata
+from shared.recordings.layout import file_path
 from shared.recordings.mcap.mcap_sink import McapSink
+from shared.recordings.received import Received
+from shared.recordings.sink import Sink
 
 if TYPE_CHECKING:  # rerun is imported only when .rrd files are wanted
     from shared.recordings.rerun.rerun_sink import RerunOptions, RerunSink
 
 LOG = logging.getLogger(__name__)
 
-_UNSAFE = re.compile(r"[^A-Za-z0-9_-]")
 #: run ids remembered per station: a ToolState starting one of them again opens no file
 STARTED_RUNS_KEPT = 64
 _ENDED_STATES = ("done", "aborted")
@@ -58,31 +52,6 @@ class FileLimits:
     max_file_duration_ns: int
     late_grace_ns: int = 2_000_000_000
     fsync: bool = True  # each flush reaches the disk: a power cut loses one interval at most
-
-
-def file_path(
-    folder: Path,
-    station: str,
-    run_id: int | None,
-    opened_ns: int,
-    part: int = 1,
-    unique: bool = True,
-) -> Path:
-    """Where a file opened at ``opened_ns`` goes; never an existing file (``unique=False``:
-    the name it would have in an empty folder, existing or not)."""
-    opened = datetime.fromtimestamp(opened_ns / 1e9, UTC)
-    safe_station = _UNSAFE.sub("_", station) or "_"
-    label = "idle" if run_id is None else f"run{run_id}"
-    stem = f"{safe_station}_{label}_{opened:%H%M%S}"
-    if part > 1:
-        stem += f"_part{part}"
-    day = folder / safe_station / f"{opened:%Y-%m-%d}"
-    path = day / f"{stem}.mcap"
-    copy = 2
-    while unique and path.exists():
-        path = day / f"{stem}_{copy}.mcap"
-        copy += 1
-    return path
 
 
 class StationFiles:
@@ -133,11 +102,9 @@ class StationFiles:
         previous = self.previous
         if previous is not None and run_id is not None and run_id == previous.run_id != sink.run_id:
             sink = previous
-        sink.write(received)
+        for target in self._sinks_of(sink):
+            target.write(received)
         self.written += 1
-        companion = self._rerun_sinks.get(sink)
-        if companion is not None:
-            companion.write(received)
         if (
             sink is self.current
             and received.schema_name == channels.TOOL.schema_name
@@ -162,12 +129,15 @@ class StationFiles:
                 on_time = [s for s in samples if s.message.run_id != previous.run_id]
                 groups = [(previous, late), (self.current, on_time)]
         for sink, group in groups:
-            sink.write_samples(group)
+            for target in self._sinks_of(sink):
+                target.write_samples(group)
             self.written += len(group)
-            companion = self._rerun_sinks.get(sink)
-            if companion is not None:
-                companion.write_samples(group)
         self._flush_if_due(now_ns)
+
+    def _sinks_of(self, sink: McapSink) -> tuple[Sink, ...]:
+        """The run file's MCAP sink, then its companions (its ``.rrd``)."""
+        companion = self._rerun_sinks.get(sink)
+        return (sink,) if companion is None else (sink, companion)
 
     def _open_or_continue(self, run_id: int | None, now_ns: int) -> None:
         """A file to write a message of ``run_id`` into (not a run's start): opened when there
@@ -192,10 +162,8 @@ class StationFiles:
     def flush(self, now_ns: int) -> None:
         for sink in (self.current, self.previous):
             if sink is not None:
-                sink.flush()
-                companion = self._rerun_sinks.get(sink)
-                if companion is not None:
-                    companion.flush()
+                for target in self._sinks_of(sink):
+                    target.flush()
         self._last_flush_ns = now_ns
 
     def close(self) -> None:

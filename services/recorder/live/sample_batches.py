@@ -26,10 +26,10 @@ time (:meth:`BatchSamples.found`; encoded again, as the station encoded them).
 
 from __future__ import annotations
 
-from services.recorder.live.incoming import Received
 from shared.contract import channels
 from shared.contract.codec import encode
 from shared.contract.messages import SampleBatch
+from shared.recordings.received import Received
 
 SAMPLE = channels.SAMPLES.schema_name
 EVENTS, INTENSITY = channels.EVENTS, channels.INTENSITY
@@ -46,7 +46,7 @@ class BatchSamples:
         self._keys: dict[str, str] = {}
 
     def samples(self, received: Received) -> list[Received]:
-        """The samples of a batch :func:`~services.recorder.live.incoming.classify` took."""
+        """The samples of a batch :func:`~shared.recordings.received.classify` took."""
         batch: SampleBatch = received.message
         samples = batch.samples
         if not samples:

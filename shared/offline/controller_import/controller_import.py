@@ -24,7 +24,8 @@ A run is written whole or not at all (:mod:`shared.offline.controller_import.imp
 and counted in the wear ledger (by (station, run): never twice) before its
 files get their real names, so a run in the folder is a run in the ledger.
 The recording is not written here: this package may not import the
-predictor; the command line replays it and hands the messages in.
+predictor; the import replays it (:mod:`.controller_replay`) and records the
+messages beside its samples.
 
 The ledger counts an imported run within the same bound as a live one
 (:mod:`.wear_bound`), with the controller's own torque shutoff as the
@@ -44,25 +45,25 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from services.recorder.live.incoming import Received, classify
-from services.recorder.live.recorder import describe_os_error
-from services.recorder.live.run_files import file_path
 from shared.contract import channels, keys
 from shared.contract.codec import encode
 from shared.contract.messages import RunSummary, Sample, ToolState
 from shared.errors import BoltwatchError, InputError
+from shared.files import describe_os_error
+from shared.offline.controller_import.controller_replay import replay_run
 from shared.offline.controller_import.controller_run import ControllerRun
 from shared.offline.controller_import.import_files import (
     put_in_place,
     read_copy,
     remove_leftovers,
     remove_temporary,
-    run_files,
     temporary_path,
 )
 from shared.quality.controller_result import controller_result
 from shared.recordings.file_metadata import FileMetadata
+from shared.recordings.layout import file_path, recording_files, rerun_path, run_file_prefix
 from shared.recordings.mcap.mcap_sink import McapSink
+from shared.recordings.received import Received, classify
 from shared.stickslip.stopped_run import PredictorReplay
 from shared.wear.wear_bound import CONTRACT_LIMITS, RunLimits
 
@@ -90,6 +91,7 @@ class ImportedRun:
     existing: Path | None = None  # the finished import that was there already
     replaced: list[Path] = field(default_factory=list)  # unfinished imports replaced
     newly_counted: bool = False  # the run entered the wear ledger now
+    summary: RunSummary | None = None  # the predictor's replay of it (None: skipped)
 
 
 def check_station_id(station: str) -> str:
@@ -117,7 +119,7 @@ def controller_messages(
             _, topic, message = outputs[next_output]
             yield topic, message, time_ns
             next_output += 1
-    end_ns = run_end_ns(run)
+    end_ns = run.ended_ns
     for _, topic, message in outputs[next_output:]:
         yield topic, message, end_ns
     yield channels.TOOL.topic, _state(station, run, "done", end_ns), end_ns
@@ -151,27 +153,22 @@ def controller_limits(run: ControllerRun) -> RunLimits:
     )
 
 
-def run_end_ns(run: ControllerRun) -> int:
-    """When the run ended: one nanosecond after its last sample (``ToolState`` done)."""
-    return run.times_ns[-1] + 1
-
-
 def import_run(
     run: ControllerRun,
     recordings: Path,
     station: str = DEFAULT_STATION,
     rerun: RerunOptions | None = None,
-    replay: PredictorReplay | None = None,
     ledger: WearLedger | None = None,
 ) -> ImportedRun:
-    """Write ``run`` under ``recordings`` (skipped if a finished import is there).
+    """Write ``run`` under ``recordings`` with the predictor's advisory replay of it
+    (skipped if a finished import is there).
 
     RunNotWrittenError when its files cannot be written; nothing of it is left then.
     """
     canonical = file_path(recordings, station, run.run_id, run.started_ns, unique=False)
     day = canonical.parent
-    prefix = f"{day.parent.name}_run{run.run_id}_"  # the station as file_path made it safe
-    copies = [read_copy(path) for path in run_files(day, prefix)] if day.is_dir() else []
+    prefix = run_file_prefix(station, run.run_id)
+    copies = [read_copy(path) for path in recording_files(day, prefix)] if day.is_dir() else []
     finished = next((copy for copy in copies if copy.holds(len(run))), None)
     if finished is not None:
         counted = _count(ledger, finished.summary, controller_limits(run))
@@ -180,14 +177,13 @@ def import_run(
     if day.is_dir():
         remove_leftovers(day, prefix)
     target = _target(canonical, unfinished)
+    replay = replay_run(station, run)
     rrd = _write(run, station, target, rerun, replay)
     moves = [(temporary_path(target), target)]
     if rrd:  # the .rrd first: a .mcap under its real name means the run is complete
-        moves.insert(0, (temporary_path(target).with_suffix(".rrd"), target.with_suffix(".rrd")))
+        moves.insert(0, (rerun_path(temporary_path(target)), rerun_path(target)))
     try:
-        counted = _count(
-            ledger, replay.summary if replay is not None else None, controller_limits(run)
-        )
+        counted = _count(ledger, replay.summary, controller_limits(run))
     except BoltwatchError:
         remove_temporary([temporary for temporary, _ in moves])
         raise
@@ -202,10 +198,11 @@ def import_run(
     return ImportedRun(
         run.source,
         target,
-        target.with_suffix(".rrd") if rrd else None,
+        rerun_path(target) if rrd else None,
         len(run),
         replaced=replaced,
         newly_counted=counted,
+        summary=replay.summary,
     )
 
 
@@ -262,14 +259,14 @@ def _write(
             if companion is not None:
                 companion.close()
         if companion is not None and companion.failed:
-            rrd = target.with_suffix(".rrd")
+            rrd = rerun_path(target)
             raise RunNotWrittenError(f"{rrd}: the Rerun recording failed (see the log above)")
     except OSError as err:
-        remove_temporary([temporary, temporary.with_suffix(".rrd")])
+        remove_temporary([temporary, rerun_path(temporary)])
         _remove_if_empty(target.parent)
         raise RunNotWrittenError(_real_names(describe_os_error(err, target), target)) from err
     except BaseException:
-        remove_temporary([temporary, temporary.with_suffix(".rrd")])
+        remove_temporary([temporary, rerun_path(temporary)])
         _remove_if_empty(target.parent)
         raise
     return companion is not None
@@ -291,7 +288,7 @@ def _open_rerun(run: ControllerRun, station: str, target: Path, options: RerunOp
     """The run's Rerun sink, writing the temporary ``.rrd`` beside ``target``."""
     from shared.recordings.rerun.rerun_sink import RerunSink
 
-    temporary = temporary_path(target).with_suffix(".rrd")
+    temporary = rerun_path(temporary_path(target))
     try:
         return RerunSink(temporary, station, run.run_id, run.started_ns, options, target.stem)
     except OSError:
@@ -299,7 +296,7 @@ def _open_rerun(run: ControllerRun, station: str, target: Path, options: RerunOp
     except Exception as err:  # the rerun SDK raises its own errors
         why = _real_names(str(err), target)
         raise RunNotWrittenError(
-            f"{target.with_suffix('.rrd')}: the Rerun recording cannot be opened: {why}"
+            f"{rerun_path(target)}: the Rerun recording cannot be opened: {why}"
         ) from err
 
 
@@ -325,7 +322,7 @@ def _remove_replaced(unfinished: list[Path], target: Path, has_rrd: bool) -> lis
         if path != target:
             path.unlink(missing_ok=True)
         if path != target or not has_rrd:
-            path.with_suffix(".rrd").unlink(missing_ok=True)
+            rerun_path(path).unlink(missing_ok=True)
         replaced.append(path)
     return replaced
 

@@ -1,10 +1,8 @@
 """An imported controller run as the predictor's replay takes it (``boltwatch import``).
 
-The replay itself is the predictor's (:mod:`shared.stickslip.advisory_replay`,
-shared with the Open Protocol bridge); the recorder may not import the
-predictor, so the command line, which knows every service, turns a
-:class:`ControllerRun` into a :class:`~shared.stickslip.stopped_run.StoppedRun` here and
-hands the replay's messages to the recorder's import.
+The replay itself is the stick-slip library's (:mod:`shared.stickslip.advisory_replay`,
+shared with the Open Protocol bridge); here a :class:`ControllerRun` becomes a
+:class:`~shared.stickslip.stopped_run.StoppedRun`.
 
 A CS351 run's target is its last step's ``TF Torque`` nominal (the torque the
 controller tightened to), its reached torque the ``TF Torque`` actual (the
@@ -13,7 +11,6 @@ highest torque measured where the last step has none).
 
 from __future__ import annotations
 
-from shared.offline.controller_import.controller_import import run_end_ns
 from shared.offline.controller_import.controller_run import ControllerRun
 from shared.stickslip.advisory_replay import replay_run as advisory_replay
 from shared.stickslip.stopped_run import PredictorReplay, StoppedRun
@@ -27,7 +24,7 @@ def stopped_run(station: str, run: ControllerRun) -> StoppedRun:
         tool_id=run.tool_id,
         program_id=run.program_id,
         started_ns=run.started_ns,
-        ended_ns=run_end_ns(run),
+        ended_ns=run.ended_ns,
         times_ns=run.times_ns,
         run_time_s=run.run_time_s,
         torque_nm=run.torque_nm,

@@ -90,6 +90,11 @@ class ControllerRun:
         return RunClock(self.date_ns).ns_of(self.time_s)
 
     @property
+    def ended_ns(self) -> int:
+        """When the run ended: one nanosecond after its last sample (``ToolState`` done)."""
+        return self.times_ns[-1] + 1
+
+    @property
     def started_ns(self) -> int:
         """The run starts at its first sample (``ToolState`` running, the file's name)."""
         return RunClock(self.date_ns).ns(self.time_s[0])

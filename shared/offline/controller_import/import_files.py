@@ -79,11 +79,6 @@ def read_copy(path: Path) -> RecordedCopy:
     return RecordedCopy(path, scan.complete, imported, samples, summary)
 
 
-def run_files(day: Path, stem_prefix: str) -> list[Path]:
-    """The ``.mcap`` files of one run in its day folder (``<station>_run<id>_*``), by name."""
-    return sorted(path for path in day.glob(f"{stem_prefix}*.mcap") if path.is_file())
-
-
 def temporary_path(final: Path) -> Path:
     """The hidden name ``final`` is written under until it is complete (same folder)."""
     return final.with_name(f".{final.stem}.{os.getpid()}{TEMPORARY_MARK}{final.suffix}")

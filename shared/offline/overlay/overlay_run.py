@@ -14,7 +14,6 @@ the run's first sample in both cases.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,6 +25,7 @@ from shared.contract import channels
 from shared.contract.codec import decode
 from shared.contract.messages import Sample, StickSlipEvent, TighteningResult
 from shared.errors import InputError
+from shared.recordings.layout import run_file_prefix, run_files, station_folder_name
 from shared.recordings.mcap.recording_reader import RecordingScan
 
 _SCHEMAS = {
@@ -33,7 +33,6 @@ _SCHEMAS = {
     channels.EVENTS.schema_name: StickSlipEvent,
     channels.RESULTS.schema_name: TighteningResult,
 }
-_UNSAFE = re.compile(r"[^A-Za-z0-9_.-]")  # as the recorder makes a station safe in file names
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -61,15 +60,12 @@ class OverlayRun:
 
 def find_run_files(folder: Path, station: str, run_id: int) -> list[Path]:
     """The MCAP files of run ``run_id`` of ``station`` under the recordings ``folder``."""
-    safe = _UNSAFE.sub("_", station) or "_"
-    station_folder = folder / safe
-    files = sorted(
-        path for path in station_folder.glob(f"*/{safe}_run{run_id}_*.mcap") if path.is_file()
-    )
+    files = run_files(folder, station, run_id)
     if not files:
+        station_folder = folder / station_folder_name(station)
         raise InputError(
-            f"run {run_id}: not found, no {safe}_run{run_id}_*.mcap in the day folders of "
-            f"{station_folder} (station {station}'s recordings)"
+            f"run {run_id}: not found, no {run_file_prefix(station, run_id)}*.mcap in the day "
+            f"folders of {station_folder} (station {station}'s recordings)"
         )
     return files
 

@@ -19,6 +19,7 @@ from pathlib import Path
 from shared.contract import channels
 from shared.contract.codec import decode
 from shared.contract.messages import RunSummary, TighteningResult
+from shared.recordings.layout import recording_files, station_days
 from shared.recordings.mcap.recording_reader import RecordingScan
 
 #: progress is told every this many files (when there are more)
@@ -56,23 +57,16 @@ class RecordedResults:
     damaged: list[str] = field(default_factory=list)  # one line per damaged file
 
 
-def recording_files(station: str, folder: Path, rule: ResultFilter) -> list[Path]:
+def files_in_range(station: str, folder: Path, rule: ResultFilter) -> list[Path]:
     """The MCAP files of ``station`` under ``folder`` whose day folder may hold the range
     (a day either side: a file opened before midnight holds runs that ended after it)."""
-    base = folder / station
-    if not base.is_dir():
-        return []
     first: date | None = rule.since.date() - timedelta(days=1) if rule.since else None
     last: date | None = rule.until.date() + timedelta(days=1) if rule.until else None
     files: list[Path] = []
-    for day in sorted(base.iterdir()):
-        try:
-            day_date = date.fromisoformat(day.name)
-        except ValueError:
+    for day_date, day in station_days(folder, station):
+        if (first and day_date < first) or (last and day_date > last):
             continue
-        if (first and day_date < first) or (last and day_date > last) or not day.is_dir():
-            continue
-        files.extend(sorted(day.glob("*.mcap")))
+        files.extend(recording_files(day))
     return files
 
 
@@ -84,7 +78,7 @@ def read_results(
     files = [
         (station, path)
         for station, folder in rule.stations
-        for path in recording_files(station, folder, rule)
+        for path in files_in_range(station, folder, rule)
     ]
     read = RecordedResults(files=len(files))
     seen: set[tuple[str, int, int, int]] = set()

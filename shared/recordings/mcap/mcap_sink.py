@@ -36,7 +36,7 @@ from typing import BinaryIO
 from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 
-from services.recorder.live.incoming import Received
+from shared.recordings.received import Received
 from shared.recordings.mcap.mcap_messages import MessageAppender, MessageRow
 from shared.recordings.mcap.recording_reader import RecordingScan
 from shared.contract import channels

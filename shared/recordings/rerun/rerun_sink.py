@@ -34,7 +34,8 @@ from urllib.parse import quote
 import numpy as np
 import rerun as rr
 
-from services.recorder.live.incoming import Received
+from shared.recordings.layout import rerun_path
+from shared.recordings.received import Received
 from shared.recordings.rerun import rerun_blueprint as bp
 from shared.recordings.rerun.rerun_streams import borrow_stream, ensure_layout_file, return_stream
 from shared.contract import channels
@@ -330,7 +331,7 @@ def open_rerun_sink(
     mcap_path: Path, station: str, run_id: int, run_started_ns: int, options: RerunOptions
 ) -> RerunSink | None:
     """The run's sink beside ``mcap_path`` (same stem, ``.rrd``); None, logged, if it fails."""
-    path = mcap_path.with_suffix(".rrd")
+    path = rerun_path(mcap_path)
     try:
         return RerunSink(path, station, run_id, run_started_ns, options)
     except Exception:

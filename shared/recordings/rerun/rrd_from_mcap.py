@@ -22,7 +22,7 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
-from services.recorder.live.incoming import classify
+from shared.recordings.received import classify
 from shared.recordings.mcap.recording_reader import RecordingScan
 from shared.recordings.rerun.rerun_sink import RerunOptions, RerunSink
 from shared.contract import channels

@@ -31,11 +31,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from services.cli.main import build_parser
-from services.recorder.live.incoming import classify
 from shared.contract.codec import encode
 from shared.contract.messages import Sample
 from shared.contract.trace import write_trace
 from shared.recordings.mcap.mcap_sink import McapSink
+from shared.recordings.received import classify
 from tests.paths import JOINT_5_2
 from tests.system.station_files import write_station
 

@@ -24,7 +24,6 @@ from shared.contract import channels, keys
 from shared.contract.codec import decode
 from shared.contract.messages import SampleBatch
 from shared.runtime.queued_publisher import QueuedPublisher
-from shared.stickslip.advisory_replay import replay_run
 from tests.live_recorder import write_station_file
 
 
@@ -90,7 +89,6 @@ class RunningBridge:
             section,
             self.publisher.publish,
             self.publisher.call,
-            replay_run,
             self.position_file,
             trace_timeout_s,
             self.counts,

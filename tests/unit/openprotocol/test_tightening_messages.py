@@ -16,7 +16,6 @@ from shared.contract.messages import (
     TighteningResult,
     ToolState,
 )
-from shared.stickslip.advisory_replay import replay_run
 from tests.unit.openprotocol.test_pending_tightenings import figures
 
 START_NS = 1_700_000_000_000_000_000
@@ -35,7 +34,7 @@ def test_the_messages_of_a_tightening_in_the_order_of_a_can_station() -> None:
     torque = Curve(7, "torque", START_NS, 0.001, saw_tooth(1200))
     angle = Curve(7, "angle", START_NS, 0.001, tuple(0.05 * i for i in range(1100)))
     tightening = Tightening(figures(7), torque, angle)
-    messages = tightening_messages("st1", 3, 1007, tightening, replay_run, "program one")
+    messages = tightening_messages("st1", 3, 1007, tightening, "program one")
     kinds = [type(message) for message in messages]
     assert kinds[0] is ToolState and messages[0].state == "running"
     samples = [m for m in messages if isinstance(m, Sample)]
@@ -64,7 +63,7 @@ def test_the_messages_of_a_tightening_in_the_order_of_a_can_station() -> None:
 def test_a_result_without_curves_is_a_run_without_samples_and_keeps_its_verdict() -> None:
     nok = figures(8)
     nok = type(nok)(**{**{f: getattr(nok, f) for f in nok.__slots__}, "ok": False})
-    messages = tightening_messages("st1", 3, 8, Tightening(nok, None, None), replay_run)
+    messages = tightening_messages("st1", 3, 8, Tightening(nok, None, None))
     assert [type(m) for m in messages] == [
         ToolState,
         ToolState,

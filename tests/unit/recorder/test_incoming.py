@@ -12,7 +12,6 @@ import json
 import math
 from typing import Any
 
-from services.recorder.live.incoming import MAX_AHEAD_S, OTHER_STATION, classify
 from shared.contract import channels
 from shared.contract.codec import encode, to_dict
 from shared.contract.messages import (
@@ -23,6 +22,7 @@ from shared.contract.messages import (
     StickSlipEvent,
     ToolState,
 )
+from shared.recordings.received import MAX_AHEAD_S, OTHER_STATION, classify
 from tests.fuzz.payloads import template
 
 T_NS = 1_700_000_000_000_000_000

@@ -9,15 +9,15 @@ import numpy as np
 import pytest
 
 from services.cli.main import main
-from services.recorder.live.incoming import classify
-from services.recorder.live.run_files import file_path
 from shared.contract.codec import encode
 from shared.contract.messages import JudgedFigure, Sample, StickSlipEvent, TighteningResult
 from shared.offline.overlay.overlay_alignment import parse_alignment
 from shared.offline.overlay.overlay_plot import build_figure, run_colours
 from shared.offline.overlay.overlay_run import find_run_files, read_overlay_run
 from shared.offline.overlay.overlay_series import Overlay, build_overlay
+from shared.recordings.layout import file_path
 from shared.recordings.mcap.mcap_sink import McapSink
+from shared.recordings.received import classify
 from tests.system.station_files import write_station
 
 T0_NS = 1_790_000_000_000_000_000

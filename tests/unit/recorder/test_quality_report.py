@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 
 from services.cli.main import main
-from services.recorder.live.incoming import classify
-from services.recorder.live.run_files import file_path
 from shared.contract.codec import encode
 from shared.contract.messages import FigureStatus, JudgedFigure, RunSummary, TighteningResult
 from shared.quality.control_chart import c4, control_chart
+from shared.recordings.layout import file_path
 from shared.recordings.mcap.mcap_sink import McapSink
+from shared.recordings.received import classify
 from tests.live_recorder import write_station_file
 
 DAY1_NS = int(datetime(2026, 3, 2, 8, 0, tzinfo=UTC).timestamp() * 1e9)

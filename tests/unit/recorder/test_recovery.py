@@ -9,13 +9,13 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from services.recorder.live.incoming import classify
 from shared.contract.codec import encode
 from shared.contract.messages import Sample
 from shared.errors import InputError
 from shared.recordings.mcap.mcap_sink import McapSink
 from shared.recordings.mcap.recording_reader import RecordingScan
 from shared.recordings.mcap.recovery import default_target, recover
+from shared.recordings.received import classify
 
 T0_NS = 1_700_000_000_000_000_000
 

@@ -26,7 +26,6 @@ from test_recording import (  # type: ignore[import-not-found]  # sibling test m
 
 from services.cli.main import main
 from services.cli.station_supervisor import stop_process
-from services.recorder.live.incoming import Received, classify
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.run_files import FileLimits
 from shared.config import LoadedStation, load_station
@@ -34,6 +33,7 @@ from shared.contract import keys
 from shared.contract.codec import encode
 from shared.contract.messages import Prediction, StickSlipEvent
 from shared.recordings.file_metadata import FileMetadata
+from shared.recordings.received import Received, classify
 from shared.recordings.rerun import rerun_blueprint as bp
 from shared.recordings.rerun.rerun_sink import RerunLive, RerunOptions, RerunSink
 from shared.recordings.rerun.rerun_streams import BLUEPRINT_FILE

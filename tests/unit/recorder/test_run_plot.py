@@ -8,7 +8,6 @@ from typing import Any
 import pytest
 
 from services.cli.main import main
-from services.recorder.live.incoming import classify
 from shared.config.joint import load_joint
 from shared.contract.codec import encode
 from shared.contract.messages import Prediction, Sample, StickSlipEvent, StopDecision
@@ -18,6 +17,7 @@ from shared.offline.post_mortem.post_mortem_run import read_run
 from shared.offline.post_mortem.run_plot import build_figure
 from shared.recordings.file_metadata import flatten
 from shared.recordings.mcap.mcap_sink import McapSink
+from shared.recordings.received import classify
 
 T0_NS = 1_700_000_000_000_000_000
 MS_NS = 1_000_000

@@ -26,7 +26,6 @@ import zenoh
 from mcap.reader import make_reader
 from pydantic import TypeAdapter
 
-from services.recorder.live.incoming import Received
 from services.recorder.live.sample_batches import BatchSamples, sample_texts
 from shared.config import LoadedStation, load_station
 from shared.contract import channels
@@ -40,6 +39,7 @@ from shared.contract.messages import (
     ToolState,
 )
 from shared.recordings.mcap.mcap_sink import RAW_ENCODING
+from shared.recordings.received import Received
 from shared.runtime.queued_publisher import QueuedPublisher
 from tests.fuzz.payloads import template
 from tests.live_recorder import RunningRecorder, publish, wait_until, write_station_file

@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 
 from services.cli.main import main
-from services.recorder.live.incoming import classify
 from shared.contract.codec import encode
 from shared.contract.messages import Sample
 from shared.contract.trace import read_trace
 from shared.errors import InputError
 from shared.recordings.mcap.mcap_sink import McapSink
 from shared.recordings.mcap.trace_export import export_trace
+from shared.recordings.received import classify
 
 T0_NS = 1_700_000_000_000_000_000
 MS_NS = 1_000_000

@@ -160,7 +160,7 @@ def test_keys() -> None:
 
 def test_a_live_decision_without_advisory_still_decodes_and_validates() -> None:
     """``advisory`` came later with a default: older payloads stay valid, and mean live."""
-    from services.recorder.live.incoming import classify  # what the recorder files it as
+    from shared.recordings.received import classify  # what the recorder files it as
 
     old = {
         "station": "st1",

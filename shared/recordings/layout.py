@@ -1,0 +1,102 @@
+"""Where a run's files go, and how they are found again: the one rule of a recordings folder.
+
+Layout (UTC)::
+
+    <recordings>/<station>/<YYYY-MM-DD>/<station>_run<run_id>_<HHMMSS>[_part<N>][_<copy>].mcap
+    <recordings>/<station>/<YYYY-MM-DD>/<station>_idle_<HHMMSS>.mcap   before a station's first run
+    ... and beside a run's .mcap its Rerun recording, the same stem with .rrd
+
+``<station>`` is the station id made safe for a file name (anything but
+letters, digits, ``_`` and ``-`` becomes ``_``): station ids are key-expression
+safe already, so this changes nothing of a valid id. ``part`` counts the
+files of one run past the recorder's size or duration limit; ``copy`` a name
+taken already. Every writer (the recorder, ``boltwatch import``) names its
+files with :func:`file_path`, every reader (``inspect``, ``report``, the
+overlay, the import's look for a run it did already) finds them with the
+functions below; only regular files are ever returned.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from datetime import UTC, date, datetime
+from pathlib import Path
+from typing import Final
+
+#: what a station id may hold in a file name; anything else becomes "_"
+_UNSAFE: Final = re.compile(r"[^A-Za-z0-9_-]")
+MCAP_SUFFIX: Final = ".mcap"
+RERUN_SUFFIX: Final = ".rrd"
+
+
+def station_folder_name(station: str) -> str:
+    """The station's folder (and file name prefix): its id made safe for a file name."""
+    return _UNSAFE.sub("_", station) or "_"
+
+
+def file_path(
+    folder: Path,
+    station: str,
+    run_id: int | None,
+    opened_ns: int,
+    part: int = 1,
+    unique: bool = True,
+) -> Path:
+    """Where a file opened at ``opened_ns`` goes; never an existing file (``unique=False``:
+    the name it would have in an empty folder, existing or not)."""
+    opened = datetime.fromtimestamp(opened_ns / 1e9, UTC)
+    safe_station = station_folder_name(station)
+    label = "idle" if run_id is None else f"run{run_id}"
+    stem = f"{safe_station}_{label}_{opened:%H%M%S}"
+    if part > 1:
+        stem += f"_part{part}"
+    day = folder / safe_station / f"{opened:%Y-%m-%d}"
+    path = day / f"{stem}{MCAP_SUFFIX}"
+    copy = 2
+    while unique and path.exists():
+        path = day / f"{stem}_{copy}{MCAP_SUFFIX}"
+        copy += 1
+    return path
+
+
+def run_file_prefix(station: str, run_id: int) -> str:
+    """The start of every file name of run ``run_id`` of ``station`` (any part, any copy)."""
+    return f"{station_folder_name(station)}_run{run_id}_"
+
+
+def rerun_path(mcap: Path) -> Path:
+    """The Rerun recording beside a run's MCAP file."""
+    return mcap.with_suffix(RERUN_SUFFIX)
+
+
+def station_days(folder: Path, station: str) -> Iterator[tuple[date, Path]]:
+    """The day folders of ``station`` under ``folder``, oldest first."""
+    base = folder / station_folder_name(station)
+    if not base.is_dir():
+        return
+    for day in sorted(base.iterdir()):
+        try:
+            day_date = date.fromisoformat(day.name)
+        except ValueError:
+            continue
+        if day.is_dir():
+            yield day_date, day
+
+
+def recording_files(day: Path, prefix: str = "") -> list[Path]:
+    """The MCAP files of one day folder whose name starts with ``prefix``, in name order."""
+    return sorted(
+        path for path in day.glob(f"{glob_escape(prefix)}*{MCAP_SUFFIX}") if path.is_file()
+    )
+
+
+def run_files(folder: Path, station: str, run_id: int) -> list[Path]:
+    """Every MCAP file of run ``run_id`` of ``station``, in any day folder, oldest first."""
+    prefix = run_file_prefix(station, run_id)
+    return [path for _, day in station_days(folder, station) for path in recording_files(day, prefix)]
+
+
+def glob_escape(text: str) -> str:
+    """``text`` as a literal in a glob pattern (a station id never needs it; a prefix may)."""
+    return re.sub(r"([*?\[])", r"[\1]", text)
