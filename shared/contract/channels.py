@@ -70,8 +70,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Generic, TypeVar
 
-import zenoh
-
 from shared.contract import keys
 from shared.contract.messages import (
     BridgeStats,
@@ -101,21 +99,13 @@ ENCODING = "json"
 
 @dataclass(frozen=True, slots=True)
 class Qos:
-    """How a channel is put (zenoh's options)."""
+    """How a channel is put, in zenoh's terms but no zenoh type: the contract needs no
+    transport (:func:`shared.runtime.zenoh_session.declare_channel` turns it into options).
 
-    priority: zenoh.Priority = field(default_factory=lambda: zenoh.Priority.DATA)
+    Every channel is put with congestion control BLOCK (above)."""
+
+    real_time: bool = False  # zenoh's REAL_TIME priority; else DATA
     express: bool = False  # no batching: latency counts
-    congestion_control: zenoh.CongestionControl = field(
-        default_factory=lambda: zenoh.CongestionControl.BLOCK
-    )
-
-    def options(self) -> dict[str, Any]:
-        """Keyword arguments of ``declare_publisher`` and ``put``."""
-        return {
-            "priority": self.priority,
-            "express": self.express,
-            "congestion_control": self.congestion_control,
-        }
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,10 +134,6 @@ class Channel(Generic[MessageT]):
         """``boltwatch/<station>/<topic>``."""
         return keys.station_key(station, self.topic)
 
-    def declare_publisher(self, session: zenoh.Session, station: str) -> zenoh.Publisher:
-        """A publisher of this channel for ``station``, with the channel's options."""
-        return session.declare_publisher(self.key(station), **self.qos.options())
-
 
 #: what a controller bridge puts in the place of a CAN station's acquisition and predictor
 _BRIDGE = ("openprotocol",)
@@ -162,7 +148,7 @@ DECISION = Channel(
     "decision",
     StopDecision,
     "predictor",
-    Qos(priority=zenoh.Priority.REAL_TIME, express=True),
+    Qos(real_time=True, express=True),
     _BRIDGE,
 )
 RUNS = Channel("runs", RunSummary, "predictor", also_by=_BRIDGE)

@@ -39,6 +39,7 @@ from shared.contract import channels
 from shared.contract.codec import encode
 from shared.contract.messages import Intensity, Sample, StickSlipEvent
 from shared.runtime.sample_batching import SampleBatching
+from shared.runtime.zenoh_session import declare_channel
 
 LOG = logging.getLogger(__name__)
 
@@ -134,6 +135,6 @@ class QueuedPublisher:
     def _publisher(self, channel: channels.Channel[Any]) -> zenoh.Publisher:
         publisher = self._publishers.get(channel.topic)
         if publisher is None:
-            publisher = channel.declare_publisher(self._session, self._station_id)
+            publisher = declare_channel(self._session, channel, self._station_id)
             self._publishers[channel.topic] = publisher
         return publisher

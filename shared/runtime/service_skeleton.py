@@ -47,7 +47,7 @@ from shared.config.common_sections import ZenohSection
 from shared.contract import keys
 from shared.contract.channels import Channel
 from shared.runtime.service_runtime import ServiceRunner
-from shared.runtime.zenoh_session import open_from, open_session
+from shared.runtime.zenoh_session import declare_channel, open_from, open_session
 
 T = TypeVar("T")
 
@@ -144,7 +144,7 @@ class ServiceSkeleton:
     def publisher(self, channel: Channel[Any], station: str) -> zenoh.Publisher:
         """A publisher of ``channel`` for ``station`` with the channel's options (its row in
         :mod:`shared.contract.channels`), undeclared in the OUTPUT stage."""
-        publisher = channel.declare_publisher(self.session, station)
+        publisher = declare_channel(self.session, channel, station)
         self._stages[Stop.OUTPUT].callback(_undeclare, publisher)
         return publisher
 

@@ -23,10 +23,12 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import zenoh
 
 from shared.config.common_sections import ENDPOINT_EXPECTED, ZenohSection
+from shared.contract.channels import Channel
 from shared.errors import ConfigError, TransportError
 
 LOG = logging.getLogger(__name__)
@@ -225,3 +227,14 @@ class RouterLink:
 
     def close(self) -> None:
         self._listener.undeclare()
+
+
+def declare_channel(session: zenoh.Session, channel: Channel[Any], station: str) -> zenoh.Publisher:
+    """A publisher of ``channel`` for ``station``, with the channel's options (its Qos)."""
+    qos = channel.qos
+    return session.declare_publisher(
+        channel.key(station),
+        priority=zenoh.Priority.REAL_TIME if qos.real_time else zenoh.Priority.DATA,
+        express=qos.express,
+        congestion_control=zenoh.CongestionControl.BLOCK,
+    )

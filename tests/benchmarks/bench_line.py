@@ -59,7 +59,7 @@ from shared.contract import channels, keys  # noqa: E402
 from shared.contract.can_database import StationDatabase  # noqa: E402
 from shared.contract.codec import decode, encode  # noqa: E402
 from shared.contract.messages import BusStats, RecorderStats  # noqa: E402
-from shared.runtime.zenoh_session import zenoh_config  # noqa: E402
+from shared.runtime.zenoh_session import declare_channel, zenoh_config  # noqa: E402
 from tests.benchmarks.bench_stop_path import serve_from  # noqa: E402
 from tests.benchmarks.line_station_runs import SHORT_PROGRAM, Heard, figures, tighten  # noqa: E402
 from tests.fuzz.payloads import template  # noqa: E402
@@ -165,7 +165,7 @@ class Station(StationPayloads):
         now = time.time_ns()
         super().__init__(station.station_id, station.config.station.tool_id, rows, now)
         self.put = {  # as the station's publisher: each channel's options (BLOCK: never lossy)
-            channel.topic: channel.declare_publisher(session, self.station).put
+            channel.topic: declare_channel(session, channel, self.station).put
             for channel in STATION_CHANNELS
         }
         self.per_sample = per_sample
