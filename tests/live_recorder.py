@@ -19,9 +19,8 @@ import zenoh
 
 from services.recorder.service import RecorderService
 from shared.config import AnyStation, ControllerStation, LoadedStation, toml_writer
-from shared.contract import keys
-from shared.contract.codec import encode
-from shared.runtime.service_skeleton import ServiceSkeleton
+from shared.contract import encode, keys
+from shared.runtime import ServiceSkeleton
 from tests.paths import STATION_FILE
 
 WAIT_S = 10.0  # upper bound on waits for zenoh; tests never assert on time

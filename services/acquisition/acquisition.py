@@ -47,20 +47,21 @@ from services.acquisition.frame_decoder import (
     ToolStatusFrame,
 )
 from services.acquisition.pairing import AssembledSample, SampleAssembler
-from shared.contract import codec
-from shared.contract.can_database import SAMPLE_RATE_HZ, StationDatabase
-from shared.contract.message_fields import can_id_bounds
-from shared.contract.messages import (
+from shared.contract import (
+    SAMPLE_RATE_HZ,
     BusStats,
     Sample,
+    StationDatabase,
     StopDecision,
     StopReason,
     StopReasonName,
     ToolRunState,
     ToolState,
+    can_id_bounds,
+    codec,
 )
 from shared.errors import InputError
-from shared.runtime.log_limit import RateLimitedLog
+from shared.runtime import RateLimitedLog
 
 LOG = logging.getLogger(__name__)
 

@@ -19,8 +19,8 @@ from collections.abc import Callable
 from typing import Protocol
 
 from shared.config import LoadedStation
-from shared.contract.messages import Sample, StopDecision, ToolState
-from shared.runtime.service_skeleton import ServiceSkeleton
+from shared.contract import Sample, StopDecision, ToolState
+from shared.runtime import ServiceSkeleton
 
 
 class Decider(Protocol):

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from shared.contract.can_database import StationDatabase
+from shared.contract import StationDatabase
 
 RejectReason = Literal["error_frame", "unknown_id", "wrong_length", "decode_error", "remote_frame"]
 

@@ -32,7 +32,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from shared.contract.can_database import COUNTER_MODULO, SAMPLE_RATE_HZ
+from shared.contract import COUNTER_MODULO, SAMPLE_RATE_HZ
 
 #: How many samples a ToolSensors frame may wait for its JointSensors partner.
 PAIRING_TOLERANCE = 2

@@ -33,13 +33,16 @@ from services.acquisition.acquisition import Acquisition
 from services.acquisition.decider import DeciderFactory
 from services.acquisition.zenoh_outlet import ZenohOutlet
 from shared.config import load_station
-from shared.contract import channels
-from shared.contract.can_database import StationDatabase
+from shared.contract import StationDatabase, channels
 from shared.errors import ConfigError
-from shared.runtime.can_bus import open_bus
-from shared.runtime.queued_publisher import QueuedPublisher
-from shared.runtime.realtime import STOP_PATH_PRIORITY, use_realtime_priority
-from shared.runtime.service_skeleton import ServiceSkeleton, Stop
+from shared.runtime import (
+    STOP_PATH_PRIORITY,
+    QueuedPublisher,
+    ServiceSkeleton,
+    Stop,
+    open_bus,
+    use_realtime_priority,
+)
 
 LOG = logging.getLogger(__name__)
 

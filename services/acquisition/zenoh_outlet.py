@@ -19,9 +19,8 @@ import logging
 
 import zenoh
 
-from shared.contract.messages import BusStats, Sample, ToolState
-from shared.runtime.queued_publisher import QueuedPublisher
-from shared.runtime.zenoh_session import RouterLink
+from shared.contract import BusStats, Sample, ToolState
+from shared.runtime import QueuedPublisher, RouterLink
 
 LOG = logging.getLogger(__name__)
 

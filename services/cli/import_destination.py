@@ -17,8 +17,8 @@ from shared import files
 from shared.errors import InputError
 
 if TYPE_CHECKING:
-    from shared.offline.controller_import.controller_run import ControllerRun
-    from shared.recordings.rerun.rerun_sink import RerunOptions
+    from shared.offline.controller_import import ControllerRun
+    from shared.recordings.rerun import RerunOptions
 
 
 def make_folder(folder: Path, what: str) -> Path:
@@ -31,8 +31,8 @@ def make_folder(folder: Path, what: str) -> Path:
 
 def write_csv_whole(target: Path, rows: Iterable[tuple[float, float, float, float | None]]) -> int:
     """:func:`shared.contract.trace.write_trace` under a temporary name, renamed when complete."""
-    from shared.contract.trace import write_trace
-    from shared.offline.controller_import.import_files import remove_temporary, temporary_path
+    from shared.contract import write_trace
+    from shared.offline.controller_import import remove_temporary, temporary_path
 
     temporary = temporary_path(target)
     try:
@@ -57,7 +57,7 @@ class CsvWriter:
     def write(self, run: ControllerRun) -> bool:
         """Write the run's trace; True (a CSV is always written, over an older one)."""
         from shared.files import describe_os_error
-        from shared.offline.controller_import.controller_import import RunNotWrittenError
+        from shared.offline.controller_import import RunNotWrittenError
 
         target = self.folder / f"{run.source.stem}.csv"
         rows = zip(run.run_time_s, run.torque_nm, run.angle_deg, [None] * len(run), strict=True)
@@ -79,20 +79,20 @@ class RecordingsWriter:
     """Each run into the recordings folder, with its predictor replay and wear-ledger count."""
 
     def __init__(self, folder: Path, station: str, rerun: bool) -> None:
-        from shared.wear.wear_ledger import WearLedger, ledger_path
+        from shared.wear import WearLedger, ledger_path
 
         self.folder = folder
         self._station = station
         self._options: RerunOptions | None = None
         if rerun:
-            from shared.recordings.rerun.rerun_sink import RerunOptions
+            from shared.recordings.rerun import RerunOptions
 
             self._options = RerunOptions()
         self._ledger = WearLedger(ledger_path(folder))
 
     def write(self, run: ControllerRun) -> bool:
         """Import the run; True when written now, False when it was already there."""
-        from shared.offline.controller_import.controller_import import import_run
+        from shared.offline.controller_import import import_run
 
         imported = import_run(run, self.folder, self._station, self._options, self._ledger)
         summary = imported.summary

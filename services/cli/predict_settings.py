@@ -16,7 +16,7 @@ import dataclasses
 import math
 from pathlib import Path
 
-from shared.contract.sensor_range import SensorRange
+from shared.contract import SensorRange
 from shared.errors import BoltwatchError, InputError
 from shared.model import JointConstants
 from shared.stickslip import DEFAULT_WINDOW_SAMPLES, PredictorSettings
@@ -103,7 +103,7 @@ def _joint_constants(path: Path) -> JointConstants:
 
 
 def _dbc_range(path: Path) -> SensorRange:
-    from shared.contract.can_database import StationDatabase
+    from shared.contract import StationDatabase
 
     try:
         return SensorRange.of_database(StationDatabase(path))

@@ -19,7 +19,7 @@ CONNECT_TIMEOUT_MS = 2000
 
 def router_client(config: Path, connect: str | None) -> tuple[str, zenoh.Config]:
     """The router endpoint and a client config that reaches it (``connect`` wins)."""
-    from shared.runtime.zenoh_session import zenoh_config
+    from shared.runtime import zenoh_config
 
     if connect is not None:
         return connect, zenoh_config("client", [connect], connect_timeout_ms=CONNECT_TIMEOUT_MS)
@@ -29,7 +29,7 @@ def router_client(config: Path, connect: str | None) -> tuple[str, zenoh.Config]
 def _router_of(config: Path) -> tuple[str, zenoh.Config]:
     from shared.config import load_any_station
     from shared.errors import ConfigError
-    from shared.runtime.zenoh_session import client_config
+    from shared.runtime import client_config
 
     section = load_any_station(config).config.zenoh
     if not section.connect:
@@ -46,7 +46,7 @@ def open_client(endpoint: str, config: zenoh.Config) -> zenoh.Session:
     import zenoh
 
     from shared.errors import TransportError
-    from shared.runtime.zenoh_session import zenoh_reason
+    from shared.runtime import zenoh_reason
 
     try:
         return zenoh.open(config)

@@ -15,10 +15,14 @@ from pathlib import Path
 
 from services.cli.command_options import check_png_target
 from shared.config import AnyStation
-from shared.offline.overlay.overlay_alignment import parse_alignment
-from shared.offline.overlay.overlay_plot import save_figure
-from shared.offline.overlay.overlay_run import OverlayRun, find_run_files, read_overlay_run
-from shared.offline.overlay.overlay_series import build_overlay
+from shared.offline.overlay import (
+    OverlayRun,
+    build_overlay,
+    find_run_files,
+    parse_alignment,
+    read_overlay_run,
+    save_figure,
+)
 
 DEFAULT_TARGET = Path("overlay.png")
 

@@ -8,7 +8,7 @@ when no result arrived for the run.
 
 from __future__ import annotations
 
-from shared.contract.messages import BridgeStats, RunSummary, TighteningResult
+from shared.contract import BridgeStats, RunSummary, TighteningResult
 
 COLUMNS = (
     ("run", 10),

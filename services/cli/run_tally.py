@@ -16,7 +16,7 @@ import logging
 from collections import Counter
 from collections.abc import Iterable
 
-from shared.contract.messages import RunSummary, ToolState
+from shared.contract import RunSummary, ToolState
 
 LOG = logging.getLogger(__name__)
 

@@ -31,11 +31,18 @@ from services.cli import run_table
 from services.cli.run_tally import RunTally
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
 from shared.config import LoadedStation, Program
-from shared.contract import channels, keys
-from shared.contract.codec import decode
-from shared.contract.messages import BridgeStats, BusStats, RunSummary, TighteningResult, ToolState
+from shared.contract import (
+    BridgeStats,
+    BusStats,
+    RunSummary,
+    TighteningResult,
+    ToolState,
+    channels,
+    decode,
+    keys,
+)
 from shared.errors import BoltwatchError, TransportError
-from shared.runtime.zenoh_session import open_from, zenoh_config
+from shared.runtime import open_from, zenoh_config
 
 LOG = logging.getLogger(__name__)
 

@@ -10,7 +10,7 @@ their stats came: it runs neither.
 
 from __future__ import annotations
 
-from shared.line_status.station_status import (
+from shared.line_status import (
     BusHealth,
     LastDecision,
     LastRun,
@@ -19,10 +19,11 @@ from shared.line_status.station_status import (
     RecorderHealth,
     StationStatus,
     StatusReport,
+    amount_text,
+    bridge_lines,
+    quality_text,
+    result_text,
 )
-from shared.line_status.status_bridge import bridge_lines
-from shared.line_status.status_last_result import amount_text, result_text
-from shared.line_status.status_quality_alert import quality_text
 
 
 def format_report(report: StatusReport) -> str:

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from shared.runtime.supervisor_link import supervisor_environment
+from shared.runtime import supervisor_environment
 
 LOG = logging.getLogger(__name__)
 

@@ -29,12 +29,9 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
-from shared.contract import channels, keys
-from shared.contract.codec import decode
-from shared.contract.messages import RunSummary, TighteningResult
+from shared.contract import RunSummary, TighteningResult, channels, decode, keys
 from shared.errors import InputError
-from shared.line_status.station_status import KNOWN_SERVICES, StationStatus, StatusCollector
-from shared.line_status.status_last_result import last_result
+from shared.line_status import KNOWN_SERVICES, StationStatus, StatusCollector, last_result
 
 #: results, stop reasons and alerts kept per station
 HISTORY = 10

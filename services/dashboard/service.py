@@ -21,7 +21,7 @@ from services.dashboard.board_feed import BoardFeed
 from services.dashboard.line_board import LineBoard, StationSetting
 from services.dashboard.web_app import Listeners, make_app
 from shared.config import load_any_line
-from shared.runtime.zenoh_session import open_session
+from shared.runtime import open_session
 
 LOG = logging.getLogger(__name__)
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from shared.runtime.option_types import seconds
+from shared.runtime import seconds
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

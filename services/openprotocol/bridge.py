@@ -50,21 +50,24 @@ from services.openprotocol.controller_session import (
 from services.openprotocol.published_ids import BridgePosition
 from services.openprotocol.result_reading import CurveRefusedError, read_curve, read_result
 from services.openprotocol.tightening_flow import TighteningFlow
-from shared.config import AnyStation
-from shared.config.openprotocol import OpenProtocolSection
-from shared.openprotocol.codec import KNOWN_MIDS, SUPPORTED_REVISIONS
-from shared.openprotocol.dialect import Dialect
-from shared.openprotocol.errors import OpenProtocolError
-from shared.openprotocol.results import (
+from shared.config import AnyStation, OpenProtocolSection
+from shared.openprotocol import (
+    KNOWN_MIDS,
+    SUPPORTED_REVISIONS,
+    CommandAccepted,
+    CommandError,
+    DataSubscribe,
+    Dialect,
     LastTighteningResult,
     OldResultRequest,
     OldTighteningResult,
+    OpenProtocolError,
     ResultAcknowledge,
     ResultSubscribe,
+    TraceCurve,
+    TraceType,
+    trace_extra_data,
 )
-from shared.openprotocol.session import CommandAccepted, CommandError
-from shared.openprotocol.subscriptions import DataSubscribe, trace_extra_data
-from shared.openprotocol.traces import TraceCurve, TraceType
 
 LOG = logging.getLogger(__name__)
 

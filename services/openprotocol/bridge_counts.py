@@ -15,9 +15,9 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from shared.contract.messages import BridgeStats, ControllerAlarm
-from shared.quality.verdict import cut_text
-from shared.runtime.log_limit import RateLimitedLog
+from shared.contract import BridgeStats, ControllerAlarm
+from shared.quality import cut_text
+from shared.runtime import RateLimitedLog
 
 LOG = logging.getLogger(__name__)
 

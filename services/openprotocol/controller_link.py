@@ -22,7 +22,7 @@ import select
 import socket
 from collections.abc import Collection
 
-from shared.openprotocol.framing import Frame, FrameReader
+from shared.openprotocol import Frame, FrameReader
 
 READ_BYTES = 65536
 
@@ -43,6 +43,8 @@ class ControllerLink:
     ) -> None:
         self.address = f"{host}:{port}"
         self._reader = FrameReader(known_mids=known_mids)
+        #: every byte read from the controller (a message coming in pieces is a live link)
+        self.bytes_received = 0
         try:
             self._socket = socket.create_connection((host, port), timeout=dead_after_s)
         except OSError as err:
@@ -68,6 +70,11 @@ class ControllerLink:
     def bad_frames(self) -> int:
         return self._reader.bad_frames
 
+    @property
+    def pending_bytes(self) -> int:
+        """Bytes of a message that has begun to come and is not complete yet."""
+        return self._reader.pending_bytes
+
     def send(self, data: bytes) -> None:
         try:
             self._socket.sendall(data)
@@ -85,6 +92,7 @@ class ControllerLink:
             raise LinkLostError(f"read from {self.address} failed: {_why(err)}") from err
         if not chunk:
             raise LinkLostError(f"{self.address} closed the link")
+        self.bytes_received += len(chunk)
         return self._reader.feed(chunk)
 
     def close(self) -> None:

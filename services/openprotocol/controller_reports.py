@@ -27,9 +27,10 @@ from collections.abc import Callable
 from typing import Any
 
 from services.openprotocol.bridge_counts import BridgeCounts
-from shared.contract.messages import ControllerAlarm
-from shared.contract.messages import ToolData as LineToolData
-from shared.openprotocol.alarms import (
+from shared.contract import ControllerAlarm
+from shared.contract import ToolData as LineToolData
+from shared.openprotocol import (
+    SUPPORTED_REVISIONS,
     Alarm,
     AlarmAcknowledge,
     AlarmAcknowledgedOnController,
@@ -37,11 +38,10 @@ from shared.openprotocol.alarms import (
     AlarmStatus,
     AlarmStatusAck,
     AlarmSubscribe,
+    ToolDataRequest,
+    timestamp_ns,
 )
-from shared.openprotocol.codec import SUPPORTED_REVISIONS
-from shared.openprotocol.timestamps import timestamp_ns
-from shared.openprotocol.tool_data import ToolData as ControllerToolData
-from shared.openprotocol.tool_data import ToolDataRequest
+from shared.openprotocol import ToolData as ControllerToolData
 
 TOOL_DATA_MID = 41
 #: the highest revisions asked: 0070 (0071 at rev 2 carries the alarm's text), 0040

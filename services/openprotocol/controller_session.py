@@ -12,9 +12,12 @@ The integrator's side of the public specification, on one
   one lower on error 97 (an expected answer: neither a fault nor a controller
   error). What the controller pushes meanwhile (0061, 0900, 0071...) goes to
   ``on_push`` in the order it came, also what shared a TCP read with the answer;
-- an answer that does not come: for a request the session cannot go on
-  without (0001, 0060) the link is dead (:class:`LinkLostError`); for any
-  other it is counted and logged, and the session goes on without it;
+- an answer that does not come within the dead-link time of the last message
+  the controller wrote (a controller busy writing long curves is not a silent
+  one; a keep-alive does not count), at most :data:`ANSWER_WAIT_LIMIT` times
+  that long: for a request the session cannot go on without (0001, 0060) the link
+  is dead (:class:`LinkLostError`); for any other it is counted and logged,
+  and the session goes on without it;
 - keep-alive: a 9999 at least every ``keep_alive_s``; the controller may
   mirror it or not. Once it has mirrored one, a controller silent for
   :data:`DEAD_AFTER_KEEP_ALIVES` keep-alive periods is a dead link;
@@ -37,17 +40,20 @@ from typing import Any
 
 from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.controller_link import ControllerLink, LinkLostError
-from shared.openprotocol.codec import SUPPORTED_REVISIONS, UnknownMessage, decode, encode
-from shared.openprotocol.dialect import Dialect
-from shared.openprotocol.errors import OpenProtocolError
-from shared.openprotocol.framing import Frame
-from shared.openprotocol.session import (
+from shared.openprotocol import (
+    SUPPORTED_REVISIONS,
     CommandAccepted,
     CommandError,
     CommunicationStart,
     CommunicationStartAck,
     CommunicationStop,
+    Dialect,
+    Frame,
     KeepAlive,
+    OpenProtocolError,
+    UnknownMessage,
+    decode,
+    encode,
 )
 
 LOG = logging.getLogger(__name__)
@@ -59,6 +65,8 @@ DEAD_AFTER_KEEP_ALIVES = 2.0
 REVISION_UNSUPPORTED = 97
 #: the longest one read waits while an answer is awaited (the stop event is looked at between)
 READ_SLICE_S = 0.1
+#: a controller that keeps writing other messages gets this many dead-link times to answer
+ANSWER_WAIT_LIMIT = 5.0
 
 #: where what the controller pushes goes (a decoded message or a RefusedFrame)
 Push = Callable[[Any], None]
@@ -103,6 +111,7 @@ class ControllerSession:
         self._mirrors = False  # the controller has mirrored a keep-alive on this link
         self.controller_name = ""
         self._garbage_seen = 0  # the link's reader counts since the link started
+        self._bytes_heard = 0
         self._bad_frames_seen = 0
         #: messages read with an answer and not handled yet (they came after it)
         self._unread: deque[Any] = deque()
@@ -201,18 +210,22 @@ class ControllerSession:
         """Write ``message``; its answer: a message of a MID in ``replies``, or the 0004 /
         0005 naming its MID (a 0004 is counted unless its code is in ``expected_errors``).
 
-        What comes meanwhile is pushed. No answer within the dead-link time:
-        LinkLostError when ``required``, else None (counted and logged)."""
+        What comes meanwhile is pushed. No answer within the dead-link time of the
+        last message heard (see the module's text): LinkLostError when
+        ``required``, else None (counted and logged)."""
         asked = _mid_of(message)
         naming = {asked, *_subscribed_mid(message)}
         self.send(message)
         deadline = self._clock() + self.dead_after_s
+        latest = self._clock() + ANSWER_WAIT_LIMIT * self.dead_after_s
         while True:
             if self._stop.is_set():
                 raise SessionStoppedError
             messages = self._take_unread() or self._receive(
                 min(READ_SLICE_S, deadline - self._clock())
             )
+            if messages or self._link.pending_bytes:  # it is writing: the answer may follow
+                deadline = min(self._clock() + self.dead_after_s, latest)
             for index, decoded in enumerate(messages):
                 if _answers(decoded, naming, replies):
                     self._unread.extendleft(reversed(messages[index + 1 :]))
@@ -262,7 +275,8 @@ class ControllerSession:
             counts.bad_messages += bad_frames
             counts.fault("bad message", "a message whose length does not fit: skipped")
         decoded: list[Any] = []
-        if frames:
+        if self._link.bytes_received != self._bytes_heard:  # a byte is a sign of life
+            self._bytes_heard = self._link.bytes_received
             self._heard = self._clock()
         for frame in frames:
             try:

@@ -27,9 +27,7 @@ import zoneinfo
 from typing import Any, Final
 
 from services.openprotocol.controller_tightening import Curve, ResultFigures
-from shared.openprotocol.results import LastTighteningResult
-from shared.openprotocol.timestamps import timestamp_ns
-from shared.openprotocol.traces import TraceCurve
+from shared.openprotocol import LastTighteningResult, TraceCurve, timestamp_ns
 
 #: 0900 trace types the bridge uses (Open Protocol: 001 angle, 002 torque)
 CURVE_KINDS = {1: "angle", 2: "torque"}

@@ -25,8 +25,7 @@ from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.published_ids import position_path
 from shared.config import load_any_station
 from shared.errors import ConfigError
-from shared.runtime.queued_publisher import QueuedPublisher
-from shared.runtime.service_skeleton import ServiceSkeleton, Stop
+from shared.runtime import QueuedPublisher, ServiceSkeleton, Stop
 
 LOG = logging.getLogger(__name__)
 

@@ -28,9 +28,8 @@ from services.openprotocol.curve_check import Reading, check_curves, readings
 from services.openprotocol.pending_tightenings import PendingTightenings, Take
 from services.openprotocol.published_ids import BridgePosition, read_position, write_position
 from services.openprotocol.tightening_messages import tightening_messages
-from shared.config import AnyStation
-from shared.config.openprotocol import OpenProtocolSection
-from shared.contract.message_fields import INT64_MAX
+from shared.config import AnyStation, OpenProtocolSection
+from shared.contract import INT64_MAX
 
 LOG = logging.getLogger(__name__)
 

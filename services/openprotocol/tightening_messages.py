@@ -32,16 +32,9 @@ import math
 from typing import Any
 
 from services.openprotocol.controller_tightening import ResultFigures, Tightening
-from shared.contract.messages import (
-    ControllerFunction,
-    ControllerResult,
-    ControllerStep,
-    Sample,
-    ToolState,
-)
-from shared.quality.controller_result import controller_result
-from shared.stickslip.advisory_replay import replay_run
-from shared.stickslip.stopped_run import StoppedRun
+from shared.contract import ControllerFunction, ControllerResult, ControllerStep, Sample, ToolState
+from shared.quality import controller_result
+from shared.stickslip import StoppedRun, replay_run
 
 #: the name of the one step a bridge's ControllerResult has (Open Protocol gives no steps)
 STEP_NAME = "Tightening"

@@ -11,17 +11,23 @@ from __future__ import annotations
 import math
 
 from shared.config import Program
-from shared.contract.messages import (
+from shared.contract import (
     Intensity,
+    RunClock,
     RunSummary,
     Sample,
     StickSlipEvent,
     StopDecision,
     ToolState,
 )
-from shared.contract.run_clock import RunClock
-from shared.stickslip import CoreDecision, EventFigures, PredictorCore, PredictorSettings
-from shared.stickslip.run_messages import decision_message, event_messages
+from shared.stickslip import (
+    CoreDecision,
+    EventFigures,
+    PredictorCore,
+    PredictorSettings,
+    decision_message,
+    event_messages,
+)
 
 Outgoing = StickSlipEvent | Intensity | StopDecision
 

@@ -34,8 +34,8 @@ from services.predictor.served_station import ServedStation
 from services.predictor.station_refusal import refuse_stations_served_elsewhere
 from services.predictor.station_runs import StationRuns
 from shared.config import LoadedStation
-from shared.contract.messages import Sample, StopDecision, ToolState
-from shared.runtime.service_skeleton import ServiceSkeleton
+from shared.contract import Sample, StopDecision, ToolState
+from shared.runtime import ServiceSkeleton
 
 LOG = logging.getLogger(__name__)
 

@@ -12,10 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from shared.config import LoadedStation, Program
-from shared.contract import codec
-from shared.contract.can_database import StationDatabase
-from shared.contract.message_fields import can_id_bounds
-from shared.contract.messages import Sample, ToolState
+from shared.contract import Sample, StationDatabase, ToolState, can_id_bounds, codec
 from shared.model import JointConstants
 from shared.stickslip import PredictorSettings
 

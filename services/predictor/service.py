@@ -42,14 +42,10 @@ from services.predictor.station_refusal import (
     refuse_stations_served_elsewhere,
 )
 from services.predictor.station_runs import StationRuns
-from shared.config import LoadedStation, load_line
-from shared.config.line import stations_by_id
-from shared.contract import channels, codec, keys
-from shared.contract.messages import Sample, StopDecision, ToolState
+from shared.config import LoadedStation, load_line, stations_by_id
+from shared.contract import Sample, StopDecision, ToolState, channels, codec, keys
 from shared.errors import InputError
-from shared.runtime.log_limit import RateLimitedLog
-from shared.runtime.receive_threads import use_one_receive_thread
-from shared.runtime.service_skeleton import ServiceSkeleton, Stop
+from shared.runtime import RateLimitedLog, ServiceSkeleton, Stop, use_one_receive_thread
 
 LOG = logging.getLogger(__name__)
 

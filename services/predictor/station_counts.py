@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shared.contract.messages import PredictorStats
-from shared.stickslip.input_guard import InputReport
+from shared.contract import PredictorStats
+from shared.stickslip import InputReport
 
 
 @dataclass

@@ -40,7 +40,7 @@ from typing import Protocol
 import zenoh
 
 from shared.contract import channels, keys
-from shared.runtime.receive_threads import keep_thread_state
+from shared.runtime import keep_thread_state
 
 #: (served station id, topic, payload) -> None; called one message at a time
 Handler = Callable[[str, str, bytes], None]

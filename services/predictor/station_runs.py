@@ -29,9 +29,9 @@ from collections import deque
 from services.predictor.active_run import ActiveRun, Outgoing
 from services.predictor.served_station import ServedStation
 from services.predictor.station_counts import StationCounts
-from shared.contract.messages import RunSummary, Sample, TighteningResult, ToolState
-from shared.quality.run_result import tightening_result
-from shared.runtime.log_limit import RateLimitedLog
+from shared.contract import RunSummary, Sample, TighteningResult, ToolState
+from shared.quality import tightening_result
+from shared.runtime import RateLimitedLog
 
 LOG = logging.getLogger(__name__)
 

@@ -25,15 +25,15 @@ from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
-from shared.config.quality import QualitySection
-from shared.contract.messages import (
+from shared.config import QualitySection
+from shared.contract import (
     JudgedFigure,
     QualityAlert,
     QualityAlertKind,
     QualityFigure,
     TighteningResult,
 )
-from shared.quality.capability import capability, window_text
+from shared.quality import capability, window_text
 
 LOG = logging.getLogger(__name__)
 

@@ -55,20 +55,23 @@ from services.recorder.live.sample_batches import BatchSamples
 from services.recorder.quality_watch import QualityWatch
 from services.recorder.wear_watch import WearWatch
 from shared.config import AnyStation, ControllerStation, LoadedStation, load_any_line
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.message_fields import MAX_TEXT_CHARS
-from shared.contract.messages import QualityAlert, RecorderStats, WearAlert
+from shared.contract import (
+    MAX_TEXT_CHARS,
+    QualityAlert,
+    RecorderStats,
+    WearAlert,
+    channels,
+    encode,
+    keys,
+)
 from shared.errors import ConfigError
-from shared.recordings.file_metadata import FileMetadata
-from shared.recordings.received import OTHER_STATION, Received, classify
-from shared.runtime.service_skeleton import ServiceSkeleton, Stop
-from shared.wear.wear_bound import StationLimits
-from shared.wear.wear_ledger import WearLedger, ledger_path
+from shared.recordings import OTHER_STATION, FileMetadata, Received, classify
+from shared.runtime import ServiceSkeleton, Stop
+from shared.wear import StationLimits, WearLedger, ledger_path
 
 if TYPE_CHECKING:
     from services.recorder.foxglove_live.foxglove_server import FoxgloveLive
-    from shared.recordings.rerun.rerun_sink import RerunLive, RerunOptions
+    from shared.recordings.rerun import RerunLive, RerunOptions
 
 LOG = logging.getLogger(__name__)
 
@@ -342,7 +345,7 @@ def rerun_options(write_files: bool, live_url: str | None) -> RerunOptions | Non
     if not write_files and live_url is None:
         return None
     try:
-        from shared.recordings.rerun.rerun_sink import LIVE_BATCH_SAMPLES, RerunOptions
+        from shared.recordings.rerun import LIVE_BATCH_SAMPLES, RerunOptions
     except ImportError:
         LOG.exception("Rerun is unusable; recording MCAP only")
         return None
@@ -357,7 +360,7 @@ def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
     if not (web or getattr(args, "rerun_serve", False)):
         return None
     try:
-        from shared.recordings.rerun.rerun_sink import RerunLive
+        from shared.recordings.rerun import RerunLive
 
         return RerunLive(args.rerun_port, args.rerun_web_port if web else None)
     except Exception:

@@ -43,12 +43,18 @@ from collections import Counter, deque
 from collections.abc import Callable
 from pathlib import Path
 
-from shared.contract.messages import RunSummary, ToolData, WearAlert
+from shared.contract import RunSummary, ToolData, WearAlert
 from shared.errors import InputError
-from shared.wear.wear_bound import RefusedSummaryError, RunLimits, refusal
-from shared.wear.wear_ledger import WearLedger
-from shared.wear.wear_ledger_file import BrokenLedgerError
-from shared.wear.wear_waiting import load_waiting, save_waiting, waiting_path
+from shared.wear import (
+    BrokenLedgerError,
+    RefusedSummaryError,
+    RunLimits,
+    WearLedger,
+    load_waiting,
+    refusal,
+    save_waiting,
+    waiting_path,
+)
 
 LOG = logging.getLogger(__name__)
 

@@ -22,8 +22,8 @@ import enum
 import logging
 
 from services.rig.physics import Measurement, TighteningPhysics
-from shared.config.station import Program
-from shared.contract.messages import ToolRunState
+from shared.config import Program
+from shared.contract import ToolRunState
 
 LOG = logging.getLogger(__name__)
 

@@ -13,9 +13,7 @@ from __future__ import annotations
 
 import can
 
-from shared.contract.can_database import COUNTER_MODULO, StationDatabase
-from shared.contract.messages import ToolRunState
-from shared.contract.sensor_range import SensorRange
+from shared.contract import COUNTER_MODULO, SensorRange, StationDatabase, ToolRunState
 
 
 class RigFrames:

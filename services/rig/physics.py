@@ -41,8 +41,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from services.rig.slip_oscillator import SlipOscillator
-from shared.config.station import Program, RigSection
-from shared.model.stiffness import JointConstants
+from shared.config import Program, RigSection
+from shared.model import JointConstants
 
 NOISE_BLOCK_SAMPLES = 1024
 SCAN_STEPS_PER_HALF_PERIOD = 16

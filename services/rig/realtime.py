@@ -25,10 +25,10 @@ import can
 from services.rig.controller import RunController, StopSource
 from services.rig.frames import RigFrames
 from services.rig.physics import TighteningPhysics
-from shared.config.station import Program, RigSection
-from shared.contract.messages import ToolRunState
+from shared.config import Program, RigSection
+from shared.contract import ToolRunState
 from shared.errors import TransportError
-from shared.model.stiffness import JointConstants
+from shared.model import JointConstants
 
 LOG = logging.getLogger(__name__)
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from shared.config.station import LoadedStation, Program
+from shared.config import LoadedStation, Program
 from shared.errors import ConfigError
 
 

@@ -24,12 +24,10 @@ from services.rig.frames import RigFrames
 from services.rig.realtime import RealtimeRig, ToolIdentity
 from services.rig.selection import choose_program, choose_seed
 from shared.config import load_station
-from shared.contract.can_database import StationDatabase
+from shared.contract import StationDatabase
 from shared.errors import ConfigError
-from shared.model.stiffness import JointConstants
-from shared.runtime.can_bus import open_bus
-from shared.runtime.realtime import RIG_PRIORITY, use_realtime_priority
-from shared.runtime.service_skeleton import ServiceSkeleton
+from shared.model import JointConstants
+from shared.runtime import RIG_PRIORITY, ServiceSkeleton, open_bus, use_realtime_priority
 
 LOG = logging.getLogger(__name__)
 

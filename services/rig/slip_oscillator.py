@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from shared.model.stiffness import JointConstants
+from shared.model import JointConstants
 
 
 @dataclass(frozen=True, slots=True)

@@ -28,8 +28,7 @@ from pathlib import Path
 import zenoh
 
 from shared.errors import ConfigError
-from shared.runtime.service_skeleton import ServiceSkeleton
-from shared.runtime.zenoh_session import TlsFiles, zenoh_config, zenoh_reason
+from shared.runtime import ServiceSkeleton, TlsFiles, zenoh_config, zenoh_reason
 
 LOG = logging.getLogger(__name__)
 

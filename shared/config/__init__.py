@@ -15,39 +15,63 @@ names), :func:`load_any_station` (a CAN or a controller station) or
   :mod:`.toml_writer` (the files boltwatch derives from others)
 """
 
+from shared.config.common_sections import ENDPOINT_EXPECTED
 from shared.config.controller_station import (
     ControllerProgram,
     ControllerStation,
     ControllerStationConfig,
 )
 from shared.config.joint import JointConfig, load_joint
-from shared.config.line import derive_stations, derived_ids, load_any_line, load_line
+from shared.config.line import (
+    check_derivable,
+    derive_stations,
+    derived_ids,
+    load_any_line,
+    load_line,
+    stations_by_id,
+)
+from shared.config.loading import resolve_relative
+from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
+from shared.config.quality import QualitySection
 from shared.config.station import (
+    CanSection,
     LoadedStation,
     PredictorSection,
     Program,
     RigSection,
     StationConfig,
+    ZenohSection,
     load_station,
 )
 from shared.config.station_kinds import AnyStation, load_any_station
+from shared.config.toml_writer import dumps
 
 __all__ = [
+    "ENDPOINT_EXPECTED",
     "AnyStation",
+    "CanSection",
     "ControllerProgram",
     "ControllerStation",
     "ControllerStationConfig",
     "JointConfig",
     "LoadedStation",
+    "OpenProtocolSection",
     "PredictorSection",
     "Program",
+    "QualitySection",
+    "RigOpenProtocolSection",
     "RigSection",
     "StationConfig",
+    "ZenohSection",
+    "check_derivable",
     "derive_stations",
     "derived_ids",
+    "dumps",
     "load_any_line",
     "load_any_station",
     "load_joint",
     "load_line",
     "load_station",
+    "resolve_relative",
+    "stations_by_id",
 ]

@@ -63,7 +63,7 @@ from shared.config.loading import StrictModel, read_toml, validate
 from shared.config.openprotocol import OpenProtocolSection
 from shared.config.program_windows import ProgramWindows
 from shared.config.quality import QualitySection
-from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
+from shared.contract import CONTRACT_RANGE, SensorRange
 from shared.errors import ConfigError
 
 #: what a controller station's samples can hold (see the module docstring)

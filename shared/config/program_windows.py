@@ -22,7 +22,7 @@ from __future__ import annotations
 from pydantic import Field, model_validator
 
 from shared.config.loading import StrictModel
-from shared.contract.sensor_range import SensorRange
+from shared.contract import SensorRange
 
 #: (figure, its minimum's key, its maximum's key, the hard limit's key, unit)
 WINDOWS = (

@@ -33,8 +33,7 @@ from shared.config.loading import StrictModel, read_toml, resolve_relative, vali
 from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
 from shared.config.program_windows import ProgramWindows
 from shared.config.quality import QualitySection
-from shared.contract.can_database import StationDatabase
-from shared.contract.sensor_range import SensorRange
+from shared.contract import SensorRange, StationDatabase
 from shared.errors import CanDatabaseError, ConfigError
 
 

@@ -10,3 +10,39 @@ run, decision, summary and result, recorder and predictor health),
 ``boltwatch status`` prints it (``services.cli.station_status_text``);
 ``boltwatch serve dashboard`` serves it live (``services.dashboard``).
 """
+
+from shared.line_status.station_status import (
+    KNOWN_SERVICES,
+    BusHealth,
+    LastDecision,
+    LastRun,
+    LastSummary,
+    PredictorHealth,
+    RecorderHealth,
+    StationStatus,
+    StatusCollector,
+    StatusReport,
+    to_json,
+)
+from shared.line_status.status_bridge import bridge_lines
+from shared.line_status.status_last_result import amount_text, last_result, result_text
+from shared.line_status.status_quality_alert import quality_text
+
+__all__ = [
+    "KNOWN_SERVICES",
+    "BusHealth",
+    "LastDecision",
+    "LastRun",
+    "LastSummary",
+    "PredictorHealth",
+    "RecorderHealth",
+    "StationStatus",
+    "StatusCollector",
+    "StatusReport",
+    "amount_text",
+    "bridge_lines",
+    "last_result",
+    "quality_text",
+    "result_text",
+    "to_json",
+]

@@ -44,9 +44,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-from shared.contract import channels, keys
-from shared.contract.codec import decode
-from shared.contract.messages import (
+from shared.contract import (
     BusStats,
     PredictorStats,
     RecorderStats,
@@ -56,6 +54,9 @@ from shared.contract.messages import (
     StopDecision,
     TighteningResult,
     ToolState,
+    channels,
+    decode,
+    keys,
 )
 from shared.errors import InputError
 from shared.line_status.status_bridge import TOPICS as BRIDGE_TOPICS

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shared.contract.messages import BusStats
+from shared.contract import BusStats
 
 _NS = 1_000_000_000
 

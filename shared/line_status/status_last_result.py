@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shared.contract.messages import TighteningResult
+from shared.contract import TighteningResult
 
 _NS = 1_000_000_000
 

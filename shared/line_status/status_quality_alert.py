@@ -16,9 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from shared.contract import channels
-from shared.contract.codec import decode
-from shared.contract.messages import QualityAlert
+from shared.contract import QualityAlert, channels, decode
 
 _NS = 1_000_000_000
 

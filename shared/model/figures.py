@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from shared.config.joint import JointConfig
+from shared.config import JointConfig
 from shared.errors import naming
 from shared.model.angles import angle_ratio
 from shared.model.joint_model import JointModel

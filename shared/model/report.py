@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from shared.config.joint import JointConfig
+from shared.config import JointConfig
 from shared.errors import InputError
 from shared.model import torque_preload
 from shared.model.characteristic_constants import stick_line_k2

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from shared.config.joint import JointConfig
+from shared.config import JointConfig
 
 MM = 1e-3
 GPA = 1e9

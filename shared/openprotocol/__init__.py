@@ -19,3 +19,113 @@ decoding.
 - :mod:`.fields` (fixed-width field layouts, read and written),
   :mod:`.timestamps` (controller time text <-> ns since the epoch)
 """
+
+from shared.openprotocol.alarms import (
+    Alarm,
+    AlarmAcknowledge,
+    AlarmAcknowledgedOnController,
+    AlarmAcknowledgedOnControllerAck,
+    AlarmStatus,
+    AlarmStatusAck,
+    AlarmSubscribe,
+    AlarmUnsubscribe,
+)
+from shared.openprotocol.codec import (
+    KNOWN_MIDS,
+    SUPPORTED_REVISIONS,
+    UnknownMessage,
+    WireMessage,
+    decode,
+    encode,
+)
+from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect
+from shared.openprotocol.errors import OpenProtocolError
+from shared.openprotocol.framing import BINARY_MIDS, Frame, FrameReader, frame_bytes
+from shared.openprotocol.results import (
+    BatchStatus,
+    LastTighteningResult,
+    OldResultRequest,
+    OldTighteningResult,
+    ResultAcknowledge,
+    ResultSubscribe,
+    ResultUnsubscribe,
+    ValueStatus,
+)
+from shared.openprotocol.session import (
+    CommandAccepted,
+    CommandError,
+    CommunicationStart,
+    CommunicationStartAck,
+    CommunicationStop,
+    ErrorCode,
+    KeepAlive,
+)
+from shared.openprotocol.subscriptions import (
+    DataSubscribe,
+    DataUnsubscribe,
+    trace_extra_data,
+    trace_types_of,
+)
+from shared.openprotocol.timestamps import format_timestamp, timestamp_ns
+from shared.openprotocol.tool_data import ToolData, ToolDataRequest
+from shared.openprotocol.traces import (
+    UNIT_DEGREE,
+    UNIT_NM,
+    ResolutionField,
+    TraceCurve,
+    TraceType,
+    VariableField,
+)
+
+__all__ = [
+    "BINARY_MIDS",
+    "DEFAULT_DIALECT",
+    "KNOWN_MIDS",
+    "SUPPORTED_REVISIONS",
+    "UNIT_DEGREE",
+    "UNIT_NM",
+    "Alarm",
+    "AlarmAcknowledge",
+    "AlarmAcknowledgedOnController",
+    "AlarmAcknowledgedOnControllerAck",
+    "AlarmStatus",
+    "AlarmStatusAck",
+    "AlarmSubscribe",
+    "AlarmUnsubscribe",
+    "BatchStatus",
+    "CommandAccepted",
+    "CommandError",
+    "CommunicationStart",
+    "CommunicationStartAck",
+    "CommunicationStop",
+    "DataSubscribe",
+    "DataUnsubscribe",
+    "Dialect",
+    "ErrorCode",
+    "Frame",
+    "FrameReader",
+    "KeepAlive",
+    "LastTighteningResult",
+    "OldResultRequest",
+    "OldTighteningResult",
+    "OpenProtocolError",
+    "ResolutionField",
+    "ResultAcknowledge",
+    "ResultSubscribe",
+    "ResultUnsubscribe",
+    "ToolData",
+    "ToolDataRequest",
+    "TraceCurve",
+    "TraceType",
+    "UnknownMessage",
+    "ValueStatus",
+    "VariableField",
+    "WireMessage",
+    "decode",
+    "encode",
+    "format_timestamp",
+    "frame_bytes",
+    "timestamp_ns",
+    "trace_extra_data",
+    "trace_types_of",
+]

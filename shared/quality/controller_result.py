@@ -36,7 +36,7 @@ unit`` Nm; Open Protocol gives Nm).
 
 from __future__ import annotations
 
-from shared.contract.messages import (
+from shared.contract import (
     ControllerFunction,
     ControllerResult,
     ControllerStep,

@@ -20,7 +20,7 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-from shared.contract.messages import JudgedFigure, RunSummary, TighteningResult
+from shared.contract import JudgedFigure, RunSummary, TighteningResult
 from shared.quality.capability import Capability, capability
 from shared.quality.control_chart import ControlChart, control_chart
 

@@ -22,7 +22,7 @@ the station (None).
 from __future__ import annotations
 
 from shared.config import Program
-from shared.contract.messages import RunSummary, TighteningResult
+from shared.contract import RunSummary, TighteningResult
 from shared.quality.verdict import cut_text, figure_reasons, judge, reasons_text, verdict
 
 #: stops boltwatch sends on a fault, not on a good joint: the run is NOK

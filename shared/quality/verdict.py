@@ -19,8 +19,7 @@ from __future__ import annotations
 
 import math
 
-from shared.contract.message_fields import MAX_TEXT_CHARS
-from shared.contract.messages import FigureStatus, JudgedFigure, Verdict
+from shared.contract import MAX_TEXT_CHARS, FigureStatus, JudgedFigure, Verdict
 
 NOT_JUDGED: FigureStatus = "not_judged"
 

@@ -24,7 +24,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from shared.config import AnyStation, ControllerStation, LoadedStation
-from shared.config.line import stations_by_id
+from shared.config import stations_by_id
 
 LOG = logging.getLogger(__name__)
 

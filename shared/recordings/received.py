@@ -27,10 +27,10 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any, NamedTuple
 
 from shared.contract import channels, keys
-from shared.contract.codec import decoder
-from shared.contract.message_fields import STATION_ID
-from shared.contract.messages import Intensity, Sample, SampleBatch, StickSlipEvent
-from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
+from shared.contract import decoder
+from shared.contract import STATION_ID
+from shared.contract import Intensity, Sample, SampleBatch, StickSlipEvent
+from shared.contract import CONTRACT_RANGE, SensorRange
 from shared.errors import InputError
 
 #: how far ahead of its arrival a message's own time may be: the clocks of two hosts of

@@ -14,7 +14,7 @@ from typing import Any
 
 import can
 
-from shared.config.station import CanSection
+from shared.config import CanSection
 from shared.errors import TransportError
 
 LOG = logging.getLogger(__name__)

@@ -35,9 +35,7 @@ from typing import Any
 
 import zenoh
 
-from shared.contract import channels
-from shared.contract.codec import encode
-from shared.contract.messages import Intensity, Sample, StickSlipEvent
+from shared.contract import Intensity, Sample, StickSlipEvent, channels, encode
 from shared.runtime.sample_batching import SampleBatching
 from shared.runtime.zenoh_session import declare_channel
 

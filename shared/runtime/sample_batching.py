@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import time
 
-from shared.contract.messages import Intensity, Sample, SampleBatch, StickSlipEvent
+from shared.contract import Intensity, Sample, SampleBatch, StickSlipEvent
 
 #: the longest a sample waits for its batch, seconds (20 batches a second at 1 kHz): each
 #: message costs the line's router and recorder about as much as 5 samples in a batch do,

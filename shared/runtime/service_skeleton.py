@@ -43,9 +43,8 @@ from typing import Any, TypeVar
 
 import zenoh
 
-from shared.config.common_sections import ZenohSection
-from shared.contract import keys
-from shared.contract.channels import Channel
+from shared.config import ZenohSection
+from shared.contract import Channel, keys
 from shared.runtime.service_runtime import ServiceRunner
 from shared.runtime.zenoh_session import declare_channel, open_from, open_session
 

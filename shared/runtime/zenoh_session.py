@@ -27,8 +27,8 @@ from typing import Any
 
 import zenoh
 
-from shared.config.common_sections import ENDPOINT_EXPECTED, ZenohSection
-from shared.contract.channels import Channel
+from shared.config import ENDPOINT_EXPECTED, ZenohSection
+from shared.contract import Channel
 from shared.errors import ConfigError, TransportError
 
 LOG = logging.getLogger(__name__)

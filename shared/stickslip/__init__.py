@@ -26,15 +26,77 @@ No zenoh, no clock: the same :class:`PredictorCore` serves the live service,
 - :mod:`.predictor_core`     the facade that joins them
 """
 
-from shared.stickslip.event_figures import EventFigures
+from shared.stickslip.advisory_replay import replay_run
+from shared.stickslip.event_figures import (
+    EventFigures,
+    compute_figures,
+    event_intensity,
+    torque_mean_nm,
+)
+from shared.stickslip.event_history import HISTORY, EventHistory
+from shared.stickslip.extremum_tracker import NOISE_FACTOR, ExtremumTracker
+from shared.stickslip.force_history import ForceHistory
+from shared.stickslip.halt_planner import MIN_EVENTS, HaltPlanner, best_halt, expected_error
+from shared.stickslip.inclination_window import MAX_PASSED, MIN_PASSED, NO_FLIP, InclinationWindow
+from shared.stickslip.input_guard import InputReport
+from shared.stickslip.model_bands import MIN_STICK_SHARE, MODEL_SLACK, ModelBandCheck
+from shared.stickslip.motor_motion import MotorMotion
 from shared.stickslip.outputs import CoreDecision
 from shared.stickslip.predictor_core import PredictorCore
-from shared.stickslip.settings import DEFAULT_WINDOW_SAMPLES, PredictorSettings
+from shared.stickslip.ramp_estimator import SPAN, RampEstimator
+from shared.stickslip.regression import fit_line, fit_parabola, predict_periods, predict_plateaus
+from shared.stickslip.run_messages import decision_message, event_messages, stick_slip_event
+from shared.stickslip.scoring import PredictionScores
+from shared.stickslip.second_difference import SEED_SAMPLES
+from shared.stickslip.settings import DEFAULT_WINDOW_SAMPLES, PlateauMethod, PredictorSettings
+from shared.stickslip.stop_policy import StopPolicy
+from shared.stickslip.stopped_run import PredictorReplay, StoppedRun
+from shared.stickslip.trace_replay import json_safe, output_record, replay
 
 __all__ = [
     "DEFAULT_WINDOW_SAMPLES",
+    "HISTORY",
+    "MAX_PASSED",
+    "MIN_EVENTS",
+    "MIN_PASSED",
+    "MIN_STICK_SHARE",
+    "MODEL_SLACK",
+    "NOISE_FACTOR",
+    "NO_FLIP",
+    "SEED_SAMPLES",
+    "SPAN",
     "CoreDecision",
     "EventFigures",
+    "EventHistory",
+    "ExtremumTracker",
+    "ForceHistory",
+    "HaltPlanner",
+    "InclinationWindow",
+    "InputReport",
+    "ModelBandCheck",
+    "MotorMotion",
+    "PlateauMethod",
+    "PredictionScores",
     "PredictorCore",
+    "PredictorReplay",
     "PredictorSettings",
+    "RampEstimator",
+    "StopPolicy",
+    "StoppedRun",
+    "best_halt",
+    "compute_figures",
+    "decision_message",
+    "event_intensity",
+    "event_messages",
+    "expected_error",
+    "fit_line",
+    "fit_parabola",
+    "json_safe",
+    "output_record",
+    "predict_periods",
+    "predict_plateaus",
+    "replay",
+    "replay_run",
+    "stick_slip_event",
+    "torque_mean_nm",
 ]

@@ -30,11 +30,11 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from shared.contract import channels
-from shared.contract.messages import RunSummary
-from shared.contract.run_clock import RunClock
-from shared.stickslip import EventFigures, PredictorCore, PredictorSettings
+from shared.contract import RunClock, RunSummary, channels
+from shared.stickslip.event_figures import EventFigures
+from shared.stickslip.predictor_core import PredictorCore
 from shared.stickslip.run_messages import decision_message, event_messages
+from shared.stickslip.settings import PredictorSettings
 from shared.stickslip.stopped_run import PredictorReplay, StoppedRun
 
 

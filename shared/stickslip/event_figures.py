@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from shared.contract.messages import Prediction
+from shared.contract import Prediction
 
 
 @dataclass(frozen=True, slots=True)

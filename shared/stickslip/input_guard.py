@@ -45,7 +45,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
-from shared.contract.sensor_range import SensorRange
+from shared.contract import SensorRange
 
 GAP_PERIODS = 5.0  # a Δt above this many nominal periods is a jump: held for the next sample
 MAX_JUMP_S = 10.0  # a jump longer than this within a run is a bad timestamp, whatever follows

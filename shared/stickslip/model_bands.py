@@ -59,8 +59,7 @@ import statistics
 from collections import deque
 from dataclasses import dataclass
 
-from shared.model import JointConstants, expected_constant_bands
-from shared.model.angles import angle_ratio
+from shared.model import JointConstants, angle_ratio, expected_constant_bands
 
 PERIOD_SLACK_SAMPLES = 2.0  # each of the two peaks of a period is read to ±1 sample
 MODEL_SLACK = 2.5  # bounds widened ×/÷ this: μ scatter, nominal μ, a missed event

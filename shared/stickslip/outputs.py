@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shared.contract.messages import StopReasonName
+from shared.contract import StopReasonName
 
 
 @dataclass(frozen=True, slots=True)

@@ -20,7 +20,7 @@ from __future__ import annotations
 import logging
 import math
 
-from shared.contract.messages import Prediction
+from shared.contract import Prediction
 from shared.stickslip.event_figures import EventFigures, compute_figures, event_period_s
 from shared.stickslip.event_history import EventHistory
 from shared.stickslip.extremum_tracker import ExtremumTracker, Slip

@@ -22,7 +22,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Sequence
 
-from shared.contract.messages import Prediction
+from shared.contract import Prediction
 from shared.stickslip.settings import PlateauMethod
 
 HORIZONS = 3

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import math
 
-from shared.contract.messages import Intensity, StickSlipEvent, StopDecision
-from shared.contract.run_clock import RunClock
-from shared.stickslip import CoreDecision, EventFigures
+from shared.contract import Intensity, RunClock, StickSlipEvent, StopDecision
+from shared.stickslip.event_figures import EventFigures
+from shared.stickslip.outputs import CoreDecision
 
 
 def stick_slip_event(

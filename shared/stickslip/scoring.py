@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from shared.contract.messages import Prediction
+from shared.contract import Prediction
 
 
 @dataclass(slots=True)

@@ -57,7 +57,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from shared.config import PredictorSection, Program
-from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
+from shared.contract import CONTRACT_RANGE, SensorRange
 from shared.model import JointConstants
 
 DEFAULT_WINDOW_SAMPLES = 5

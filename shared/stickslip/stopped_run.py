@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from shared.contract.messages import RunSummary
+from shared.contract import RunSummary
 
 
 @dataclass(frozen=True, slots=True)

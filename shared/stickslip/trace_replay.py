@@ -12,8 +12,10 @@ import math
 from collections.abc import Iterator
 from typing import Any
 
-from shared.contract.trace import Trace
-from shared.stickslip import CoreDecision, EventFigures, PredictorCore
+from shared.contract import Trace
+from shared.stickslip.event_figures import EventFigures
+from shared.stickslip.outputs import CoreDecision
+from shared.stickslip.predictor_core import PredictorCore
 
 
 def replay(core: PredictorCore, trace: Trace) -> Iterator[EventFigures | CoreDecision]:

@@ -11,3 +11,45 @@
 - :mod:`.wear_table`: the ledger as a table (``boltwatch wear``)
 - :mod:`.wear_plant`: every line's ledger merged (``boltwatch wear --plant``)
 """
+
+from shared.wear.wear_bound import (
+    CONTRACT_LIMITS,
+    F_SS_MAX_HZ,
+    RefusedSummaryError,
+    RunLimits,
+    StationLimits,
+    refusal,
+)
+from shared.wear.wear_ledger import RunWear, ToolWear, WearLedger, ledger_path
+from shared.wear.wear_ledger_file import APPLICATION_ID, COLUMNS, LEDGER_VERSION, BrokenLedgerError
+from shared.wear.wear_plant import WearReply, merge, parse_reply
+from shared.wear.wear_reset import reset_ledger
+from shared.wear.wear_since_service import ADDED_SINCE
+from shared.wear.wear_table import format_table
+from shared.wear.wear_waiting import load_waiting, save_waiting, waiting_path
+
+__all__ = [
+    "ADDED_SINCE",
+    "APPLICATION_ID",
+    "COLUMNS",
+    "CONTRACT_LIMITS",
+    "F_SS_MAX_HZ",
+    "LEDGER_VERSION",
+    "BrokenLedgerError",
+    "RefusedSummaryError",
+    "RunLimits",
+    "RunWear",
+    "StationLimits",
+    "ToolWear",
+    "WearLedger",
+    "WearReply",
+    "format_table",
+    "ledger_path",
+    "load_waiting",
+    "merge",
+    "parse_reply",
+    "refusal",
+    "reset_ledger",
+    "save_waiting",
+    "waiting_path",
+]

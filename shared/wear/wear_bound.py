@@ -45,9 +45,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from shared.config import AnyStation, LoadedStation
-from shared.contract.messages import RunSummary
-from shared.contract.run_clock import RunClock
-from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
+from shared.contract import CONTRACT_RANGE, RunClock, RunSummary, SensorRange
 from shared.errors import InputError
 
 #: The contract's sample rate (docs/design.md, "CAN"): ToolSensors at 1 kHz while running.

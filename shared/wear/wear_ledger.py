@@ -36,7 +36,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from shared.contract.messages import RunSummary, ToolData
+from shared.contract import RunSummary, ToolData
 from shared.errors import InputError
 from shared.wear import wear_tool_data
 from shared.wear.wear_bound import RefusedSummaryError, RunLimits, refusal

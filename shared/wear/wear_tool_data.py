@@ -19,7 +19,7 @@ import sqlite3
 from dataclasses import dataclass
 from typing import Any
 
-from shared.contract.messages import ToolData
+from shared.contract import ToolData
 
 TABLE = "tool_data"
 #: its columns, in order (checked by :func:`~.wear_ledger_file.schema_problem`)

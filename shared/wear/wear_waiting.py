@@ -23,8 +23,7 @@ from collections.abc import Iterable
 from datetime import UTC, datetime
 from pathlib import Path
 
-from shared.contract.codec import decode, encode
-from shared.contract.messages import RunSummary
+from shared.contract import RunSummary, decode, encode
 from shared.errors import InputError
 
 LOG = logging.getLogger(__name__)

@@ -22,8 +22,12 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from shared.contract import codec  # noqa: E402
-from shared.contract.messages import Prediction, Sample, StickSlipEvent  # noqa: E402
+from shared.contract import (
+    Prediction,
+    Sample,
+    StickSlipEvent,
+    codec,
+)
 
 SAMPLE = Sample("st1", 17, 1234, 1_700_000_000_000_000_000, 12.5, 345.25, 31000.0, 1.234)
 EVENT = StickSlipEvent(

@@ -46,8 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from shared.config import RigSection
-from shared.stickslip import EventFigures, PredictorCore, PredictorSettings
-from shared.stickslip.extremum_tracker import NOISE_FACTOR
+from shared.stickslip import NOISE_FACTOR, EventFigures, PredictorCore, PredictorSettings
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # run as a script: the repo root
 from tests.benchmarks.bench_predictor_accuracy import (

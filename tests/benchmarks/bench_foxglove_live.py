@@ -23,16 +23,21 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from services.recorder.foxglove_live.foxglove_server import FoxgloveLive  # noqa: E402
-from services.recorder.live.recorder import Recorder  # noqa: E402
-from services.recorder.live.run_files import FileLimits  # noqa: E402
-from shared.config import load_station  # noqa: E402
-from shared.contract.codec import encode  # noqa: E402
-from shared.contract.messages import Sample, ToolState  # noqa: E402
-from shared.recordings.file_metadata import FileMetadata  # noqa: E402
-from shared.recordings.received import classify  # noqa: E402
-from tests.foxglove_client import FoxgloveClient  # noqa: E402
-from tests.live_recorder import free_port, write_station_file  # noqa: E402
+from services.recorder.foxglove_live.foxglove_server import FoxgloveLive
+from services.recorder.live.recorder import Recorder
+from services.recorder.live.run_files import FileLimits
+from shared.config import load_station
+from shared.contract import (
+    Sample,
+    ToolState,
+    encode,
+)
+from shared.recordings import (
+    FileMetadata,
+    classify,
+)
+from tests.foxglove_client import FoxgloveClient
+from tests.live_recorder import free_port, write_station_file
 
 SAMPLES = 20_000
 KEY = "boltwatch/st1/samples"

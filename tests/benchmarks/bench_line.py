@@ -53,19 +53,24 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from services.cli.station_supervisor import stop_process  # noqa: E402
-from shared.config import LoadedStation, derive_stations, load_station  # noqa: E402
-from shared.contract import channels, keys  # noqa: E402
-from shared.contract.can_database import StationDatabase  # noqa: E402
-from shared.contract.codec import decode, encode  # noqa: E402
-from shared.contract.messages import BusStats, RecorderStats  # noqa: E402
-from shared.runtime.zenoh_session import declare_channel, zenoh_config  # noqa: E402
-from tests.benchmarks.bench_stop_path import serve_from  # noqa: E402
-from tests.benchmarks.line_station_runs import SHORT_PROGRAM, Heard, figures, tighten  # noqa: E402
-from tests.fuzz.payloads import template  # noqa: E402
-from tests.system.can_injector import StopListener  # noqa: E402
-from tests.system.station_files import free_tcp_port, write_station  # noqa: E402
-from tests.unit.predictor.synthetic import staircase  # noqa: E402
+from services.cli.station_supervisor import stop_process
+from shared.config import LoadedStation, derive_stations, load_station
+from shared.contract import (
+    BusStats,
+    RecorderStats,
+    StationDatabase,
+    channels,
+    decode,
+    encode,
+    keys,
+)
+from shared.runtime import declare_channel, zenoh_config
+from tests.benchmarks.bench_stop_path import serve_from
+from tests.benchmarks.line_station_runs import SHORT_PROGRAM, Heard, figures, tighten
+from tests.fuzz.payloads import template
+from tests.system.can_injector import StopListener
+from tests.system.station_files import free_tcp_port, write_station
+from tests.unit.predictor.synthetic import staircase
 
 REAL_STATION = "st1"
 START_TIMEOUT_S = 120.0

@@ -56,20 +56,25 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from services.cli.station_supervisor import stop_process  # noqa: E402
-from services.predictor.service import PredictorService  # noqa: E402
-from services.predictor.station_inbox import Handler, Inbox, StationInbox  # noqa: E402
-from shared.config import derive_stations, load_line  # noqa: E402
-from shared.contract import channels, keys  # noqa: E402
-from shared.contract.codec import decode  # noqa: E402
-from shared.contract.messages import RunSummary  # noqa: E402
-from shared.recordings.mcap.recording_reader import RecordingScan  # noqa: E402
-from shared.runtime.service_skeleton import ServiceSkeleton  # noqa: E402
-from shared.runtime.zenoh_session import zenoh_config  # noqa: E402
-from tests.benchmarks.bench_line import cpu_s, wait_alive  # noqa: E402
-from tests.benchmarks.line_station_runs import SHORT_PROGRAM  # noqa: E402
-from tests.system.station_files import free_tcp_port, serve, write_station  # noqa: E402
-from tests.unit.predictor.synthetic import staircase  # noqa: E402
+from services.cli.station_supervisor import stop_process
+from services.predictor.service import PredictorService
+from services.predictor.station_inbox import Handler, Inbox, StationInbox
+from shared.config import derive_stations, load_line
+from shared.contract import (
+    RunSummary,
+    channels,
+    decode,
+    keys,
+)
+from shared.recordings.mcap import RecordingScan
+from shared.runtime import (
+    ServiceSkeleton,
+    zenoh_config,
+)
+from tests.benchmarks.bench_line import cpu_s, wait_alive
+from tests.benchmarks.line_station_runs import SHORT_PROGRAM
+from tests.system.station_files import free_tcp_port, serve, write_station
+from tests.unit.predictor.synthetic import staircase
 
 TOPICS = (channels.SAMPLES.topic, channels.TOOL.topic)
 WAKE = b""

@@ -60,24 +60,37 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from services.cli.station_supervisor import stop_process  # noqa: E402
-from services.rig.frames import RigFrames  # noqa: E402
-from services.rig.realtime import RealtimeRig, ToolIdentity  # noqa: E402
-from shared.config import load_station  # noqa: E402
-from shared.config.station import RigSection  # noqa: E402
-from shared.contract import channels, keys  # noqa: E402
-from shared.contract.can_database import StationDatabase  # noqa: E402
-from shared.contract.codec import decode  # noqa: E402
-from shared.contract.messages import RunSummary, StopDecision  # noqa: E402
-from shared.contract.trace import read_trace  # noqa: E402
-from shared.model import JointConstants  # noqa: E402
-from shared.recordings.mcap.trace_export import export_trace  # noqa: E402
-from shared.runtime.can_bus import open_bus  # noqa: E402
-from shared.runtime.realtime import RIG_PRIORITY, use_realtime_priority  # noqa: E402
-from shared.runtime.zenoh_session import zenoh_config  # noqa: E402
-from shared.stickslip import CoreDecision, PredictorCore, PredictorSettings  # noqa: E402
-from shared.stickslip.trace_replay import replay  # noqa: E402
-from tests.benchmarks.bench_predictor_accuracy import (  # noqa: E402
+from services.cli.station_supervisor import stop_process
+from services.rig.frames import RigFrames
+from services.rig.realtime import RealtimeRig, ToolIdentity
+from shared.config import (
+    RigSection,
+    load_station,
+)
+from shared.contract import (
+    RunSummary,
+    StationDatabase,
+    StopDecision,
+    channels,
+    decode,
+    keys,
+    read_trace,
+)
+from shared.model import JointConstants
+from shared.recordings.mcap import export_trace
+from shared.runtime import (
+    RIG_PRIORITY,
+    open_bus,
+    use_realtime_priority,
+    zenoh_config,
+)
+from shared.stickslip import (
+    CoreDecision,
+    PredictorCore,
+    PredictorSettings,
+    replay,
+)
+from tests.benchmarks.bench_predictor_accuracy import (
     Joint,
     conventional,
     draw_joint,
@@ -89,9 +102,9 @@ from tests.benchmarks.bench_predictor_accuracy import (  # noqa: E402
     stats,
     torque_error,
 )
-from tests.benchmarks.bench_stop_path import serve_from, wait_alive  # noqa: E402
-from tests.benchmarks.joint_files import joint_toml  # noqa: E402
-from tests.system.station_files import write_station  # noqa: E402
+from tests.benchmarks.bench_stop_path import serve_from, wait_alive
+from tests.benchmarks.joint_files import joint_toml
+from tests.system.station_files import write_station
 
 STATION = "st1"
 #: the contract DBC's ranges: the drawn programs' limits are held inside them

@@ -55,8 +55,7 @@ import numpy as np
 from services.rig.physics import Measurement, TighteningPhysics
 from shared.config import Program, RigSection
 from shared.model import JointConstants
-from shared.stickslip import PredictorCore, PredictorSettings
-from shared.stickslip.settings import PlateauMethod
+from shared.stickslip import PlateauMethod, PredictorCore, PredictorSettings
 
 SETTLE_SAMPLES = 300
 LATENCY_SAMPLES = 1  # samples the motor still turns after the sample that triggered the stop

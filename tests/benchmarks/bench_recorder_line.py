@@ -34,14 +34,16 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-import zenoh  # noqa: E402
+import zenoh
 
-from services.recorder.service import RecorderService  # noqa: E402
-from shared.config import derive_stations, load_station  # noqa: E402
-from shared.contract import channels  # noqa: E402
-from shared.runtime.service_skeleton import ServiceSkeleton  # noqa: E402
-from shared.runtime.zenoh_session import zenoh_config  # noqa: E402
-from tests.benchmarks.bench_line import (  # noqa: E402
+from services.recorder.service import RecorderService
+from shared.config import derive_stations, load_station
+from shared.contract import channels
+from shared.runtime import (
+    ServiceSkeleton,
+    zenoh_config,
+)
+from tests.benchmarks.bench_line import (
     BATCH_SAMPLES,
     RUN_PAUSE_TICKS,
     RUN_SAMPLES,
@@ -49,7 +51,7 @@ from tests.benchmarks.bench_line import (  # noqa: E402
     events_in,
     run_rows,
 )
-from tests.system.station_files import write_station  # noqa: E402
+from tests.system.station_files import write_station
 
 TAKE_MS = 5  # the service's TAKE_INTERVAL_S
 

@@ -35,11 +35,9 @@ def one_recorder(runs: int, rerun: bool) -> None:
     from services.recorder.live.recorder import Recorder
     from services.recorder.live.run_files import FileLimits
     from shared.config import load_station
-    from shared.contract.codec import encode
-    from shared.contract.messages import Sample, ToolState
-    from shared.recordings.file_metadata import FileMetadata
-    from shared.recordings.received import classify
-    from shared.recordings.rerun.rerun_sink import RerunOptions
+    from shared.contract import Sample, ToolState, encode
+    from shared.recordings import FileMetadata, classify
+    from shared.recordings.rerun import RerunOptions
     from tests.live_recorder import write_station_file
 
     tmp = Path(tempfile.mkdtemp(prefix="boltwatch-memory-"))

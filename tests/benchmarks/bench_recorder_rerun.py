@@ -20,15 +20,22 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from services.recorder.live.recorder import Recorder  # noqa: E402
-from services.recorder.live.run_files import FileLimits  # noqa: E402
-from shared.config import load_station  # noqa: E402
-from shared.contract.codec import encode  # noqa: E402
-from shared.contract.messages import Sample, StickSlipEvent, ToolState  # noqa: E402
-from shared.recordings.file_metadata import FileMetadata  # noqa: E402
-from shared.recordings.received import Received, classify  # noqa: E402
-from shared.recordings.rerun.rerun_sink import RerunOptions, RerunSink  # noqa: E402
-from tests.live_recorder import write_station_file  # noqa: E402
+from services.recorder.live.recorder import Recorder
+from services.recorder.live.run_files import FileLimits
+from shared.config import load_station
+from shared.contract import (
+    Sample,
+    StickSlipEvent,
+    ToolState,
+    encode,
+)
+from shared.recordings import (
+    FileMetadata,
+    Received,
+    classify,
+)
+from shared.recordings.rerun import RerunOptions, RerunSink
+from tests.live_recorder import write_station_file
 
 SAMPLES = 60_000  # one minute at 1 kHz
 RATE_HZ = 1000

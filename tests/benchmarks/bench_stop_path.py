@@ -55,15 +55,19 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from services.cli.station_supervisor import stop_process  # noqa: E402
-from shared.config import LoadedStation, derive_stations, load_station  # noqa: E402
-from shared.contract import channels, keys  # noqa: E402
-from shared.contract.can_database import StationDatabase  # noqa: E402
-from shared.contract.codec import decode  # noqa: E402
-from shared.contract.messages import RunSummary, StopDecision  # noqa: E402
-from shared.runtime.zenoh_session import zenoh_config  # noqa: E402
-from tests.system.can_injector import HeardStop, StopListener  # noqa: E402
-from tests.system.station_files import free_tcp_port, write_station  # noqa: E402
+from services.cli.station_supervisor import stop_process
+from shared.config import LoadedStation, derive_stations, load_station
+from shared.contract import (
+    RunSummary,
+    StationDatabase,
+    StopDecision,
+    channels,
+    decode,
+    keys,
+)
+from shared.runtime import zenoh_config
+from tests.system.can_injector import HeardStop, StopListener
+from tests.system.station_files import free_tcp_port, write_station
 
 STATION = "st1"
 HARD_LIMIT_PROGRAM, PLATEAU_PROGRAM = 1, 2

@@ -24,9 +24,11 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from shared.contract.messages import RunSummary  # noqa: E402
-from shared.wear.wear_bound import CONTRACT_LIMITS  # noqa: E402
-from shared.wear.wear_ledger import WearLedger  # noqa: E402
+from shared.contract import RunSummary
+from shared.wear import (
+    CONTRACT_LIMITS,
+    WearLedger,
+)
 
 T0_NS = 1_700_000_000_000_000_000
 S_NS = 1_000_000_000

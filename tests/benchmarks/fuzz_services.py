@@ -30,9 +30,9 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from tests.fuzz.property import FuzzCount, fuzz  # noqa: E402
-from tests.fuzz.rules import ACQUISITION, PREDICTOR, RECORDER, ServiceRules  # noqa: E402
-from tests.fuzz.targets import AcquisitionTarget, PredictorTarget, RecorderTarget  # noqa: E402
+from tests.fuzz.property import FuzzCount, fuzz
+from tests.fuzz.rules import ACQUISITION, PREDICTOR, RECORDER, ServiceRules
+from tests.fuzz.targets import AcquisitionTarget, PredictorTarget, RecorderTarget
 
 
 class CountingHandler(logging.Handler):

@@ -17,9 +17,8 @@ from __future__ import annotations
 import math
 import tomllib
 
-from shared.config.joint import JointConfig
-from shared.model import JointConstants
-from shared.model.stiffness import friction_radius_m
+from shared.config import JointConfig
+from shared.model import JointConstants, friction_radius_m
 
 SHEAR_MODULUS_GPA = 81.0
 YOUNGS_MODULUS_GPA = 210.0

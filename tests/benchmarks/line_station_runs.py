@@ -17,9 +17,7 @@ from pathlib import Path
 
 import zenoh
 
-from shared.contract import channels
-from shared.contract.codec import decode
-from shared.contract.messages import RunSummary, StickSlipEvent, StopDecision
+from shared.contract import RunSummary, StickSlipEvent, StopDecision, channels, decode
 from tests.system.can_injector import HeardStop
 from tests.system.station_files import serve
 

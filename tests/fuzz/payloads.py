@@ -32,16 +32,12 @@ from typing import Any
 from hypothesis import strategies as st
 
 from services.recorder.wear_watch import WearAlert
-from shared.contract.codec import MAX_PAYLOAD_BYTES, to_dict
-from shared.contract.message_fields import (
+from shared.contract import (
     DEFAULT_FLOAT,
     DEFAULT_INT,
     DEFAULT_TEXT,
     FLOAT_MAX,
-    NumberRange,
-    TextRange,
-)
-from shared.contract.messages import (
+    MAX_PAYLOAD_BYTES,
     BridgeStats,
     BusStats,
     ControllerAlarm,
@@ -50,6 +46,7 @@ from shared.contract.messages import (
     ControllerStep,
     Intensity,
     JudgedFigure,
+    NumberRange,
     Prediction,
     PredictorStats,
     QualityAlert,
@@ -60,9 +57,11 @@ from shared.contract.messages import (
     SampleBatch,
     StickSlipEvent,
     StopDecision,
+    TextRange,
     TighteningResult,
     ToolData,
     ToolState,
+    to_dict,
 )
 
 #: depths of [[[...]]]: past the parser's recursion limit, within and beyond the size bound

@@ -21,8 +21,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from shared.contract import channels
-from shared.contract.sensor_range import CONTRACT_RANGE
+from shared.contract import CONTRACT_RANGE, channels
 from tests.fuzz.payloads import as_json, dumps
 
 AHEAD_NS = 300 * 1_000_000_000  # shared/recordings/received.py: MAX_AHEAD_S

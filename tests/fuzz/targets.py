@@ -36,14 +36,20 @@ from services.acquisition.acquisition import Acquisition
 from services.acquisition.service import decision_handler
 from services.predictor.service import PredictorService
 from shared.config import load_line, load_station
-from shared.contract import channels, keys
-from shared.contract.can_database import StationDatabase
-from shared.contract.channels import CHANNELS
-from shared.contract.codec import decode, encode
-from shared.contract.messages import BusStats, Sample, StopDecision, ToolState
-from shared.recordings.mcap.mcap_sink import RAW_ENCODING
-from shared.runtime.service_skeleton import ServiceSkeleton
-from shared.runtime.zenoh_session import zenoh_config
+from shared.contract import (
+    CHANNELS,
+    BusStats,
+    Sample,
+    StationDatabase,
+    StopDecision,
+    ToolState,
+    channels,
+    decode,
+    encode,
+    keys,
+)
+from shared.recordings.mcap import RAW_ENCODING
+from shared.runtime import ServiceSkeleton, zenoh_config
 from tests.fuzz.payloads import template
 from tests.live_recorder import (
     RunningRecorder,

@@ -22,10 +22,9 @@ from types import TracebackType
 
 import can
 
-from shared.config.station import CanSection
-from shared.contract.can_database import COUNTER_MODULO, StationDatabase
-from shared.contract.messages import ToolRunState
-from shared.runtime.can_bus import open_bus
+from shared.config import CanSection
+from shared.contract import COUNTER_MODULO, StationDatabase, ToolRunState
+from shared.runtime import open_bus
 
 
 class CanInjector:

@@ -27,14 +27,18 @@ import zenoh
 
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
 from shared.config import LoadedStation, load_station
-from shared.contract import channels, keys
-from shared.contract.can_database import StationDatabase
-from shared.contract.codec import decode
-from shared.contract.messages import RunSummary, StopDecision, ToolRunState
+from shared.contract import (
+    RunSummary,
+    StationDatabase,
+    StopDecision,
+    ToolRunState,
+    channels,
+    decode,
+    keys,
+)
 from shared.errors import TransportError
-from shared.recordings.mcap.recording_reader import RecordingScan
-from shared.runtime.can_bus import open_bus
-from shared.runtime.zenoh_session import open_from, zenoh_config
+from shared.recordings.mcap import RecordingScan
+from shared.runtime import open_bus, open_from, zenoh_config
 from tests.system.station_files import write_station
 
 STATION = "st1"

@@ -14,11 +14,9 @@ from pathlib import Path
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.run_files import FileLimits
 from shared.config import load_station
-from shared.contract.codec import encode
-from shared.contract.messages import Sample, ToolState
-from shared.recordings.file_metadata import FileMetadata
-from shared.recordings.mcap.recording_reader import RecordingScan
-from shared.recordings.received import Received, classify
+from shared.contract import Sample, ToolState, encode
+from shared.recordings import FileMetadata, Received, classify
+from shared.recordings.mcap import RecordingScan
 from tests.live_recorder import write_station_file
 
 MS = 1_000_000

@@ -23,13 +23,19 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
-from shared.config import load_station
-from shared.config.station import CanSection
-from shared.contract import channels, keys
-from shared.contract.can_database import StationDatabase
-from shared.contract.codec import decode, encode
-from shared.contract.messages import BusStats, StopDecision, ToolRunState, ToolState
-from shared.runtime.zenoh_session import zenoh_config
+from shared.config import CanSection, load_station
+from shared.contract import (
+    BusStats,
+    StationDatabase,
+    StopDecision,
+    ToolRunState,
+    ToolState,
+    channels,
+    decode,
+    encode,
+    keys,
+)
+from shared.runtime import zenoh_config
 from tests.live_recorder import wait_until
 from tests.system.can_injector import CanInjector, StopListener
 from tests.system.station_files import free_tcp_port, serve, write_station

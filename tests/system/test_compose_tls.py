@@ -34,11 +34,9 @@ import zenoh
 
 from services.cli.station_supervisor import stop_process
 from shared.config import load_station
-from shared.contract import channels, keys
-from shared.contract.codec import decode
-from shared.contract.messages import RunSummary, StopDecision
+from shared.contract import RunSummary, StopDecision, channels, decode, keys
 from shared.errors import BoltwatchError
-from shared.runtime.zenoh_session import open_session
+from shared.runtime import open_session
 from tests.compose_layout import (
     BASE_FILE,
     IDENTITY,

@@ -26,9 +26,7 @@ from pathlib import Path
 
 import pytest
 
-from shared.contract import channels
-from shared.contract.codec import decode
-from shared.contract.messages import TighteningResult
+from shared.contract import TighteningResult, channels, decode
 from tests.live_recorder import free_port
 from tests.paths import REPO
 from tests.system.live_station import STATION, live_station

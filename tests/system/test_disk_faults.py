@@ -21,10 +21,9 @@ from pathlib import Path
 import pytest
 
 from services.recorder.live.recorder import RETRY_INTERVAL_NS
-from shared.contract.messages import RunSummary
-from shared.recordings.mcap.recording_reader import RecordingScan
-from shared.wear.wear_bound import CONTRACT_LIMITS
-from shared.wear.wear_ledger import WearLedger
+from shared.contract import RunSummary
+from shared.recordings.mcap import RecordingScan
+from shared.wear import CONTRACT_LIMITS, WearLedger
 from tests.paths import REPO
 from tests.system.disk_faults import fill_up, read_only, tmpfs
 from tests.system.live_station import check_next_run_normal, live_station

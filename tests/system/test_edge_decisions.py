@@ -17,11 +17,8 @@ import zenoh
 
 from services.cli.station_supervisor import stop_process
 from shared.config import load_station
-from shared.contract import channels, keys
-from shared.contract.can_database import StationDatabase
-from shared.contract.codec import encode
-from shared.contract.messages import StopDecision, ToolRunState
-from shared.runtime.zenoh_session import zenoh_config
+from shared.contract import StationDatabase, StopDecision, ToolRunState, channels, encode, keys
+from shared.runtime import zenoh_config
 from tests.system.can_injector import CanInjector, Pacer, StopListener
 from tests.system.station_files import free_tcp_port, serve, write_station
 

@@ -21,7 +21,7 @@ import pytest
 
 from services.cli.station_supervisor import stop_process
 from shared.contract import keys
-from shared.runtime.zenoh_session import open_from, zenoh_config
+from shared.runtime import open_from, zenoh_config
 from tests.paths import REPO
 from tests.system.station_files import serve, write_station
 from tests.system.test_status_command import router  # noqa: F401  (the fixture)

@@ -20,8 +20,7 @@ import jsonschema
 import pytest
 from mcap.reader import make_reader
 
-from shared.contract import channels
-from shared.contract.codec import json_schema
+from shared.contract import channels, json_schema
 from tests.foxglove_client import FoxgloveClient
 from tests.live_recorder import free_port, wait_until
 from tests.system.station_files import serve, write_station

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import pytest
 
-from shared.offline.controller_import.import_files import read_copy
-from shared.wear.wear_ledger import WearLedger
+from shared.offline.controller_import import read_copy
+from shared.wear import WearLedger
 from tests.paths import PROJECT_REAL_RUNS, REPO
 
 pytestmark = pytest.mark.system

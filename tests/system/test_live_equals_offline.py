@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from shared.recordings.mcap.trace_export import export_trace
+from shared.recordings.mcap import export_trace
 from tests.paths import REPO
 from tests.system.station_files import write_station
 from tests.system.test_station_up import read_recordings, run_up

@@ -32,9 +32,7 @@ import zenoh
 
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
 from services.rig.openprotocol.simulated_controller import LINGER_S
-from shared.contract import channels
-from shared.contract.codec import decode
-from shared.contract.messages import BridgeStats
+from shared.contract import BridgeStats, channels, decode
 from tests.live_recorder import free_port
 from tests.paths import REPO
 from tests.system.live_station import open_client

@@ -10,9 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from shared.offline.overlay.overlay_alignment import parse_alignment
-from shared.offline.overlay.overlay_run import find_run_files, read_overlay_run
-from shared.offline.overlay.overlay_series import build_overlay
+from shared.offline.overlay import build_overlay, find_run_files, parse_alignment, read_overlay_run
 from tests.paths import REPO
 from tests.system.station_files import write_station
 from tests.system.test_station_up import read_recordings, run_up

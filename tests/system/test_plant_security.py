@@ -26,9 +26,9 @@ import zenoh
 
 from services.cli.station_supervisor import stop_processes
 from services.router.access_control import line_access_control
-from shared.config.station import ZenohSection
+from shared.config import ZenohSection
 from shared.contract import channels, keys
-from shared.runtime.zenoh_session import open_session
+from shared.runtime import open_session
 from tests.live_recorder import has_subscribers
 from tests.paths import REPO
 from tests.system.station_files import free_tcp_port

@@ -17,12 +17,9 @@ import pytest
 import zenoh
 from mcap.reader import make_reader
 
-from shared.contract import channels
-from shared.contract.codec import encode
-from shared.contract.messages import Sample, ToolState
-from shared.recordings.mcap.recording_reader import RecordingScan
-from shared.recordings.mcap.recovery import recover
-from shared.runtime.zenoh_session import zenoh_config
+from shared.contract import Sample, ToolState, channels, encode
+from shared.recordings.mcap import RecordingScan, recover
+from shared.runtime import zenoh_config
 from tests.live_recorder import (
     free_port,
     has_subscribers,

@@ -31,11 +31,9 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
-from shared.contract import channels, keys
-from shared.contract.codec import decode
-from shared.contract.messages import BusStats, RecorderStats, RunSummary, Sample
-from shared.recordings.mcap.recording_reader import RecordingScan
-from shared.runtime.zenoh_session import zenoh_config
+from shared.contract import BusStats, RecorderStats, RunSummary, Sample, channels, decode, keys
+from shared.recordings.mcap import RecordingScan
+from shared.runtime import zenoh_config
 from tests.live_recorder import wait_until
 from tests.system.station_files import free_tcp_port, serve, write_station
 

@@ -23,10 +23,10 @@ import zenoh
 
 from services.cli.station_supervisor import stop_process
 from services.router.access_control import line_access_control
-from shared.config.station import ZenohSection
+from shared.config import ZenohSection
 from shared.contract import channels
 from shared.errors import TransportError
-from shared.runtime.zenoh_session import open_session
+from shared.runtime import open_session
 from tests.live_recorder import has_subscribers
 from tests.paths import REPO
 from tests.system.station_files import free_tcp_port

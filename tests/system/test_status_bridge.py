@@ -17,10 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.messages import BridgeStats, ControllerAlarm
-from shared.runtime.zenoh_session import open_from, zenoh_config
+from shared.contract import BridgeStats, ControllerAlarm, channels, encode, keys
+from shared.runtime import open_from, zenoh_config
 from tests.fuzz.payloads import template
 from tests.system.station_files import write_station
 from tests.system.test_status_command import boltwatch, router  # noqa: F401  (the fixture)

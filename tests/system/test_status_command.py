@@ -18,11 +18,18 @@ from pathlib import Path
 import pytest
 
 from services.cli.station_supervisor import stop_process
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.messages import BusStats, RunSummary, Sample, StopDecision, ToolState
+from shared.contract import (
+    BusStats,
+    RunSummary,
+    Sample,
+    StopDecision,
+    ToolState,
+    channels,
+    encode,
+    keys,
+)
 from shared.errors import TransportError
-from shared.runtime.zenoh_session import open_from, zenoh_config
+from shared.runtime import open_from, zenoh_config
 from tests.paths import REPO
 from tests.system.station_files import free_tcp_port, write_station
 

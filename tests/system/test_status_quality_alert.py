@@ -13,10 +13,8 @@ import pytest
 import zenoh
 
 from shared.config import load_station
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.messages import JudgedFigure, TighteningResult, Verdict
-from shared.runtime.zenoh_session import open_from, zenoh_config
+from shared.contract import JudgedFigure, TighteningResult, Verdict, channels, encode, keys
+from shared.runtime import open_from, zenoh_config
 from tests.live_recorder import RunningRecorder, has_subscribers, wait_until, write_station_file
 from tests.system.test_status_command import REPO, router  # noqa: F401  (the fixture)
 

@@ -18,9 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from shared.contract import channels
-from shared.contract.codec import encode
-from shared.contract.messages import RunSummary
+from shared.contract import RunSummary, channels, encode
 from tests.paths import REPO
 from tests.system.live_station import open_client
 from tests.system.station_files import write_station

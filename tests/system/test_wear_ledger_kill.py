@@ -24,9 +24,8 @@ from pathlib import Path
 
 import pytest
 
-from shared.contract.messages import RunSummary
-from shared.wear.wear_bound import CONTRACT_LIMITS
-from shared.wear.wear_ledger import WearLedger
+from shared.contract import RunSummary
+from shared.wear import CONTRACT_LIMITS, WearLedger
 from tests.paths import REPO
 
 pytestmark = pytest.mark.system

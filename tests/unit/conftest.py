@@ -7,7 +7,7 @@ from collections.abc import Iterator
 import pytest
 import zenoh
 
-from shared.runtime.zenoh_session import zenoh_config
+from shared.runtime import zenoh_config
 from tests.live_recorder import free_port
 
 

@@ -22,8 +22,7 @@ import yaml
 from services.cli.main import build_parser
 from services.router.access_control import line_access_control
 from services.router.service import router_config
-from shared.config import load_line, load_station
-from shared.config.loading import resolve_relative
+from shared.config import load_line, load_station, resolve_relative
 from shared.contract import channels, keys
 from tests.access_rules import put_keys_granted
 from tests.compose_layout import (

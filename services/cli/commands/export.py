@@ -33,7 +33,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from shared.recordings.mcap.trace_export import export_trace
+    from shared.recordings.mcap import export_trace
 
     report = export_trace(args.recording, args.out, args.run)
     if not report.complete:

@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
     from shared.config import load_any_line
     from shared.contract import keys
     from shared.errors import ConfigError
-    from shared.runtime.zenoh_session import client_config, open_from
+    from shared.runtime import client_config, open_from
 
     stations = load_any_line(args.config)
     section = stations[0].config.zenoh

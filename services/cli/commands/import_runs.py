@@ -89,9 +89,12 @@ class Tally:
 def run(args: argparse.Namespace) -> int:
     from services.cli.import_destination import CsvWriter, RecordingsWriter, make_folder
     from shared.errors import BoltwatchError, InputError
-    from shared.offline.controller_import.controller_import import DEFAULT_STATION, check_station_id
-    from shared.offline.controller_import.controller_run import read_controller_run
-    from shared.wear.wear_bound import RefusedSummaryError
+    from shared.offline.controller_import import (
+        DEFAULT_STATION,
+        check_station_id,
+        read_controller_run,
+    )
+    from shared.wear import RefusedSummaryError
 
     tally = Tally(len(args.runs))
     writer: CsvWriter | RecordingsWriter

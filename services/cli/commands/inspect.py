@@ -97,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     if args.reference is not None or args.align != "start":
         option = "--reference" if args.reference is not None else "--align"
         raise InputError(f"{option} is an option of --overlay; give --overlay RUN... with it")
-    from shared.offline.post_mortem.run_plot import draw_run
+    from shared.offline.post_mortem import draw_run
 
     target = args.out or args.recording.with_suffix(".png")
     check_png_target(target, "the report")
@@ -114,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _write_rrd(args: argparse.Namespace) -> int:
-    from shared.recordings.layout import rerun_path
+    from shared.recordings import rerun_path
 
     if args.run is not None or args.overlay is not None:
         raise InputError("--rerun writes the whole file's run; give no --run or --overlay with it")
@@ -125,8 +125,7 @@ def _write_rrd(args: argparse.Namespace) -> int:
         )
     if target.exists():
         raise InputError(f"{target} exists (the recorder wrote it live?); give another --out")
-    from shared.recordings.rerun.rerun_streams import BLUEPRINT_FILE
-    from shared.recordings.rerun.rrd_from_mcap import rrd_from_mcap
+    from shared.recordings.rerun import BLUEPRINT_FILE, rrd_from_mcap
 
     written = rrd_from_mcap(args.recording, target)
     if not written.scan.complete:

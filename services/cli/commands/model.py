@@ -22,11 +22,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from services.cli.command_options import check_png_target
-from shared.runtime.option_types import float_in
+from shared.runtime import float_in
 
 if TYPE_CHECKING:
-    from shared.model.envelope_check import EventMetrics, Share
-    from shared.model.stiffness import JointConstants
+    from shared.model import EventMetrics, JointConstants, Share
 
 NAME = "model"
 HELP = "the analytical stick-slip model of a joint (report, plot, rig validation)"
@@ -90,7 +89,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from shared.config.joint import load_joint
+    from shared.config import load_joint
     from shared.errors import InputError
 
     if args.validate:
@@ -102,12 +101,12 @@ def run(args: argparse.Namespace) -> int:
         target_force_n, target_torque_nm = DEFAULT_TARGET_FORCE_N, DEFAULT_TARGET_TORQUE_NM
     joint = load_joint(args.joint)
 
-    from shared.model.report import format_report, joint_report
+    from shared.model import format_report, joint_report
 
     report = joint_report(joint, args.speed, target_force_n, target_torque_nm)
     if args.plot is not None:
         check_png_target(args.plot, "the plot")
-        from shared.model.figures import draw_joint_figure
+        from shared.model import draw_joint_figure
 
         draw_joint_figure(joint, args.speed, report["time"]["model_time_at_target_s"], args.plot)
         report["plot"] = str(args.plot)
@@ -123,9 +122,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _validate(args: argparse.Namespace) -> int:
     """Tighten the validation grid on the rig; report the shares inside the envelopes."""
-    from shared.config.joint import load_joint
-    from shared.model import JointConstants, JointModel
-    from shared.model.envelope_check import envelope_shares
+    from shared.config import load_joint
+    from shared.model import JointConstants, JointModel, envelope_shares
 
     if args.out is not None:
         check_png_target(args.out, "the figure")
@@ -158,7 +156,7 @@ def _validate(args: argparse.Namespace) -> int:
     else:
         print(_format_validation(rows))
     if args.out is not None and reference is not None:
-        from shared.model.figures import draw_validation_figure
+        from shared.model import draw_validation_figure
 
         draw_validation_figure(*reference, args.out)
         if not args.json:
@@ -211,8 +209,8 @@ def _simulate(constants: JointConstants, speed: float) -> EventMetrics:
     import numpy as np
 
     from services.rig.physics import TighteningPhysics
-    from shared.config.station import Program, RigSection
-    from shared.model.envelope_check import event_metrics
+    from shared.config import Program, RigSection
+    from shared.model import event_metrics
 
     program = Program(
         id=1,

@@ -80,9 +80,8 @@ def run(args: argparse.Namespace) -> int:
     import sys
 
     from services.cli.predict_settings import predict_settings
-    from shared.contract.trace import read_trace
-    from shared.stickslip import PredictorCore
-    from shared.stickslip.trace_replay import json_safe, output_record, replay
+    from shared.contract import read_trace
+    from shared.stickslip import PredictorCore, json_safe, output_record, replay
 
     trace = read_trace(args.trace)
     settings, note = predict_settings(args, trace.has_force)

@@ -33,11 +33,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     if args.file.suffix == ".rrd":
-        from shared.recordings.rerun.rrd_recovery import recover_rrd
+        from shared.recordings.rerun import recover_rrd
 
         print(recover_rrd(args.file, args.out).describe())
         return 0
-    from shared.recordings.mcap.recovery import recover
+    from shared.recordings.mcap import recover
 
     print(recover(args.file, args.out).describe())
     return 0

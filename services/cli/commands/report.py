@@ -19,7 +19,7 @@ from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from services.cli.command_options import add_station_file_option
-from shared.runtime.option_types import int_in
+from shared.runtime import int_in
 
 NAME = "report"
 HELP = "statistics per program over recorded results: X̄/R charts, Cp/Cpk, NOK Pareto (HTML, PNG)"
@@ -90,8 +90,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from shared.config import load_any_station
-    from shared.offline.report.quality_report import write_report
-    from shared.offline.report.recorded_results import ResultFilter
+    from shared.offline.report import ResultFilter, write_report
 
     stations = []
     for path in args.config:
@@ -112,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
     report = write_report(rule, args.out, args.subgroup_size, progress)
     for line in report.damaged:
         print(f"boltwatch report: warning: {line}; read what is readable", file=sys.stderr)
-    from shared.offline.report.report_page import terminal_lines
+    from shared.offline.report import terminal_lines
 
     print(f"{report.results} results from {report.files} files")
     for line in terminal_lines(report.programs):

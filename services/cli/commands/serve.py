@@ -79,8 +79,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from shared.runtime.logging_setup import setup_logging
-    from shared.runtime.supervisor_link import follow_supervisor
+    from shared.runtime import follow_supervisor, setup_logging
 
     setup_logging(args.service, args.log_level)
     follow_supervisor()  # started by boltwatch up: stop when it dies

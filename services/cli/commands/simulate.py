@@ -40,8 +40,8 @@ def run(args: argparse.Namespace) -> int:
     from services.rig.physics import TighteningPhysics
     from services.rig.selection import choose_program, choose_seed
     from shared.config import load_station
-    from shared.contract.trace import write_trace
-    from shared.model.stiffness import JointConstants
+    from shared.contract import write_trace
+    from shared.model import JointConstants
 
     station = load_station(args.config)
     config = station.config

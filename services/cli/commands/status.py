@@ -15,12 +15,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from services.cli.command_options import DEFAULT_STATION_FILE
-from shared.runtime.option_types import seconds
+from shared.runtime import seconds
 
 if TYPE_CHECKING:
     import zenoh
 
-    from shared.line_status.station_status import StatusReport
+    from shared.line_status import StatusReport
 
 NAME = "status"
 HELP = (
@@ -70,7 +70,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from services.cli.router_client import router_client
     from services.cli.station_status_text import format_report
-    from shared.line_status.station_status import to_json
+    from shared.line_status import to_json
 
     endpoint, config = router_client(args.config or DEFAULT_STATION_FILE, args.connect)
     report = _watch(endpoint, config, args.listen_s)
@@ -88,7 +88,7 @@ def _watch(endpoint: str, config: zenoh.Config, listen_s: float) -> StatusReport
 
     from services.cli.router_client import open_client
     from shared.contract import keys
-    from shared.line_status.station_status import StatusCollector
+    from shared.line_status import StatusCollector
 
     session = open_client(endpoint, config)
 

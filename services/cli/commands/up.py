@@ -37,7 +37,7 @@ from pathlib import Path
 from types import FrameType
 
 from services.cli.command_options import add_station_file_option
-from shared.runtime.option_types import seconds
+from shared.runtime import seconds
 
 NAME = "up"
 HELP = "run the simulated station (or --stations N) end to end: rig, acquisition, predictor, ..."
@@ -94,8 +94,7 @@ def run(args: argparse.Namespace) -> int:
     from services.cli.station_run import StationRun
     from services.rig.selection import choose_program
     from services.rig.service import RUN_ID_MAX
-    from shared.config import derive_stations, load_line, load_station
-    from shared.config.line import check_derivable
+    from shared.config import check_derivable, derive_stations, load_line, load_station
     from shared.errors import ConfigError
 
     if args.runs < 1:

@@ -23,7 +23,7 @@ import argparse
 from pathlib import Path
 
 from services.cli.command_options import add_recordings_folder_options, recordings_folder
-from shared.runtime.option_types import int_in, seconds
+from shared.runtime import int_in, seconds
 
 NAME = "wear"
 HELP = "show the wear ledger per tool, record a tool's service, or replace a broken ledger"
@@ -89,8 +89,7 @@ def run(args: argparse.Namespace) -> int:
     import time
 
     from shared.errors import InputError
-    from shared.wear.wear_ledger import WearLedger, ledger_path
-    from shared.wear.wear_table import format_table
+    from shared.wear import WearLedger, format_table, ledger_path
 
     if args.plant or args.connect is not None:
         return _plant(args)
@@ -116,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _reset(args: argparse.Namespace, path: Path) -> int:
     from shared.errors import InputError
-    from shared.wear.wear_reset import reset_ledger
+    from shared.wear import reset_ledger
 
     if args.tool is not None:
         raise InputError("reset takes no tool id: boltwatch wear reset [--recordings DIR]")
@@ -141,8 +140,7 @@ def _plant(args: argparse.Namespace) -> int:
     from services.cli.router_client import open_client, router_client
     from shared.contract import keys
     from shared.errors import InputError
-    from shared.wear.wear_plant import WearReply, merge, parse_reply
-    from shared.wear.wear_table import format_table
+    from shared.wear import WearReply, format_table, merge, parse_reply
 
     if args.action is not None:
         raise InputError(

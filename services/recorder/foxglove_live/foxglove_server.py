@@ -33,9 +33,8 @@ from collections.abc import Iterable
 import foxglove
 from foxglove.websocket import WebSocketServer
 
-from shared.contract import channels
-from shared.contract.codec import json_schema
-from shared.recordings.received import Received
+from shared.contract import channels, json_schema
+from shared.recordings import Received
 
 LOG = logging.getLogger(__name__)
 

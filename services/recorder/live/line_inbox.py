@@ -27,7 +27,7 @@ from collections.abc import Sequence
 
 import zenoh
 
-from shared.runtime.receive_threads import keep_thread_state
+from shared.runtime import keep_thread_state
 
 #: (zenoh key, payload, receive time in ns) of one message
 Message = tuple[str, bytes, int]

@@ -29,12 +29,11 @@ from typing import TYPE_CHECKING
 
 from services.recorder.live.run_files import FileLimits, StationFiles
 from shared.files import describe_os_error
-from shared.recordings.file_metadata import FileMetadata
-from shared.recordings.received import Received
-from shared.runtime.log_limit import RateLimitedLog
+from shared.recordings import FileMetadata, Received
+from shared.runtime import RateLimitedLog
 
 if TYPE_CHECKING:
-    from shared.recordings.rerun.rerun_sink import RerunOptions
+    from shared.recordings.rerun import RerunOptions
 
 LOG = logging.getLogger(__name__)
 

@@ -36,7 +36,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
-from shared.contract.messages import QualityAlert, RecorderStats
+from shared.contract import QualityAlert, RecorderStats
 
 _NS_PER_MS = 1_000_000
 

@@ -27,14 +27,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from shared.contract import channels
-from shared.recordings.file_metadata import FileMetadata
-from shared.recordings.layout import file_path
-from shared.recordings.mcap.mcap_sink import McapSink
-from shared.recordings.received import Received
-from shared.recordings.sink import Sink
+from shared.recordings import FileMetadata, Received, Sink, file_path
+from shared.recordings.mcap import McapSink
 
 if TYPE_CHECKING:  # rerun is imported only when .rrd files are wanted
-    from shared.recordings.rerun.rerun_sink import RerunOptions, RerunSink
+    from shared.recordings.rerun import RerunOptions, RerunSink
 
 LOG = logging.getLogger(__name__)
 
@@ -253,7 +250,7 @@ class StationFiles:
 
     def _open_rerun(self, path: Path, run_id: int, now_ns: int, options: RerunOptions) -> None:
         try:
-            from shared.recordings.rerun.rerun_sink import open_rerun_sink
+            from shared.recordings.rerun import open_rerun_sink
         except ImportError:
             LOG.exception("Rerun is unusable; recording MCAP only from now on")
             self._rerun = None

@@ -26,10 +26,8 @@ time (:meth:`BatchSamples.found`; encoded again, as the station encoded them).
 
 from __future__ import annotations
 
-from shared.contract import channels
-from shared.contract.codec import encode
-from shared.contract.messages import SampleBatch
-from shared.recordings.received import Received
+from shared.contract import SampleBatch, channels, encode
+from shared.recordings import Received
 
 SAMPLE = channels.SAMPLES.schema_name
 EVENTS, INTENSITY = channels.EVENTS, channels.INTENSITY

@@ -21,7 +21,7 @@ from services.rig.openprotocol.tightening_counter import TighteningCounter
 from services.rig.selection import choose_program, choose_seed
 from shared.config import load_station
 from shared.errors import ConfigError
-from shared.runtime.service_skeleton import ServiceSkeleton, Stop
+from shared.runtime import ServiceSkeleton, Stop
 
 LOG = logging.getLogger(__name__)
 

@@ -41,14 +41,19 @@ from services.rig.openprotocol.result_messages import (
 )
 from services.rig.openprotocol.result_store import ResultStore
 from services.rig.openprotocol.tightening import Tightening
-from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
-from shared.config.station import Program
-from shared.openprotocol.alarms import Alarm, AlarmAcknowledgedOnController, AlarmStatus
-from shared.openprotocol.codec import SUPPORTED_REVISIONS, WireMessage, encode
-from shared.openprotocol.dialect import Dialect
-from shared.openprotocol.session import CommunicationStartAck
-from shared.openprotocol.tool_data import ToolData
-from shared.openprotocol.traces import TraceCurve
+from shared.config import OpenProtocolSection, Program, RigOpenProtocolSection
+from shared.openprotocol import (
+    SUPPORTED_REVISIONS,
+    Alarm,
+    AlarmAcknowledgedOnController,
+    AlarmStatus,
+    CommunicationStartAck,
+    Dialect,
+    ToolData,
+    TraceCurve,
+    WireMessage,
+    encode,
+)
 
 LOG = logging.getLogger(__name__)
 

@@ -41,32 +41,33 @@ from dataclasses import dataclass
 from services.rig.openprotocol.controller_counters import ControllerCounters
 from services.rig.openprotocol.controller_state import ControllerState
 from services.rig.openprotocol.tightening import Tightening
-from shared.openprotocol.alarms import (
+from shared.openprotocol import (
+    KNOWN_MIDS,
     AlarmAcknowledge,
     AlarmAcknowledgedOnControllerAck,
     AlarmStatusAck,
     AlarmSubscribe,
     AlarmUnsubscribe,
-)
-from shared.openprotocol.codec import KNOWN_MIDS, WireMessage, decode
-from shared.openprotocol.errors import OpenProtocolError
-from shared.openprotocol.framing import Frame, FrameReader
-from shared.openprotocol.results import (
-    OldResultRequest,
-    ResultAcknowledge,
-    ResultSubscribe,
-    ResultUnsubscribe,
-)
-from shared.openprotocol.session import (
     CommandAccepted,
     CommandError,
     CommunicationStart,
     CommunicationStop,
+    DataSubscribe,
+    DataUnsubscribe,
     ErrorCode,
+    Frame,
+    FrameReader,
     KeepAlive,
+    OldResultRequest,
+    OpenProtocolError,
+    ResultAcknowledge,
+    ResultSubscribe,
+    ResultUnsubscribe,
+    ToolDataRequest,
+    WireMessage,
+    decode,
+    trace_types_of,
 )
-from shared.openprotocol.subscriptions import DataSubscribe, DataUnsubscribe, trace_types_of
-from shared.openprotocol.tool_data import ToolDataRequest
 
 LOG = logging.getLogger(__name__)
 

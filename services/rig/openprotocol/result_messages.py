@@ -31,14 +31,17 @@ import numpy as np
 import numpy.typing as npt
 
 from services.rig.openprotocol.tightening import SAMPLE_PERIOD_S, FigureStatus, Tightening
-from shared.openprotocol.results import (
+from shared.openprotocol import (
+    UNIT_DEGREE,
+    UNIT_NM,
     BatchStatus,
     LastTighteningResult,
     OldTighteningResult,
+    TraceCurve,
+    TraceType,
     ValueStatus,
+    format_timestamp,
 )
-from shared.openprotocol.timestamps import format_timestamp
-from shared.openprotocol.traces import UNIT_DEGREE, UNIT_NM, TraceCurve, TraceType
 
 STRATEGY_TORQUE_ANGLE_MONITORING = 2
 #: samples that fit one 0900 (9999 bytes: header, about 120 of ASCII, 2 bytes a sample)

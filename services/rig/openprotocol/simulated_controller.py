@@ -22,9 +22,9 @@ from services.rig.openprotocol.controller_state import ControllerState
 from services.rig.openprotocol.simulated_tool import SimulatedTool
 from services.rig.openprotocol.tightening import Tightening, TighteningJudge
 from services.rig.openprotocol.tightening_counter import TighteningCounter
-from shared.config.station import LoadedStation, Program
+from shared.config import LoadedStation, Program
 from shared.errors import ConfigError
-from shared.model.stiffness import JointConstants
+from shared.model import JointConstants
 
 LOG = logging.getLogger(__name__)
 

@@ -19,8 +19,8 @@ import time
 from collections.abc import Callable
 
 from services.rig.openprotocol.tightening import Tightening, TighteningJudge, tighten
-from shared.config.station import Program, RigSection
-from shared.model.stiffness import JointConstants
+from shared.config import Program, RigSection
+from shared.model import JointConstants
 
 LOG = logging.getLogger(__name__)
 

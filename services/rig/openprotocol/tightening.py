@@ -37,10 +37,9 @@ import numpy.typing as npt
 
 from services.rig.controller import LIMITS, RunController, StopSource
 from services.rig.physics import TighteningPhysics
-from shared.config.openprotocol import RigOpenProtocolSection
-from shared.config.station import Program, RigSection
-from shared.model.stiffness import JointConstants
-from shared.quality.verdict import judge
+from shared.config import Program, RigOpenProtocolSection, RigSection
+from shared.model import JointConstants
+from shared.quality import judge
 
 SAMPLE_PERIOD_S = 1e-3
 FigureStatus = Literal["low", "ok", "high"]

@@ -7,3 +7,28 @@
   (its TighteningResult: :mod:`shared.quality.controller_result`)
 - :mod:`.import_files`: a run's files written whole or not at all
 """
+
+from shared.offline.controller_import.controller_import import (
+    DEFAULT_STATION,
+    RunNotWrittenError,
+    check_station_id,
+    import_run,
+)
+from shared.offline.controller_import.controller_run import ControllerRun, read_controller_run
+from shared.offline.controller_import.import_files import (
+    read_copy,
+    remove_temporary,
+    temporary_path,
+)
+
+__all__ = [
+    "DEFAULT_STATION",
+    "ControllerRun",
+    "RunNotWrittenError",
+    "check_station_id",
+    "import_run",
+    "read_controller_run",
+    "read_copy",
+    "remove_temporary",
+    "temporary_path",
+]

@@ -45,9 +45,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.messages import RunSummary, Sample, ToolState
+from shared.contract import RunSummary, Sample, ToolState, channels, encode, keys
 from shared.errors import BoltwatchError, InputError
 from shared.files import describe_os_error
 from shared.offline.controller_import.controller_replay import replay_run
@@ -59,17 +57,23 @@ from shared.offline.controller_import.import_files import (
     remove_temporary,
     temporary_path,
 )
-from shared.quality.controller_result import controller_result
-from shared.recordings.file_metadata import FileMetadata
-from shared.recordings.layout import file_path, recording_files, rerun_path, run_file_prefix
-from shared.recordings.mcap.mcap_sink import McapSink
-from shared.recordings.received import Received, classify
-from shared.stickslip.stopped_run import PredictorReplay
-from shared.wear.wear_bound import CONTRACT_LIMITS, RunLimits
+from shared.quality import controller_result
+from shared.recordings import (
+    FileMetadata,
+    Received,
+    classify,
+    file_path,
+    recording_files,
+    rerun_path,
+    run_file_prefix,
+)
+from shared.recordings.mcap import McapSink
+from shared.stickslip import PredictorReplay
+from shared.wear import CONTRACT_LIMITS, RunLimits
 
 if TYPE_CHECKING:
-    from shared.recordings.rerun.rerun_sink import RerunOptions, RerunSink
-    from shared.wear.wear_ledger import WearLedger
+    from shared.recordings.rerun import RerunOptions, RerunSink
+    from shared.wear import WearLedger
 
 STATION_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 DEFAULT_STATION = "cs351"
@@ -286,7 +290,7 @@ def _real_names(text: str, target: Path) -> str:
 
 def _open_rerun(run: ControllerRun, station: str, target: Path, options: RerunOptions) -> RerunSink:
     """The run's Rerun sink, writing the temporary ``.rrd`` beside ``target``."""
-    from shared.recordings.rerun.rerun_sink import RerunSink
+    from shared.recordings.rerun import RerunSink
 
     temporary = rerun_path(temporary_path(target))
     try:

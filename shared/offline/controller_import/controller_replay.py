@@ -12,8 +12,8 @@ highest torque measured where the last step has none).
 from __future__ import annotations
 
 from shared.offline.controller_import.controller_run import ControllerRun
-from shared.stickslip.advisory_replay import replay_run as advisory_replay
-from shared.stickslip.stopped_run import PredictorReplay, StoppedRun
+from shared.stickslip import PredictorReplay, StoppedRun
+from shared.stickslip import replay_run as advisory_replay
 
 
 def stopped_run(station: str, run: ControllerRun) -> StoppedRun:

@@ -26,8 +26,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from shared.contract.messages import ControllerResult, ControllerStep
-from shared.contract.run_clock import RunClock
+from shared.contract import ControllerResult, ControllerStep, RunClock
 from shared.errors import InputError
 from shared.offline.controller_import.controller_steps import (
     ControllerVerdict,

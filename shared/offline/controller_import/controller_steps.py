@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from shared.contract.messages import ControllerFunction, ControllerStep
+from shared.contract import ControllerFunction, ControllerStep
 from shared.errors import InputError
 
 FUNCTIONS_KEY = "tightening functions"

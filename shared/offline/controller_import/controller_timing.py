@@ -23,7 +23,7 @@ from __future__ import annotations
 from datetime import UTC, datetime
 from pathlib import Path
 
-from shared.contract.run_clock import RunClock
+from shared.contract import RunClock
 from shared.errors import InputError
 
 #: The last nanosecond a signed 64-bit ``time_ns`` holds (2262-04-11 23:47:16.854775807 UTC).

@@ -26,11 +26,9 @@ from pathlib import Path
 
 from mcap.records import Message, Metadata
 
-from shared.contract import channels
-from shared.contract.codec import decode
-from shared.contract.messages import RunSummary
+from shared.contract import RunSummary, channels, decode
 from shared.errors import InputError
-from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.recordings.mcap import RecordingScan
 
 TEMPORARY_MARK = ".importing"
 CONTROLLER_RECORD = "controller"

@@ -21,12 +21,10 @@ import numpy as np
 import numpy.typing as npt
 from mcap.records import Message
 
-from shared.contract import channels
-from shared.contract.codec import decode
-from shared.contract.messages import Sample, StickSlipEvent, TighteningResult
+from shared.contract import Sample, StickSlipEvent, TighteningResult, channels, decode
 from shared.errors import InputError
-from shared.recordings.layout import run_file_prefix, run_files, station_folder_name
-from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.recordings import run_file_prefix, run_files, station_folder_name
+from shared.recordings.mcap import RecordingScan
 
 _SCHEMAS = {
     channels.SAMPLES.schema_name: Sample,

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shared.contract.messages import TighteningResult
+from shared.contract import TighteningResult
 from shared.errors import InputError
 from shared.offline.overlay.overlay_alignment import Alignment, align_index
 from shared.offline.overlay.overlay_run import FloatArray, OverlayRun

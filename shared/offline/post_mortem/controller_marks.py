@@ -22,8 +22,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shared.contract.messages import ControllerResult, ResultSource, TighteningResult
-from shared.quality.controller_result import controller_result
+from shared.contract import ControllerResult, ResultSource, TighteningResult
+from shared.quality import controller_result
 
 Window = tuple[float | None, float | None]
 

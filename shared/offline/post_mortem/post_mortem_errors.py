@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shared.contract.messages import StickSlipEvent
+from shared.contract import StickSlipEvent
 
 HORIZONS = (1, 2, 3)
 

@@ -14,9 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from shared.contract.messages import StickSlipEvent, StopDecision
-from shared.model import JointModel
-from shared.model.slip_bounds import PAPER_PARTIAL_RELIEF
+from shared.contract import StickSlipEvent, StopDecision
+from shared.model import PAPER_PARTIAL_RELIEF, JointModel
 from shared.offline.post_mortem.post_mortem_errors import HORIZONS, PredictionError
 from shared.offline.post_mortem.post_mortem_run import ModelClock, RecordedRun
 

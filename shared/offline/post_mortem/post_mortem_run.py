@@ -30,22 +30,21 @@ from typing import Any
 
 from mcap.records import Message, Metadata
 
-from shared.config.joint import JointConfig
-from shared.contract import channels
-from shared.contract.codec import decode
-from shared.contract.messages import (
+from shared.config import JointConfig
+from shared.contract import (
     ControllerResult,
+    RunClock,
     Sample,
     StickSlipEvent,
     StopDecision,
     TighteningResult,
+    channels,
+    decode,
 )
-from shared.contract.run_clock import RunClock
 from shared.errors import InputError
 from shared.model import JointConstants, JointModel
 from shared.offline.post_mortem.controller_marks import ControllerMarks
-from shared.recordings.mcap.recording_reader import RecordingScan
-from shared.recordings.mcap.trace_export import SAMPLE_SCHEMA
+from shared.recordings.mcap import SAMPLE_SCHEMA, RecordingScan
 
 LOG = logging.getLogger(__name__)
 

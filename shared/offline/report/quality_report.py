@@ -15,7 +15,7 @@ from shared.errors import InputError
 from shared.offline.report.recorded_results import ResultFilter, read_results
 from shared.offline.report.report_figure import build_figure, png_bytes
 from shared.offline.report.report_page import html_page
-from shared.quality.program_statistics import ProgramStatistics, program_statistics
+from shared.quality import ProgramStatistics, program_statistics
 
 HTML_NAME = "report.html"
 PNG_NAME = "report.png"

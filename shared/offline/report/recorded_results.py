@@ -16,11 +16,9 @@ from dataclasses import dataclass, field
 from datetime import UTC, date, datetime, timedelta
 from pathlib import Path
 
-from shared.contract import channels
-from shared.contract.codec import decode
-from shared.contract.messages import RunSummary, TighteningResult
-from shared.recordings.layout import recording_files, station_days
-from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.contract import RunSummary, TighteningResult, channels, decode
+from shared.recordings import recording_files, station_days
+from shared.recordings.mcap import RecordingScan
 
 #: progress is told every this many files (when there are more)
 PROGRESS_EVERY_FILES = 50

@@ -15,8 +15,7 @@ import io
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
-from shared.quality.capability import window_text
-from shared.quality.program_statistics import FigureStatistics, ProgramStatistics
+from shared.quality import FigureStatistics, ProgramStatistics, window_text
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -13,8 +13,7 @@ import base64
 import html
 from collections.abc import Sequence
 
-from shared.quality.capability import window_text
-from shared.quality.program_statistics import FigureStatistics, ProgramStatistics
+from shared.quality import FigureStatistics, ProgramStatistics, window_text
 
 _STYLE = (
     "body{font-family:sans-serif;margin:1.5em}table{border-collapse:collapse;margin:.5em 0}"

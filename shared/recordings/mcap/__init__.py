@@ -6,3 +6,12 @@
 - :mod:`.recovery`: a truncated MCAP made valid (``boltwatch recover``)
 - :mod:`.trace_export`: a recording as a CSV trace (``boltwatch export``)
 """
+
+
+from shared.recordings.mcap.mcap_messages import MessageAppender, MessageRow
+from shared.recordings.mcap.mcap_sink import McapSink, RAW_ENCODING, RAW_REASON
+from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.recordings.mcap.recovery import default_target, recover, remove_unfinished
+from shared.recordings.mcap.trace_export import SAMPLE_SCHEMA, export_trace
+
+__all__ = ["McapSink", "MessageAppender", "MessageRow", "RAW_ENCODING", "RAW_REASON", "RecordingScan", "SAMPLE_SCHEMA", "default_target", "export_trace", "recover", "remove_unfinished"]

@@ -40,7 +40,7 @@ from shared.recordings.received import Received
 from shared.recordings.mcap.mcap_messages import MessageAppender, MessageRow
 from shared.recordings.mcap.recording_reader import RecordingScan
 from shared.contract import channels
-from shared.contract.codec import json_schema
+from shared.contract import json_schema
 from shared.errors import InputError
 
 LOG = logging.getLogger(__name__)

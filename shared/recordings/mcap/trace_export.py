@@ -22,8 +22,8 @@ from typing import Any
 from shared.recordings.mcap.recording_reader import RecordingScan
 from shared.contract import channels
 from shared.errors import InputError
-from shared.contract.run_clock import RunClock
-from shared.contract.trace import write_trace
+from shared.contract import RunClock
+from shared.contract import write_trace
 
 SAMPLE_SCHEMA = channels.SAMPLES.schema_name
 

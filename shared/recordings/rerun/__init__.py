@@ -7,3 +7,11 @@
 - :mod:`.rrd_from_mcap`: a run's ``.rrd`` made from its MCAP (``inspect --rerun``), for
   recorders that write MCAP only
 """
+
+
+from shared.recordings.rerun.rerun_sink import LIVE_BATCH_SAMPLES, RerunLive, RerunOptions, RerunSink, open_rerun_sink
+from shared.recordings.rerun.rerun_streams import BLUEPRINT_FILE
+from shared.recordings.rerun.rrd_from_mcap import rrd_from_mcap
+from shared.recordings.rerun.rrd_recovery import check_rrd, recover_rrd, rows_by_entity
+
+__all__ = ["BLUEPRINT_FILE", "LIVE_BATCH_SAMPLES", "RerunLive", "RerunOptions", "RerunSink", "check_rrd", "open_rerun_sink", "recover_rrd", "rows_by_entity", "rrd_from_mcap"]

@@ -39,7 +39,7 @@ from shared.recordings.received import Received
 from shared.recordings.rerun import rerun_blueprint as bp
 from shared.recordings.rerun.rerun_streams import borrow_stream, ensure_layout_file, return_stream
 from shared.contract import channels
-from shared.contract.run_clock import RunClock
+from shared.contract import RunClock
 
 LOG = logging.getLogger(__name__)
 

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from shared.recordings.received import classify
-from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.recordings.mcap import RecordingScan
 from shared.recordings.rerun.rerun_sink import RerunOptions, RerunSink
 from shared.contract import channels
 from shared.errors import InputError

@@ -22,7 +22,7 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
-from shared.recordings.mcap.recovery import remove_unfinished
+from shared.recordings.mcap import remove_unfinished
 from shared.recordings.rerun.rerun_blueprint import TORQUE
 from shared.errors import InputError
 

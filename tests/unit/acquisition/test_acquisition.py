@@ -10,9 +10,15 @@ import can
 import pytest
 
 from services.acquisition.acquisition import Acquisition
-from shared.contract.can_database import StationDatabase
-from shared.contract.codec import encode
-from shared.contract.messages import BusStats, Sample, StopDecision, StopReason, ToolState
+from shared.contract import (
+    BusStats,
+    Sample,
+    StationDatabase,
+    StopDecision,
+    StopReason,
+    ToolState,
+    encode,
+)
 from tests.paths import DBC_FILE
 
 DATABASE = StationDatabase(DBC_FILE)

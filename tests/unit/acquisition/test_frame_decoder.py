@@ -10,7 +10,7 @@ from services.acquisition.frame_decoder import (
     ToolSensorsFrame,
     ToolStatusFrame,
 )
-from shared.contract.can_database import StationDatabase
+from shared.contract import StationDatabase
 from tests.paths import DBC_FILE
 
 DATABASE = StationDatabase(DBC_FILE)

@@ -31,11 +31,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from services.cli.main import build_parser
-from shared.contract.codec import encode
-from shared.contract.messages import Sample
-from shared.contract.trace import write_trace
-from shared.recordings.mcap.mcap_sink import McapSink
-from shared.recordings.received import classify
+from shared.contract import Sample, encode, write_trace
+from shared.recordings import classify
+from shared.recordings.mcap import McapSink
 from tests.paths import JOINT_5_2
 from tests.system.station_files import write_station
 

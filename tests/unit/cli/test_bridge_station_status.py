@@ -10,10 +10,8 @@ import json
 from dataclasses import replace
 
 from services.cli.station_status_text import format_report
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.messages import BridgeStats
-from shared.line_status.station_status import StatusCollector, to_json
+from shared.contract import BridgeStats, channels, encode, keys
+from shared.line_status import StatusCollector, to_json
 from tests.fuzz.payloads import template
 
 S = 1_000_000_000

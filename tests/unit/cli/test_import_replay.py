@@ -22,11 +22,9 @@ import pytest
 from mcap.reader import make_reader
 
 from services.cli.main import main
-from shared.contract.codec import json_schema
-from shared.contract.messages import ControllerResult
-from shared.contract.trace import read_trace
-from shared.offline.controller_import.controller_run import read_controller_run
-from shared.wear.wear_ledger import WearLedger
+from shared.contract import ControllerResult, json_schema, read_trace
+from shared.offline.controller_import import read_controller_run
+from shared.wear import WearLedger
 from tests.paths import PROJECT_REAL_RUNS
 
 RUNS = sorted(PROJECT_REAL_RUNS.glob("Ch_*.json"))

@@ -7,10 +7,8 @@ from dataclasses import replace
 
 from services.cli import run_table
 from services.cli.station_status_text import format_report
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.messages import JudgedFigure, TighteningResult
-from shared.line_status.station_status import StatusCollector, to_json
+from shared.contract import JudgedFigure, TighteningResult, channels, encode, keys
+from shared.line_status import StatusCollector, to_json
 from tests.unit.cli.test_station_status import summary
 
 T0 = 1_800_000_000_000_000_000

@@ -6,9 +6,7 @@ import json
 from typing import Any
 
 from services.cli.station_status_text import format_report
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.messages import (
+from shared.contract import (
     BusStats,
     PredictorStats,
     RecorderStats,
@@ -16,8 +14,11 @@ from shared.contract.messages import (
     Sample,
     StopDecision,
     ToolState,
+    channels,
+    encode,
+    keys,
 )
-from shared.line_status.station_status import LastRun, StatusCollector, to_json
+from shared.line_status import LastRun, StatusCollector, to_json
 
 S = 1_000_000_000
 T0 = 1_700_000_000 * S

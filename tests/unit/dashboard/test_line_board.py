@@ -9,9 +9,7 @@ import pytest
 
 from services.dashboard import line_board
 from services.dashboard.line_board import HISTORY, LineBoard, StationSetting
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.messages import QualityAlert, QualityFigure, WearAlert
+from shared.contract import QualityAlert, QualityFigure, WearAlert, channels, encode, keys
 from shared.errors import InputError
 from tests.unit.cli.test_station_status import T0, S, summary
 

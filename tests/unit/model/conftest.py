@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from shared.config.joint import JointConfig, load_joint
+from shared.config import JointConfig, load_joint
 from shared.model import JointConstants
 
 JOINTS = Path(__file__).resolve().parents[3] / "config" / "joints"

@@ -11,9 +11,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shared.model import JointConstants, JointModel, expected_constant_bands, stick_line_k2
-from shared.model.characteristic_constants import k1_of, k2_of, k3_of
-from shared.model.timing import screw_tension_time_s, total_time_s
+from shared.model import (
+    JointConstants,
+    JointModel,
+    expected_constant_bands,
+    k1_of,
+    k2_of,
+    k3_of,
+    screw_tension_time_s,
+    stick_line_k2,
+    total_time_s,
+)
 
 ROUND = JointConstants(
     k_e_nm_per_rad=1000.0, k_s_n_per_rad=100_000.0, r_m=0.01, mu_stick=0.5, mu_slip=0.25

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from services.cli.commands import model as command
-from shared.model.envelope_check import event_metrics, share
+from shared.model import event_metrics, share
 
 
 def test_metrics_by_hand() -> None:

@@ -7,11 +7,13 @@ import math
 
 import pytest
 
-from shared.config.joint import JointConfig
-from shared.model import JointConstants, extension_stiffness_nm_per_rad, friction_radius_m
-from shared.model.resonance import extension_natural_frequency_hz
-from shared.model.torque_preload import (
+from shared.config import JointConfig
+from shared.model import (
+    JointConstants,
     apparent_friction_coefficient,
+    extension_natural_frequency_hz,
+    extension_stiffness_nm_per_rad,
+    friction_radius_m,
     total_friction_coefficient,
 )
 

@@ -20,10 +20,8 @@ from services.openprotocol.bridge import OpenProtocolBridge
 from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.published_ids import position_path
 from shared.config import load_any_station, toml_writer
-from shared.contract import channels, keys
-from shared.contract.codec import decode
-from shared.contract.messages import SampleBatch
-from shared.runtime.queued_publisher import QueuedPublisher
+from shared.contract import SampleBatch, channels, decode, keys
+from shared.runtime import QueuedPublisher
 from tests.live_recorder import write_station_file
 
 

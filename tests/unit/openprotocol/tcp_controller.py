@@ -17,27 +17,28 @@ import socket
 import threading
 from dataclasses import dataclass, field
 
-from shared.openprotocol.alarms import AlarmSubscribe
-from shared.openprotocol.codec import decode, encode
-from shared.openprotocol.framing import FrameReader
-from shared.openprotocol.results import (
-    LastTighteningResult,
-    OldResultRequest,
-    OldTighteningResult,
-    ResultAcknowledge,
-    ResultSubscribe,
-)
-from shared.openprotocol.session import (
+from shared.openprotocol import (
+    AlarmSubscribe,
     CommandAccepted,
     CommandError,
     CommunicationStart,
     CommunicationStartAck,
     CommunicationStop,
+    DataSubscribe,
+    FrameReader,
     KeepAlive,
+    LastTighteningResult,
+    OldResultRequest,
+    OldTighteningResult,
+    ResultAcknowledge,
+    ResultSubscribe,
+    ToolData,
+    ToolDataRequest,
+    TraceCurve,
+    TraceType,
+    decode,
+    encode,
 )
-from shared.openprotocol.subscriptions import DataSubscribe
-from shared.openprotocol.tool_data import ToolData, ToolDataRequest
-from shared.openprotocol.traces import TraceCurve, TraceType
 
 TIMESTAMP = "2026-11-24:10:00:00"
 SAMPLES = 400

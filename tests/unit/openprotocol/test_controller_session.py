@@ -20,11 +20,15 @@ import pytest
 from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.controller_link import ControllerLink, LinkLostError
 from services.openprotocol.controller_session import ControllerSession, SessionStoppedError
-from shared.openprotocol.alarms import AlarmStatus, AlarmSubscribe
-from shared.openprotocol.dialect import Dialect
-from shared.openprotocol.results import ResultSubscribe
-from shared.openprotocol.session import CommandAccepted
-from shared.openprotocol.subscriptions import DataSubscribe, trace_extra_data
+from shared.openprotocol import (
+    AlarmStatus,
+    AlarmSubscribe,
+    CommandAccepted,
+    DataSubscribe,
+    Dialect,
+    ResultSubscribe,
+    trace_extra_data,
+)
 
 KEEP_ALIVE_S = 0.5
 

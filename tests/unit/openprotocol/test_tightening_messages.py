@@ -6,7 +6,7 @@ import math
 
 from services.openprotocol.controller_tightening import Curve, Tightening
 from services.openprotocol.tightening_messages import tightening_messages
-from shared.contract.messages import (
+from shared.contract import (
     ControllerResult,
     Intensity,
     RunSummary,

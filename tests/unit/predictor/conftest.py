@@ -11,8 +11,7 @@ import zenoh
 
 from services.predictor.service import PredictorService
 from shared.config import LoadedStation, load_line
-from shared.runtime.service_skeleton import ServiceSkeleton
-from shared.runtime.zenoh_session import zenoh_config
+from shared.runtime import ServiceSkeleton, zenoh_config
 from tests.live_recorder import free_port
 from tests.unit.predictor.live_predictor import PROGRAM_OF, station_text
 

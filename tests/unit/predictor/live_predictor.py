@@ -14,8 +14,7 @@ from typing import Any
 
 import zenoh
 
-from shared.contract import channels, codec, keys
-from shared.contract.messages import Sample, StopReasonName, ToolState
+from shared.contract import Sample, StopReasonName, ToolState, channels, codec, keys
 
 REPO = Path(__file__).resolve().parents[3]
 TARGET_N = 30_400.0

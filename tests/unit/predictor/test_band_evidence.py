@@ -12,7 +12,7 @@ import pytest
 
 from shared.config import Program, RigSection
 from shared.model import JointConstants, expected_constant_bands
-from shared.stickslip.model_bands import MIN_STICK_SHARE, ModelBandCheck
+from shared.stickslip import MIN_STICK_SHARE, ModelBandCheck
 from tests.unit.predictor.test_model_bands import TRACE_JOINT, rig_decision
 
 SPEED_RAD_S = 0.5

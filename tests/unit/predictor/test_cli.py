@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
-from shared.contract.trace import read_trace, write_trace
+from shared.contract import read_trace, write_trace
 from tests.unit.predictor.synthetic import staircase
 
 REAL_RUNS = Path(__file__).resolve().parents[3].parent / "shared/data/cs351-real-runs"

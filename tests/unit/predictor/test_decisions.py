@@ -192,14 +192,14 @@ def test_torque_target_stops_on_a_stick_ramp_at_the_target() -> None:
 
 
 def first_stop(policy: object, ramp: list[tuple[float, float]]) -> float | None:
-    from shared.stickslip.stop_policy import StopPolicy
+    from shared.stickslip import StopPolicy
 
     assert isinstance(policy, StopPolicy)
     return next((tq for t, tq in ramp if policy.on_sample(t, tq, None, 0.0) is not None), None)
 
 
 def test_a_halt_plan_moves_the_torque_stop_and_holds_one_phase_only() -> None:
-    from shared.stickslip.stop_policy import StopPolicy
+    from shared.stickslip import StopPolicy
 
     settings = PredictorSettings(target_torque_nm=100.0, has_force=False)
     ramp = [(i * 1e-3, 95.0 + 0.5 * i) for i in range(30)]
@@ -232,7 +232,7 @@ def test_a_halt_plan_moves_the_torque_stop_and_holds_one_phase_only() -> None:
 def test_a_halt_plan_never_aims_past_the_torque_limit() -> None:
     """A program whose limit sits within the plan's reach (target 100, limit 102): the plan
     is capped below the limit, so the stop is the planned one, never a limit fault."""
-    from shared.stickslip.stop_policy import StopPolicy
+    from shared.stickslip import StopPolicy
 
     settings = PredictorSettings(target_torque_nm=100.0, has_force=False, max_torque_nm=102.0)
     policy = StopPolicy(settings)

@@ -6,12 +6,22 @@ import math
 
 import pytest
 
-from shared.contract.messages import Prediction
-from shared.stickslip.event_figures import compute_figures, event_intensity, torque_mean_nm
-from shared.stickslip.force_history import ForceHistory
-from shared.stickslip.inclination_window import MAX_PASSED, MIN_PASSED, NO_FLIP, InclinationWindow
-from shared.stickslip.regression import fit_line, fit_parabola, predict_periods, predict_plateaus
-from shared.stickslip.scoring import PredictionScores
+from shared.contract import Prediction
+from shared.stickslip import (
+    MAX_PASSED,
+    MIN_PASSED,
+    NO_FLIP,
+    ForceHistory,
+    InclinationWindow,
+    PredictionScores,
+    compute_figures,
+    event_intensity,
+    fit_line,
+    fit_parabola,
+    predict_periods,
+    predict_plateaus,
+    torque_mean_nm,
+)
 
 
 def test_slope_sum_is_eq_46_over_the_window_pairs() -> None:

@@ -5,11 +5,16 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from shared.contract.messages import StickSlipEvent
-from shared.contract.run_clock import RunClock
-from shared.stickslip import EventFigures, PredictorCore, PredictorSettings
-from shared.stickslip.event_history import HISTORY, EventHistory
-from shared.stickslip.run_messages import event_messages, stick_slip_event
+from shared.contract import RunClock, StickSlipEvent
+from shared.stickslip import (
+    HISTORY,
+    EventFigures,
+    EventHistory,
+    PredictorCore,
+    PredictorSettings,
+    event_messages,
+    stick_slip_event,
+)
 from tests.unit.predictor.synthetic import staircase
 
 CORE_ONLY = {"current_force_n", "detected_at_s"}  # what the core keeps and the wire does not

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from shared.stickslip.halt_planner import MIN_EVENTS, HaltPlanner, best_halt, expected_error
+from shared.stickslip import MIN_EVENTS, HaltPlanner, best_halt, expected_error
 
 
 def phi(z: float) -> float:

@@ -13,9 +13,8 @@ import pytest
 import zenoh
 
 from services.predictor.service import PredictorService
-from shared.contract import codec, keys
-from shared.contract.messages import PredictorStats, RunSummary, Sample, StopDecision
-from shared.runtime.zenoh_session import zenoh_config
+from shared.contract import PredictorStats, RunSummary, Sample, StopDecision, codec, keys
+from shared.runtime import zenoh_config
 from tests.unit.predictor.live_predictor import (
     PROGRAM_OF,
     START_NS,

@@ -11,10 +11,15 @@ import pytest
 from services.cli.main import main
 from services.rig.physics import TighteningPhysics
 from shared.config import Program, RigSection
-from shared.contract.trace import write_trace
+from shared.contract import write_trace
 from shared.model import JointConstants, expected_constant_bands
-from shared.stickslip import CoreDecision, PredictorCore, PredictorSettings
-from shared.stickslip.model_bands import MODEL_SLACK, ModelBandCheck
+from shared.stickslip import (
+    MODEL_SLACK,
+    CoreDecision,
+    ModelBandCheck,
+    PredictorCore,
+    PredictorSettings,
+)
 from tests.unit.predictor.synthetic import smooth_ramp, staircase
 from tests.unit.rig.rig_fixtures import constants as paper_constants
 from tests.unit.rig.rig_fixtures import paper_program, paper_rig

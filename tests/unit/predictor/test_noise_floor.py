@@ -13,10 +13,14 @@ import math
 
 import numpy as np
 
-from shared.stickslip import EventFigures, PredictorCore, PredictorSettings
-from shared.stickslip.extremum_tracker import ExtremumTracker
-from shared.stickslip.motor_motion import MotorMotion
-from shared.stickslip.second_difference import SEED_SAMPLES
+from shared.stickslip import (
+    SEED_SAMPLES,
+    EventFigures,
+    ExtremumTracker,
+    MotorMotion,
+    PredictorCore,
+    PredictorSettings,
+)
 
 NOISE_NM = 0.2  # the rig's torque noise
 RAMP_NM_PER_SAMPLE = 0.05  # a slow stick ramp: k_e 334 Nm/rad at 0.15 rad/s, 1 kHz

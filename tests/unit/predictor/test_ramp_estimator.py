@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from shared.stickslip.ramp_estimator import SPAN, RampEstimator
+from shared.stickslip import SPAN, RampEstimator
 
 
 def test_steady_ramp_is_projected_over_the_lead() -> None:

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from shared.offline.controller_import.controller_run import read_controller_run
+from shared.offline.controller_import import read_controller_run
 from shared.stickslip import CoreDecision, EventFigures, PredictorCore, PredictorSettings
 from tests.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 

@@ -10,9 +10,8 @@ from typing import Any
 import pytest
 
 from shared.config import Program
-from shared.contract.codec import decode, encode
-from shared.contract.messages import RunSummary, TighteningResult
-from shared.quality.run_result import tightening_result
+from shared.contract import RunSummary, TighteningResult, decode, encode
+from shared.quality import tightening_result
 
 WINDOWS = {
     "torque_min_nm": 180.0,

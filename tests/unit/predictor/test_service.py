@@ -14,18 +14,19 @@ import zenoh
 
 from services.predictor.service import PredictorService
 from shared.config import LoadedStation
-from shared.contract import channels, codec, keys
-from shared.contract.messages import (
+from shared.contract import (
     Intensity,
     RunSummary,
     Sample,
     StickSlipEvent,
     StopDecision,
     TighteningResult,
+    channels,
+    codec,
+    keys,
 )
 from shared.errors import ConfigError
-from shared.runtime.service_skeleton import ServiceSkeleton
-from shared.runtime.zenoh_session import zenoh_config
+from shared.runtime import ServiceSkeleton, zenoh_config
 from tests.unit.predictor.live_predictor import (
     PROGRAM_OF,
     START_NS,

@@ -14,7 +14,7 @@ import zenoh
 
 from services.predictor.station_inbox import StationInbox
 from shared.contract import channels, keys
-from shared.runtime.zenoh_session import zenoh_config
+from shared.runtime import zenoh_config
 from tests.live_recorder import free_port, wait_until
 
 Handled = list[tuple[str, str, bytes]]

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from shared.stickslip import PredictorSettings
-from shared.stickslip.stop_policy import StopPolicy
+from shared.stickslip import PredictorSettings, StopPolicy
 
 SETTINGS = PredictorSettings(
     target_force_n=50_000.0,

@@ -9,7 +9,7 @@ import pytest
 import zenoh
 
 from shared.config import LoadedStation, load_station
-from shared.runtime.zenoh_session import zenoh_config
+from shared.runtime import zenoh_config
 from tests.live_recorder import RunningRecorder, free_port, write_station_file
 
 

@@ -15,14 +15,27 @@ from mcap.reader import make_reader
 
 from services.cli.main import main
 from shared.config import LoadedStation
-from shared.contract import channels, keys
-from shared.contract.codec import decode, json_schema
-from shared.contract.messages import ControllerAlarm, RunSummary, ToolData, ToolState
-from shared.wear.wear_bound import CONTRACT_LIMITS as LIMITS
-from shared.wear.wear_ledger import WearLedger, ledger_path
-from shared.wear.wear_ledger_file import APPLICATION_ID, LEDGER_VERSION, BrokenLedgerError
-from shared.wear.wear_ledger_file import COLUMNS as LEDGER_COLUMNS
-from shared.wear.wear_plant import merge, parse_reply
+from shared.contract import (
+    ControllerAlarm,
+    RunSummary,
+    ToolData,
+    ToolState,
+    channels,
+    decode,
+    json_schema,
+    keys,
+)
+from shared.wear import (
+    APPLICATION_ID,
+    LEDGER_VERSION,
+    BrokenLedgerError,
+    WearLedger,
+    ledger_path,
+    merge,
+    parse_reply,
+)
+from shared.wear import COLUMNS as LEDGER_COLUMNS
+from shared.wear import CONTRACT_LIMITS as LIMITS
 from tests.fuzz.payloads import template
 from tests.live_recorder import RunningRecorder, publish, wait_until
 

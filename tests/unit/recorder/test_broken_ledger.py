@@ -27,12 +27,9 @@ import zenoh
 
 from services.cli.main import main
 from shared.config import LoadedStation
-from shared.contract import channels
-from shared.contract.codec import decode
-from shared.contract.messages import RecorderStats, RunSummary, Sample, ToolState
-from shared.runtime.zenoh_session import zenoh_config
-from shared.wear.wear_bound import CONTRACT_LIMITS
-from shared.wear.wear_ledger import WearLedger
+from shared.contract import RecorderStats, RunSummary, Sample, ToolState, channels, decode
+from shared.runtime import zenoh_config
+from shared.wear import CONTRACT_LIMITS, WearLedger
 from tests.live_recorder import RunningRecorder, publish, wait_until
 from tests.paths import REPO
 

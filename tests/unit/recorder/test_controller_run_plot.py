@@ -20,9 +20,8 @@ import zenoh
 
 from services.cli.main import main
 from shared.config import load_any_station, toml_writer
-from shared.offline.post_mortem.post_mortem_run import read_run
-from shared.offline.post_mortem.run_plot import build_figure
-from shared.runtime.zenoh_session import zenoh_config
+from shared.offline.post_mortem import build_figure, read_run
+from shared.runtime import zenoh_config
 from tests.live_recorder import RunningRecorder, free_port, wait_until
 from tests.unit.openprotocol.bridge_harness import RunningBridge, bridge_station_file
 from tests.unit.openprotocol.tcp_controller import TcpController

@@ -12,12 +12,9 @@ import pytest
 from mcap.reader import make_reader
 
 from services.cli.main import main
-from shared.contract.codec import encode
-from shared.contract.messages import Sample, ToolState
-from shared.contract.trace import read_trace
-from shared.recordings.mcap.mcap_sink import McapSink
-from shared.recordings.mcap.recording_reader import RecordingScan
-from shared.recordings.received import classify
+from shared.contract import Sample, ToolState, encode, read_trace
+from shared.recordings import classify
+from shared.recordings.mcap import McapSink, RecordingScan
 
 T0_NS = 1_700_000_000_000_000_000
 SAMPLES = 3000

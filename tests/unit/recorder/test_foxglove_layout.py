@@ -8,7 +8,7 @@ from typing import Any
 
 from services.recorder.foxglove_live.foxglove_layout import SHIPPED_LAYOUT, layout, layout_text
 from services.recorder.foxglove_live.foxglove_server import served_channels
-from shared.contract.codec import json_schema
+from shared.contract import json_schema
 
 PATH = re.compile(r'^"(?P<topic>[^"]+)"(?:\.(?P<field>\w+))?$')
 

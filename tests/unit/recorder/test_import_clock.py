@@ -16,8 +16,8 @@ from typing import Any
 import pytest
 
 from services.cli.main import main
-from shared.offline.controller_import.controller_run import read_controller_run
-from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.offline.controller_import import read_controller_run
+from shared.recordings.mcap import RecordingScan
 from tests.paths import PROJECT_REAL_RUNS
 
 SOURCE = PROJECT_REAL_RUNS / "Ch_000001596334.json"  # 4 steps, 624 samples

@@ -22,10 +22,8 @@ import pytest
 from mcap.reader import make_reader
 
 from services.cli.main import main
-from shared.contract.channels import SCHEMA_TYPES
-from shared.contract.codec import json_schema
-from shared.contract.trace import read_trace
-from shared.offline.controller_import.controller_run import read_controller_run
+from shared.contract import SCHEMA_TYPES, json_schema, read_trace
+from shared.offline.controller_import import read_controller_run
 from tests.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 
 SHIPPED = sorted(PROJECT_REAL_RUNS.glob("Ch_*.json"))

@@ -19,9 +19,8 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
-from shared.recordings.mcap.mcap_sink import McapSink
-from shared.recordings.mcap.recording_reader import RecordingScan
-from shared.wear.wear_ledger import WearLedger
+from shared.recordings.mcap import McapSink, RecordingScan
+from shared.wear import WearLedger
 from tests.paths import PROJECT_REAL_RUNS, REPO
 
 CLASS_1 = [PROJECT_REAL_RUNS / "Ch_000001596334.json", PROJECT_REAL_RUNS / "Ch_000001596339.json"]

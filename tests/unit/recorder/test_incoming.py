@@ -12,17 +12,18 @@ import json
 import math
 from typing import Any
 
-from shared.contract import channels
-from shared.contract.codec import encode, to_dict
-from shared.contract.messages import (
+from shared.contract import (
     Intensity,
     RunSummary,
     Sample,
     SampleBatch,
     StickSlipEvent,
     ToolState,
+    channels,
+    encode,
+    to_dict,
 )
-from shared.recordings.received import MAX_AHEAD_S, OTHER_STATION, classify
+from shared.recordings import MAX_AHEAD_S, OTHER_STATION, classify
 from tests.fuzz.payloads import template
 
 T_NS = 1_700_000_000_000_000_000

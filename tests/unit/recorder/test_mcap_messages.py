@@ -8,7 +8,7 @@ import pytest
 from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
-from shared.recordings.mcap.mcap_messages import MessageAppender, MessageRow
+from shared.recordings.mcap import MessageAppender, MessageRow
 
 T0_NS = 1_700_000_000_000_000_000
 

@@ -9,15 +9,18 @@ import numpy as np
 import pytest
 
 from services.cli.main import main
-from shared.contract.codec import encode
-from shared.contract.messages import JudgedFigure, Sample, StickSlipEvent, TighteningResult
-from shared.offline.overlay.overlay_alignment import parse_alignment
-from shared.offline.overlay.overlay_plot import build_figure, run_colours
-from shared.offline.overlay.overlay_run import find_run_files, read_overlay_run
-from shared.offline.overlay.overlay_series import Overlay, build_overlay
-from shared.recordings.layout import file_path
-from shared.recordings.mcap.mcap_sink import McapSink
-from shared.recordings.received import classify
+from shared.contract import JudgedFigure, Sample, StickSlipEvent, TighteningResult, encode
+from shared.offline.overlay import (
+    Overlay,
+    build_figure,
+    build_overlay,
+    find_run_files,
+    parse_alignment,
+    read_overlay_run,
+    run_colours,
+)
+from shared.recordings import classify, file_path
+from shared.recordings.mcap import McapSink
 from tests.system.station_files import write_station
 
 T0_NS = 1_790_000_000_000_000_000

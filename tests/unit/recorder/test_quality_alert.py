@@ -14,9 +14,15 @@ import zenoh
 from mcap.reader import make_reader
 
 from shared.config import LoadedStation, load_station
-from shared.contract import channels
-from shared.contract.codec import decode, encode
-from shared.contract.messages import JudgedFigure, QualityAlert, TighteningResult, Verdict
+from shared.contract import (
+    JudgedFigure,
+    QualityAlert,
+    TighteningResult,
+    Verdict,
+    channels,
+    decode,
+    encode,
+)
 from tests.live_recorder import (
     RunningRecorder,
     has_subscribers,

@@ -15,12 +15,10 @@ import numpy as np
 import pytest
 
 from services.cli.main import main
-from shared.contract.codec import encode
-from shared.contract.messages import FigureStatus, JudgedFigure, RunSummary, TighteningResult
-from shared.quality.control_chart import c4, control_chart
-from shared.recordings.layout import file_path
-from shared.recordings.mcap.mcap_sink import McapSink
-from shared.recordings.received import classify
+from shared.contract import FigureStatus, JudgedFigure, RunSummary, TighteningResult, encode
+from shared.quality import c4, control_chart
+from shared.recordings import classify, file_path
+from shared.recordings.mcap import McapSink
 from tests.live_recorder import write_station_file
 
 DAY1_NS = int(datetime(2026, 3, 2, 8, 0, tzinfo=UTC).timestamp() * 1e9)

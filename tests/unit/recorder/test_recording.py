@@ -22,19 +22,20 @@ from mcap.well_known import MessageEncoding
 
 from services.recorder.service import RecorderService
 from shared.config import LoadedStation, load_station
-from shared.contract import channels, keys
-from shared.contract.codec import encode, json_schema
-from shared.contract.messages import (
+from shared.contract import (
     Intensity,
     RunSummary,
     Sample,
     StickSlipEvent,
     StopDecision,
     ToolState,
+    channels,
+    encode,
+    json_schema,
+    keys,
 )
-from shared.recordings.mcap.mcap_sink import RAW_ENCODING, RAW_REASON
-from shared.runtime.service_skeleton import ServiceSkeleton
-from shared.runtime.zenoh_session import zenoh_config
+from shared.recordings.mcap import RAW_ENCODING, RAW_REASON
+from shared.runtime import ServiceSkeleton, zenoh_config
 from tests.live_recorder import (
     RunningRecorder,
     has_subscribers,

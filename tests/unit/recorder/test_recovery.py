@@ -9,13 +9,10 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from shared.contract.codec import encode
-from shared.contract.messages import Sample
+from shared.contract import Sample, encode
 from shared.errors import InputError
-from shared.recordings.mcap.mcap_sink import McapSink
-from shared.recordings.mcap.recording_reader import RecordingScan
-from shared.recordings.mcap.recovery import default_target, recover
-from shared.recordings.received import classify
+from shared.recordings import classify
+from shared.recordings.mcap import McapSink, RecordingScan, default_target, recover
 
 T0_NS = 1_700_000_000_000_000_000
 

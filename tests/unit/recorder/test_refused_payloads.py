@@ -21,10 +21,8 @@ from mcap.reader import make_reader
 from test_recording import recorded_files  # type: ignore[import-not-found]
 
 from shared.config import LoadedStation
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.messages import RunSummary, Sample, StopDecision, ToolState
-from shared.recordings.mcap.mcap_sink import RAW_ENCODING
+from shared.contract import RunSummary, Sample, StopDecision, ToolState, channels, encode, keys
+from shared.recordings.mcap import RAW_ENCODING
 from tests.live_recorder import RunningRecorder, publish, wait_until
 
 RUN = 7

@@ -29,14 +29,10 @@ from services.cli.station_supervisor import stop_process
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.run_files import FileLimits
 from shared.config import LoadedStation, load_station
-from shared.contract import keys
-from shared.contract.codec import encode
-from shared.contract.messages import Prediction, StickSlipEvent
-from shared.recordings.file_metadata import FileMetadata
-from shared.recordings.received import Received, classify
+from shared.contract import Prediction, StickSlipEvent, encode, keys
+from shared.recordings import FileMetadata, Received, classify
+from shared.recordings.rerun import BLUEPRINT_FILE, RerunLive, RerunOptions, RerunSink
 from shared.recordings.rerun import rerun_blueprint as bp
-from shared.recordings.rerun.rerun_sink import RerunLive, RerunOptions, RerunSink
-from shared.recordings.rerun.rerun_streams import BLUEPRINT_FILE
 from tests.live_recorder import wait_until, write_station_file
 
 RERUN_CLI = Path(sys.executable).parent / "rerun"
@@ -193,7 +189,7 @@ def test_a_failing_rerun_sink_leaves_the_mcap_file_whole(
 def test_a_cut_rrd_is_reported_and_its_complete_chunks_recovered(tmp_path: Path) -> None:
     """As a kill -9 leaves it: no footer. verify says so; recover keeps what is whole."""
     from shared.errors import InputError
-    from shared.recordings.rerun.rrd_recovery import check_rrd, recover_rrd, rows_by_entity
+    from shared.recordings.rerun import check_rrd, recover_rrd, rows_by_entity
 
     whole = tmp_path / "st1_run1_000000.rrd"
     items = run_messages(1, 3000)

@@ -10,11 +10,8 @@ from mcap.reader import make_reader
 
 from services.recorder.live.run_files import FileLimits, StationFiles
 from shared.config import LoadedStation
-from shared.contract.codec import encode
-from shared.contract.messages import BusStats, RunSummary, Sample, ToolState
-from shared.recordings.file_metadata import FileMetadata
-from shared.recordings.layout import file_path
-from shared.recordings.received import classify
+from shared.contract import BusStats, RunSummary, Sample, ToolState, encode
+from shared.recordings import FileMetadata, classify, file_path
 
 T0_NS = 1_700_000_000_000_000_000  # 2023-11-14T22:13:20Z
 SECOND_NS = 1_000_000_000

@@ -8,16 +8,11 @@ from typing import Any
 import pytest
 
 from services.cli.main import main
-from shared.config.joint import load_joint
-from shared.contract.codec import encode
-from shared.contract.messages import Prediction, Sample, StickSlipEvent, StopDecision
-from shared.offline.post_mortem.post_mortem_errors import prediction_errors
-from shared.offline.post_mortem.post_mortem_panels import plateau_bars
-from shared.offline.post_mortem.post_mortem_run import read_run
-from shared.offline.post_mortem.run_plot import build_figure
-from shared.recordings.file_metadata import flatten
-from shared.recordings.mcap.mcap_sink import McapSink
-from shared.recordings.received import classify
+from shared.config import load_joint
+from shared.contract import Prediction, Sample, StickSlipEvent, StopDecision, encode
+from shared.offline.post_mortem import build_figure, plateau_bars, prediction_errors, read_run
+from shared.recordings import classify, flatten
+from shared.recordings.mcap import McapSink
 
 T0_NS = 1_700_000_000_000_000_000
 MS_NS = 1_000_000

@@ -28,19 +28,20 @@ from pydantic import TypeAdapter
 
 from services.recorder.live.sample_batches import BatchSamples, sample_texts
 from shared.config import LoadedStation, load_station
-from shared.contract import channels
-from shared.contract.codec import decode, encode
-from shared.contract.messages import (
+from shared.contract import (
     BusStats,
     Intensity,
     RecorderStats,
     Sample,
     SampleBatch,
     ToolState,
+    channels,
+    decode,
+    encode,
 )
-from shared.recordings.mcap.mcap_sink import RAW_ENCODING
-from shared.recordings.received import Received
-from shared.runtime.queued_publisher import QueuedPublisher
+from shared.recordings import Received
+from shared.recordings.mcap import RAW_ENCODING
+from shared.runtime import QueuedPublisher
 from tests.fuzz.payloads import template
 from tests.live_recorder import RunningRecorder, publish, wait_until, write_station_file
 

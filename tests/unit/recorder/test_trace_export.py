@@ -10,13 +10,10 @@ import numpy as np
 import pytest
 
 from services.cli.main import main
-from shared.contract.codec import encode
-from shared.contract.messages import Sample
-from shared.contract.trace import read_trace
+from shared.contract import Sample, encode, read_trace
 from shared.errors import InputError
-from shared.recordings.mcap.mcap_sink import McapSink
-from shared.recordings.mcap.trace_export import export_trace
-from shared.recordings.received import classify
+from shared.recordings import classify
+from shared.recordings.mcap import McapSink, export_trace
 
 T0_NS = 1_700_000_000_000_000_000
 MS_NS = 1_000_000

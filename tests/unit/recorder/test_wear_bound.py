@@ -19,9 +19,8 @@ import pytest
 
 from services.cli.main import main
 from shared.config import load_station
-from shared.contract.messages import RunSummary
-from shared.wear.wear_bound import F_SS_MAX_HZ, RefusedSummaryError, StationLimits, refusal
-from shared.wear.wear_ledger import WearLedger
+from shared.contract import RunSummary
+from shared.wear import F_SS_MAX_HZ, RefusedSummaryError, StationLimits, WearLedger, refusal
 from tests.live_recorder import write_station_file
 from tests.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 

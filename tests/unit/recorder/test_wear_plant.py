@@ -7,8 +7,7 @@ import json
 import pytest
 
 from shared.errors import InputError
-from shared.wear.wear_ledger import RunWear, ToolWear
-from shared.wear.wear_plant import WearReply, merge, parse_reply
+from shared.wear import RunWear, ToolWear, WearReply, merge, parse_reply
 
 T0_NS = 1_700_000_000_000_000_000
 

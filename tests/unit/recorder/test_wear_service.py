@@ -10,9 +10,7 @@ import zenoh
 from mcap.reader import make_reader
 
 from shared.config import LoadedStation, load_station
-from shared.contract import channels, keys
-from shared.contract.codec import encode
-from shared.contract.messages import RunSummary, ToolState
+from shared.contract import RunSummary, ToolState, channels, encode, keys
 from tests.live_recorder import (
     RunningRecorder,
     has_subscribers,
@@ -92,9 +90,8 @@ def test_summaries_count_once_and_a_due_tool_raises_an_alert(
 def test_a_ledger_that_cannot_be_written_keeps_the_runs_until_it_can(tmp_path: Path) -> None:
     """A file where the ledger's folder should be: logged, nothing raised, counted later."""
     from services.recorder.wear_watch import WearWatch
-    from shared.contract.codec import decode
-    from shared.wear.wear_bound import CONTRACT_LIMITS
-    from shared.wear.wear_ledger import WearLedger
+    from shared.contract import decode
+    from shared.wear import CONTRACT_LIMITS, WearLedger
 
     blocker = tmp_path / "recordings"
     blocker.write_text("not a folder")
@@ -118,8 +115,7 @@ def test_summaries_beyond_their_bound_are_refused_counted_and_said_in_recorder_s
 ) -> None:
     """The issue's probes on a running recorder: negative intensity (-2e9) and 9e11 (random
     frames on the ToolSensors id), a forged 1e15: none in the ledger, each counted."""
-    from shared.contract.codec import decode
-    from shared.contract.messages import RecorderStats
+    from shared.contract import RecorderStats, decode
 
     stats: list[RecorderStats] = []
     subscriber = publisher_session.declare_subscriber(

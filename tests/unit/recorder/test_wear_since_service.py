@@ -14,10 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from shared.contract.messages import RunSummary
-from shared.wear.wear_bound import CONTRACT_LIMITS as LIMITS
-from shared.wear.wear_ledger import WearLedger
-from shared.wear.wear_since_service import ADDED_SINCE
+from shared.contract import RunSummary
+from shared.wear import ADDED_SINCE, WearLedger
+from shared.wear import CONTRACT_LIMITS as LIMITS
 
 T0_NS = 1_700_000_000_000_000_000
 S_NS = 1_000_000_000

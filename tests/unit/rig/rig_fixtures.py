@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from shared.config import LoadedStation, Program, RigSection, load_station
-from shared.model.stiffness import JointConstants
+from shared.model import JointConstants
 
 STATION_FILE = Path(__file__).resolve().parents[3] / "config" / "station.toml"
 

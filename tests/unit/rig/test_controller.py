@@ -7,7 +7,7 @@ import pytest
 from services.rig.controller import RunController, StopSource
 from services.rig.physics import TighteningPhysics
 from shared.config import Program
-from shared.contract.messages import ToolRunState
+from shared.contract import ToolRunState
 
 from .rig_fixtures import constants, paper_program, paper_rig
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from services.rig.frames import RigFrames
-from shared.contract.can_database import StationDatabase
+from shared.contract import StationDatabase
 from tests.paths import DBC_FILE
 
 

@@ -14,8 +14,7 @@ from services.rig.controller import StopSource
 from services.rig.frames import RigFrames
 from services.rig.realtime import RealtimeRig, RunSummary, ToolIdentity
 from shared.config import Program
-from shared.contract.can_database import StationDatabase
-from shared.contract.messages import ToolRunState
+from shared.contract import StationDatabase, ToolRunState
 
 from .rig_fixtures import constants, paper_program, paper_rig, station
 

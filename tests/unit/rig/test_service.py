@@ -10,8 +10,7 @@ from pathlib import Path
 import can
 
 from services.rig import service
-from shared.contract.can_database import StationDatabase
-from shared.contract.messages import ToolRunState
+from shared.contract import StationDatabase, ToolRunState
 
 from .rig_fixtures import STATION_FILE
 

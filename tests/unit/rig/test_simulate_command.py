@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from services.cli.commands import simulate
-from shared.contract.trace import read_trace
+from shared.contract import read_trace
 from shared.errors import ConfigError
 
 from .rig_fixtures import STATION_FILE

@@ -16,10 +16,10 @@ from collections.abc import Callable
 import jsonschema
 import pytest
 
-from shared.contract import codec
-from shared.contract.channels import CHANNELS, SCHEMA_TYPES
-from shared.contract.message_fields import MAX_TEXT_CHARS
-from shared.contract.messages import (
+from shared.contract import (
+    CHANNELS,
+    MAX_TEXT_CHARS,
+    SCHEMA_TYPES,
     ControllerResult,
     RunSummary,
     Sample,
@@ -27,6 +27,7 @@ from shared.contract.messages import (
     StickSlipEvent,
     StopDecision,
     ToolState,
+    codec,
 )
 from shared.errors import InputError
 from tests.fuzz.payloads import refused_values, template

@@ -12,8 +12,7 @@ import math
 
 import pytest
 
-from shared.contract import codec
-from shared.contract.messages import (
+from shared.contract import (
     BusStats,
     Prediction,
     RunSummary,
@@ -21,6 +20,7 @@ from shared.contract.messages import (
     StickSlipEvent,
     StopDecision,
     ToolState,
+    codec,
 )
 from shared.errors import InputError
 

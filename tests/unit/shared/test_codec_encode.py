@@ -13,8 +13,7 @@ import math
 
 import pytest
 
-from shared.contract import codec
-from shared.contract.messages import Intensity, Prediction, Sample, StickSlipEvent
+from shared.contract import Intensity, Prediction, Sample, StickSlipEvent, codec
 from shared.errors import InputError
 
 EVENT = StickSlipEvent(

@@ -10,11 +10,9 @@ from typing import Any
 import jsonschema
 import pytest
 
-from shared.contract import channels, keys
-from shared.contract.can_database import CONTRACT, StationDatabase
-from shared.contract.channels import SCHEMA_TYPES
-from shared.contract.codec import decode, encode, json_schema
-from shared.contract.messages import (
+from shared.contract import (
+    CONTRACT,
+    SCHEMA_TYPES,
     BusStats,
     ControllerFunction,
     ControllerResult,
@@ -22,12 +20,18 @@ from shared.contract.messages import (
     Prediction,
     RunSummary,
     Sample,
+    StationDatabase,
     StickSlipEvent,
     StopDecision,
     StopReason,
     StopReasonName,
     ToolRunState,
     ToolState,
+    channels,
+    decode,
+    encode,
+    json_schema,
+    keys,
 )
 from shared.errors import CanDatabaseError, InputError
 from tests.paths import DBC_FILE
@@ -160,7 +164,7 @@ def test_keys() -> None:
 
 def test_a_live_decision_without_advisory_still_decodes_and_validates() -> None:
     """``advisory`` came later with a default: older payloads stay valid, and mean live."""
-    from shared.recordings.received import classify  # what the recorder files it as
+    from shared.recordings import classify  # what the recorder files it as
 
     old = {
         "station": "st1",

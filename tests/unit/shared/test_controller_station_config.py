@@ -19,7 +19,7 @@ from shared.config import (
     load_any_station,
     load_station,
 )
-from shared.contract.sensor_range import CONTRACT_RANGE
+from shared.contract import CONTRACT_RANGE
 from shared.errors import ConfigError
 from tests.paths import CONFIG, STATION_FILE
 

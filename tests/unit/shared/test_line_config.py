@@ -8,8 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from shared.config import derive_stations, derived_ids, load_line, load_station
-from shared.config.toml_writer import dumps
+from shared.config import derive_stations, derived_ids, dumps, load_line, load_station
 from shared.errors import ConfigError
 from tests.paths import CONFIG, STATION_FILE
 from tests.system.station_files import write_station

@@ -6,7 +6,7 @@ import logging
 
 import pytest
 
-from shared.runtime.log_limit import RateLimitedLog
+from shared.runtime import RateLimitedLog
 
 
 def test_the_first_at_once_then_one_line_per_interval_counting_the_rest(

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from shared.contract.messages import Intensity, Sample, StickSlipEvent
-from shared.runtime.sample_batching import BATCH_PERIOD_S, MAX_BATCH_SAMPLES, SampleBatching
+from shared.contract import Intensity, Sample, StickSlipEvent
+from shared.runtime import BATCH_PERIOD_S, MAX_BATCH_SAMPLES, SampleBatching
 from tests.fuzz.payloads import template
 
 T0_NS = 1_700_000_000_000_000_000

@@ -7,8 +7,7 @@ from pathlib import Path
 import pytest
 
 from shared.config import load_station
-from shared.contract.can_database import StationDatabase
-from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
+from shared.contract import CONTRACT_RANGE, SensorRange, StationDatabase
 from tests.paths import DBC_FILE, STATION_FILE
 
 

@@ -15,8 +15,7 @@ import zenoh
 
 from shared.contract import channels, keys
 from shared.errors import BoltwatchError
-from shared.runtime.service_skeleton import ServiceSkeleton, Stop
-from shared.runtime.zenoh_session import zenoh_config
+from shared.runtime import ServiceSkeleton, Stop, zenoh_config
 from tests.live_recorder import WAIT_S, free_port
 
 TOKEN_KEY = keys.health_key("st1", "tester")

@@ -9,7 +9,7 @@ import subprocess
 import sys
 import time
 
-from shared.runtime.supervisor_link import SUPERVISOR_PID_ENV
+from shared.runtime import SUPERVISOR_PID_ENV
 from tests.paths import REPO
 
 FOLLOWER = """

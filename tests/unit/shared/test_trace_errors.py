@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
-from shared.contract.trace import read_trace
+from shared.contract import read_trace
 from shared.errors import InputError
 
 GOOD = "time_s,torque_nm,angle_deg,force_n\n0.000,1.0,0.1,100.0\n0.001,1.5,0.2,\n"

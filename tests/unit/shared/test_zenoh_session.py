@@ -10,9 +10,9 @@ import pytest
 import zenoh
 from pydantic import ValidationError
 
-from shared.config.station import ZenohSection
+from shared.config import ZenohSection
 from shared.errors import TransportError
-from shared.runtime.zenoh_session import RouterLink, open_session, zenoh_config
+from shared.runtime import RouterLink, open_session, zenoh_config
 from tests.system.station_files import free_tcp_port
 
 

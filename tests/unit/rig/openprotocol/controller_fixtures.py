@@ -12,10 +12,17 @@ from pathlib import Path
 
 from services.rig.openprotocol.simulated_controller import SimulatedController
 from shared.config import load_station
-from shared.openprotocol.codec import WireMessage, decode, encode
-from shared.openprotocol.framing import Frame, FrameReader, frame_bytes
-from shared.openprotocol.session import CommandAccepted, CommandError
-from shared.openprotocol.subscriptions import DataSubscribe
+from shared.openprotocol import (
+    CommandAccepted,
+    CommandError,
+    DataSubscribe,
+    Frame,
+    FrameReader,
+    WireMessage,
+    decode,
+    encode,
+    frame_bytes,
+)
 from tests.live_recorder import free_port
 from tests.paths import CONFIG, STATION_FILE
 

@@ -8,29 +8,29 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from shared.openprotocol.alarms import (
+from shared.openprotocol import (
+    UNIT_DEGREE,
+    UNIT_NM,
     Alarm,
     AlarmStatus,
     AlarmSubscribe,
-)
-from shared.openprotocol.codec import decode
-from shared.openprotocol.results import (
+    CommunicationStart,
+    CommunicationStartAck,
+    DataSubscribe,
+    ErrorCode,
+    KeepAlive,
     LastTighteningResult,
     OldResultRequest,
     OldTighteningResult,
     ResultAcknowledge,
     ResultSubscribe,
+    TraceCurve,
+    TraceType,
     ValueStatus,
+    decode,
+    timestamp_ns,
+    trace_extra_data,
 )
-from shared.openprotocol.session import (
-    CommunicationStart,
-    CommunicationStartAck,
-    ErrorCode,
-    KeepAlive,
-)
-from shared.openprotocol.subscriptions import DataSubscribe, trace_extra_data
-from shared.openprotocol.timestamps import timestamp_ns
-from shared.openprotocol.traces import UNIT_DEGREE, UNIT_NM, TraceCurve, TraceType
 from tests.unit.rig.openprotocol.controller_fixtures import (
     FIRST_ID,
     RawIntegrator,

@@ -9,18 +9,23 @@ from pathlib import Path
 import pytest
 
 from services.rig.openprotocol.controller_server import MAX_LINKS
-from shared.openprotocol.codec import encode
-from shared.openprotocol.results import OldResultRequest, ResultSubscribe, ResultUnsubscribe
-from shared.openprotocol.session import (
+from shared.openprotocol import (
     CommandAccepted,
     CommunicationStart,
     CommunicationStartAck,
     CommunicationStop,
+    DataSubscribe,
+    DataUnsubscribe,
     ErrorCode,
     KeepAlive,
+    OldResultRequest,
+    ResultSubscribe,
+    ResultUnsubscribe,
+    ToolData,
+    ToolDataRequest,
+    encode,
+    trace_extra_data,
 )
-from shared.openprotocol.subscriptions import DataSubscribe, DataUnsubscribe, trace_extra_data
-from shared.openprotocol.tool_data import ToolData, ToolDataRequest
 from tests.unit.rig.openprotocol.controller_fixtures import (
     RawIntegrator,
     running_controller,

@@ -11,10 +11,8 @@ from services.rig.openprotocol.controller_state import ControllerState
 from services.rig.openprotocol.result_messages import coefficient_for, trace_curves
 from services.rig.openprotocol.result_store import ResultStore
 from services.rig.openprotocol.tightening import RunCurves, TighteningJudge
-from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
-from shared.config.station import Program
-from shared.openprotocol.alarms import Alarm, AlarmAcknowledgedOnController
-from shared.openprotocol.codec import encode
+from shared.config import OpenProtocolSection, Program, RigOpenProtocolSection
+from shared.openprotocol import Alarm, AlarmAcknowledgedOnController, encode
 from tests.unit.rig.rig_fixtures import paper_program
 
 SECTION = OpenProtocolSection(host="127.0.0.1")

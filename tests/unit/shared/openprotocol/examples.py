@@ -4,10 +4,20 @@ from __future__ import annotations
 
 import dataclasses
 
-from shared.openprotocol import alarms, results, session, subscriptions, tool_data
-from shared.openprotocol.codec import WireMessage
-from shared.openprotocol.results import BatchStatus, ValueStatus
-from shared.openprotocol.traces import ResolutionField, TraceCurve, TraceType, VariableField
+from shared.openprotocol import (
+    BatchStatus,
+    ResolutionField,
+    TraceCurve,
+    TraceType,
+    ValueStatus,
+    VariableField,
+    WireMessage,
+    alarms,
+    results,
+    session,
+    subscriptions,
+    tool_data,
+)
 from tests.unit.shared.openprotocol.test_golden_messages import (
     LAST_RESULT_1,
     LAST_RESULT_2,

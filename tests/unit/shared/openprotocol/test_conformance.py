@@ -29,11 +29,19 @@ from typing import Any
 
 import pytest
 
-from shared.openprotocol.codec import KNOWN_MIDS, UnknownMessage, decode, encode
-from shared.openprotocol.dialect import Dialect
-from shared.openprotocol.errors import OpenProtocolError
-from shared.openprotocol.framing import Frame, FrameReader, frame_bytes
-from shared.openprotocol.subscriptions import DataSubscribe, trace_types_of
+from shared.openprotocol import (
+    KNOWN_MIDS,
+    DataSubscribe,
+    Dialect,
+    Frame,
+    FrameReader,
+    OpenProtocolError,
+    UnknownMessage,
+    decode,
+    encode,
+    frame_bytes,
+    trace_types_of,
+)
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[3] / "data" / "openprotocol" / "examples"
 SENDERS = {"controller", "integrator"}

@@ -6,8 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from shared.openprotocol.errors import OpenProtocolError
-from shared.openprotocol.framing import Frame, FrameReader, frame_bytes
+from shared.openprotocol import Frame, FrameReader, OpenProtocolError, frame_bytes
 
 # Written by hand from the header layout: 0001 rev 1, no data.
 START_SPACES = b"00200001001         \x00"

@@ -4,17 +4,20 @@ from __future__ import annotations
 
 import pytest
 
-from shared.openprotocol.alarms import Alarm
-from shared.openprotocol.codec import decode, encode
-from shared.openprotocol.framing import FrameReader
-from shared.openprotocol.results import (
+from shared.openprotocol import (
+    Alarm,
     BatchStatus,
+    CommandError,
+    CommunicationStart,
+    CommunicationStartAck,
+    FrameReader,
     LastTighteningResult,
     OldTighteningResult,
+    ToolData,
     ValueStatus,
+    decode,
+    encode,
 )
-from shared.openprotocol.session import CommandError, CommunicationStart, CommunicationStartAck
-from shared.openprotocol.tool_data import ToolData
 
 NAME = "Airbag1".ljust(25)
 VIN = "KPOL3456JKLO897".ljust(25)

@@ -8,14 +8,19 @@ import datetime as dt
 import pytest
 
 from shared.errors import InputError
-from shared.openprotocol.codec import WireMessage, decode, encode
-from shared.openprotocol.errors import OpenProtocolError
-from shared.openprotocol.framing import Frame
-from shared.openprotocol.results import LastTighteningResult
-from shared.openprotocol.session import CommandError
-from shared.openprotocol.subscriptions import trace_extra_data
-from shared.openprotocol.timestamps import format_timestamp, timestamp_ns
-from shared.openprotocol.traces import TraceCurve
+from shared.openprotocol import (
+    CommandError,
+    Frame,
+    LastTighteningResult,
+    OpenProtocolError,
+    TraceCurve,
+    WireMessage,
+    decode,
+    encode,
+    format_timestamp,
+    timestamp_ns,
+    trace_extra_data,
+)
 from tests.unit.shared.openprotocol.examples import TRACE
 from tests.unit.shared.openprotocol.test_golden_messages import (
     LAST_RESULT_1,

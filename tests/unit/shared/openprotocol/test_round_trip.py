@@ -4,18 +4,22 @@ from __future__ import annotations
 
 import pytest
 
-from shared.openprotocol.codec import (
+from shared.openprotocol import (
+    BINARY_MIDS,
     KNOWN_MIDS,
     SUPPORTED_REVISIONS,
+    CommandAccepted,
+    CommandError,
+    Dialect,
+    Frame,
+    FrameReader,
+    KeepAlive,
+    OpenProtocolError,
     UnknownMessage,
     WireMessage,
     decode,
     encode,
 )
-from shared.openprotocol.dialect import Dialect
-from shared.openprotocol.errors import OpenProtocolError
-from shared.openprotocol.framing import BINARY_MIDS, Frame, FrameReader
-from shared.openprotocol.session import CommandAccepted, CommandError, KeepAlive
 from tests.unit.shared.openprotocol.examples import EXAMPLES
 
 DIALECTS = [

@@ -6,11 +6,21 @@ import dataclasses
 
 import pytest
 
-from shared.openprotocol.codec import decode, encode
-from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect
-from shared.openprotocol.framing import Frame, FrameReader
-from shared.openprotocol.subscriptions import DataSubscribe, trace_extra_data, trace_types_of
-from shared.openprotocol.traces import ResolutionField, TraceCurve, TraceType, VariableField
+from shared.openprotocol import (
+    DEFAULT_DIALECT,
+    DataSubscribe,
+    Dialect,
+    Frame,
+    FrameReader,
+    ResolutionField,
+    TraceCurve,
+    TraceType,
+    VariableField,
+    decode,
+    encode,
+    trace_extra_data,
+    trace_types_of,
+)
 
 # Written by hand from the layout: tightening 345, torque in Nm, coefficient
 # 0.01 (PID 02214), 1 ms between samples (unit 202), three samples 100, -50, 1234.
