@@ -1,4 +1,16 @@
-"""(to be written)"""
+"""What crosses a process or a file boundary: the contracts other tools rely on.
+
+- :mod:`.messages` (every message on the line), :mod:`.controller_messages` (what
+  tool controllers say: their results, tool data, alarms, a bridge's counters)
+- :mod:`.channels` (every channel: topic, message type, who puts it, how),
+  :mod:`.keys` (zenoh key expressions)
+- :mod:`.codec` (JSON encoding and the JSON schema of each message),
+  :mod:`.message_fields` (the bounds of every field), :mod:`.message_shape`
+  (what a decoder derives once from a message type)
+- :mod:`.can_database` (the station's DBC, checked against the CAN contract),
+  :mod:`.sensor_range` (what a station's sensors can measure)
+- :mod:`.trace` (the offline trace CSV), :mod:`.run_clock` (a run's clock: ns <-> s)
+"""
 
 from shared.contract.can_database import CONTRACT, COUNTER_MODULO, SAMPLE_RATE_HZ, StationDatabase
 from shared.contract.channels import CHANNELS, SCHEMA_TYPES, Channel

@@ -1,4 +1,13 @@
-"""(to be written)"""
+"""OK or NOK, and how capable a program is: the verdict, results, Cpk and control charts. Pure.
+
+- :mod:`.verdict` (each final figure against its window, then the verdict: where
+  OK/NOK is decided)
+- :mod:`.run_result` (a live run's TighteningResult from its summary and
+  program), :mod:`.controller_result` (a controller's run's, from its own values)
+- :mod:`.capability` (mean, σ, Cp and Cpk of one figure against its window),
+  :mod:`.control_chart` (Shewhart X̄/R and X̄/s), :mod:`.program_statistics`
+  (a program's statistics over its results)
+"""
 
 from shared.quality.capability import capability, window_text
 from shared.quality.control_chart import c4, control_chart

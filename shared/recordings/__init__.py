@@ -1,4 +1,12 @@
-"""(to be written)"""
+"""Recordings, without zenoh: where a run's files go, what is recorded, and the file formats.
+
+- :mod:`.layout` (where a run's files go and how to find them: the one rule)
+- :mod:`.received` (one received payload, classified, checked and decoded: what
+  every sink writes), :mod:`.sink` (the shape every writer of a run shares)
+- :mod:`.file_metadata` (the metadata records of a recording)
+- :mod:`.mcap` (MCAP: written, read back, recovered, exported), :mod:`.rerun`
+  (Rerun ``.rrd``: written, recovered, made from MCAP)
+"""
 
 from shared.recordings.file_metadata import FileMetadata, flatten
 from shared.recordings.layout import (

@@ -1,4 +1,18 @@
-"""(to be written)"""
+"""How a service lives and talks: its skeleton, its zenoh session, its publishers, its CAN bus.
+
+- :mod:`.service_skeleton` (what a service opens and declares, and the order it
+  stops in), :mod:`.service_runtime` (signals, the work thread, the exit status),
+  :mod:`.supervisor_link` (stop when ``boltwatch up`` dies)
+- :mod:`.zenoh_session` (sessions from configuration, the router link watched,
+  a channel's publisher), :mod:`.receive_threads` (cheap callbacks on zenoh's threads)
+- :mod:`.queued_publisher` (publishing without waiting, in order, per station),
+  :mod:`.sample_batching` (samples toward the line in batches)
+- :mod:`.can_bus` (the station's CAN bus, python-can), :mod:`.realtime` (real-time
+  scheduling of the stop path's threads)
+- :mod:`.logging_setup` (one line per event, JSON in containers), :mod:`.log_limit`
+  (one log line for a flood of alike faults), :mod:`.option_types` (argparse
+  types that refuse impossible numbers)
+"""
 
 from shared.runtime.can_bus import open_bus
 from shared.runtime.log_limit import RateLimitedLog

@@ -1,7 +1,8 @@
-"""The pure predictor core: samples in, stick-slip events and stop decisions out.
+"""The paper's stick-slip algorithm as a library: samples in, events and stop decisions out. Pure.
 
 No zenoh, no clock: the same :class:`PredictorCore` serves the live service,
-``boltwatch predict`` and the tests. Files, one concept each:
+the acquisition's edge predictor, ``boltwatch predict``, ``boltwatch import``,
+the Open Protocol bridge and the tests. Files, one concept each:
 
 - :mod:`.settings`           what one run is predicted against (program, targets, limits)
 - :mod:`.input_guard`        bad input (NaN, absurd values, bad times, gaps, lost frames) made safe
@@ -24,6 +25,10 @@ No zenoh, no clock: the same :class:`PredictorCore` serves the live service,
                              plateau (eqs. 64/65), intensity (eq. 70), constant bands (eq. 71)
 - :mod:`.outputs`            the stop decision: CoreDecision
 - :mod:`.predictor_core`     the facade that joins them
+- :mod:`.run_messages`       the core's outputs as the messages a station publishes
+- :mod:`.trace_replay`       the core over an offline trace (``boltwatch predict``)
+- :mod:`.stopped_run`, :mod:`.advisory_replay`  the core over a run a tool controller
+                             stopped, after the fact (``boltwatch import``, the bridge)
 """
 
 from shared.stickslip.advisory_replay import replay_run
