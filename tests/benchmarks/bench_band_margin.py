@@ -11,7 +11,7 @@ benchmark's stop latency and settling do not matter here) twice:
   out for lack of evidence (noise floor not settled, a period that was not
   one stick phase), and the largest share of its widened bound any median
   reached per constant (1.0 = a stop);
-- configured wrongly, as ``tests/unit/predictor/test_model_bands.py`` does
+- configured wrongly, as ``tests/unit/shared/stickslip/test_model_bands.py`` does
   (μ_slip so low that the configured slips are far larger): the share of
   joints stopped on ``constant_out_of_band``, and how many events it took.
 """

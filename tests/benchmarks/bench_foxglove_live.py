@@ -4,7 +4,7 @@ Run: ``.venv/bin/python tests/benchmarks/bench_foxglove_live.py [--repeats N]`` 
 collected by pytest). Files 20 s of one station's 1 kHz samples as the recorder's worker
 does (each sample classified, written to MCAP with fsync off, and handed to
 :class:`FoxgloveLive`), three ways, alternating: no Foxglove server, a server with no
-client, a server with a real WebSocket client (:mod:`tests.foxglove_client`) subscribed
+client, a server with a real WebSocket client (:mod:`tests.support.foxglove_client`) subscribed
 to the samples. Prints the medians of the worker thread's CPU per sample (the server's
 own threads and the client are not the recorder's cost, and share the two cores) and how
 many samples the client received.
@@ -36,8 +36,8 @@ from shared.recordings import (
     FileMetadata,
     classify,
 )
-from tests.foxglove_client import FoxgloveClient
-from tests.live_recorder import free_port, write_station_file
+from tests.support.foxglove_client import FoxgloveClient
+from tests.support.live_recorder import free_port, write_station_file
 
 SAMPLES = 20_000
 KEY = "boltwatch/st1/samples"

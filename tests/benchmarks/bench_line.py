@@ -67,10 +67,10 @@ from shared.contract import (
 from shared.runtime import declare_channel, zenoh_config
 from tests.benchmarks.bench_stop_path import serve_from
 from tests.benchmarks.line_station_runs import SHORT_PROGRAM, Heard, figures, tighten
-from tests.fuzz.payloads import template
-from tests.system.can_injector import StopListener
-from tests.system.station_files import free_tcp_port, write_station
-from tests.unit.predictor.synthetic import staircase
+from tests.support.can_injector import StopListener
+from tests.support.fuzz.payloads import template
+from tests.support.station_files import free_tcp_port, write_station
+from tests.support.synthetic_runs import staircase
 
 REAL_STATION = "st1"
 START_TIMEOUT_S = 120.0

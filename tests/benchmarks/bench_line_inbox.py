@@ -73,8 +73,8 @@ from shared.runtime import (
 )
 from tests.benchmarks.bench_line import cpu_s, wait_alive
 from tests.benchmarks.line_station_runs import SHORT_PROGRAM
-from tests.system.station_files import free_tcp_port, serve, write_station
-from tests.unit.predictor.synthetic import staircase
+from tests.support.station_files import free_tcp_port, serve, write_station
+from tests.support.synthetic_runs import staircase
 
 TOPICS = (channels.SAMPLES.topic, channels.TOOL.topic)
 WAKE = b""

@@ -104,7 +104,7 @@ from tests.benchmarks.bench_predictor_accuracy import (
 )
 from tests.benchmarks.bench_stop_path import serve_from, wait_alive
 from tests.benchmarks.joint_files import joint_toml
-from tests.system.station_files import write_station
+from tests.support.station_files import write_station
 
 STATION = "st1"
 #: the contract DBC's ranges: the drawn programs' limits are held inside them

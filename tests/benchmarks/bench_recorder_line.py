@@ -51,7 +51,7 @@ from tests.benchmarks.bench_line import (
     events_in,
     run_rows,
 )
-from tests.system.station_files import write_station
+from tests.support.station_files import write_station
 
 TAKE_MS = 5  # the service's TAKE_INTERVAL_S
 

@@ -38,7 +38,7 @@ def one_recorder(runs: int, rerun: bool) -> None:
     from shared.contract import Sample, ToolState, encode
     from shared.recordings import FileMetadata, classify
     from shared.recordings.rerun import RerunOptions
-    from tests.live_recorder import write_station_file
+    from tests.support.live_recorder import write_station_file
 
     tmp = Path(tempfile.mkdtemp(prefix="boltwatch-memory-"))
     station_file = write_station_file(tmp / "station.toml", tmp / "rec", ["tcp/127.0.0.1:1"])

@@ -35,7 +35,7 @@ from shared.recordings import (
     classify,
 )
 from shared.recordings.rerun import RerunOptions, RerunSink
-from tests.live_recorder import write_station_file
+from tests.support.live_recorder import write_station_file
 
 SAMPLES = 60_000  # one minute at 1 kHz
 RATE_HZ = 1000

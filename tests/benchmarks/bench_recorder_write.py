@@ -35,7 +35,7 @@ from shared.recordings import (
     classify,
 )
 from shared.recordings.mcap import McapSink
-from tests.live_recorder import write_station_file
+from tests.support.live_recorder import write_station_file
 
 SAMPLES = 60_000  # one minute at 1 kHz
 FLUSHES = SAMPLES // 1000  # the simulated receive clock flushes once a second

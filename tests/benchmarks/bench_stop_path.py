@@ -66,8 +66,8 @@ from shared.contract import (
     keys,
 )
 from shared.runtime import zenoh_config
-from tests.system.can_injector import HeardStop, StopListener
-from tests.system.station_files import free_tcp_port, write_station
+from tests.support.can_injector import HeardStop, StopListener
+from tests.support.station_files import free_tcp_port, write_station
 
 STATION = "st1"
 HARD_LIMIT_PROGRAM, PLATEAU_PROGRAM = 1, 2

@@ -5,7 +5,7 @@ Run on demand (not collected by pytest)::
     .venv/bin/python tests/benchmarks/fuzz_services.py --minutes 10
 
 The same targets, payloads and property as ``tests/unit/*/test_*_fuzz.py``
-(:mod:`tests.fuzz`): each live service (acquisition, predictor, recorder)
+(:mod:`tests.support.fuzz`): each live service (acquisition, predictor, recorder)
 gets a third of the time, in rounds of ``--examples`` hypothesis examples,
 each new round drawing new payloads; then it must still serve (a good
 decision stops the tool, a good run is decided, a good run is recorded), and
@@ -30,9 +30,9 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from tests.fuzz.property import FuzzCount, fuzz
-from tests.fuzz.rules import ACQUISITION, PREDICTOR, RECORDER, ServiceRules
-from tests.fuzz.targets import AcquisitionTarget, PredictorTarget, RecorderTarget
+from tests.support.fuzz.property import FuzzCount, fuzz
+from tests.support.fuzz.rules import ACQUISITION, PREDICTOR, RECORDER, ServiceRules
+from tests.support.fuzz.targets import AcquisitionTarget, PredictorTarget, RecorderTarget
 
 
 class CountingHandler(logging.Handler):

@@ -18,8 +18,8 @@ from pathlib import Path
 import zenoh
 
 from shared.contract import RunSummary, StickSlipEvent, StopDecision, channels, decode
-from tests.system.can_injector import HeardStop
-from tests.system.station_files import serve
+from tests.support.can_injector import HeardStop
+from tests.support.station_files import serve
 
 #: The short program: program 1 of the embedded station, to a lower preload, faster.
 SHORT_PROGRAM = {

@@ -35,7 +35,7 @@ from mcap.reader import make_reader
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 
-from tests.system.station_files import child_pids, command_line, write_station
+from tests.support.station_files import child_pids, command_line, write_station
 
 SECONDS_PER_RUN_AT_MOST = 1.0  # program 1 takes about 2 s a run: never too few runs
 WARM_UP_S = 60.0

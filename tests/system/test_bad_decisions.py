@@ -36,9 +36,9 @@ from shared.contract import (
     keys,
 )
 from shared.runtime import zenoh_config
-from tests.live_recorder import wait_until
-from tests.system.can_injector import CanInjector, StopListener
-from tests.system.station_files import free_tcp_port, serve, write_station
+from tests.support.can_injector import CanInjector, StopListener
+from tests.support.live_recorder import wait_until
+from tests.support.station_files import free_tcp_port, serve, write_station
 
 pytestmark = pytest.mark.system
 

@@ -2,7 +2,7 @@
 
 The router and ``boltwatch serve acquisition`` run as processes on an
 isolated station file; the test plays the tool and the force sensor on the
-same ``udp_multicast`` bus (:mod:`tests.system.can_injector`) and watches
+same ``udp_multicast`` bus (:mod:`tests.support.can_injector`) and watches
 ``boltwatch/st1/*`` from its own zenoh client session. One run carries every
 fault kind at once; the samples that reach zenoh must be exactly the good
 ones, in order, with the right sequence, and the BusStats counters must
@@ -40,9 +40,9 @@ from shared.contract import (
     keys,
 )
 from shared.runtime import zenoh_config
-from tests.live_recorder import wait_until
-from tests.system.can_injector import CanInjector, Pacer, StopListener
-from tests.system.station_files import free_tcp_port, serve, write_station
+from tests.support.can_injector import CanInjector, Pacer, StopListener
+from tests.support.live_recorder import wait_until
+from tests.support.station_files import free_tcp_port, serve, write_station
 
 pytestmark = pytest.mark.system
 

@@ -2,7 +2,7 @@
 
 Certificates come from config/security/make-compose-certs.sh; the compose files
 are merged as ``docker compose -f docker-compose.yml -f docker-compose.tls.yml``
-merges them (tests/compose_layout.py). Each service runs as
+merges them (tests/support/compose_layout.py). Each service runs as
 ``python -m services.cli`` with the exact arguments of its merged command, in a
 copy of what its container sees (config, its own identity, the recordings),
 with two things changed for loopback: the router is ``127.0.0.1`` on a free port
@@ -37,7 +37,7 @@ from shared.config import load_station
 from shared.contract import RunSummary, StopDecision, channels, decode, keys
 from shared.errors import BoltwatchError
 from shared.runtime import open_session
-from tests.compose_layout import (
+from tests.support.compose_layout import (
     BASE_FILE,
     IDENTITY,
     TLS_FILE,
@@ -46,9 +46,9 @@ from tests.compose_layout import (
     make_compose_certs,
     split_volume,
 )
-from tests.live_recorder import has_subscribers
-from tests.paths import REPO
-from tests.system.station_files import free_tcp_port, free_udp_port, serve
+from tests.support.live_recorder import has_subscribers
+from tests.support.paths import REPO
+from tests.support.station_files import free_tcp_port, free_udp_port, serve
 
 pytestmark = [
     pytest.mark.system,

@@ -1,7 +1,7 @@
 """``boltwatch serve dashboard`` in a real headless browser, on a real line.
 
 A live station (router, recorder, acquisition with its edge predictor, rig:
-real processes, :mod:`tests.system.live_station`) with a wear threshold its
+real processes, :mod:`tests.support.live_station`) with a wear threshold its
 tool reaches after about four runs (program 2: some 1.2e6 a run); the page's own process
 (``serve dashboard``); Debian's chromium driven by playwright. The page must
 show a result the test heard on zenoh (its run and its OK/NOK), then a newer
@@ -27,9 +27,9 @@ from pathlib import Path
 import pytest
 
 from shared.contract import TighteningResult, channels, decode
-from tests.live_recorder import free_port
-from tests.paths import REPO
-from tests.system.live_station import STATION, live_station
+from tests.support.live_recorder import free_port
+from tests.support.live_station import STATION, live_station
+from tests.support.paths import REPO
 
 pytestmark = pytest.mark.system
 

@@ -24,10 +24,10 @@ from services.recorder.live.recorder import RETRY_INTERVAL_NS
 from shared.contract import RunSummary
 from shared.recordings.mcap import RecordingScan
 from shared.wear import CONTRACT_LIMITS, WearLedger
-from tests.paths import REPO
-from tests.system.disk_faults import fill_up, read_only, tmpfs
-from tests.system.live_station import check_next_run_normal, live_station
-from tests.system.recorder_driver import RecorderDriver, recorded_messages
+from tests.support.disk_faults import fill_up, read_only, tmpfs
+from tests.support.live_station import check_next_run_normal, live_station
+from tests.support.paths import REPO
+from tests.support.recorder_driver import RecorderDriver, recorded_messages
 
 pytestmark = pytest.mark.system
 
@@ -147,7 +147,7 @@ def _limit_file_size() -> None:
 def test_a_file_size_limit_gives_efbig_and_the_next_run_is_recorded(tmp_path: Path) -> None:
     """RLIMIT_FSIZE in a child process: the first run's file hits it, the next one fits."""
     result = subprocess.run(
-        [sys.executable, "-m", "tests.system.recorder_driver", str(tmp_path)],
+        [sys.executable, "-m", "tests.support.recorder_driver", str(tmp_path)],
         cwd=REPO,
         capture_output=True,
         text=True,

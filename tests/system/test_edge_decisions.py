@@ -19,8 +19,8 @@ from services.cli.station_supervisor import stop_process
 from shared.config import load_station
 from shared.contract import StationDatabase, StopDecision, ToolRunState, channels, encode, keys
 from shared.runtime import zenoh_config
-from tests.system.can_injector import CanInjector, Pacer, StopListener
-from tests.system.station_files import free_tcp_port, serve, write_station
+from tests.support.can_injector import CanInjector, Pacer, StopListener
+from tests.support.station_files import free_tcp_port, serve, write_station
 
 pytestmark = pytest.mark.system
 

@@ -22,9 +22,8 @@ import pytest
 from services.cli.station_supervisor import stop_process
 from shared.contract import keys
 from shared.runtime import open_from, zenoh_config
-from tests.paths import REPO
-from tests.system.station_files import serve, write_station
-from tests.system.test_status_command import router  # noqa: F401  (the fixture)
+from tests.support.paths import REPO
+from tests.support.station_files import serve, write_station
 
 pytestmark = pytest.mark.system
 
@@ -75,7 +74,7 @@ def processes(tmp_path: Path) -> Iterator[list[subprocess.Popen[bytes]]]:
 
 def test_the_predictor_of_an_edge_station_refuses_at_once_before_and_after_the_acquisition(
     tmp_path: Path,
-    router: str,  # noqa: F811
+    router: str,
     processes: list[subprocess.Popen[bytes]],
 ) -> None:
     station_file = write_station(tmp_path, zenoh_port=int(router.rsplit(":", 1)[1]))
@@ -103,7 +102,7 @@ def test_without_a_router_the_refusal_is_the_same_line(tmp_path: Path) -> None:
 
 def test_a_line_placed_station_still_gets_its_predictor(
     tmp_path: Path,
-    router: str,  # noqa: F811
+    router: str,
     processes: list[subprocess.Popen[bytes]],
 ) -> None:
     station_file = write_station(

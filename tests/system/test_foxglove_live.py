@@ -3,7 +3,7 @@
 ``boltwatch up`` runs a real station (router, recorder, acquisition with its
 predictor, rig on a CAN bus); beside it a viewer (``serve recorder
 --view-only --foxglove-port``, its own scratch folder) serves the Foxglove
-WebSocket. A real client (``websockets``, :mod:`tests.foxglove_client`)
+WebSocket. A real client (``websockets``, :mod:`tests.support.foxglove_client`)
 subscribes before the first run and receives the runs: every sample of a run
 one by one (the station sends batches), its decision and its result, each
 payload valid against the JSON schema its channel advertised, the same
@@ -21,10 +21,10 @@ import pytest
 from mcap.reader import make_reader
 
 from shared.contract import channels, json_schema
-from tests.foxglove_client import FoxgloveClient
-from tests.live_recorder import free_port, wait_until
-from tests.system.station_files import serve, write_station
-from tests.system.test_station_up import run_up
+from tests.support.foxglove_client import FoxgloveClient
+from tests.support.live_recorder import free_port, wait_until
+from tests.support.station_files import serve, write_station
+from tests.support.station_up import run_up
 
 pytestmark = pytest.mark.system
 

@@ -22,7 +22,7 @@ import pytest
 
 from shared.offline.controller_import import read_copy
 from shared.wear import WearLedger
-from tests.paths import PROJECT_REAL_RUNS, REPO
+from tests.support.paths import PROJECT_REAL_RUNS, REPO
 
 pytestmark = pytest.mark.system
 

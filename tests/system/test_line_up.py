@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.system.station_files import write_station
-from tests.system.test_station_up import read_recordings, run_up
+from tests.support.station_files import write_station
+from tests.support.station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
 

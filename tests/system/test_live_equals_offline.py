@@ -20,9 +20,9 @@ from pathlib import Path
 import pytest
 
 from shared.recordings.mcap import export_trace
-from tests.paths import REPO
-from tests.system.station_files import write_station
-from tests.system.test_station_up import read_recordings, run_up
+from tests.support.paths import REPO
+from tests.support.station_files import write_station
+from tests.support.station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
 

@@ -27,9 +27,9 @@ import pytest
 from mcap.reader import make_reader
 
 from services.cli.station_supervisor import stop_process
-from tests.paths import REPO
-from tests.system.netns_line import SERVER_ADDRESS, Line, unavailable_reason
-from tests.system.station_files import write_station
+from tests.support.netns_line import SERVER_ADDRESS, Line, unavailable_reason
+from tests.support.paths import REPO
+from tests.support.station_files import write_station
 
 WHY_NOT = unavailable_reason()
 pytestmark = pytest.mark.skipif(WHY_NOT is not None, reason=WHY_NOT or "")

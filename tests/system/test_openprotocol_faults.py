@@ -3,7 +3,7 @@
 Router, recorder, the simulated controller (``serve rig --controller
 openprotocol --runs N``) and the bridge (``serve openprotocol``) run as the
 station runs them; the bridge's station file points at a proxy of the test
-(:mod:`tests.system.openprotocol_proxy`) that forwards to the controller's port
+(:mod:`tests.support.openprotocol_proxy`) that forwards to the controller's port
 and damages what the controller says: the link pulled while a curve (0900) is
 half forwarded, garbage bytes and a wrong length, a 0061 with a field out of
 range. Another test SIGKILLs the bridge mid-run and starts it again. In every
@@ -33,12 +33,12 @@ import zenoh
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
 from services.rig.openprotocol.simulated_controller import LINGER_S
 from shared.contract import BridgeStats, channels, decode
-from tests.live_recorder import free_port
-from tests.paths import REPO
-from tests.system.live_station import open_client
-from tests.system.openprotocol_proxy import Damage, OpenProtocolProxy
-from tests.system.station_files import write_station
-from tests.system.test_station_up import read_recordings
+from tests.support.live_recorder import free_port
+from tests.support.live_station import open_client
+from tests.support.openprotocol_proxy import Damage, OpenProtocolProxy
+from tests.support.paths import REPO
+from tests.support.station_files import write_station
+from tests.support.station_up import read_recordings
 
 pytestmark = pytest.mark.system
 

@@ -23,10 +23,10 @@ from typing import Any
 import pytest
 
 from services.cli.station_supervisor import StationSupervisor
-from tests.paths import REPO
 from tests.support.openprotocol_controller import SpecController
-from tests.system.station_files import write_station
-from tests.system.test_station_up import read_recordings
+from tests.support.paths import REPO
+from tests.support.station_files import write_station
+from tests.support.station_up import read_recordings
 
 pytestmark = pytest.mark.system
 

@@ -16,10 +16,10 @@ from pathlib import Path
 
 import pytest
 
-from tests.live_recorder import free_port
-from tests.paths import REPO
-from tests.system.station_files import write_station
-from tests.system.test_station_up import read_recordings, run_up
+from tests.support.live_recorder import free_port
+from tests.support.paths import REPO
+from tests.support.station_files import write_station
+from tests.support.station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
 

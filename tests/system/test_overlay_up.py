@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from shared.offline.overlay import build_overlay, find_run_files, parse_alignment, read_overlay_run
-from tests.paths import REPO
-from tests.system.station_files import write_station
-from tests.system.test_station_up import read_recordings, run_up
+from tests.support.paths import REPO
+from tests.support.station_files import write_station
+from tests.support.station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
 

@@ -21,8 +21,8 @@ from typing import Any
 
 import pytest
 
-from tests.system.netns_line import unavailable_reason
-from tests.system.plant import (
+from tests.support.netns_line import unavailable_reason
+from tests.support.plant import (
     LINES,
     TOOL_ID,
     Hosts,

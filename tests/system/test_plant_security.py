@@ -29,9 +29,9 @@ from services.router.access_control import line_access_control
 from shared.config import ZenohSection
 from shared.contract import channels, keys
 from shared.runtime import open_session
-from tests.live_recorder import has_subscribers
-from tests.paths import REPO
-from tests.system.station_files import free_tcp_port
+from tests.support.live_recorder import has_subscribers
+from tests.support.paths import REPO
+from tests.support.station_files import free_tcp_port
 
 pytestmark = [
     pytest.mark.system,

@@ -20,13 +20,13 @@ from mcap.reader import make_reader
 from shared.contract import Sample, ToolState, channels, encode
 from shared.recordings.mcap import RecordingScan, recover
 from shared.runtime import zenoh_config
-from tests.live_recorder import (
+from tests.support.live_recorder import (
     free_port,
     has_subscribers,
     wait_until,
     write_station_file,
 )
-from tests.paths import REPO
+from tests.support.paths import REPO
 
 pytestmark = pytest.mark.system
 

@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.paths import REPO
-from tests.system.station_files import write_station
-from tests.system.test_station_up import read_recordings, run_up
+from tests.support.paths import REPO
+from tests.support.station_files import write_station
+from tests.support.station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
 

@@ -34,8 +34,8 @@ from services.cli.station_supervisor import stop_process
 from shared.contract import BusStats, RecorderStats, RunSummary, Sample, channels, decode, keys
 from shared.recordings.mcap import RecordingScan
 from shared.runtime import zenoh_config
-from tests.live_recorder import wait_until
-from tests.system.station_files import free_tcp_port, serve, write_station
+from tests.support.live_recorder import wait_until
+from tests.support.station_files import free_tcp_port, serve, write_station
 
 pytestmark = pytest.mark.system
 

@@ -27,9 +27,9 @@ from shared.config import ZenohSection
 from shared.contract import channels
 from shared.errors import TransportError
 from shared.runtime import open_session
-from tests.live_recorder import has_subscribers
-from tests.paths import REPO
-from tests.system.station_files import free_tcp_port
+from tests.support.live_recorder import has_subscribers
+from tests.support.paths import REPO
+from tests.support.station_files import free_tcp_port
 
 pytestmark = [
     pytest.mark.system,

@@ -2,7 +2,7 @@
 recording keeps a bounded part, and the restarted service makes the next run normal.
 
 One station (router, recorder, predictor, acquisition, rig on program 2) runs for the
-whole module (:mod:`tests.system.live_station`); each test kills one service while a
+whole module (:mod:`tests.support.live_station`); each test kills one service while a
 run is under way, then starts it again as compose ``restart:`` or systemd would:
 
 - what the tool does is read from the CAN bus itself: the killed run ends at the
@@ -28,13 +28,13 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from tests.paths import REPO
-from tests.system.live_station import (
+from tests.support.live_station import (
     LiveStation,
     check_next_run_normal,
     live_station,
     recorded_sequences,
 )
+from tests.support.paths import REPO
 
 pytestmark = pytest.mark.system
 

@@ -8,72 +8,30 @@ leaves nothing running.
 
 from __future__ import annotations
 
-import json
 import signal
 import subprocess
-import sys
 import time
 from collections import defaultdict
 from pathlib import Path
-from typing import Any
 
 import pytest
 from mcap.reader import make_reader
 
-from tests.paths import REPO
-from tests.system.station_files import (
-    child_pids,
-    command_line,
+from tests.support.station_files import (
     is_running,
     kill_all,
     process_report,
     write_station,
 )
+from tests.support.station_up import (
+    read_recordings,
+    run_up,
+    services_of,
+    start_up,
+    wait_for_first_run,
+)
 
 pytestmark = pytest.mark.system
-
-UP_TIMEOUT_S = 150
-
-
-def up_command(station: Path, runs: int) -> list[str]:
-    return [
-        sys.executable,
-        "-m",
-        "services.cli",
-        "up",
-        "--config",
-        str(station),
-        "--runs",
-        str(runs),
-    ]
-
-
-def run_up(station: Path, runs: int, *options: str) -> subprocess.CompletedProcess[str]:
-    """``boltwatch up`` to its end; it must exit 0 (its output is the failure's message)."""
-    result = subprocess.run(
-        [*up_command(station, runs), *options],
-        capture_output=True,
-        text=True,
-        timeout=UP_TIMEOUT_S,
-        cwd=REPO,
-        check=False,
-    )
-    assert result.returncode == 0, result.stdout + result.stderr
-    return result
-
-
-def read_recordings(folder: Path) -> dict[str, list[dict[str, Any]]]:
-    """Every message of every MCAP file under ``folder``, by topic, decoded with json only."""
-    by_topic: dict[str, list[dict[str, Any]]] = defaultdict(list)
-    files = sorted(folder.rglob("*.mcap"))
-    assert files, f"no MCAP files under {folder}"
-    for path in files:
-        with path.open("rb") as handle:
-            for schema, channel, message in make_reader(handle).iter_messages():
-                assert schema is not None and schema.encoding == "jsonschema"
-                assert channel.message_encoding == "json"
-                by_topic[channel.topic].append(json.loads(message.data))
-    return by_topic
 
 
 def test_up_tightens_stops_and_records_every_sample(tmp_path: Path) -> None:
@@ -133,41 +91,6 @@ def test_up_tightens_stops_and_records_every_sample(tmp_path: Path) -> None:
             judged["nok_reasons"] == ""
         )
         assert verdicts[summary["run_id"]] == judged["result"]  # up's table says the same
-
-
-def start_up(station: Path, runs: int) -> subprocess.Popen[str]:
-    return subprocess.Popen(
-        up_command(station, runs),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        cwd=REPO,
-    )
-
-
-def wait_for_first_run(up: subprocess.Popen[str]) -> str:
-    """Read ``up``'s output until the first table row (a line starting with a run id)."""
-    assert up.stdout is not None
-    seen = ""
-    deadline = time.monotonic() + UP_TIMEOUT_S
-    while time.monotonic() < deadline:
-        line = up.stdout.readline()
-        if not line:
-            break
-        seen += line
-        if line.strip()[:1].isdigit() and "kN" in line:
-            return seen
-    up.kill()
-    raise AssertionError(f"no run finished; output so far:\n{seen}")
-
-
-def services_of(up: subprocess.Popen[str]) -> dict[str, int]:
-    found = {}
-    for pid in child_pids(up.pid):
-        words = command_line(pid).split()
-        if "serve" in words:
-            found[words[words.index("serve") + 1]] = pid
-    return found
 
 
 def test_killed_service_is_reported_and_the_rest_stop(tmp_path: Path) -> None:

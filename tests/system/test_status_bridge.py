@@ -19,9 +19,9 @@ import pytest
 
 from shared.contract import BridgeStats, ControllerAlarm, channels, encode, keys
 from shared.runtime import open_from, zenoh_config
-from tests.fuzz.payloads import template
-from tests.system.station_files import write_station
-from tests.system.test_status_command import boltwatch, router  # noqa: F401  (the fixture)
+from tests.support.fuzz.payloads import template
+from tests.support.router_process import boltwatch
+from tests.support.station_files import write_station
 
 pytestmark = pytest.mark.system
 
@@ -50,7 +50,7 @@ def bridge_stats(now_ns: int) -> BridgeStats:
 
 
 def test_status_shows_the_bridge_link_its_faults_and_the_newest_active_alarm(
-    router: str,  # noqa: F811
+    router: str,
     tmp_path: Path,
 ) -> None:
     station_file = write_station(tmp_path, zenoh_port=int(router.rsplit(":", 1)[1]))

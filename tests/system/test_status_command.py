@@ -28,53 +28,15 @@ from shared.contract import (
     encode,
     keys,
 )
-from shared.errors import TransportError
 from shared.runtime import open_from, zenoh_config
-from tests.paths import REPO
-from tests.system.station_files import free_tcp_port, write_station
+from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
+from tests.support.station_files import free_tcp_port, write_station
 
 pytestmark = pytest.mark.system
 
 STATION = "line3-st9"
 PUBLISH_PERIOD_S = 0.005  # ~200 samples/s: enough to see, cheap to send
-
-
-def boltwatch(*args: str, timeout_s: float = 30) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "services.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=timeout_s,
-        cwd=REPO,
-        check=False,
-    )
-
-
-@pytest.fixture
-def router(tmp_path: Path) -> Iterator[str]:
-    """A ``boltwatch serve router`` process; yields its endpoint once it accepts clients."""
-    endpoint = f"tcp/127.0.0.1:{free_tcp_port()}"
-    log = (tmp_path / "router.log").open("w")
-    process = subprocess.Popen(
-        [sys.executable, "-m", "services.cli", "serve", "router", "--listen", endpoint],
-        cwd=REPO,
-        stdout=log,
-        stderr=subprocess.STDOUT,
-    )
-    try:
-        deadline = time.monotonic() + 20
-        while True:
-            assert process.poll() is None, (tmp_path / "router.log").read_text()
-            try:
-                open_from(zenoh_config("client", [endpoint], connect_timeout_ms=300)).close()
-                break
-            except TransportError:
-                if time.monotonic() > deadline:
-                    raise
-        yield endpoint
-    finally:
-        stop_process(process, grace_s=10)
-        log.close()
 
 
 class FakeStation:

@@ -15,8 +15,13 @@ import zenoh
 from shared.config import load_station
 from shared.contract import JudgedFigure, TighteningResult, Verdict, channels, encode, keys
 from shared.runtime import open_from, zenoh_config
-from tests.live_recorder import RunningRecorder, has_subscribers, wait_until, write_station_file
-from tests.system.test_status_command import REPO, router  # noqa: F401  (the fixture)
+from tests.support.live_recorder import (
+    RunningRecorder,
+    has_subscribers,
+    wait_until,
+    write_station_file,
+)
+from tests.support.paths import REPO
 
 pytestmark = pytest.mark.system
 
@@ -66,7 +71,7 @@ def status_during_an_alert(
 
 
 def test_status_shows_the_newest_active_quality_alert(
-    router: str,  # noqa: F811
+    router: str,
     tmp_path: Path,
 ) -> None:
     station_file = write_station_file(

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import pytest
 
-from tests.paths import REPO
-from tests.system.station_files import write_station
-from tests.system.test_station_up import UP_TIMEOUT_S, read_recordings, start_up, wait_for_first_run
+from tests.support.paths import REPO
+from tests.support.station_files import write_station
+from tests.support.station_up import UP_TIMEOUT_S, read_recordings, start_up, wait_for_first_run
 
 pytestmark = pytest.mark.system
 

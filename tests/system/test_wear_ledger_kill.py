@@ -26,7 +26,7 @@ import pytest
 
 from shared.contract import RunSummary
 from shared.wear import CONTRACT_LIMITS, WearLedger
-from tests.paths import REPO
+from tests.support.paths import REPO
 
 pytestmark = pytest.mark.system
 

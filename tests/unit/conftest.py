@@ -2,13 +2,26 @@
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Iterator
 
 import pytest
 import zenoh
 
 from shared.runtime import zenoh_config
-from tests.live_recorder import free_port
+from tests.support.live_recorder import free_port
+
+
+@pytest.fixture(autouse=True)
+def logging_restored() -> Iterator[None]:
+    """A command run in the test's process (``main([...])``) configures the root logger as
+    its process would; each test gets it back as it was, so that no test's log lines
+    reach the next one's standard error."""
+    root = logging.getLogger()
+    handlers, level = root.handlers[:], root.level
+    yield
+    root.handlers[:] = handlers
+    root.setLevel(level)
 
 
 @pytest.fixture

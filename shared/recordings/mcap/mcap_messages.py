@@ -8,7 +8,7 @@ message records with one ``struct`` pack each into the chunk the writer has
 open, updates the writer's chunk index and statistics once per batch and
 writes each chunk's message index with one pack, so
 the file is the one ``add_message`` would have written, byte for byte
-(``tests/unit/recorder/test_mcap_messages.py`` compares them; one difference:
+(``tests/unit/shared/recordings/test_mcap_messages.py`` compares them; one difference:
 a chunk that reaches the writer's ``chunk_size`` closes after the batch that
 filled it, not after the message, and the recorder's flushes close chunks
 long before that size).

@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 import tomllib
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -42,8 +41,9 @@ from shared.openprotocol import (
     frame_bytes,
     trace_types_of,
 )
+from tests.support.paths import REPO
 
-EXAMPLES_DIR = Path(__file__).resolve().parents[3] / "data" / "openprotocol" / "examples"
+EXAMPLES_DIR = REPO / "tests" / "data" / "openprotocol" / "examples"
 SENDERS = {"controller", "integrator"}
 ENTRY_KEYS = {
     "id", "source", "mid", "revision", "sender", "wire", "tail_hex", "data", "expect",

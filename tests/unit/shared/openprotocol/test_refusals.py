@@ -21,14 +21,15 @@ from shared.openprotocol import (
     timestamp_ns,
     trace_extra_data,
 )
-from tests.unit.shared.openprotocol.examples import TRACE
-from tests.unit.shared.openprotocol.test_golden_messages import (
+from tests.support.openprotocol_examples import TRACE
+from tests.support.openprotocol_golden import (
+    ASCII_PART,
+    BIG,
     LAST_RESULT_1,
     LAST_RESULT_1_WIRE,
     LAST_RESULT_2,
     LAST_RESULT_2_WIRE,
 )
-from tests.unit.shared.openprotocol.test_trace_curve import ASCII_PART, BIG
 
 
 def _data(wire: bytes) -> bytes:

@@ -20,7 +20,7 @@ from shared.openprotocol import (
     decode,
     encode,
 )
-from tests.unit.shared.openprotocol.examples import EXAMPLES
+from tests.support.openprotocol_examples import EXAMPLES
 
 DIALECTS = [
     Dialect(),

@@ -21,20 +21,7 @@ from shared.openprotocol import (
     trace_extra_data,
     trace_types_of,
 )
-
-# Written by hand from the layout: tightening 345, torque in Nm, coefficient
-# 0.01 (PID 02214), 1 ms between samples (unit 202), three samples 100, -50, 1234.
-ASCII_PART = (
-    b"0000000345" b"2024-06-01:07:31:02" b"000" b"02" b"01" b"001"
-    b"001" b"02214" b"004" b"03" b"000" b"0000" b"0.01"
-    b"001" b"00001" b"00003" b"001" b"01" b"202" b"1"
-    b"00003"
-)  # fmt: skip
-BIG = b"\x00\x64\xff\xce\x04\xd2"
-LITTLE = b"\x64\x00\xce\xff\xd2\x04"
-# the specification (2.2.4): the length counts the ASCII part's NUL and the samples, and "no
-# NUL character is sent after the binary data"
-TRACE_WIRE = b"01170900001         " + ASCII_PART + b"\x00" + BIG
+from tests.support.openprotocol_golden import ASCII_PART, BIG, LITTLE, TRACE_WIRE
 
 
 def _trace(data: bytes, dialect: Dialect = DEFAULT_DIALECT) -> TraceCurve:

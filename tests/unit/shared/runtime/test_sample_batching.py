@@ -1,0 +1,52 @@
+"""An edge station's batch in progress: when it goes, and what rides in it."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from shared.contract import Intensity, Sample, StickSlipEvent
+from shared.runtime import BATCH_PERIOD_S, MAX_BATCH_SAMPLES, SampleBatching
+from tests.support.fuzz.payloads import template
+
+T0_NS = 1_700_000_000_000_000_000
+MS_NS = 1_000_000
+
+
+def sample(run_id: int, n: int) -> Sample:
+    return Sample("st1", run_id, n, T0_NS + n * MS_NS, 10.0, 1.0, 2e4)
+
+
+def event(run_id: int, index: int) -> StickSlipEvent:
+    found: StickSlipEvent = template("events", "st1", T0_NS + index * MS_NS, run_id)
+    return dataclasses.replace(found, index=index)
+
+
+def test_a_batch_goes_when_due_full_or_at_a_new_run() -> None:
+    batching = SampleBatching("st1")
+    assert batching.add(sample(1, 0), 0.0) == []
+    assert batching.wait_s(0.0) == BATCH_PERIOD_S
+    (due,) = batching.add(sample(1, 1), BATCH_PERIOD_S)
+    assert [s.sequence for s in due.samples] == [0, 1]
+    batching.add(sample(1, 2), 1.0)
+    (first_run,) = batching.add(sample(2, 0), 1.0)  # never two runs in one batch
+    assert [s.run_id for s in first_run.samples] == [1]
+    ready = [b for n in range(1, MAX_BATCH_SAMPLES) for b in batching.add(sample(2, n), 1.0)]
+    assert [len(b.samples) for b in ready] == [MAX_BATCH_SAMPLES]
+
+
+def test_events_and_intensities_ride_in_the_batch_of_their_run_after_its_samples() -> None:
+    batching = SampleBatching("st1")
+    assert not batching.add_found(event(1, 1))  # no batch in progress: it goes alone
+    batching.add(sample(1, 0), 0.0)
+    assert not batching.add_found(event(2, 1))  # not this batch's run
+    figures = Intensity("st1", 1, T0_NS + MS_NS, 0.5, 0.5)
+    assert batching.add_found(event(1, 1)) and batching.add_found(figures)
+    batching.add(sample(1, 1), 0.001)
+    batch = batching.take()
+    assert batch is not None
+    assert [s.sequence for s in batch.samples] == [0, 1]
+    assert (batch.events, batch.intensities) == ([event(1, 1)], [figures])
+    assert batching.take() is None  # the next batch starts empty
+    batching.add(sample(1, 2), 0.002)
+    after = batching.take()
+    assert after is not None and (after.events, after.intensities) == ([], [])
