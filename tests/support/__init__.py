@@ -1,13 +1,33 @@
-"""Test doubles that speak real protocols, written independently of the code they test.
+"""Every helper the tests share (no test module imports another): real processes and sockets.
 
-- `openprotocol_controller`: `SpecController`, an Open Protocol tightening controller on
-  127.0.0.1 written from the public specification (what it answers to each MID).
-- `openprotocol_core`: its settings, records, serving thread, timers and cut writes.
-- `openprotocol_link`: one integrator's link state, the write cutting of each write mode,
-  and the MID 0900 subscription's extra data.
-- `openprotocol_wire`: framing (header, NUL, binary part) and field formatting; a stream
-  reader that takes any split of the stream.
-- `openprotocol_messages`: MID 0002, 0004, 0005, 0041, 0071, 0074, 0076 data fields.
-- `openprotocol_results`: tightening results and their MID 0061 / MID 0065 data fields.
-- `openprotocol_traces`: torque and angle curves of a tightening and their MID 0900.
+Peers written independently of the code they test:
+:mod:`.openprotocol_controller` (a controller from the specification's text,
+with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
+:mod:`.openprotocol_wire`, :mod:`.openprotocol_messages`,
+:mod:`.openprotocol_results`, :mod:`.openprotocol_traces`),
+:mod:`.foxglove_client` (the Foxglove WebSocket protocol),
+:mod:`.openprotocol_proxy` (a TCP proxy that damages what passes).
+
+- messages and data: :mod:`.factories` (messages with plausible values),
+  :mod:`.synthetic_runs` (synthetic traces), :mod:`.recorded_runs` (a whole run
+  as a station publishes it), :mod:`.openprotocol_golden`,
+  :mod:`.openprotocol_examples` (Open Protocol messages with their bytes),
+  :mod:`.imported_runs` (real controller runs imported), :mod:`.model_band_runs`
+  (the core over a simulated joint)
+- stations and files: :mod:`.paths` (the repository's files), :mod:`.config_files`
+  (station files written from the shipped one), :mod:`.station_files` (isolated
+  station files for system tests), :mod:`.rig_fixtures` (rigs and programs)
+- services in a test: :mod:`.live_recorder`, :mod:`.recorder_driver`,
+  :mod:`.live_predictor`, :mod:`.bridge_harness`, :mod:`.tcp_controller` (a small
+  controller built on the codec), :mod:`.simulated_controller` (the rig's
+  controller in a test)
+- processes: :mod:`.station_up` (``boltwatch up``), :mod:`.router_process` (a
+  router, ``boltwatch`` as a command), :mod:`.live_station` (a whole station),
+  :mod:`.plant`, :mod:`.netns_line` (lines in network namespaces),
+  :mod:`.can_injector` (frames on the CAN bus), :mod:`.disk_faults` (a full or
+  read-only disk)
+- deployment: :mod:`.compose_layout`, :mod:`.access_rules`
+- :mod:`.fuzz` (hostile payloads for the live services), :mod:`.bad_arguments`
+  (every bad argument of every command)
+- :mod:`.import_rules` (``make lint``: no test module imports another)
 """
