@@ -16,6 +16,6 @@ import-linter holds the layers in ``make lint`` (``pyproject.toml``):
 - :mod:`.contract` (what crosses a process or file boundary: messages, channels,
   keys, codec, bounds, the DBC, the trace CSV), :mod:`.openprotocol` (Open
   Protocol bytes <-> messages, no sockets), :mod:`.files` (folders; an OSError in
-  one line)
+  one line), :mod:`.option_types` (command-line values that refuse impossible numbers)
 - :mod:`.errors`: the exception tree
 """

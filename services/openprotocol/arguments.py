@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from shared.runtime import seconds
+from shared.option_types import seconds
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

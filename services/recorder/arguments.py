@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from shared.runtime import port_number
+from shared.option_types import port_number
 
 DEFAULT_FOXGLOVE_HOST = "127.0.0.1"
 DEFAULT_FOXGLOVE_PORT = 8765

@@ -10,14 +10,12 @@
 - :mod:`.can_bus` (the station's CAN bus, python-can), :mod:`.realtime` (real-time
   scheduling of the stop path's threads)
 - :mod:`.logging_setup` (one line per event, JSON in containers), :mod:`.log_limit`
-  (one log line for a flood of alike faults), :mod:`.option_types` (argparse
-  types that refuse impossible numbers)
+  (one log line for a flood of alike faults)
 """
 
 from shared.runtime.can_bus import open_bus
 from shared.runtime.log_limit import RateLimitedLog
 from shared.runtime.logging_setup import setup_logging
-from shared.runtime.option_types import float_in, int_in, port_number, seconds
 from shared.runtime.queued_publisher import QueuedPublisher
 from shared.runtime.realtime import RIG_PRIORITY, STOP_PATH_PRIORITY, use_realtime_priority
 from shared.runtime.receive_threads import keep_thread_state, use_one_receive_thread
@@ -54,15 +52,11 @@ __all__ = [
     "TlsFiles",
     "client_config",
     "declare_channel",
-    "float_in",
     "follow_supervisor",
-    "int_in",
     "keep_thread_state",
     "open_bus",
     "open_from",
     "open_session",
-    "port_number",
-    "seconds",
     "setup_logging",
     "supervisor_environment",
     "use_one_receive_thread",

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from services.cli.command_options import check_png_target
-from shared.runtime import float_in
+from shared.option_types import float_in
 
 if TYPE_CHECKING:
     from shared.model import EventMetrics, JointConstants, Share

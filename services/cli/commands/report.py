@@ -19,7 +19,7 @@ from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from services.cli.command_options import add_station_file_option
-from shared.runtime import int_in
+from shared.option_types import int_in
 
 NAME = "report"
 HELP = "statistics per program over recorded results: X̄/R charts, Cp/Cpk, NOK Pareto (HTML, PNG)"

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from services.cli.command_options import DEFAULT_STATION_FILE
-from shared.runtime import seconds
+from shared.option_types import seconds
 
 if TYPE_CHECKING:
     import zenoh

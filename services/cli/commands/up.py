@@ -37,7 +37,7 @@ from pathlib import Path
 from types import FrameType
 
 from services.cli.command_options import add_station_file_option
-from shared.runtime import seconds
+from shared.option_types import seconds
 
 NAME = "up"
 HELP = "run the simulated station (or --stations N) end to end: rig, acquisition, predictor, ..."

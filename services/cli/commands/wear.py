@@ -23,7 +23,7 @@ import argparse
 from pathlib import Path
 
 from services.cli.command_options import add_recordings_folder_options, recordings_folder
-from shared.runtime import int_in, seconds
+from shared.option_types import int_in, seconds
 
 NAME = "wear"
 HELP = "show the wear ledger per tool, record a tool's service, or replace a broken ledger"

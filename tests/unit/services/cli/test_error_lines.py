@@ -4,7 +4,7 @@ the option), what is wrong and why, exit status 2 (issue 14, item 5).
 The no-traceback tests (``test_no_traceback.py``) drive every command with every kind of
 bad value; these pin the words for the cases the issue names and for each mechanism:
 OSErrors told by ``services/cli/error_lines.py``, numbers refused while parsing
-(``shared/runtime/option_types.py``), endpoints, station files that are not text.
+(``shared/option_types.py``), endpoints, station files that are not text.
 """
 
 from __future__ import annotations
