@@ -1,10 +1,15 @@
 """Folders and files: making a folder, and saying plainly why one cannot be made; an
-``OSError`` in one line that names its file."""
+``OSError`` in one line that names its file; a small JSON file replaced atomically."""
 
 from __future__ import annotations
 
+import contextlib
 import errno
+import json
+import os
+import tempfile
 from pathlib import Path
+from typing import Any
 
 from shared.errors import BoltwatchError
 
@@ -33,3 +38,26 @@ def describe_os_error(err: OSError, path: Path | None) -> str:
     where = err.filename if err.filename is not None else (path or "?")
     code = errno.errorcode.get(err.errno, str(err.errno)) if err.errno is not None else "?"
     return f"{where}: {err.strerror or err} ({code})"
+
+
+def write_json_atomically(path: Path, document: Any) -> None:
+    """Replace ``path`` by ``document`` as JSON, whole or not at all: a temporary file in the
+    same folder, fsync, rename, fsync of the folder (after a crash: the old or the new)."""
+    folder = path.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=folder)
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            json.dump(document, stream)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temporary)
+        raise
+    directory = os.open(folder, os.O_RDONLY)
+    try:
+        os.fsync(directory)
+    finally:
+        os.close(directory)

@@ -41,6 +41,7 @@ from shared.runtime import (
     ServiceSkeleton,
     Stop,
     open_bus,
+    station_spool,
     use_realtime_priority,
 )
 
@@ -73,7 +74,9 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
     with ServiceSkeleton("acquisition") as skeleton:
         bus = skeleton.device(open_bus(station.config.can))
         session = skeleton.open_session(station.config.zenoh)
-        publisher = QueuedPublisher(session, station_id, batch_samples=edge)
+        publisher = QueuedPublisher(
+            session, station_id, batch_samples=edge, spool=station_spool(station, "acquisition")
+        )
         skeleton.on_stop(Stop.OUTPUT, publisher.close)
         outlet = ZenohOutlet(session, publisher)
         skeleton.on_stop(Stop.OUTPUT, outlet.close)  # the link first, then the queue's flush

@@ -23,6 +23,7 @@ from shared.line_status import (
     bridge_lines,
     quality_text,
     result_text,
+    spool_text,
 )
 
 
@@ -71,6 +72,7 @@ def _station_lines(status: StationStatus) -> list[str]:
             status, status.predictor, line("predictor", _predictor_text(status.predictor))
         ),
         line("recorder", _recorder_text(status.recorder)),
+        *(line("spool", f"{spool.source}: {spool_text(spool)}") for spool in status.spools),
         *(line(label, text) for label, text in bridge_lines(status.bridge)),
     ]
     if status.unreadable_messages:

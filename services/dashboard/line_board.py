@@ -241,6 +241,7 @@ def _station_view(
         "predictor": latest_view.get("predictor"),
         "bus": latest_view.get("bus"),
         "bridge": latest_view.get("bridge"),
+        "spools": latest_view.get("spools", []),
         "unreadable_messages": latest_view.get("unreadable_messages", 0),
         "results": [_result_view(result, now_ns) for result in history.results],
         "stops": [_stop_view(summary, now_ns) for summary in history.summaries],

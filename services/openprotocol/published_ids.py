@@ -34,14 +34,13 @@ tightening id of each result stays the controller's own.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import logging
-import os
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from shared.files import write_json_atomically
 
 LOG = logging.getLogger(__name__)
 
@@ -99,24 +98,7 @@ def read_position(path: Path) -> BridgePosition:
 
 def write_position(path: Path, position: BridgePosition) -> None:
     """Replace the file by ``position`` atomically (temporary + fsync + rename + fsync)."""
-    folder = path.parent
-    folder.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=folder)
-    try:
-        with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            json.dump(_document(position), stream)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.replace(temporary, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(temporary)
-        raise
-    directory = os.open(folder, os.O_RDONLY)
-    try:
-        os.fsync(directory)
-    finally:
-        os.close(directory)
+    write_json_atomically(path, _document(position))
 
 
 def _document(position: BridgePosition) -> dict[str, object]:

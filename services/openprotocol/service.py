@@ -25,7 +25,7 @@ from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.published_ids import position_path
 from shared.config import load_any_station
 from shared.errors import ConfigError
-from shared.runtime import QueuedPublisher, ServiceSkeleton, Stop
+from shared.runtime import QueuedPublisher, ServiceSkeleton, Stop, station_spool
 
 LOG = logging.getLogger(__name__)
 
@@ -43,7 +43,9 @@ def main(args: argparse.Namespace) -> int:
     counts = BridgeCounts(station_id, f"{section.host}:{section.port}")
     with ServiceSkeleton("openprotocol") as skeleton:
         session = skeleton.open_session(station.config.zenoh)
-        publisher = QueuedPublisher(session, station_id, batch_samples=True)
+        publisher = QueuedPublisher(
+            session, station_id, batch_samples=True, spool=station_spool(station, "openprotocol")
+        )
         skeleton.on_stop(Stop.OUTPUT, publisher.close)
         bridge = OpenProtocolBridge(
             station,

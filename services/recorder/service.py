@@ -50,28 +50,32 @@ import zenoh
 from services.recorder.live.line_inbox import LineInbox, Message
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.recorder_health import RecorderHealth
-from services.recorder.live.run_files import FileLimits
+from services.recorder.live.run_files import StationFiles
 from services.recorder.live.sample_batches import BatchSamples
+from services.recorder.live.spool_filing import SpoolFiling
+from services.recorder.live.spool_keeper import SpoolKeeper
+from services.recorder.live_views import rerun_options, start_foxglove, start_rerun_live
 from services.recorder.quality_watch import QualityWatch
+from services.recorder.served_stations import limits_of, served_stations
 from services.recorder.wear_watch import WearWatch
-from shared.config import AnyStation, ControllerStation, LoadedStation, load_any_line
+from shared.config import AnyStation, load_any_line
 from shared.contract import (
     MAX_TEXT_CHARS,
     QualityAlert,
     RecorderStats,
+    SpoolAck,
     WearAlert,
     channels,
     encode,
     keys,
+    parse_seq_attachment,
 )
-from shared.errors import ConfigError
 from shared.recordings import OTHER_STATION, FileMetadata, Received, classify
 from shared.runtime import ServiceSkeleton, Stop
 from shared.wear import StationLimits, WearLedger, ledger_path
 
 if TYPE_CHECKING:
     from services.recorder.foxglove_live.foxglove_server import FoxgloveLive
-    from shared.recordings.rerun import RerunLive, RerunOptions
 
 LOG = logging.getLogger(__name__)
 
@@ -85,38 +89,7 @@ VIEWER = "viewer"
 _BUS_STATS = channels.BUS.schema_name
 _SAMPLE = channels.SAMPLES.schema_name
 _BATCH = channels.SAMPLE_BATCHES.schema_name
-
-
-def limits_of(loaded: AnyStation) -> FileLimits:
-    section = loaded.config.recorder
-    return FileLimits(
-        flush_interval_ns=round(section.flush_interval_s * 1e9),
-        max_file_bytes=section.max_file_bytes,
-        max_file_duration_ns=round(section.max_file_duration_s * 1e9),
-    )
-
-
-def served_stations(loaded: AnyStation | Sequence[AnyStation]) -> list[AnyStation]:
-    """The station files of one recorder (CAN or controller stations); ConfigError when their
-    [recorder] sections differ."""
-    stations = [loaded] if isinstance(loaded, LoadedStation | ControllerStation) else list(loaded)
-    if not stations:
-        raise ConfigError("the recorder needs at least one station file")
-    first = stations[0]
-    settings = first.config.recorder.model_dump(exclude={"folder"})
-    for other in stations[1:]:
-        if other.recordings_folder.resolve() != first.recordings_folder.resolve():
-            raise ConfigError(
-                f"{other.path}: recorder.folder: {other.recordings_folder} differs from "
-                f"{first.recordings_folder} of {first.path}; one recorder writes one folder"
-            )
-        for name, value in other.config.recorder.model_dump(exclude={"folder"}).items():
-            if settings[name] != value:
-                raise ConfigError(
-                    f"{other.path}: recorder.{name}: {value} differs from {settings[name]} "
-                    f"of {first.path}; one recorder has one [recorder] section"
-                )
-    return stations
+_SPOOL = channels.SPOOL.schema_name
 
 
 class RecorderService:
@@ -153,6 +126,14 @@ class RecorderService:
         self.foxglove = foxglove
         self.wear: WearWatch | None = None
         self.quality: QualityWatch | None = None
+        #: what the line's recorder filed of the stations' spools (a view acknowledges nothing)
+        self.spooling = (
+            None
+            if view_only
+            else SpoolFiling(
+                SpoolKeeper(first.recordings_folder), self.recorder, self._file_received
+            )
+        )
         if not view_only:
             settings = {station.station_id: station.config.quality for station in stations}
             self.quality = QualityWatch(settings, self._publish_alert)
@@ -191,11 +172,13 @@ class RecorderService:
                         self.wear.tick(time.time_ns())
                     next_tick = now + self._tick_s
                 if now >= next_stats and not self.view_only:
+                    self._acknowledge(time.time_ns())
                     self._publish_stats(time.time_ns())
                     next_stats = now + STATS_PERIOD_S
             self._file(self._inbox.take(0))  # a receive thread waiting for room gets it
             self._inbox.close()
             self._file(self._inbox.take(0))
+            self._acknowledge(time.time_ns())  # what is in the files now
         finally:
             self._inbox.close()
             if self._inbox.after_close:
@@ -226,24 +209,52 @@ class RecorderService:
 
     def _file(self, messages: list[Message]) -> None:
         filed_ns = time.time_ns()  # the lag counts the wait in the inbox too
-        for key, payload, received_ns in messages:
-            self._handle(key, payload, received_ns, filed_ns)
+        for key, payload, received_ns, attachment in messages:
+            self._handle(key, payload, received_ns, filed_ns, attachment)
 
-    def _handle(self, key: str, payload: bytes, now_ns: int, filed_ns: int) -> None:
-        """File one message received at ``now_ns`` (its MCAP log time) at ``filed_ns``."""
-        received = classify(key, payload, now_ns, self._sensor_ranges)
+    def _handle(
+        self, key: str, payload: bytes, now_ns: int, filed_ns: int, attachment: bytes | None = None
+    ) -> None:
+        """File one message received at ``now_ns`` (its MCAP log time) at ``filed_ns``; one a
+        station's spool numbered (``attachment``) goes where its order says."""
+        mark = parse_seq_attachment(attachment)
+        live_key = keys.live_key_of(key)
+        again = live_key is not None and mark is not None and mark.again
+        if again and self.spooling is None:
+            return  # a live view: what a spool sends again is for the line's recorder
+        if mark is not None and mark.again != again:
+            mark = None  # a mark that does not fit its key: not numbered (an again/ key: raw)
+        filed_key = live_key if again and live_key is not None else key
+        received = classify(filed_key, payload, now_ns, self._sensor_ranges)
+        spooling = self.spooling
+        if spooling is None or received.station == OTHER_STATION:
+            self._file_received(received, filed_ns)
+        elif mark is None:
+            self._file_received(received, filed_ns, spooling.unnumbered_files(received.station))
+        else:
+            spooling.file(received, mark, filed_ns)
+
+    def _file_received(
+        self, received: Received, filed_ns: int, hole: StationFiles | None = None
+    ) -> None:
+        """File into the station's live files, or a hole's (``hole``: sent again, neither
+        lag nor a live view's business)."""
         if received.schema_name == _BATCH and received.message is not None:
-            self._file_batch(received, filed_ns)
+            self._file_batch(received, filed_ns, hole)
             return
-        self._file_one(received, filed_ns)
+        self._file_one(received, filed_ns, hole)
 
-    def _file_one(self, received: Received, filed_ns: int) -> None:
+    def _file_one(
+        self, received: Received, filed_ns: int, hole: StationFiles | None = None
+    ) -> None:
         """File one message (a batch's event too) into its run's file and its counts."""
         now_ns = received.log_time_ns
-        self.recorder.write(received)
-        if self.foxglove is not None:
+        self.recorder.write(received, hole)
+        if self.foxglove is not None and hole is None:
             self.foxglove.log(received)
-        if received.station != OTHER_STATION:
+        if hole is not None and received.schema_name == _SAMPLE:
+            self.health.refiled(received.station, 1)
+        if received.station != OTHER_STATION and hole is None:
             is_sample = received.schema_name == _SAMPLE
             sample_time_ns = (
                 received.publish_time_ns if is_sample and received.message is not None else None
@@ -256,6 +267,8 @@ class RecorderService:
                 self.health.bus_stats(received.station, bus.samples, bus.started_ns)
         if received.message is None:
             return
+        if self.spooling is not None and received.schema_name == _SPOOL:
+            self.spooling.keeper.on_stats(received.message)
         if self.quality is not None and received.schema_name == channels.RESULTS.schema_name:
             self.quality.on_result(received.message)
         if self.wear is not None:
@@ -264,19 +277,38 @@ class RecorderService:
             elif received.schema_name == channels.TOOL_DATA.schema_name:
                 self.wear.on_tool_data(received.message, now_ns)
 
-    def _file_batch(self, batch: Received, filed_ns: int) -> None:
+    def _file_batch(self, batch: Received, filed_ns: int, hole: StationFiles | None) -> None:
         """Each sample of a batch, then its events and intensities, as if each had come alone
-        (a refused batch is filed raw by :meth:`_handle`: its samples are not received, so
+        (a refused batch is filed raw by :meth:`_file_one`: its samples are not received, so
         they count as missing)."""
         samples = self._batches.samples(batch)
-        self.recorder.write_samples(batch.station, samples)
-        times_ns = [sample.publish_time_ns for sample in samples]
-        self.health.samples_written(batch.station, filed_ns, times_ns)
-        if self.foxglove is not None:
-            for sample in samples:
-                self.foxglove.log(sample)
+        self.recorder.write_samples(batch.station, samples, hole)
+        if hole is not None:
+            self.health.refiled(batch.station, len(samples))
+        else:
+            times_ns = [sample.publish_time_ns for sample in samples]
+            self.health.samples_written(batch.station, filed_ns, times_ns)
+            if self.foxglove is not None:
+                for sample in samples:
+                    self.foxglove.log(sample)
         for found in self._batches.found(batch):
-            self._file_one(found, filed_ns)
+            self._file_one(found, filed_ns, hole)
+
+    def _acknowledge(self, now_ns: int) -> None:
+        """Flush the spooling stations' files; acknowledge what they hold."""
+        if self.spooling is not None:
+            self.spooling.acknowledge(now_ns, self._publish_ack)
+
+    def _publish_ack(self, ack: SpoolAck) -> None:
+        """To the station only: a put this session also heard would come back to the inbox."""
+        try:
+            self._session.put(
+                channels.SPOOL_ACK.key(ack.station),
+                encode(ack),
+                allowed_destination=zenoh.Locality.REMOTE,
+            )
+        except zenoh.ZError as err:  # session closing: the station sends it again
+            LOG.debug("spool acknowledgement of %s not published: %s", ack.station, err)
 
     def _publish_stats(self, now_ns: int) -> None:
         """Put each station's RecorderStats for everyone but this recorder (not recorded)."""
@@ -338,52 +370,6 @@ class RecorderService:
 def station_keys(station: str) -> str:
     """Everything of one station: ``boltwatch/<st>/**``."""
     return keys.station_key(station, "**")
-
-
-def rerun_options(write_files: bool, live_url: str | None) -> RerunOptions | None:
-    """What goes to Rerun; None when nothing does or (logged) when Rerun cannot be imported."""
-    if not write_files and live_url is None:
-        return None
-    try:
-        from shared.recordings.rerun import LIVE_BATCH_SAMPLES, RerunOptions
-    except ImportError:
-        LOG.exception("Rerun is unusable; recording MCAP only")
-        return None
-    if live_url is None:
-        return RerunOptions(write_files=write_files)
-    return RerunOptions(LIVE_BATCH_SAMPLES, live_url=live_url, write_files=write_files)
-
-
-def start_rerun_live(args: argparse.Namespace) -> RerunLive | None:
-    """The live Rerun server (and web viewer) when asked for; None when off or failing."""
-    web = bool(getattr(args, "rerun_web", False))
-    if not (web or getattr(args, "rerun_serve", False)):
-        return None
-    try:
-        from shared.recordings.rerun import RerunLive
-
-        return RerunLive(args.rerun_port, args.rerun_web_port if web else None)
-    except Exception:
-        LOG.exception("cannot start the Rerun live view; recording goes on without it")
-        return None
-
-
-def start_foxglove(args: argparse.Namespace, station_ids: Sequence[str]) -> FoxgloveLive | None:
-    """The live Foxglove WebSocket when asked for (``--foxglove-port``); None when off or
-    when it cannot listen (one line: recording goes on without it)."""
-    port = getattr(args, "foxglove_port", None)
-    if port is None:
-        return None
-    host = getattr(args, "foxglove_host", "127.0.0.1")
-    try:
-        from services.recorder.foxglove_live.foxglove_server import FoxgloveLive
-
-        return FoxgloveLive(station_ids, host, port)
-    except Exception as err:  # the SDK raises its own errors (address in use, bad host)
-        LOG.error(
-            "cannot serve Foxglove on %s:%d: %s; recording goes on without it", host, port, err
-        )
-        return None
 
 
 def main(args: argparse.Namespace) -> int:

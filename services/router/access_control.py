@@ -17,7 +17,10 @@ may declare subscribers, queryables and liveliness tokens under
   station (``boltwatch serve openprotocol``: the run's samples, tool states,
   the advisory predictor's keys, the controller's result, tool data, alarms and
   its own stats; :func:`shared.contract.channels.topics_of` ``("openprotocol")``),
-- ``line-recorder`` may put ``boltwatch/<st>/recorder`` and ``wear/**``.
+- ``line-recorder`` may put ``boltwatch/<st>/recorder``, ``wear/**`` and
+  ``spool/ack`` (what it has of a station's spool);
+- the station's spooling services (``acquisition``, ``openprotocol``) may put
+  ``again/**`` too (what their spool sends again).
 
 No one else may put a station's decision; in a plant of several lines the
 router of another line (``--peer NAME=ST,...``: the common name of that
@@ -46,9 +49,11 @@ from typing import Any
 
 from shared.contract import channels, keys
 
-ACQUISITION_TOPICS = channels.topics_of("acquisition")
+#: what a station's spool sends again (the spooling services: acquisition, openprotocol)
+AGAIN_TOPICS = (f"{keys.AGAIN}/**",)
+ACQUISITION_TOPICS = (*channels.topics_of("acquisition"), *AGAIN_TOPICS)
 PREDICTOR_TOPICS = channels.topics_of("predictor")
-BRIDGE_TOPICS = channels.topics_of("openprotocol")
+BRIDGE_TOPICS = (*channels.topics_of("openprotocol"), *AGAIN_TOPICS)
 #: its channels below ``wear/**`` (the alert) and the wear ledger's queryable
 RECORDER_TOPICS = (
     *(topic for topic in channels.topics_of("recorder") if not topic.startswith(keys.WEAR)),

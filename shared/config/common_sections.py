@@ -5,8 +5,8 @@ station (:mod:`shared.config.station`: ``[can]``, a joint, programs with motor
 and hard limits) or a controller station (:mod:`shared.config.controller_station`:
 ``[openprotocol]``, no ``[can]``). Both have the sections here, read the same
 way: ``[station]`` ``id`` and ``tool_id``, ``[zenoh]`` (the line's router,
-reconnection, TLS) and ``[recorder]`` (where the recordings go). Paths are
-relative to the station file.
+reconnection, TLS), ``[recorder]`` (where the recordings go) and ``[spool]``
+(store and forward on the edge box). Paths are relative to the station file.
 """
 
 from __future__ import annotations
@@ -23,6 +23,9 @@ from shared.errors import ConfigError
 from shared.files import FolderError, make_folder
 
 StationId = str
+#: the default bound of a spool: about 8 hours of an edge station (SPOOL_BYTES_PER_HOUR,
+#: measured by tests/benchmarks/bench_spool.py) with room to spare
+SPOOL_MAX_BYTES = 2 * 1024**3
 
 #: a zenoh endpoint: ``<protocol>/<address>[?<metadata>][#<config>]``
 ENDPOINT_FORM = re.compile(r"[A-Za-z0-9_-]+/[^?#\s]+(\?[^#\s]*)?(#\S*)?")
@@ -122,6 +125,43 @@ class RecorderSection(StrictModel):
         gt=0,
         description="intensity since last service (eq. 69) at which the recorder alerts",
     )
+
+
+class SpoolSection(StrictModel):
+    """Store and forward on the station's edge box (``[spool]``): what the station puts
+    toward the line is kept until the line's recorder has it (see :mod:`shared.spool`)."""
+
+    enabled: bool = Field(default=True, description="false: nothing is kept, a cut loses data")
+    folder: Path | None = Field(
+        default=None,
+        description="on the edge box, relative to this station file; none: .spool/ in the "
+        "recordings folder",
+    )
+    max_bytes: int = Field(
+        default=SPOOL_MAX_BYTES,
+        ge=1024 * 1024,
+        description="its bound (the messages as stored): past it the oldest samples go first",
+    )
+    drain_messages_per_s: float = Field(
+        default=200.0,
+        gt=0,
+        le=100_000,
+        description="what it sends again at most, a second (a batch of samples is one)",
+    )
+    resend_after_s: float = Field(
+        default=3.0,
+        gt=0,
+        le=600,
+        description="a message not acknowledged this long after its put is sent again",
+    )
+
+
+def spool_folder(station_file: Path, section: SpoolSection, recordings: Path) -> Path:
+    """``spool.folder`` resolved against the station file (none: ``.spool/`` in the
+    recordings folder)."""
+    if section.folder is None:
+        return recordings / ".spool"
+    return resolve_relative(section.folder, station_file)
 
 
 def recordings_folder(station_file: Path, section: RecorderSection) -> Path:

@@ -52,12 +52,14 @@ from pydantic import Field, model_validator
 
 from shared.config.common_sections import (
     RecorderSection,
+    SpoolSection,
     StationIdentity,
     ZenohSection,
     check_unique_ids,
     find_program,
     make_recordings_folder,
     recordings_folder,
+    spool_folder,
 )
 from shared.config.loading import StrictModel, read_toml, validate
 from shared.config.openprotocol import OpenProtocolSection
@@ -129,6 +131,7 @@ class ControllerStationConfig(StrictModel):
     zenoh: ZenohSection
     openprotocol: OpenProtocolSection
     recorder: RecorderSection
+    spool: SpoolSection = SpoolSection()
     quality: QualitySection = QualitySection()
     programs: list[ControllerProgram] = Field(
         default_factory=list, description="the controller's psets, to name their runs"
@@ -156,6 +159,10 @@ class ControllerStation:
     @property
     def station_id(self) -> str:
         return self.config.station.id
+
+    @property
+    def spool_folder(self) -> Path:
+        return spool_folder(self.path, self.config.spool, self.recordings_folder)
 
     @property
     def recordings_folder(self) -> Path:

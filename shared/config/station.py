@@ -20,12 +20,14 @@ from pydantic import Field, model_validator
 
 from shared.config.common_sections import (
     RecorderSection,
+    SpoolSection,
     StationIdentity,
     ZenohSection,
     check_unique_ids,
     find_program,
     make_recordings_folder,
     recordings_folder,
+    spool_folder,
 )
 from shared.config.controller_station import is_controller_station
 from shared.config.joint import JointConfig, load_joint
@@ -171,6 +173,7 @@ class StationConfig(StrictModel):
     predictor: PredictorSection = PredictorSection()
     rig: RigSection = RigSection()
     recorder: RecorderSection
+    spool: SpoolSection = SpoolSection()
     quality: QualitySection = QualitySection()
     openprotocol: OpenProtocolSection | None = Field(
         default=None, description="the station's tool controller speaks Open Protocol"
@@ -220,6 +223,10 @@ class LoadedStation:
     def joint_of(self, program_id: int) -> JointConfig:
         """The joint program ``program_id`` tightens: its own, else the station's."""
         return self.program_joints.get(program_id, self.joint)
+
+    @property
+    def spool_folder(self) -> Path:
+        return spool_folder(self.path, self.config.spool, self.recordings_folder)
 
     @property
     def recordings_folder(self) -> Path:

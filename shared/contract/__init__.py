@@ -10,6 +10,7 @@
 - :mod:`.can_database` (the station's DBC, checked against the CAN contract),
   :mod:`.sensor_range` (what a station's sensors can measure)
 - :mod:`.trace` (the offline trace CSV), :mod:`.run_clock` (a run's clock: ns <-> s)
+- :mod:`.spool_messages` (what a station's spool and the recorder say to each other)
 """
 
 from shared.contract.can_database import CONTRACT, COUNTER_MODULO, SAMPLE_RATE_HZ, StationDatabase
@@ -62,6 +63,14 @@ from shared.contract.messages import (
 )
 from shared.contract.run_clock import RunClock
 from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
+from shared.contract.spool_messages import (
+    SeqMark,
+    SeqRange,
+    SpoolAck,
+    SpoolStats,
+    parse_seq_attachment,
+    seq_attachment,
+)
 from shared.contract.trace import Trace, read_trace, write_trace
 
 __all__ = [
@@ -103,6 +112,10 @@ __all__ = [
     "Sample",
     "SampleBatch",
     "SensorRange",
+    "SeqMark",
+    "SeqRange",
+    "SpoolAck",
+    "SpoolStats",
     "StationDatabase",
     "StepStatus",
     "StickSlipEvent",
@@ -122,7 +135,9 @@ __all__ = [
     "decoder",
     "encode",
     "json_schema",
+    "parse_seq_attachment",
     "read_trace",
+    "seq_attachment",
     "to_dict",
     "write_trace",
 ]

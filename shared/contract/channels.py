@@ -5,7 +5,8 @@ A channel is a key below a station, ``boltwatch/<station>/<topic>``
 encoded as JSON by :mod:`shared.contract.codec` with the JSON schema the codec
 derives (the MCAP channel's schema, named ``boltwatch.<Type>``), put by one
 service with one set of zenoh options (priority, congestion control,
-express). Publishers are declared from here (:meth:`Channel.declare_publisher`);
+express). Publishers are declared from here
+(:func:`shared.runtime.zenoh_session.declare_channel`);
 the recorder, ``boltwatch status``, the tests and the benchmarks look channels
 up here (:func:`by_topic`, :func:`of_message`, :data:`CHANNELS`). Adding a
 channel: its message type in :mod:`shared.contract.messages`, its row below.
@@ -40,6 +41,10 @@ topic              publisher             message, when
 ``tool_data``      openprotocol          :class:`ToolData`, when the controller says it
 ``alarms``         openprotocol          :class:`ControllerAlarm`, per alarm message
 ``openprotocol``   openprotocol          :class:`BridgeStats`, once a second
+``spool``          acquisition           :class:`SpoolStats`, once a second: what the
+                   (openprotocol)        station keeps until the line has it
+``spool/ack``      recorder              :class:`SpoolAck`, once a second per spooling
+                                         source: what it wrote to disk of the spool
 =================  ====================  ===========================================
 
 In brackets: who else may put the channel (:attr:`Channel.also_by`). A
@@ -83,6 +88,8 @@ from shared.contract.messages import (
     RunSummary,
     Sample,
     SampleBatch,
+    SpoolAck,
+    SpoolStats,
     StickSlipEvent,
     StopDecision,
     TighteningResult,
@@ -161,6 +168,8 @@ CONTROLLER = Channel("controller", ControllerResult, "import", also_by=_BRIDGE)
 TOOL_DATA = Channel("tool_data", ToolData, "openprotocol")
 ALARMS = Channel("alarms", ControllerAlarm, "openprotocol")
 OPENPROTOCOL = Channel("openprotocol", BridgeStats, "openprotocol")
+SPOOL = Channel("spool", SpoolStats, "acquisition", also_by=_BRIDGE)
+SPOOL_ACK = Channel("spool/ack", SpoolAck, "recorder")
 
 #: every channel, in the order of the table above
 CHANNELS: tuple[Channel[Any], ...] = (
@@ -181,6 +190,8 @@ CHANNELS: tuple[Channel[Any], ...] = (
     TOOL_DATA,
     ALARMS,
     OPENPROTOCOL,
+    SPOOL,
+    SPOOL_ACK,
 )
 
 _BY_TOPIC: dict[str, Channel[Any]] = {channel.topic: channel for channel in CHANNELS}

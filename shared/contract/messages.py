@@ -33,6 +33,11 @@ from shared.contract.controller_messages import (  # noqa: F401  (re-exported: o
     ToolData,
 )
 from shared.contract.message_fields import WIRE_CONFIG, Count, Id, Measured, StationId, TimeNs
+from shared.contract.spool_messages import (  # noqa: F401  (re-exported: one import for every message)
+    SeqRange,
+    SpoolAck,
+    SpoolStats,
+)
 
 ToolStateName = Literal["idle", "running", "done", "aborted"]
 StopReasonName = Literal[

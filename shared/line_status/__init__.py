@@ -6,7 +6,8 @@ run, decision, summary and result, recorder and predictor health),
 :mod:`.status_bus` (the acquisition's rate and bus faults),
 :mod:`.status_last_result` (the last tightening result: OK/NOK and why),
 :mod:`.status_bridge` (a controller bridge's link, faults and alarms),
-:mod:`.status_quality_alert` (the newest active quality alert).
+:mod:`.status_quality_alert` (the newest active quality alert),
+:mod:`.status_spool` (a station's spool: what waits for the recorder, alerts).
 ``boltwatch status`` prints it (``services.cli.station_status_text``);
 ``boltwatch serve dashboard`` serves it live (``services.dashboard``).
 """
@@ -27,6 +28,7 @@ from shared.line_status.station_status import (
 from shared.line_status.status_bridge import bridge_lines
 from shared.line_status.status_last_result import amount_text, last_result, result_text
 from shared.line_status.status_quality_alert import quality_text
+from shared.line_status.status_spool import SpoolStatus, spool_text
 
 __all__ = [
     "KNOWN_SERVICES",
@@ -36,6 +38,7 @@ __all__ = [
     "LastSummary",
     "PredictorHealth",
     "RecorderHealth",
+    "SpoolStatus",
     "StationStatus",
     "StatusCollector",
     "StatusReport",
@@ -44,5 +47,6 @@ __all__ = [
     "last_result",
     "quality_text",
     "result_text",
+    "spool_text",
     "to_json",
 ]

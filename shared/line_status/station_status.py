@@ -35,7 +35,9 @@ Per station:
 - a controller bridge's link, faults and newest active alarm, and its services
   (``kind`` "bridge"), for a station with one (:mod:`shared.line_status.status_bridge`);
 - the newest active quality alert of the recorder (a program's Cpk or NOKs,
-  :mod:`shared.line_status.status_quality_alert`).
+  :mod:`shared.line_status.status_quality_alert`);
+- its spools: what waits for the line's recorder, and an alert when one fills
+  or drops (:mod:`shared.line_status.status_spool`).
 """
 
 from __future__ import annotations
@@ -51,6 +53,7 @@ from shared.contract import (
     RunSummary,
     Sample,
     SampleBatch,
+    SpoolStats,
     StopDecision,
     TighteningResult,
     ToolState,
@@ -75,6 +78,9 @@ from shared.line_status.status_quality_alert import (
     QualitySeen,
     quality_alert,
 )
+from shared.line_status.status_spool import TOPIC as SPOOL_TOPIC
+from shared.line_status.status_spool import SpoolStatus, spool_status
+from shared.line_status.status_spool import take as take_spool
 
 #: The services of a CAN station, in display order; others are shown if alive.
 KNOWN_SERVICES = ("acquisition", "predictor", "recorder", "rig")
@@ -112,6 +118,7 @@ class _Seen:
     predictor_received_ns: int = 0
     bridge: BridgeSeen = field(default_factory=BridgeSeen)
     quality: QualitySeen = field(default_factory=QualitySeen)
+    spools: dict[str, tuple[SpoolStats, int]] = field(default_factory=dict)
     unreadable: int = 0
 
 
@@ -190,6 +197,7 @@ class StationStatus:
     bridge: BridgeStatus | None = None  # None: no controller bridge spoke in the window
     quality_alert: ActiveQualityAlert | None = None  # None: none active in the window
     kind: str = "can"  # "bridge": a controller bridge's station (services: its own)
+    spools: list[SpoolStatus] = field(default_factory=list)  # its spools heard in the window
 
 
 @dataclass(frozen=True)
@@ -254,10 +262,8 @@ class StatusCollector:
             elif topic == channels.PREDICTOR.topic:
                 seen.predictor = decode(PredictorStats, payload)
                 seen.predictor_received_ns = received_ns
-            elif topic in BRIDGE_TOPICS:
-                seen.bridge.take(topic, payload, received_ns)
-            elif topic == QUALITY_TOPIC:
-                seen.quality.take(payload)
+            else:
+                _take_other(seen, topic, payload, received_ns)
         except InputError:
             seen.unreadable += 1
 
@@ -267,6 +273,16 @@ class StatusCollector:
             _status(name, seen, listened_s, now_ns) for name, seen in sorted(self._stations.items())
         ]
         return StatusReport(endpoint=endpoint, listened_s=listened_s, stations=stations)
+
+
+def _take_other(seen: _Seen, topic: str, payload: bytes, received_ns: int) -> None:
+    """A message of a bridge, a quality alert, a spool's counters (any other: nothing)."""
+    if topic in BRIDGE_TOPICS:
+        seen.bridge.take(topic, payload, received_ns)
+    elif topic == QUALITY_TOPIC:
+        seen.quality.take(payload)
+    elif topic == SPOOL_TOPIC:
+        take_spool(seen.spools, payload, received_ns)
 
 
 def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationStatus:
@@ -289,6 +305,7 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
         bridge=bridge_status(seen.bridge, now_ns),
         quality_alert=quality_alert(seen.quality, now_ns),
         kind="bridge" if is_bridge_station(seen.services, seen.bridge) else "can",
+        spools=spool_status(seen.spools, now_ns),
     )
 
 

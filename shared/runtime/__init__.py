@@ -16,7 +16,7 @@
 from shared.runtime.can_bus import open_bus
 from shared.runtime.log_limit import RateLimitedLog
 from shared.runtime.logging_setup import setup_logging
-from shared.runtime.queued_publisher import QueuedPublisher
+from shared.runtime.queued_publisher import QueuedPublisher, station_spool
 from shared.runtime.realtime import RIG_PRIORITY, STOP_PATH_PRIORITY, use_realtime_priority
 from shared.runtime.receive_threads import keep_thread_state, use_one_receive_thread
 from shared.runtime.sample_batching import BATCH_PERIOD_S, MAX_BATCH_SAMPLES, SampleBatching
@@ -58,6 +58,7 @@ __all__ = [
     "open_from",
     "open_session",
     "setup_logging",
+    "station_spool",
     "supervisor_environment",
     "use_one_receive_thread",
     "use_realtime_priority",

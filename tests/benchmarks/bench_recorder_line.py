@@ -108,7 +108,7 @@ def bench(count: int, seconds: float, rerun: bool, profile: int) -> None:
                 profiler.enable()
             next_tick_ns = t0_ns
             for now_ns, batch in load:
-                service._file([(key, payload, now_ns) for key, payload in batch])
+                service._file([(key, payload, now_ns, None) for key, payload in batch])
                 if now_ns >= next_tick_ns:
                     service.recorder.tick(now_ns)
                     if service.wear is not None:

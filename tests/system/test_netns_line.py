@@ -4,7 +4,8 @@ The line server runs the zenoh router and the recorder; each station box runs
 its own simulated rig on its own CAN bus (multicast on the box's loopback),
 its acquisition and its predictor, all zenoh clients of the router over the
 box's own cable. Every station tightens; station 3's cable is pulled for ten
-seconds in the middle. The other two must be untouched (every run recorded,
+seconds in the middle; the stations' spools are off (store and forward, on by default,
+loses nothing: ``test_store_and_forward.py``). The other two must be untouched (every run recorded,
 no sample lost); station 3 must be reported down while cut off, its lost
 samples counted, and its runs after the cable is back recorded in full.
 
@@ -99,7 +100,9 @@ def station_files(tmp_path: Path) -> list[Path]:
             },
         )
         text = path.read_text().replace(str(folder / "recordings"), str(recordings))
-        path.write_text(text)
+        # the spool off: a cut's loss is counted exactly (with it, nothing is lost:
+        # tests/system/test_store_and_forward.py)
+        path.write_text(text + "\n[spool]\nenabled = false\n")
         files.append(path)
     return files
 

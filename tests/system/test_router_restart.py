@@ -3,7 +3,9 @@
 Router, recorder, predictor, acquisition and rig run as ``boltwatch serve``
 processes; the test SIGKILLs the router while the rig tightens joints one
 after the other, restarts it on the same endpoint a few seconds later, and
-checks, without restarting any service:
+checks, without restarting any service (and with the station's spool off, so that
+what an outage costs is counted: with it nothing is lost,
+``tests/system/test_store_and_forward.py``):
 
 - the acquisition counted the samples it published with no router
   (``BusStats.unsent_samples``) and logged the outage with its length;
@@ -118,6 +120,9 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
             'mode = "client"': f'mode = "client"\nreconnect_period_max_s = {RECONNECT_PERIOD_MAX_S}'
         },
     )
+    # the spool off: what the outage costs a station without store and forward is counted
+    # exactly (with it, nothing is lost: tests/system/test_store_and_forward.py)
+    path.write_text(path.read_text() + "\n[spool]\nenabled = false\n")
     logs = {n: tmp_path / f"{n}.log" for n in ("router", "recorder", "predictor", "acq", "rig")}
     heard = Heard()
     router = serve(["router", "--listen", endpoint], logs["router"])

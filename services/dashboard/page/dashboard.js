@@ -49,6 +49,13 @@ function figures(station) {
     if (station.recorder.lag_p50_ms !== null) parts.push(`recorder lag ${fixed(station.recorder.lag_p50_ms, 1, " ms")}`);
   }
   if (station.bridge) parts.push(`controller ${station.bridge.controller} ${station.bridge.connected ? "connected" : "NOT connected"}`);
+  for (const spool of station.spools) {
+    const waiting = spool.messages === 0 ? "nothing waiting"
+      : `${spool.runs} runs, ${spool.samples} samples waiting` +
+        (spool.oldest_run_id === null ? "" : ` (oldest run ${spool.oldest_run_id})`);
+    const resend = spool.resend_per_s ? `, sending again ${fixed(spool.resend_per_s, 0, " /s")}` : "";
+    parts.push(`spool: ${waiting}, ${fixed(spool.full_pct, 1, " %")} full${resend}`);
+  }
   return el("p", { class: "figures" }, parts.join(" · "));
 }
 
@@ -98,6 +105,9 @@ function alerts(station) {
   const items = station.alerts.map((a) => el("li", { class: "alert" }, `${a.topic}: ${a.text}`));
   const alarm = station.bridge && station.bridge.alarm;
   if (alarm) items.unshift(el("li", { class: "alert" }, `controller alarm ${alarm.error_code}: ${alarm.text}`));
+  for (const spool of station.spools) {
+    if (spool.alert) items.unshift(el("li", { class: "alert spool" }, `spool (${spool.source}): ${spool.alert}`));
+  }
   return items.length ? el("ul", { class: "alerts" }, ...items) : none("no alert");
 }
 

@@ -2,8 +2,8 @@
 
 One subscriber per key expression (the recorder's: one per station it
 serves, ``boltwatch/<st>/**``) whose callback runs on zenoh's receive
-thread (``indirect=False``) and only appends ``(key, payload, receive time)``
-to a pending list. The recorder's worker takes the whole list at once
+thread (``indirect=False``) and only appends ``(key, payload, receive time,
+attachment)`` to a pending list. The recorder's worker takes the whole list at once
 (:meth:`LineInbox.take`, every few milliseconds) and files it: one
 hand-over per batch instead of one per message (a ``FifoChannel`` read with
 a blocking ``recv()``, as before; measured side by side in the README's
@@ -29,8 +29,8 @@ import zenoh
 
 from shared.runtime import keep_thread_state
 
-#: (zenoh key, payload, receive time in ns) of one message
-Message = tuple[str, bytes, int]
+#: (zenoh key, payload, receive time in ns, attachment) of one message
+Message = tuple[str, bytes, int, bytes | None]
 
 #: messages waiting before the receive thread waits too: 2 s of 50 stations at 1 kHz
 MAX_PENDING = 100_000
@@ -65,7 +65,13 @@ class LineInbox:
 
     def _deliver(self, sample: zenoh.Sample) -> None:
         keep_thread_state()
-        message = (str(sample.key_expr), sample.payload.to_bytes(), time.time_ns())
+        attachment = sample.attachment
+        message = (
+            str(sample.key_expr),
+            sample.payload.to_bytes(),
+            time.time_ns(),
+            None if attachment is None else attachment.to_bytes(),
+        )
         with self._lock:
             if len(self._pending) >= self._max_pending and not self._closed:
                 self.full_waits += 1

@@ -56,6 +56,8 @@ class Recorder:
         self._limits = limits
         self._metadata = metadata
         self._stations: dict[str, StationFiles] = {}
+        self._holes: list[StationFiles] = []  # the files of holes of stations' spools
+        self._closed_holes: list[Path] = []
         self.messages = 0
         self.refused: Counter[str] = Counter()  # per station: refused payloads, recorded raw
         self.unknown_keys: Counter[str] = Counter()  # per station: not a message key, raw
@@ -70,8 +72,10 @@ class Recorder:
         self._retry_at_ns = 0
         self._remind_at_ns = 0
 
-    def write(self, received: Received) -> None:
-        files = self._files(received.station)
+    def write(self, received: Received, files: StationFiles | None = None) -> None:
+        """File one received message into its station's live files (or ``files``: the
+        files of a hole of the station's spool, :meth:`hole_files`)."""
+        files = files or self._files(received.station)
         if not received.decodable:
             self.refused[received.station] += 1
             self._log_refused(
@@ -97,11 +101,13 @@ class Recorder:
             return
         self._maybe_recovered(files, now_ns)
 
-    def write_samples(self, station: str, samples: Sequence[Received]) -> None:
+    def write_samples(
+        self, station: str, samples: Sequence[Received], files: StationFiles | None = None
+    ) -> None:
         """The decoded Samples of one batch of ``station``, as :meth:`write` files each."""
         if not samples:
             return
-        files = self._files(station)
+        files = files or self._files(station)
         self.messages += len(samples)
         now_ns = samples[-1].log_time_ns
         if self._waits_for_retry(files, now_ns):
@@ -116,8 +122,45 @@ class Recorder:
             return
         self._maybe_recovered(files, now_ns)
 
+    def hole_files(self, station: str, hand_over: bool) -> StationFiles:
+        """Files for a hole of ``station``'s spool (``hand_over``: they go on with the run the
+        live files were recording, and the live files start afresh)."""
+        files = StationFiles(
+            station, self._folder, self._limits, self._metadata, self._rerun, sent_again=True
+        )
+        if hand_over:
+            files.adopt(self._files(station).hand_over())
+        self._holes.append(files)
+        return files
+
+    def hand_back(self, files: StationFiles) -> None:
+        """A hole caught up with the live messages: the live files go on with its open run."""
+        self._files(files.station).adopt(files.hand_over())
+
+    def close_hole(self, files: StationFiles) -> None:
+        """The hole is filled: its files are finished."""
+        if files in self._holes:
+            self._holes.remove(files)
+        try:
+            files.close()
+        except OSError as err:
+            self._fault(files, err, self._fault_started_ns, unwritten=0)
+        self._closed_holes.extend(files.closed_paths)
+
+    def flush(self, station: str, now_ns: int) -> bool:
+        """What ``station``'s files (live and holes) hold reaches the disk now; False when
+        writing failed (nothing more of it can be taken as written)."""
+        ok = True
+        for files in [self._files(station), *(f for f in self._holes if f.station == station)]:
+            try:
+                files.flush(now_ns)
+            except OSError as err:
+                self._fault(files, err, now_ns, unwritten=0)
+                ok = False
+        return ok and self.recording_ok
+
     def tick(self, now_ns: int) -> None:
-        for files in self._stations.values():
+        for files in [*self._stations.values(), *self._holes]:
             try:
                 files.tick(now_ns)
             except OSError as err:
@@ -129,8 +172,8 @@ class Recorder:
 
     def close(self) -> list[Path]:
         """Finish every open file; the paths of every file closed so far."""
-        closed: list[Path] = []
-        for files in self._stations.values():
+        closed: list[Path] = list(self._closed_holes)
+        for files in [*self._holes, *self._stations.values()]:
             try:
                 files.close()
             except OSError as err:

@@ -26,8 +26,10 @@ missing for at most one report and drop out at the next. When the
 acquisition restarts (``BusStats.started_ns`` changes, or its count goes
 down) the loss so far is kept and the counting starts again at the new
 process's first BusStats (samples around a restart, before the new
-process's first report, are not judged). This
-catches what no link-level counter can: a cable pulled for less than zenoh's
+process's first report, are not judged). Samples a station's spool sends
+again after a cut count as received when the recorder files them
+(:meth:`RecorderHealth.refiled`): the level drops back to what the drain
+could not bring. This catches what no link-level counter can: a cable pulled for less than zenoh's
 lease loses samples while no session ever sees its router go.
 """
 
@@ -109,6 +111,11 @@ class RecorderHealth:
         counts.messages += len(sample_times_ns)
         counts.samples_received += len(sample_times_ns)
         counts.lags_ns += [received_ns - time_ns for time_ns in sample_times_ns]
+
+    def refiled(self, station: str, samples: int) -> None:
+        """Samples of ``station`` its spool sent again, filed now: received (no lag: they are
+        old by design), so ``missing_samples`` says what is missing after the drain."""
+        self._counts(station).samples_received += samples
 
     def bus_stats(self, station: str, published_samples: int, started_ns: int) -> None:
         """A BusStats of ``station`` arrived: recount its missing samples."""

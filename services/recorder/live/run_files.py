@@ -37,6 +37,8 @@ LOG = logging.getLogger(__name__)
 
 #: run ids remembered per station: a ToolState starting one of them again opens no file
 STARTED_RUNS_KEPT = 64
+#: a run sent again by a station's spool is named by its start when it is at most this old
+SENT_AGAIN_MAX_AGE_NS = 7 * 24 * 3600 * 1_000_000_000
 _ENDED_STATES = ("done", "aborted")
 
 
@@ -51,6 +53,19 @@ class FileLimits:
     fsync: bool = True  # each flush reaches the disk: a power cut loses one interval at most
 
 
+@dataclass(frozen=True, slots=True)
+class OpenRun:
+    """A run's open file, handed from one StationFiles to another (:meth:`~StationFiles.adopt`)."""
+
+    sink: McapSink
+    companion: RerunSink | None
+    part: int
+    ended: bool
+    started: tuple[int | None, int]
+    tool_id: int | None
+    program_id: int | None
+
+
 class StationFiles:
     """Route one station's payloads into its run files; flush and rotate them."""
 
@@ -61,8 +76,11 @@ class StationFiles:
         limits: FileLimits,
         metadata: FileMetadata,
         rerun: RerunOptions | None = None,
+        sent_again: bool = False,
     ) -> None:
+        """``sent_again``: the files of what a station's spool sends again (a hole)."""
         self.station = station
+        self.sent_again = sent_again
         self._folder = folder
         self._limits = limits
         self._metadata = metadata
@@ -191,6 +209,42 @@ class StationFiles:
         self.previous = self.current = None
         return lost
 
+    def hand_over(self) -> OpenRun | None:
+        """Give away the open file of the run in progress (with its ``.rrd``), and close the
+        one before: a station's spool is to send the rest of that run again, into the same
+        file, while its newer runs go on here (:meth:`adopt` on the other side)."""
+        if self.previous is not None:
+            self._close(self.previous)
+            self.previous = None
+        sink, self.current = self.current, None
+        if sink is None:
+            return None
+        handed = OpenRun(
+            sink,
+            self._rerun_sinks.pop(sink, None),
+            self._part,
+            self._run_ended,
+            self._run_started,
+            self._tool_id,
+            self._program_id,
+        )
+        return handed
+
+    def adopt(self, run: OpenRun | None) -> None:
+        """Go on with a run's open file another StationFiles handed over (the files open
+        here are finished first)."""
+        if run is None:
+            return
+        self.close()
+        self.current = run.sink
+        if run.companion is not None:
+            self._rerun_sinks[run.sink] = run.companion
+        self._part = run.part
+        self._run_ended = run.ended
+        self._run_started = run.started
+        self._tool_id, self._program_id = run.tool_id, run.program_id
+        self._started_runs.append(run.sink.run_id)
+
     @property
     def unflushed_messages(self) -> int:
         """Messages of the open files not yet on the disk."""
@@ -231,7 +285,14 @@ class StationFiles:
         self._run_ended = False
         self._resume = (run_id, part)  # until the file is open: a failed open is retried as is
         self.current = None
-        path = file_path(self._folder, self.station, run_id, now_ns, part)
+        started_run, started_ns = self._run_started
+        named_ns = now_ns
+        # a run sent again after a cut opens late: named by its start, as it would have been
+        # live, unless the station's clock says something no spool holds
+        sent_again_run = self.sent_again and part == 1 and started_run == run_id is not None
+        if sent_again_run and 0 <= now_ns - started_ns <= SENT_AGAIN_MAX_AGE_NS:
+            named_ns = started_ns
+        path = file_path(self._folder, self.station, run_id, named_ns, part)
         tool_id = self._tool_id if run_id is not None else None
         program_id = self._program_id if run_id is not None else None
         metadata = self._metadata.for_file(self.station, run_id, tool_id, program_id)

@@ -158,12 +158,14 @@ PREDICTOR_PUTS = {
     channels.PREDICTOR.topic,
 }
 ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), per station
-    # the acquisition hosts the station's predictor (placement "edge") and publishes for it
-    "acquisition": set(channels.topics_of("acquisition")) | PREDICTOR_PUTS,
+    # the acquisition hosts the station's predictor (placement "edge") and publishes for it,
+    # and its spool sends again what the line's recorder lacks (again/<topic>)
+    "acquisition": set(channels.topics_of("acquisition")) | PREDICTOR_PUTS | {f"{keys.AGAIN}/**"},
     "predictor": PREDICTOR_PUTS,
     "recorder": {
         channels.RECORDER.topic,
         channels.QUALITY_ALERT.topic,
+        channels.SPOOL_ACK.topic,
         keys.WEAR,
         f"{keys.WEAR}/**",
     },

@@ -42,9 +42,9 @@ def test_every_message_is_kept_in_order_with_its_key_and_receive_time(
         taken = take_until(inbox, 500)
     finally:
         inbox.close()
-    assert [payload for _, payload, _ in taken] == [str(i).encode() for i in range(500)]
-    assert {key for key, _, _ in taken} == {"boltwatch/a1/samples", "boltwatch/a2/tool"}
-    times_ns = [received_ns for _, _, received_ns in taken]
+    assert [payload for _, payload, _, _ in taken] == [str(i).encode() for i in range(500)]
+    assert {key for key, _, _, _ in taken} == {"boltwatch/a1/samples", "boltwatch/a2/tool"}
+    times_ns = [received_ns for _, _, received_ns, _ in taken]
     assert times_ns == sorted(times_ns)
     assert inbox.full_waits == 0
 
@@ -71,7 +71,7 @@ def test_a_full_inbox_holds_the_publisher_back_and_loses_nothing(
     finally:
         inbox.close()
     assert published.is_set()
-    assert [payload for _, payload, _ in taken] == [str(i).encode() for i in range(300)]
+    assert [payload for _, payload, _, _ in taken] == [str(i).encode() for i in range(300)]
 
 
 def test_close_keeps_what_came_before_for_a_last_take(
@@ -88,7 +88,7 @@ def test_close_keeps_what_came_before_for_a_last_take(
     wait_until(lambda: not has_subscribers(samples), "the subscriber gone")
     samples.put(b"after close")
     kept = inbox.take(0)
-    assert [payload for _, payload, _ in kept] == [str(i).encode() for i in range(20)]
+    assert [payload for _, payload, _, _ in kept] == [str(i).encode() for i in range(20)]
     assert inbox.take(0) == []
 
 
@@ -127,4 +127,4 @@ def test_close_wakes_a_receive_thread_waiting_for_room_and_counts_its_message(
     publisher_thread.join(10.0)
     assert not publisher_thread.is_alive()
     kept = inbox.take(0)
-    assert [payload for _, payload, _ in kept] == [str(i).encode() for i in range(10)]
+    assert [payload for _, payload, _, _ in kept] == [str(i).encode() for i in range(10)]

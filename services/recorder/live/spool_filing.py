@@ -1,0 +1,89 @@
+"""The line's recorder filing what stations' spools numbered: live, into holes, or waiting.
+
+Wires the pure :class:`~services.recorder.live.spool_order.SpoolOrder` (through
+the :class:`~services.recorder.live.spool_keeper.SpoolKeeper`) to the files of
+the :class:`~services.recorder.live.recorder.Recorder`: a hole gets files of
+its own (handed the run the live files were recording when it opened, handed
+back when it catches up), a live message the hole is not ready for waits in
+memory (:mod:`.waiting_live`) and is filed as soon as the hole reaches it,
+and a hole filled to its end has its files finished. A station's messages
+that carry no number (its spool's own counters) go where its run in progress
+is: an open hole's files while there is one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from services.recorder.live.recorder import Recorder
+from services.recorder.live.run_files import StationFiles
+from services.recorder.live.spool_keeper import SpoolKeeper
+from services.recorder.live.spool_order import Fate
+from services.recorder.live.waiting_live import WaitingLive
+from shared.contract import SeqMark, SpoolAck
+from shared.recordings import Received
+
+#: files one received message at a time: (message, filed at, a hole's files or None: live)
+FileReceived = Callable[[Received, int, "StationFiles | None"], None]
+
+
+class SpoolFiling:
+    """Numbered messages of every spool a recorder hears, into its files."""
+
+    def __init__(self, keeper: SpoolKeeper, recorder: Recorder, file: FileReceived) -> None:
+        self.keeper = keeper
+        self._recorder = recorder
+        self._file = file
+        self._waiting: dict[tuple[str, str], WaitingLive[tuple[Received, SeqMark]]] = {}
+
+    def file(self, received: Received, mark: SeqMark, filed_ns: int) -> None:
+        """File message ``mark.seq`` where its order says; then what waited for it."""
+        self._file_numbered(received, mark, filed_ns)
+        waiting = self._waiting.get((received.station, mark.source))
+        order = self.keeper.order_of(received.station, mark.source)
+        while waiting and order is not None:
+            ready = waiting.take(order.next_expected)
+            if ready is None:
+                return
+            self._file_numbered(*ready, filed_ns)
+
+    def unnumbered_files(self, station: str) -> StationFiles | None:
+        """Where a message of ``station`` without a number goes: the files of a hole holding
+        its run in progress; None: the live files."""
+        files = self.keeper.open_hole_files(station)
+        return files if isinstance(files, StationFiles) else None
+
+    def acknowledge(self, now_ns: int, publish: Callable[[SpoolAck], None]) -> None:
+        """Flush the spooling stations' files; acknowledge what they hold."""
+        recorder = self._recorder
+        self.keeper.acknowledge(now_ns, lambda station: recorder.flush(station, now_ns), publish)
+        self._close_holes()
+
+    def waiting_full(self) -> int:
+        """Live messages not kept in memory (it was full): the stations send them again."""
+        return sum(waiting.full for waiting in self._waiting.values())
+
+    def _file_numbered(self, received: Received, mark: SeqMark, filed_ns: int) -> None:
+        station = received.station
+        routing = self.keeper.route(station, mark, received.run_started)
+        hole = routing.hole
+        if hole is not None and hole.files is None:
+            hole.files = self._recorder.hole_files(station, hand_over=routing.opened)
+        if routing.fate is Fate.DEFER:
+            if not mark.again:
+                waiting = self._waiting.setdefault((station, mark.source), WaitingLive())
+                waiting.keep(mark.seq, (received, mark), len(received.payload))
+            return
+        if routing.fate is Fate.SKIP:
+            return
+        if routing.caught_up and hole is not None and isinstance(hole.files, StationFiles):
+            self._recorder.hand_back(hole.files)
+        files = hole.files if routing.fate is Fate.HOLE and hole is not None else None
+        self._file(received, filed_ns, files)
+        self.keeper.filed_as(station, mark, routing)
+        self._close_holes()
+
+    def _close_holes(self) -> None:
+        for hole in self.keeper.holes_done():
+            if isinstance(hole.files, StationFiles):
+                self._recorder.close_hole(hole.files)

@@ -1,0 +1,190 @@
+"""The recorder's side of store and forward: what it filed of each station's spool, kept and
+acknowledged.
+
+One :class:`~services.recorder.live.spool_order.SpoolOrder` per (station,
+source) says where each numbered message goes (:meth:`SpoolKeeper.route`).
+Once a second (:meth:`SpoolKeeper.acknowledge`) the recorder flushes the
+station's files; what they hold is then saved
+(``<recordings>/.spool/<station>-<source>.filed.json``, replaced atomically)
+and acknowledged to the station (:class:`~shared.contract.SpoolAck`), which
+deletes it from its spool. So a station deletes only what is on the
+recorder's disk, and a recorder that restarts knows what it has: the numbers
+missing below the highest it saved are holes to fill again.
+
+A flush that fails (a full disk) acknowledges nothing: the order goes back to
+what was saved, and the station sends the rest again once the disk takes it
+(at least once: what the failed files held may come twice, never not at
+all). A message from a spool of another id (the station's spool was made
+again: its numbers start from 1 again) starts that source afresh.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Final
+
+from services.recorder.live.spool_order import Hole, Routing, SpoolOrder
+from shared.contract import SeqMark, SeqRange, SpoolAck, SpoolStats
+from shared.files import describe_os_error, write_json_atomically
+from shared.spool import SeqRanges
+
+LOG = logging.getLogger(__name__)
+
+#: the recorder's state, in its recordings folder
+STATE_FOLDER: Final = ".spool"
+#: at most this many ranges above ``through`` in one acknowledgement (the station sends the
+#: rest again, and they are skipped)
+MAX_ACK_RANGES: Final = 256
+
+
+@dataclass
+class SpoolSource:
+    """What the recorder has of one spool (one source of one station)."""
+
+    station: str
+    source: str
+    spool_id: int
+    order: SpoolOrder
+    path: Path
+    saved: SeqRanges  # on the recorder's disk, as far as it knows: what it acknowledges
+    saved_gone: int = 0
+
+    def ack(self, now_ns: int) -> SpoolAck:
+        through = self.saved.through
+        ranges = [SeqRange(first, last) for first, last in self.saved.above(through)]
+        return SpoolAck(
+            station=self.station,
+            source=self.source,
+            spool_id=self.spool_id,
+            time_ns=now_ns,
+            through=through,
+            ranges=ranges[:MAX_ACK_RANGES],
+        )
+
+
+class SpoolKeeper:
+    """Every spool the recorder hears of, by (station, source)."""
+
+    def __init__(self, recordings_folder: Path) -> None:
+        self._folder = recordings_folder / STATE_FOLDER
+        self._sources: dict[tuple[str, str], SpoolSource] = {}
+        self._closing: list[Hole] = []  # holes let go of: their files to close
+        self.save_errors = 0
+        self.last_error: str | None = None
+
+    def route(self, station: str, mark: SeqMark, run_started: bool) -> Routing:
+        """Where message ``mark.seq`` goes (:meth:`SpoolOrder.route`)."""
+        order = self._source(station, mark.source, mark.spool_id).order
+        return order.route(mark.seq, run_started, mark.kept_before)
+
+    def filed_as(self, station: str, mark: SeqMark, routing: Routing) -> None:
+        self._source(station, mark.source, mark.spool_id).order.filed_as(mark.seq, routing)
+
+    def on_stats(self, stats: SpoolStats) -> None:
+        """A station's spool counters: what it no longer has is gone."""
+        source = self._source(stats.station, stats.source, stats.spool_id)
+        oldest = stats.oldest_seq if stats.messages else stats.head_seq + 1
+        gone = source.order.station_has_from(oldest)
+        if gone:
+            LOG.error(
+                "%s: %d messages of its %s spool are gone (dropped to keep its bound) "
+                "before the recorder had them",
+                stats.station,
+                gone,
+                stats.source,
+            )
+
+    def holes_done(self) -> list[Hole]:
+        """Holes filled to their end, or let go of: their files are to be closed."""
+        done, self._closing = self._closing, []
+        for source in self._sources.values():
+            done.extend(source.order.completed())
+        return done
+
+    def order_of(self, station: str, source: str) -> SpoolOrder | None:
+        known = self._sources.get((station, source))
+        return None if known is None else known.order
+
+    def open_hole_files(self, station: str) -> object | None:
+        """The files of a hole of ``station`` that holds its run in progress (None: none)."""
+        for source in self.sources(station):
+            opened = source.order.open_hole
+            if opened is not None and opened.files is not None:
+                return opened.files
+        return None
+
+    def sources(self, station: str) -> list[SpoolSource]:
+        return [source for source in self._sources.values() if source.station == station]
+
+    def acknowledge(
+        self, now_ns: int, flush: Callable[[str], bool], publish: Callable[[SpoolAck], None]
+    ) -> None:
+        """Flush each spooling station's files; save and acknowledge what they hold (or, when
+        the flush failed, go back to what was saved)."""
+        for station in sorted({source.station for source in self._sources.values()}):
+            flushed = flush(station)
+            for source in self.sources(station):
+                if flushed:
+                    self._save(source)
+                else:
+                    self._closing.extend(source.order.holes)
+                    source.order = SpoolOrder.resumed(SeqRanges(source.saved), source.saved_gone)
+                publish(source.ack(now_ns))
+
+    def _source(self, station: str, name: str, spool_id: int) -> SpoolSource:
+        source = self._sources.get((station, name))
+        if source is not None and source.spool_id == spool_id:
+            return source
+        if source is not None:
+            LOG.warning(
+                "%s: its %s spool is a new one (id %d, was %d): its numbers start again",
+                station,
+                name,
+                spool_id,
+                source.spool_id,
+            )
+            self._closing.extend(source.order.holes)
+        source = self._load(station, name, spool_id)
+        self._sources[(station, name)] = source
+        return source
+
+    def _load(self, station: str, name: str, spool_id: int) -> SpoolSource:
+        path = self._folder / f"{station}-{name}.filed.json"
+        filed, gone = SeqRanges(), 0
+        try:
+            document = json.loads(path.read_text(encoding="utf-8"))
+            if document.get("spool_id") == spool_id:
+                filed = SeqRanges(tuple(pair) for pair in document["filed"])
+                gone = int(document.get("gone", 0))
+        except FileNotFoundError:
+            pass
+        except (OSError, ValueError, KeyError, TypeError) as err:
+            LOG.error("%s: unreadable, the spool of %s starts afresh: %s", path, station, err)
+        return SpoolSource(
+            station, name, spool_id, SpoolOrder.resumed(filed, gone), path, SeqRanges(filed), gone
+        )
+
+    def _save(self, source: SpoolSource) -> None:
+        order = source.order
+        if order.filed == source.saved and order.gone == source.saved_gone:
+            return
+        document = {
+            "station": source.station,
+            "source": source.source,
+            "spool_id": source.spool_id,
+            "filed": order.filed.as_list(),
+            "gone": order.gone,
+        }
+        try:
+            write_json_atomically(source.path, document)
+        except OSError as err:
+            self.save_errors += 1
+            self.last_error = describe_os_error(err, source.path)
+            LOG.error("spool state not saved (nothing acknowledged): %s", self.last_error)
+            return
+        source.saved = SeqRanges(order.filed)
+        source.saved_gone = order.gone

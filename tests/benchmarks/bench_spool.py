@@ -1,0 +1,298 @@
+"""Store and forward, measured: what a station's spool needs, how fast it drains, and zenoh's
+own cache beside it (not a test).
+
+Run on demand::
+
+    .venv/bin/python tests/benchmarks/bench_spool.py [--runs 20] [--stations 10]
+        [--skip-station]
+
+1. **A station's hour.** The real processes (``serve acquisition`` with its edge
+   predictor, ``serve rig``) tighten ``--runs`` joints on loopback with no
+   recorder on the line: nothing is acknowledged, the spool keeps everything.
+   Reported: spool bytes and messages per run, runs per hour at the rig's
+   pace, and so bytes per station-hour (the default ``[spool] max_bytes``
+   must hold 8 hours).
+2. **A cut of 10 minutes and of an hour.** What a spool holds after such a cut
+   (step 1's messages, repeated with fresh numbers: time compressed) drained
+   into a live recorder through real zenoh at the default rate
+   (``drain_messages_per_s``) and at a high one: messages per second and the
+   time to empty. The 1-hour drain is extrapolated from the rate measured on
+   the 10-minute one at the default rate (the rate is the bound, not the
+   recorder).
+3. **A line coming back at once.** ``--stations`` spools, each holding a
+   10-minute cut, drained into one recorder at once, while one more station
+   publishes live: the recorder's lag (its RecorderStats ``lag_p50_ms`` /
+   ``lag_max_ms`` for the live station) during the drain, and the time until
+   every spool is empty.
+4. **zenoh's AdvancedPublisher cache** (zenoh-ext, the alternative looked at
+   first): the process's resident memory for a cache holding step 1's
+   messages scaled to an hour (measured on 10 minutes), and whether a
+   late-joining AdvancedSubscriber gets the history (it does, from a running
+   publisher) and whether anything survives the publisher's restart (nothing:
+   the cache is the publisher's memory).
+
+The stop path while the station spools is ``bench_stop_path.py`` (the spool
+is on by default), side by side with the code before with ``--repo``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import json
+import resource
+import statistics
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO) not in sys.path:  # run as a script from anywhere
+    sys.path.insert(0, str(REPO))
+
+import zenoh
+import zenoh.ext
+
+from services.cli.station_supervisor import stop_process
+from shared.config import load_station
+from shared.contract import RecorderStats, SpoolStats, decode
+from shared.runtime import QueuedPublisher, zenoh_config
+from shared.spool import SeqRanges, Spooled, SpoolFile, StationSpool
+from tests.support.live_recorder import RunningRecorder, free_port, write_station_file
+from tests.support.station_files import serve, write_station
+
+HOUR_S = 3600.0
+
+
+def station_hour(folder: Path, runs: int) -> tuple[list[Spooled], float]:
+    """Step 1: the spooled messages of ``runs`` real runs and the seconds they took."""
+    path = write_station(folder, zenoh_mode="peer")
+    station = load_station(path)
+    logs = folder / "logs"
+    logs.mkdir()
+    acquisition = serve(["acquisition", "--config", str(path)], logs / "acquisition.log")
+    try:
+        time.sleep(3.0)
+        started = time.monotonic()
+        rig = serve(["rig", "--config", str(path), "--runs", str(runs)], logs / "rig.log")
+        assert rig.wait(runs * 20) == 0, f"the rig failed: {logs}"
+        took_s = time.monotonic() - started
+        time.sleep(1.5)  # the last group commit and stats
+    finally:
+        stop_process(acquisition)
+    spool = SpoolFile(station.spool_folder / f"{station.station_id}-acquisition.sqlite")
+    messages = spool.after(0, 10**9, 2**62, SeqRanges())
+    depth = spool.depth()
+    spool.close()
+    per_run = depth.file_bytes / runs
+    runs_per_hour = runs / took_s * HOUR_S
+    print(
+        f"1. a station's hour: {runs} runs in {took_s:.1f} s, {depth.messages} messages, "
+        f"{depth.samples} samples, spool {depth.file_bytes / 1e6:.2f} MB on disk "
+        f"({per_run / 1e3:.1f} kB a run, {len(messages) / runs:.0f} messages a run); "
+        f"{runs_per_hour:.0f} runs an hour: {per_run * runs_per_hour / 1e6:.0f} MB "
+        f"per station-hour, {8 * per_run * runs_per_hour / 1e9:.2f} GB for 8 hours"
+    )
+    return messages, took_s
+
+
+def cut_spool(path: Path, station: str, messages: list[Spooled], repeat: int) -> StationSpool:
+    """A spool holding ``messages`` ``repeat`` times over (fresh numbers), of ``station``."""
+    spool = SpoolFile(path)
+    for _ in range(repeat):
+        for message in messages:
+            payload = message.payload.replace(b'"station":"st1"', f'"station":"{station}"'.encode())
+            spool.append(message.topic, payload, 0, None, 0, time.time_ns() - 10**12)
+        spool.commit()
+    return StationSpool(station, "acquisition", spool, 1 << 40, 200.0, 1.0)
+
+
+class SpoolWatch:
+    """Every station's latest SpoolStats and RecorderStats, as the line hears them."""
+
+    def __init__(self, session: zenoh.Session) -> None:
+        self.spools: dict[str, SpoolStats] = {}
+        self.recorder: dict[str, list[RecorderStats]] = {}
+        self._lock = threading.Lock()
+        self._subscribers = [
+            session.declare_subscriber("boltwatch/*/spool", self._on_spool),
+            session.declare_subscriber("boltwatch/*/recorder", self._on_recorder),
+        ]
+
+    def _on_spool(self, sample: zenoh.Sample) -> None:
+        stats = decode(SpoolStats, sample.payload.to_bytes())
+        with self._lock:
+            self.spools[stats.station] = stats
+
+    def _on_recorder(self, sample: zenoh.Sample) -> None:
+        stats = decode(RecorderStats, sample.payload.to_bytes())
+        with self._lock:
+            self.recorder.setdefault(stats.station, []).append(stats)
+
+    def empty(self, stations: list[str]) -> bool:
+        with self._lock:
+            return all(
+                s in self.spools and self.spools[s].messages == 0 and self.spools[s].resent
+                for s in stations
+            )
+
+
+def drain(
+    folder: Path,
+    messages: list[Spooled],
+    cut_s: float,
+    took_s: float,
+    stations: int,
+    rate: float,
+    live: bool,
+) -> tuple[float, int, dict[str, list[RecorderStats]]]:
+    """Spools of ``stations`` stations each holding ``cut_s`` of step 1, drained into one
+    recorder at ``rate``; (seconds to empty, messages, RecorderStats heard)."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    names = [f"st{n}" for n in range(1, stations + 1)]
+    files = []
+    for name in [*names, *(["live"] if live else [])]:
+        path = write_station_file(folder / f"{name}.toml", folder / "recordings", listen=[endpoint])
+        path.write_text(path.read_text().replace('id = "st1"', f'id = "{name}"'))
+        files.append(load_station(path))
+    repeat = max(1, round(cut_s / took_s))
+    recorder = RunningRecorder(files)
+    session = zenoh.open(zenoh_config("peer", connect=[endpoint]))
+    watch = SpoolWatch(session)
+    publishers = []
+    try:
+        spools = [
+            cut_spool(folder / "edge" / f"{name}.sqlite", name, messages, repeat) for name in names
+        ]
+        for spool in spools:
+            spool._rate = rate  # the benchmark's rate (the station file's drain_messages_per_s)
+        total = sum(spool.stats().messages for spool in spools)
+        started = time.monotonic()
+        publishers = [QueuedPublisher(session, s.station, True, spool=s) for s in spools]
+        stop_live = threading.Event()
+        live_thread = None
+        if live:
+            live_thread = threading.Thread(target=live_station, args=(session, stop_live))
+            live_thread.start()
+        while not watch.empty(names):
+            time.sleep(0.2)
+            if time.monotonic() - started > 3 * HOUR_S:
+                raise AssertionError("the spools did not empty")
+        took = time.monotonic() - started
+        stop_live.set()
+        if live_thread is not None:
+            live_thread.join()
+    finally:
+        for publisher in publishers:
+            publisher.close()
+        recorder.finish()
+        session.close()
+    return took, total, watch.recorder
+
+
+def live_station(session: zenoh.Session, stop: threading.Event) -> None:
+    """One station publishing samples live at 1 kHz (batches of 50 every 50 ms) meanwhile."""
+    from tests.support.recorded_runs import run_messages
+
+    publisher = QueuedPublisher(session, "live", batch_samples=True)
+    run_id = 1
+    while not stop.is_set():
+        for _topic, message in run_messages(run_id, 1000):
+            if stop.is_set():
+                break
+            publisher.publish(dataclasses.replace(message, station="live"))
+            if _topic == "samples":
+                time.sleep(0.001)
+        run_id += 1
+    publisher.close()
+
+
+def advanced_publisher(messages: list[Spooled], scale: int) -> None:
+    """Step 4: zenoh-ext's cache, in this process's memory."""
+    session = zenoh.open(zenoh_config("peer"))
+    before_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    count = len(messages) * scale
+    publishers: dict[str, zenoh.ext.AdvancedPublisher] = {}
+    for message in messages:
+        if message.topic not in publishers:
+            publishers[message.topic] = zenoh.ext.declare_advanced_publisher(
+                session,
+                f"boltwatch/st1/{message.topic}",
+                cache=zenoh.ext.CacheConfig(max_samples=count),
+                sample_miss_detection=zenoh.ext.MissDetectionConfig(
+                    heartbeat=1.0, sporadic_heartbeat=None
+                ),
+                publisher_detection=True,
+            )
+    payload_bytes = 0
+    for _ in range(scale):
+        for message in messages:
+            publishers[message.topic].put(message.payload)
+            payload_bytes += len(message.payload)
+    after_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    got: list[int] = []
+    subscriber = zenoh.ext.declare_advanced_subscriber(
+        session,
+        "boltwatch/st1/tool",
+        lambda sample: got.append(1),
+        history=zenoh.ext.HistoryConfig(detect_late_publishers=True),
+        recovery=zenoh.ext.RecoveryConfig(periodic_queries=None, heartbeat=True),
+    )
+    time.sleep(2.0)
+    tool_puts = sum(1 for m in messages if m.topic == "tool") * scale
+    for publisher in publishers.values():
+        publisher.undeclare()
+    subscriber.undeclare()
+    session.close()
+    print(
+        f"4. AdvancedPublisher cache: {count} messages ({payload_bytes / 1e6:.0f} MB of "
+        f"payloads) raised this process's peak memory by {(after_kb - before_kb) / 1e3:.0f} MB "
+        f"(in RAM, uncompressed, per key max_samples); a late-joining AdvancedSubscriber got "
+        f"{len(got)} of {tool_puts} tool states from the running publisher's cache; "
+        "a restarted publisher starts with an empty cache (nothing on disk)"
+    )
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--runs", type=int, default=20, help="real runs measured (20)")
+    parser.add_argument("--stations", type=int, default=10, help="stations draining at once")
+    parser.add_argument("--keep", type=Path, default=None, help="keep files here")
+    args = parser.parse_args()
+    with contextlib.ExitStack() as stack:
+        folder = args.keep or Path(stack.enter_context(tempfile.TemporaryDirectory()))
+        (folder / "station").mkdir(parents=True, exist_ok=True)
+        messages, took_s = station_hour(folder / "station", args.runs)
+        for cut_s, rate in ((600.0, 200.0), (600.0, 2000.0)):
+            work = folder / f"drain-{cut_s:.0f}-{rate:.0f}"
+            work.mkdir()
+            seconds, total, _ = drain(work, messages, cut_s, took_s, 1, rate, live=False)
+            print(
+                f"2. a {cut_s / 60:.0f}-minute cut, drained at {rate:.0f}/s: {total} messages "
+                f"in {seconds:.1f} s ({total / seconds:.0f} messages/s; an hour's cut: "
+                f"{6 * total / (total / seconds) / 60:.1f} min)"
+            )
+        work = folder / "line"
+        work.mkdir()
+        seconds, total, heard = drain(
+            work, messages, 600.0, took_s, args.stations, 200.0, live=True
+        )
+        live = [s for s in heard.get("live", []) if s.lag_p50_ms is not None]
+        lags = [s.lag_p50_ms for s in live if s.lag_p50_ms is not None]
+        lag_p50 = statistics.median(lags) if lags else float("nan")
+        lag_max = max((s.lag_max_ms or 0.0) for s in live) if live else float("nan")
+        print(
+            f"3. {args.stations} stations, a 10-minute cut each, drained at once: {total} "
+            f"messages in {seconds:.1f} s; the live station's recorder lag meanwhile: "
+            f"p50 {lag_p50:.1f} ms (median of the seconds), max {lag_max:.1f} ms"
+        )
+        advanced_publisher(messages, max(1, round(600.0 / took_s)))
+        print(json.dumps({"runs": args.runs, "run_s": took_s / args.runs}))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,222 @@
+"""Nothing lost when the line's network drops: three station boxes, cables cut, the recorder killed.
+
+The line server (a network namespace) runs the router and the recorder; each
+station box its simulated rig and its acquisition (which hosts the station's
+predictor: placement edge, the default), a zenoh client of the router over
+the box's own cable, spooling what it puts toward the line (``[spool]``, on by
+default). While every station tightens:
+
+1. station 2's and station 3's cables are pulled for :data:`CUT_S`; station
+   2's acquisition is restarted (SIGTERM, started again) while its cable is out;
+2. the cables back, the line's recorder is killed (SIGKILL) for :data:`CUT_S`,
+   then started again.
+
+Then every run of every station is in the recordings whole: its tool states,
+every sample once (sequences 0..n-1, n as its summary says), every event the
+summary counts, its decision, result and summary; the wear ledger counts
+every run once; the recorder says no sample is missing and every spool is
+empty. Skips, with the reason, where network namespaces cannot be made.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from collections import Counter, defaultdict
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from services.cli.station_supervisor import stop_process
+from shared.recordings.mcap import RecordingScan
+from shared.wear import ledger_path
+from tests.support.netns_line import SERVER_ADDRESS, Line, unavailable_reason
+from tests.support.paths import REPO
+from tests.support.station_files import write_station
+
+WHY_NOT = unavailable_reason()
+pytestmark = pytest.mark.skipif(WHY_NOT is not None, reason=WHY_NOT or "")
+
+STATIONS = 3
+#: about two seconds a run: the rigs tighten through both faults and some time after
+RUNS = 75
+CUT_S = 60.0
+ENDPOINT = f"tcp/{SERVER_ADDRESS}:7447"
+CLI = [sys.executable, "-m", "services.cli"]
+
+
+@dataclass
+class RunRecord:
+    """What the recordings hold of one run."""
+
+    samples: Counter[int] = field(default_factory=Counter)  # sequence -> times recorded
+    topics: Counter[str] = field(default_factory=Counter)
+    summary: dict[str, Any] | None = None
+
+
+def read_recordings(folder: Path) -> dict[str, dict[int, RunRecord]]:
+    """Per station and run, everything recorded (a killed recorder's files read as far as
+    they are whole)."""
+    runs: dict[str, dict[int, RunRecord]] = defaultdict(lambda: defaultdict(RunRecord))
+    for path in sorted(folder.rglob("*.mcap")):
+        for _schema, channel, message in RecordingScan(path).messages():
+            parts = channel.topic.split("/", 2)
+            if len(parts) != 3 or parts[2].startswith("raw"):
+                continue
+            body = json.loads(message.data)
+            run_id = body.get("run_id") if isinstance(body, dict) else None
+            if run_id is None:
+                continue
+            record = runs[parts[1]][run_id]
+            record.topics[parts[2]] += 1
+            if parts[2] == "samples":
+                record.samples[body["sequence"]] += 1
+            elif parts[2] == "runs":
+                record.summary = body
+    return runs
+
+
+def station_files(tmp_path: Path) -> list[Path]:
+    recordings = tmp_path / "recordings"
+    files = []
+    for index in range(1, STATIONS + 1):
+        folder = tmp_path / f"st{index}"
+        folder.mkdir()
+        path = write_station(
+            folder,
+            zenoh_port=7447,
+            replacements={
+                "tcp/127.0.0.1:7447": ENDPOINT,
+                'id = "st1"': f'id = "st{index}"',
+                "tool_id = 7": f"tool_id = {100 + index}",
+                "seed = 7": f"seed = {index}",
+            },
+        )
+        text = path.read_text().replace(str(folder / "recordings"), str(recordings))
+        # the spool on the station's own box (its folder), not in the line's recordings
+        path.write_text(text + f'\n[spool]\nfolder = "{folder / "spool"}"\n')
+        files.append(path)
+    return files
+
+
+def line_status(line: Line) -> dict[str, dict[str, Any]]:
+    """``boltwatch status --json`` as seen from the line server ({} when it failed)."""
+    result = line.run(
+        line.server,
+        [*CLI, "status", "--connect", ENDPOINT, "--listen-s", "1.5", "--json"],
+        cwd=REPO,
+    )
+    if result.returncode != 0:
+        return {}
+    stations: dict[str, dict[str, Any]] = json.loads(result.stdout)["stations"]
+    return stations
+
+
+def drained(status: dict[str, dict[str, Any]]) -> bool:
+    """No run and no sample of any station waits in its spool (what waits is the last
+    seconds' counters, not acknowledged yet), and the recorder misses no sample."""
+    for index in range(1, STATIONS + 1):
+        view = status.get(f"st{index}", {})
+        spools, recorder = view.get("spools") or [], view.get("recorder") or {}
+        if not spools or any(spool["runs"] or spool["samples"] for spool in spools):
+            return False
+        if any((spool["oldest_age_s"] or 0.0) > 10.0 for spool in spools):
+            return False
+        if recorder.get("missing_samples") != 0:
+            return False
+    return True
+
+
+def wait_until_up(line: Line, services: tuple[str, ...], timeout_s: float = 60.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    status: dict[str, dict[str, Any]] = {}
+    while time.monotonic() < deadline:
+        status = line_status(line)
+        if all(
+            (status.get(f"st{i}", {}).get("services") or {}).get(service)
+            for i in range(1, STATIONS + 1)
+            for service in services
+        ):
+            return
+        time.sleep(0.5)
+    raise AssertionError(f"not every station came up in {timeout_s} s: {status}")
+
+
+def test_cables_cut_and_the_recorder_killed_lose_nothing(tmp_path: Path) -> None:
+    files = station_files(tmp_path)
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    processes: dict[str, subprocess.Popen[bytes]] = {}
+
+    def start(line: Line, namespace: str, name: str, args: list[str]) -> None:
+        log = (logs / f"{name}.log").open("ab")
+        processes[name] = line.popen(namespace, [*CLI, *args], log, cwd=REPO)
+
+    def start_recorder(line: Line) -> None:
+        config_all = [str(path) for path in files]
+        start(line, line.server, "recorder", ["serve", "recorder", "--config", *config_all])
+
+    status: dict[str, dict[str, Any]] = {}
+    with Line(STATIONS) as line:
+        try:
+            start(line, line.server, "router", ["serve", "router", "--listen", ENDPOINT])
+            start_recorder(line)
+            for index, path in enumerate(files, start=1):
+                args = ["serve", "acquisition", "--config", str(path)]
+                start(line, line.station(index), f"st{index}-acquisition", args)
+            wait_until_up(line, ("acquisition", "recorder"))
+            for index, path in enumerate(files, start=1):
+                args = ["serve", "rig", "--config", str(path), "--runs", str(RUNS)]
+                start(line, line.station(index), f"st{index}-rig", args)
+            time.sleep(5.0)
+
+            for index in (2, 3):  # 1. two cables out; station 2's acquisition restarted
+                line.cut(index)
+            time.sleep(CUT_S / 2)
+            stop_process(processes["st2-acquisition"])
+            args = ["serve", "acquisition", "--config", str(files[1])]
+            start(line, line.station(2), "st2-acquisition", args)
+            time.sleep(CUT_S / 2)
+            for index in (2, 3):
+                line.reconnect(index)
+            time.sleep(10.0)
+
+            processes["recorder"].send_signal(signal.SIGKILL)  # 2. the recorder killed
+            processes["recorder"].wait(10)
+            time.sleep(CUT_S)
+            start_recorder(line)
+
+            for index in range(1, STATIONS + 1):
+                rig = processes[f"st{index}-rig"]
+                assert rig.wait(300) == 0, f"st{index}'s rig failed; see {logs}"
+            deadline = time.monotonic() + 120
+            while not drained(status) and time.monotonic() < deadline:
+                time.sleep(1.0)
+                status = line_status(line)
+        finally:
+            for process in reversed(processes.values()):
+                stop_process(process)
+    assert drained(status), json.dumps(status, indent=1)[:4000]
+
+    recordings = read_recordings(tmp_path / "recordings")
+    with sqlite3.connect(ledger_path(tmp_path / "recordings")) as ledger:
+        counted = Counter(ledger.execute("SELECT station FROM runs").fetchall())
+    for index in range(1, STATIONS + 1):
+        station = f"st{index}"
+        runs = recordings[station]
+        assert len(runs) >= RUNS, f"{station}: {len(runs)} runs recorded"
+        for run_id, record in runs.items():
+            where = f"{station} run {run_id}"
+            assert record.summary is not None, f"{where}: no summary"
+            count = record.summary["samples"]
+            assert sorted(record.samples) == list(range(count)), f"{where}: samples missing"
+            assert record.topics["results"] >= 1 and record.topics["decision"] <= 1, where
+            assert record.topics["events"] >= record.summary["events"], where
+            assert record.topics["tool"] >= 2, f"{where}: tool states {record.topics}"
+        assert counted[(station,)] == len(runs), f"{station}: the wear ledger's runs"

@@ -1,0 +1,137 @@
+"""Store and forward over real zenoh: a station's spooling publisher and the line's recorder.
+
+The recorder is stopped while the station goes on (a dead recorder: what the
+station puts meanwhile reaches nobody), then started again; the station's
+spool sends what the recorder lacks. Afterwards every run is in one file,
+whole: every sample once, in order, every event, decision, result, summary
+and tool state as it was put (read back from the MCAP files), and the
+spool is empty.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+from collections import defaultdict
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+import zenoh
+from mcap.reader import make_reader
+
+from shared.config import LoadedStation
+from shared.contract import SpoolStats, channels, decode, to_dict
+from shared.runtime import QueuedPublisher, zenoh_config
+from shared.spool import SpoolFile, StationSpool
+from tests.support.live_recorder import RunningRecorder, wait_until
+from tests.support.recorded_runs import run_messages
+
+SAMPLES = 400  # per run: eight batches of samples
+
+
+class SpoolWatch:
+    """The station's spool counters as the line hears them (``boltwatch/st1/spool``)."""
+
+    def __init__(self, session: zenoh.Session) -> None:
+        self.latest: SpoolStats | None = None
+        self._lock = threading.Lock()
+        self._subscriber = session.declare_subscriber(channels.SPOOL.key("st1"), self._on_stats)
+
+    def _on_stats(self, sample: zenoh.Sample) -> None:
+        with self._lock:
+            self.latest = decode(SpoolStats, sample.payload.to_bytes())
+
+    def emptied_through(self, head_seq: int) -> bool:
+        with self._lock:
+            stats = self.latest
+        return stats is not None and stats.head_seq >= head_seq and stats.messages == 0
+
+
+@pytest.fixture
+def station_session(endpoint: str) -> Iterator[zenoh.Session]:
+    session = zenoh.open(zenoh_config("peer", connect=[endpoint]))
+    try:
+        yield session
+    finally:
+        session.close()
+
+
+def read_back(station: LoadedStation) -> dict[Path, list[tuple[str, dict[str, Any]]]]:
+    """(topic, message) of every file of st1, in file order."""
+    files = {}
+    for path in sorted(station.recordings_folder.glob("st1/*/*.mcap")):
+        with path.open("rb") as handle:
+            files[path] = [
+                (channel.topic.split("/", 2)[2], json.loads(message.data))
+                for _schema, channel, message in make_reader(handle).iter_messages()
+            ]
+    return files
+
+
+@pytest.mark.parametrize("batch_samples", [True, False], ids=["edge", "line"])
+def test_a_run_put_while_the_recorder_was_down_is_recorded_whole_once_it_is_back(
+    tmp_path: Path, station: LoadedStation, station_session: zenoh.Session, batch_samples: bool
+) -> None:
+    spool = StationSpool(
+        "st1",
+        "acquisition",
+        SpoolFile(tmp_path / "edge" / "st1-acquisition.sqlite"),
+        1 << 30,
+        drain_messages_per_s=500.0,
+        resend_after_s=0.5,
+    )
+    publisher = QueuedPublisher(station_session, "st1", batch_samples=batch_samples, spool=spool)
+    watch = SpoolWatch(station_session)
+    runs = {run_id: run_messages(run_id, SAMPLES) for run_id in (1, 2, 3, 4)}
+    put = 0
+
+    def publish(messages: list[tuple[str, Any]]) -> None:
+        nonlocal put
+        for _topic, message in messages:
+            publisher.publish(message)
+        publisher.call(lambda: None)
+        put += len(messages)
+
+    recorder = RunningRecorder(station)
+    try:
+        publish(runs[1])
+        wait_until(lambda: spool.stats().head_seq > 0 and watch.emptied_through(1), "run 1 acked")
+        recorder.finish()  # the line's recorder is down
+        publish(runs[2])
+        half = len(runs[3]) // 2
+        publish(runs[3][:half])
+        stopped = threading.Event()
+        publisher.call(stopped.set)
+        wait_until(stopped.is_set, "the station's puts")
+        recorder = RunningRecorder(station)  # back: the station sends again what it lacks
+        publish(runs[3][half:])
+        publish(runs[4])
+        head = threading.Event()
+        publisher.call(head.set)
+        wait_until(head.is_set, "the last puts")
+        head_seq = spool.stats().head_seq
+        wait_until(lambda: watch.emptied_through(head_seq), "the spool emptied", timeout_s=60)
+    finally:
+        recorder.finish()
+        publisher.close()
+
+    files = read_back(station)
+    by_run: dict[int, list[Path]] = defaultdict(list)
+    for path, messages in files.items():
+        for run_id in {int(m["run_id"]) for _, m in messages if m.get("run_id") is not None}:
+            by_run[run_id].append(path)
+    assert sorted(by_run) == [1, 2, 3, 4]
+    for run_id, published in runs.items():
+        (path,) = by_run[run_id]  # one file per run
+        recorded = [(t, m) for t, m in files[path] if m.get("run_id") == run_id]
+        samples = [m["sequence"] for t, m in recorded if t == "samples"]
+        assert samples == list(range(SAMPLES)), f"run {run_id}: samples out of order or lost"
+        expected = [(topic, to_dict(message)) for topic, message in published if topic != "samples"]
+        others = [(t, m) for t, m in recorded if t != "samples"]
+        assert sorted(others, key=repr) == sorted(expected, key=repr), f"run {run_id}"
+        published_samples = [to_dict(m) for t, m in published if t == "samples"]
+        assert [m for t, m in recorded if t == "samples"] == published_samples
+    # what went while the recorder was down came again (run 2 alone is 8 batches and 6 more)
+    assert spool.resent >= 14
