@@ -1,68 +1,16 @@
 """What flows on a line, in one place: every channel of boltwatch and its contract.
 
 A channel is a key below a station, ``boltwatch/<station>/<topic>``
-(:mod:`shared.contract.keys`), carrying one message type of :mod:`shared.contract.messages`,
-encoded as JSON by :mod:`shared.contract.codec` with the JSON schema the codec
-derives (the MCAP channel's schema, named ``boltwatch.<Type>``), put by one
-service with one set of zenoh options (priority, congestion control,
-express). Publishers are declared from here (:meth:`Channel.declare_publisher`);
-the recorder, ``boltwatch status``, the tests and the benchmarks look channels
-up here (:func:`by_topic`, :func:`of_message`, :data:`CHANNELS`). Adding a
-channel: its message type in :mod:`shared.contract.messages`, its row below.
-
-=================  ====================  ===========================================
-topic              publisher             message, when
-=================  ====================  ===========================================
-``samples``        acquisition           :class:`Sample`, one per 1 kHz sample (placement
-                   (openprotocol)        line: what the line's predictor decides on)
-``sample_batches`` acquisition           :class:`SampleBatch`, every 50 ms (placement
-                   (openprotocol)        edge: what the line records), with the
-                                         events and intensities found in it
-``tool``           acquisition           :class:`ToolState`, on every change
-                   (openprotocol)
-``bus``            acquisition           :class:`BusStats`, once a second
-``events``         predictor             :class:`StickSlipEvent`, one per event (placement
-                   (openprotocol)        edge: only when no batch is in progress)
-``intensity``      predictor             :class:`Intensity`, one per event (the same)
-                   (openprotocol)
-``decision``       predictor             :class:`StopDecision`, at most one per run
-                   (openprotocol)        (a bridge's: advisory, the controller stopped)
-``runs``           predictor             :class:`RunSummary`, one per run
-                   (openprotocol)
-``results``        predictor (import,    :class:`TighteningResult`, one per run, just
-                   openprotocol)         before its summary: OK/NOK against the windows
-``predictor``      predictor             :class:`PredictorStats`, once a second
-``recorder``       recorder              :class:`RecorderStats`, once a second
-``wear/alert``     recorder              :class:`WearAlert`, when a tool is due
-``quality/alert``  recorder              :class:`QualityAlert`, when a program's Cpk or
-                                         NOKs go out of bounds, and when back
-``controller``     import (openprotocol) :class:`ControllerResult`, one per run
-``tool_data``      openprotocol          :class:`ToolData`, when the controller says it
-``alarms``         openprotocol          :class:`ControllerAlarm`, per alarm message
-``openprotocol``   openprotocol          :class:`BridgeStats`, once a second
-=================  ====================  ===========================================
-
-In brackets: who else may put the channel (:attr:`Channel.also_by`). A
-controller bridge (``boltwatch serve openprotocol``, publisher
-``openprotocol``) stands for a CAN station's acquisition and predictor: it
-publishes what they would, from what its controller says.
-
-A station's samples go toward the line once, on one of the two sample
-channels: one message per sample where a line predictor decides on them
-(``[predictor] placement = "line"``), in batches otherwise (the decision is
-taken on the station; the line only records them).
-
-Not channels: ``health/<service>`` (liveliness tokens) and ``wear`` (the
-recorder's queryable of the wear ledger), in :mod:`shared.contract.keys`.
-
-Every channel is put with congestion control BLOCK: zenoh's default (DROP)
-lost events under load, silently, and loss is counted end to end. Samples
-and tool states share one priority, so a run's ``done`` never overtakes its
-samples; a decision is REAL_TIME. Samples, tool states and decisions are
-express (no batching in zenoh: latency counts). Sample batches are not: they
-are recorded, not decided on, and zenoh packs the batches of many stations
-into one frame toward the line's recorder (``bench_line.py`` at 50 stations:
-0.6 to 1.0 µs less of the recorder's CPU per sample, lag no worse).
+(:mod:`shared.contract.keys`), carrying one message type of
+:mod:`shared.contract.messages` as JSON with the schema the codec derives
+(``boltwatch.<Type>``), put by one service (others that may put it in that
+service's place: :attr:`Channel.also_by`) with one :class:`Qos`. Publishers
+are declared from here; the recorder, ``boltwatch status``, the tests and the
+benchmarks look channels up here (:func:`by_topic`, :func:`of_message`,
+:data:`CHANNELS`). Adding a channel: its message type, its row below. The
+table as a page: ``docs/reference/channels.md`` (written from this module);
+why each channel is put as it is: ``docs/explanation/design.md``, "The line's
+channels".
 """
 
 from __future__ import annotations
@@ -102,7 +50,10 @@ class Qos:
     """How a channel is put, in zenoh's terms but no zenoh type: the contract needs no
     transport (:func:`shared.runtime.zenoh_session.declare_channel` turns it into options).
 
-    Every channel is put with congestion control BLOCK (above)."""
+    Every channel is put with congestion control BLOCK (a put waits rather than drops:
+    loss is counted end to end), at priority REAL_TIME where ``real_time`` is set and
+    DATA otherwise; ``express`` puts go out at once, the others may be packed by zenoh
+    into one frame with other puts."""
 
     real_time: bool = False  # zenoh's REAL_TIME priority; else DATA
     express: bool = False  # no batching: latency counts
