@@ -59,8 +59,12 @@ def markdown_of(text: str) -> str:
 
 
 def cell(text: str) -> str:
-    """Text that fits in one cell of a Markdown table."""
-    return " ".join(text.split()).replace("|", "\\|")
+    """Text that fits in one cell of a Markdown table: one line, ``|`` escaped outside code
+    (inside a code span the table reads it as text, and an escape would show)."""
+    parts = " ".join(text.split()).split("`")
+    return "`".join(
+        part if index % 2 else part.replace("|", "\\|") for index, part in enumerate(parts)
+    )
 
 
 def paragraphs(text: str) -> str:
@@ -258,7 +262,7 @@ def _fields_table(cls: type) -> list[str]:
             note = f"{note} (default {item.default!r})" if note else f"default {item.default!r}"
         elif item.default_factory is not dataclasses.MISSING:
             note = f"{note} (default empty)" if note else "default empty"
-        rows.append(f"| `{item.name}` | `{cell(annotation)}` | {cell(markdown_of(note))} |")
+        rows.append(f"| `{item.name}` | {cell(f'`{annotation}`')} | {cell(markdown_of(note))} |")
     return [*rows, ""]
 
 
