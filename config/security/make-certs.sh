@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Make the line's certificates for zenoh mutual TLS (README, "Security").
+# Make the line's certificates for zenoh mutual TLS (docs/how-to/compose-and-tls.md).
 #
 #   config/security/make-certs.sh OUT_DIR NAME...
 #
@@ -11,7 +11,7 @@
 # reach it with ROUTER_SAN="DNS:router.plant.local,IP:10.0.0.5".
 # A plant of several lines shares one CA: ROUTER_NAME=line2-router makes
 # line2-router.pem + .key instead of router.pem (its common name is what the
-# other lines' access control names with --peer; README, "A plant of several lines").
+# other lines' access control names with --peer; docs/reference/access-control.md).
 # An existing CA in OUT_DIR is reused, so services can be added later.
 # Needs the openssl CLI (1.1.1 or 3.x). Keys are EC P-256, certificates last
 # DAYS days (default 825). Private keys are written 0600 and never committed.

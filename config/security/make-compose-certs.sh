@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Certificates and access control for docker-compose.tls.yml (README, "Compose with TLS").
+# Certificates and access control for docker-compose.tls.yml (docs/how-to/compose-and-tls.md).
 #
 #   config/security/make-compose-certs.sh OUT_DIR [STATION...]      (default stations: st1 st2)
 #   BOLTWATCH_CERTS=OUT_DIR BOLTWATCH_RECORDINGS=$PWD/recordings \

@@ -1,9 +1,10 @@
 """What may decide on the acquisition's own CAN thread: the stop path of one sample.
 
-A station whose predictor runs on its edge box (the default: README, "Where
-the decision runs") hands the acquisition a :class:`Decider`. Each sample
-goes to it on the CAN thread as soon as it is complete, and a decision goes
-out as a ``StopCommand`` from that same thread: CAN in, CAN out, no process
+A station whose predictor runs on its edge box (the default:
+``docs/explanation/decisions/0001-edge-stop-decision.md``) hands the
+acquisition a :class:`Decider`. Each sample goes to it on the CAN thread as
+soon as it is complete, and a decision goes out as a ``StopCommand`` from that
+same thread: CAN in, CAN out, no process
 or network between them. The acquisition defines this protocol and the
 predictor implements it (``services/predictor/edge_predictor.py``); the CLI
 joins the two (services never import each other).

@@ -73,7 +73,9 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
     station_id = station.station_id
     with ServiceSkeleton("acquisition") as skeleton:
         bus = skeleton.device(open_bus(station.config.can))
-        session = skeleton.open_session(station.config.zenoh)
+        # a spooling station starts without its router: the spool keeps what it measures
+        wait = not station.config.spool.enabled
+        session = skeleton.open_session(station.config.zenoh, wait_for_router=wait)
         publisher = QueuedPublisher(
             session, station_id, batch_samples=edge, spool=station_spool(station, "acquisition")
         )

@@ -40,7 +40,12 @@ class ZenohOutlet:
         self._unsent_at_outage_start = 0
         self.link = RouterLink(session, self._link_changed)
         if not self.link.connected:
-            LOG.warning("zenoh: no router yet; samples are counted as unsent until one is reached")
+            LOG.warning(
+                "zenoh: no router yet; %s",
+                "the spool keeps what is measured"
+                if self._spooling
+                else "samples are counted as unsent until one is reached",
+            )
 
     @property
     def unsent_samples(self) -> int:

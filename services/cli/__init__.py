@@ -9,9 +9,11 @@
 - ``boltwatch status``: :mod:`.station_status_text` (what it prints of
   :mod:`shared.line_status`, which collects it; the line's page shares that);
   with ``wear --plant``: :mod:`.router_client` (a client of the line's router)
-- ``boltwatch import``: :mod:`.import_destination` (recordings or trace CSVs),
-  :mod:`.controller_replay` (an imported run as the predictor's advisory replay
-  takes it: here, because the recorder may not import the predictor)
+- ``boltwatch import``: :mod:`.import_destination` (recordings or trace CSVs); the
+  import itself, with the predictor's replay of each run, is
+  :mod:`shared.offline.controller_import`
 - ``boltwatch predict``: :mod:`.predict_settings` (its options, or a station's program)
 - ``boltwatch inspect --overlay``: :mod:`.run_overlay` (run ids or paths to runs, drawn)
+- :mod:`.reference_pages` (``docs/reference/cli.md`` and ``channels.md``, written from
+  the parser and the channel table)
 """

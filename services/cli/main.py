@@ -7,10 +7,11 @@ name, see that package's docstring). How a command ends:
   its one-line message, ``boltwatch COMMAND: ...``, and exit status 2;
 - an ``OSError`` (a path that is missing, a folder, under a file, not
   writable, a full disk ...): one line naming the path and why
-  (:mod:`services.cli.error_lines`), exit status 2;
+  (:mod:`services.cli.error_lines`: ``boltwatch export: /x/y.csv: folder /x
+  does not exist``), exit status 2;
 - standard output's reader gone (``boltwatch predict ... | head -1``): the
   output stops without a word, exit status 141 (128 + SIGPIPE, what a shell
-  reports for any tool whose reader went away);
+  reports for any tool whose reader went away, seen with ``set -o pipefail``);
 - Ctrl-C: exit status 130.
 
 Started with standard output closed (``>&-``, a supervisor that closes it),

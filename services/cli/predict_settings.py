@@ -4,7 +4,7 @@
 the live station decides that program with (targets, hard limits, motor
 speed, the program's joint for the eq. 71 band, the DBC's sensor range, the
 ``[predictor]`` section), so the prediction over a recorded run is the live
-decision (README, "Live = offline"). Explicit ``--target-force``,
+decision (live = offline: ``docs/explanation/algorithm.md``). Explicit ``--target-force``,
 ``--target-torque``, ``--joint``, ``--window`` and ``--dbc`` replace what the
 station file says. Without ``--config``, a target is required.
 """

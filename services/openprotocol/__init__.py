@@ -3,7 +3,7 @@
 ``boltwatch serve openprotocol --config STATION`` connects to the controller
 named in the station file's ``[openprotocol]`` section as an Open Protocol
 integrator (TCP, port 4545) and publishes what a CAN station's acquisition and
-predictor would (README, "Connecting an Open Protocol controller").
+predictor would (``docs/how-to/openprotocol-controller.md``).
 
 - :mod:`.service` (the service: zenoh, the queued publisher, the health token,
   the counters once a second), :mod:`.arguments`

@@ -42,7 +42,9 @@ def main(args: argparse.Namespace) -> int:
     station_id = station.station_id
     counts = BridgeCounts(station_id, f"{section.host}:{section.port}")
     with ServiceSkeleton("openprotocol") as skeleton:
-        session = skeleton.open_session(station.config.zenoh)
+        # a spooling station starts without its router: the spool keeps what it measures
+        wait = not station.config.spool.enabled
+        session = skeleton.open_session(station.config.zenoh, wait_for_router=wait)
         publisher = QueuedPublisher(
             session, station_id, batch_samples=True, spool=station_spool(station, "openprotocol")
         )

@@ -1,6 +1,6 @@
 """The predictor of one station on its acquisition's CAN thread: the stop path of one sample.
 
-Where the decision runs (README, "Where the decision runs"): a station whose
+Where the decision runs (``docs/explanation/decisions/0001-edge-stop-decision.md``): a station whose
 ``[predictor] placement`` is ``"edge"`` (the default) decides in its
 acquisition process, on the thread that reads the CAN bus. Each complete
 sample goes from the frame decoder through :class:`StationRuns` (the same

@@ -211,7 +211,7 @@ class PredictorService:
 def main(args: argparse.Namespace) -> int:
     """Load every station file once, open one session, serve until a signal."""
     # One receive thread: callbacks never pass the GIL between two receive threads
-    # (measured with bench_line_inbox.py, variant callback-rx1; figures in the README).
+    # (measured with bench_line_inbox.py, variant callback-rx1: docs/explanation/design.md).
     use_one_receive_thread()
     stations = load_line(args.config)
     refuse_edge_stations(stations)  # an edge station's acquisition decides: refused at once

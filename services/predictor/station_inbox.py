@@ -1,34 +1,17 @@
 """The predictor's inbox: every served station's samples and tool states, handled one at a time.
 
-Zenoh has no key expression for "these N stations and no other", and a
-subscriber on ``boltwatch/*/*`` would carry every station of the line into
-this process. So each served station gets its own two subscribers
-(``samples`` and ``tool``). Their callbacks run on zenoh's receive thread
-(``indirect=False``: no thread per subscriber) and handle the message right
-there, under one lock, so decisions still come from one message at a time,
-in arrival order. No queue and no hand-over to a worker thread (a wake-up and
-a GIL switch per sample). While a message is handled zenoh reads no further:
-back-pressure goes to the router as with a full FIFO, and the acquisition's
-samples are published with BLOCK, so none is dropped. A thread per
-subscriber (``FifoChannel`` + ``recv()``, or ``indirect=True``) was measured
-too and is wrong: a run's ``tool`` and ``samples`` then race each other.
-
-Each callback first keeps its receive thread's Python thread state
-(:func:`shared.runtime.receive_threads.keep_thread_state`; the inbox variants are
-measured side by side in ``tests/benchmarks/bench_line_inbox.py``, figures in
-the README).
-
-The handler publishes (events, decisions, with BLOCK) from inside the
-callback. That is safe because the predictor never subscribes, on the same
-session, to a key it publishes: zenoh delivers a session-local put on the
-publishing thread, and the lock here is not re-entrant. A publish blocked by
-a congested link holds this receive thread (and so the samples behind it)
-until zenoh's block timeout closes the link, as a full FIFO did before.
-
-An exception in the handler is not swallowed by zenoh: the first one is
-kept, later messages are counted in :attr:`StationInbox.lost_after_failure`,
-and :meth:`StationInbox.serve` raises it in the service's worker thread, so
-the service ends with status 1 as it would on any worker error.
+Each served station gets its own two subscribers (``samples`` and ``tool``)
+whose callbacks run on zenoh's receive thread (``indirect=False``), keep that
+thread's Python thread state (:func:`shared.runtime.receive_threads.keep_thread_state`)
+and handle the message right there, under one lock: decisions come from one
+message at a time, in arrival order, with no queue and no hand-over to a
+worker, and back-pressure goes to the router. The handler may publish from
+inside the callback because the predictor never subscribes, on the same
+session, to a key it publishes. An exception in the handler is kept, later
+messages are counted in :attr:`StationInbox.lost_after_failure`, and
+:meth:`StationInbox.serve` raises it in the service's worker thread (exit
+status 1). Why this shape, and the variants measured against it:
+``docs/explanation/design.md``, "Receive threads and inboxes".
 """
 
 from __future__ import annotations

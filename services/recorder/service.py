@@ -80,6 +80,9 @@ if TYPE_CHECKING:
 LOG = logging.getLogger(__name__)
 
 STATS_PERIOD_S = 1.0
+#: how often what a station's spool sends again is acknowledged while it comes (else with
+#: the stats, once a second)
+REFILING_ACK_S = 0.2
 #: how often the worker takes what the inbox received (a batch of 250 messages
 #: on 50 stations): MCAP log times are taken on arrival; lag (RecorderStats) is
 #: measured when a batch is filed, so it includes the wait in the inbox
@@ -161,11 +164,17 @@ class RecorderService:
 
     def work(self, stop: threading.Event) -> None:
         """Record until ``stop`` is set, then file what was received and finish every file."""
-        next_tick = next_stats = time.monotonic()
+        next_tick = next_stats = next_ack = time.monotonic()
         try:
             while not stop.is_set():
                 self._file(self._inbox.take(TAKE_INTERVAL_S))
                 now = time.monotonic()
+                spooling = self.spooling
+                if spooling is not None and spooling.refiling and now >= next_ack:
+                    # what a hole filed is acknowledged soon: a recorder killed meanwhile
+                    # files again (twice) only what it filed since
+                    self._acknowledge(time.time_ns())
+                    next_ack = now + REFILING_ACK_S
                 if now >= next_tick:
                     self.recorder.tick(time.time_ns())
                     if self.wear is not None:

@@ -1,7 +1,7 @@
 """Keeps the wear ledger up to date from RunSummaries and alerts when a tool is due.
 
 What a controller says of its tool (a bridge's :class:`~shared.contract.messages.ToolData`)
-goes in beside the runs (:mod:`.wear_tool_data`); while the ledger fails the
+goes in beside the runs (:mod:`shared.wear.wear_tool_data`); while the ledger fails the
 newest of each (station, tool) waits in memory (not kept on disk at a stop: a
 bridge says it again at its next connection).
 
@@ -10,7 +10,7 @@ with ``recorder.wear_service_threshold``; at or above it a :class:`WearAlert`
 is published on ``boltwatch/<station>/wear/alert`` after every run until the
 tool is serviced (and logged once per crossing).
 
-A summary beyond what its run can carry (:mod:`.wear_bound`: negative, not
+A summary beyond what its run can carry (:mod:`shared.wear.wear_bound`: negative, not
 finite, more than its tool's torque limit allows, or inconsistent) is
 refused: counted per station (``refused``, in RecorderStats and ``boltwatch
 status``) and logged (at most one line per :data:`LOG_INTERVAL_NS`, with the
@@ -21,7 +21,7 @@ in order, and go in when it works again. Two kinds of failure:
 
 - it cannot be written now (disk full, read-only folder): tried again with
   every summary and every :data:`CHECK_INTERVAL_NS`;
-- it is broken (:class:`~.wear_ledger_file.BrokenLedgerError`: empty, not
+- it is broken (:class:`~shared.wear.wear_ledger_file.BrokenLedgerError`: empty, not
   SQLite, another schema, corrupt; or the file was emptied, overwritten or
   replaced while the recorder had it open): nothing is written into it; the
   summaries wait until a person moves it aside (``boltwatch wear reset``),
@@ -32,7 +32,7 @@ Either is logged at ERROR when it starts, reminded every
 ledger works again; ``last_ledger_error`` says it to RecorderStats
 (``last_error``), ``waiting`` how many runs wait. Runs still waiting when
 the recorder stops are kept on disk and counted first at its next start
-(:mod:`.wear_waiting`).
+(:mod:`shared.wear.wear_waiting`).
 """
 
 from __future__ import annotations

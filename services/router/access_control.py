@@ -7,18 +7,18 @@ common name ``<station>-<role>``, or one of the line's observers
 may declare subscribers, queryables and liveliness tokens under
 ``boltwatch/**`` and receive what is published there; only
 
-- ``<st>-acquisition`` may put ``boltwatch/<st>/samples``, ``tool``, ``bus``
-  and the predictor's keys ``events``, ``intensity``, ``decision``, ``runs``,
-  ``predictor`` (its stats) (it hosts the station's predictor:
-  ``[predictor] placement = "edge"``, the default),
+- ``<st>-acquisition`` may put ``boltwatch/<st>/samples``, ``sample_batches``,
+  ``tool``, ``bus`` and the predictor's keys ``events``, ``intensity``,
+  ``decision``, ``runs``, ``results``, ``predictor`` (its stats) (it hosts the
+  station's predictor: ``[predictor] placement = "edge"``, the default),
 - ``<st>-predictor`` may put the predictor's keys (a line predictor,
   ``boltwatch serve predictor`` for a station with ``placement = "line"``),
 - ``<st>-openprotocol`` may put what an Open Protocol bridge publishes for its
   station (``boltwatch serve openprotocol``: the run's samples, tool states,
   the advisory predictor's keys, the controller's result, tool data, alarms and
   its own stats; :func:`shared.contract.channels.topics_of` ``("openprotocol")``),
-- ``line-recorder`` may put ``boltwatch/<st>/recorder``, ``wear/**`` and
-  ``spool/ack`` (what it has of a station's spool);
+- ``line-recorder`` may put ``boltwatch/<st>/recorder``, ``quality/alert``,
+  ``wear/**`` and ``spool/ack`` (what it has of a station's spool);
 - the station's spooling services (``acquisition``, ``openprotocol``) may put
   ``again/**`` too (what their spool sends again).
 

@@ -22,7 +22,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="ENDPOINT",
         help="another line's router to mesh with, repeatable (a plant of several lines: "
         "each line's services connect to their own router, the routers to each other; "
-        "README, A plant of several lines). Retried for ever, so the lines may start "
+        "docs/how-to/line-and-plant.md). Retried for ever, so the lines may start "
         "in any order",
     )
     tls = parser.add_argument_group("TLS (mutual: every service shows a certificate)")

@@ -13,7 +13,7 @@ yet is retried for ever (every ``RECONNECT_PERIOD_MAX_MS`` at most).
 With ``--tls-*`` it takes only TLS connections from services whose
 certificate the line's CA signed (mutual TLS); with ``--access-control`` it
 enforces zenoh's access control, e.g. only a station's predictor may put
-its decisions (README, Security). Listening in plain tcp on anything but
+its decisions (``docs/reference/access-control.md``). Listening in plain tcp on anything but
 loopback, it warns loudly at start: any node that reaches the port can then
 stop a tool, write the wear ledger and read the whole line.
 """
@@ -51,7 +51,7 @@ def exposure_warning(endpoints: list[str]) -> str | None:
         "it can stop a tool (a StopDecision), write the wear ledger (a RunSummary) and read "
         "every sample, unauthenticated. On a plant network run the router with mutual TLS "
         "and access control (--listen tls/HOST:PORT --tls-root-ca --tls-cert --tls-key "
-        "--access-control; README, Security)"
+        "--access-control; docs/how-to/compose-and-tls.md)"
     )
 
 

@@ -54,7 +54,9 @@ class StationIdentity(StrictModel):
 
 
 class ZenohSection(StrictModel):
-    """How a service joins the line: its router, reconnection, and TLS (see README, Security)."""
+    """How a service joins the line: its router, reconnection and TLS.
+
+    TLS: ``docs/how-to/compose-and-tls.md``."""
 
     mode: Literal["peer", "client"] = "client"
     connect: list[Endpoint] = Field(default_factory=list, description="e.g. tcp/127.0.0.1:7447")
@@ -174,7 +176,7 @@ def make_recordings_folder(station_file: Path, section: RecorderSection) -> Path
 
     Called at a service's start: a folder that can never be made is a
     configuration error, while a disk that fails later is a fault the
-    recorder rides out (README, "Faults").
+    recorder rides out (docs/reference/faults.md).
     """
     folder = recordings_folder(station_file, section)
     try:

@@ -1,6 +1,6 @@
 """A station file of either kind, for what serves every station: the bridge, recorder, tools.
 
-Two kinds of station file (README, "Configuration"):
+Two kinds of station file (docs/reference/configuration.md):
 
 - a CAN station (:class:`~shared.config.station.LoadedStation`): ``[can]``, a
   joint, programs with motor speed and hard limits; its tool is read over

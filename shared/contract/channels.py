@@ -1,17 +1,6 @@
 """What flows on a line, in one place: every channel of boltwatch and its contract.
 
 A channel is a key below a station, ``boltwatch/<station>/<topic>``
-(:mod:`shared.contract.keys`), carrying one message type of :mod:`shared.contract.messages`,
-encoded as JSON by :mod:`shared.contract.codec` with the JSON schema the codec
-derives (the MCAP channel's schema, named ``boltwatch.<Type>``), put by one
-service with one set of zenoh options (priority, congestion control,
-express). Publishers are declared from here
-(:func:`shared.runtime.zenoh_session.declare_channel`);
-the recorder, ``boltwatch status``, the tests and the benchmarks look channels
-up here (:func:`by_topic`, :func:`of_message`, :data:`CHANNELS`). Adding a
-channel: its message type in :mod:`shared.contract.messages`, its row below.
-
-=================  ====================  ===========================================
 topic              publisher             message, when
 =================  ====================  ===========================================
 ``samples``        acquisition           :class:`Sample`, one per 1 kHz sample (placement
@@ -68,6 +57,17 @@ express (no batching in zenoh: latency counts). Sample batches are not: they
 are recorded, not decided on, and zenoh packs the batches of many stations
 into one frame toward the line's recorder (``bench_line.py`` at 50 stations:
 0.6 to 1.0 µs less of the recorder's CPU per sample, lag no worse).
+=======
+(:mod:`shared.contract.keys`), carrying one message type of
+:mod:`shared.contract.messages` as JSON with the schema the codec derives
+(``boltwatch.<Type>``), put by one service (others that may put it in that
+service's place: :attr:`Channel.also_by`) with one :class:`Qos`. Publishers
+are declared from here; the recorder, ``boltwatch status``, the tests and the
+benchmarks look channels up here (:func:`by_topic`, :func:`of_message`,
+:data:`CHANNELS`). Adding a channel: its message type, its row below. The
+table as a page: ``docs/reference/channels.md`` (written from this module);
+why each channel is put as it is: ``docs/explanation/design.md``, "The line's
+channels".
 """
 
 from __future__ import annotations
@@ -109,7 +109,10 @@ class Qos:
     """How a channel is put, in zenoh's terms but no zenoh type: the contract needs no
     transport (:func:`shared.runtime.zenoh_session.declare_channel` turns it into options).
 
-    Every channel is put with congestion control BLOCK (above)."""
+    Every channel is put with congestion control BLOCK (a put waits rather than drops:
+    loss is counted end to end), at priority REAL_TIME where ``real_time`` is set and
+    DATA otherwise; ``express`` puts go out at once, the others may be packed by zenoh
+    into one frame with other puts."""
 
     real_time: bool = False  # zenoh's REAL_TIME priority; else DATA
     express: bool = False  # no batching: latency counts

@@ -17,8 +17,8 @@ A payload pydantic refuses is looked at once more, field by field, by
 and a strict parser does not (``1.0`` for an integer: producers such as
 serde's f64 write it) and otherwise raises :class:`~shared.errors.InputError`
 naming the field, its value and what was expected, as an operator reads it
-in a log. Measured side by side with the hand-written codec this replaced
-(``tests/benchmarks/bench_line_decode.py``; README, Benchmarks).
+in a log. Measured with ``tests/benchmarks/bench_codec.py`` (``docs/benchmarks.md``);
+why pydantic: ``docs/explanation/decisions/0006-pydantic-codec.md``.
 """
 
 from __future__ import annotations

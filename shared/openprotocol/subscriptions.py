@@ -6,19 +6,12 @@ no parameter ids::
     subscription MID (4) | wanted revision of that MID (3) | extra data length (2) | extra data
 
 The 0008 header revision is 0008's own; the revision of the data MID asked is
-the second field (OpenProtocolInterpreter ``Mid0008.cs``). The controller
-answers 0005 (command accepted, data "0008") or 0004. Reading also takes data
-that stops after the wanted revision (no extra data length field) as no extra
-data: node-open-protocol's test ``test/0008.spec.js`` "parser rev 1 without
-extraData" reads "0900001" so; writing always gives the length ("00").
-
-**Acknowledging a pushed 0900**: the integrator answers each 0900 with 0005
-command accepted whose data is "0900" (:class:`~.session.CommandAccepted`
-with ``mid=900``), as the 0900 serializer of the node-open-protocol-v2 fork
-(diwakrZha, ``src/mid/0900.js``, test "Serializer acknowledgment") does and as
-the specification's 5.27.1 answers 0900 ("MID 0005 Command accepted"); there
-is no 0900-specific acknowledge MID. A subscription with the header no-ack flag
-asks for none.
+the second field. The controller answers 0005 (command accepted, data
+"0008") or 0004; reading also takes data that stops after the wanted
+revision as no extra data, and writing always gives the length ("00"). The
+integrator acknowledges each pushed 0900 with 0005 whose data is "0900"
+(:class:`~.session.CommandAccepted` with ``mid=900``); a subscription with the
+header no-ack flag asks for none.
 
 **0900 extra data** (:func:`trace_extra_data`, :func:`trace_types_of`), the
 specification's Table 158 (Open Protocol 2.8.0, 5.27.1.1)::
@@ -29,16 +22,10 @@ specification's Table 158 (Open Protocol 2.8.0, 5.27.1.1)::
     | alternatives 3-4: first (10) | last (10)
     | number of trace types (2) | trace type (3) per type: 001 angle, 002 torque...
 
-Fields not used are zeros (the table) or spaces (the specification's own
-example: "0", 29 spaces, "01001", extra data length 35, for angle only); both
-are read. Bytes after the trace types are ignored: the example of 5.2.7, which
-node-open-protocol's ``test/0008.spec.js`` quotes, ends its 39 bytes with one
-more "0". Written: zeros, e.g. 30 zeros + "03001002003" for angle, torque and
-current, as the node-open-protocol-v2 fork (diwakrZha) sends it from
-``src/mid/0900.js``. An earlier reading here (result id (10) | time stamp (19)
-| number of types (3)) gave the same bytes for new data only and the
-specification's types, but refused the example's spaces and put a start index
-where the send alternative belongs.
+Fields not used are read as zeros or spaces, bytes after the trace types are
+ignored; written: zeros, e.g. 30 zeros + "03001002003" for angle, torque and
+current. The sources each reading follows: ``docs/explanation/openprotocol-bridge.md``,
+"Reading what the sources disagree on".
 """
 
 from __future__ import annotations

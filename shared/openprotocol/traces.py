@@ -1,6 +1,7 @@
 """0900 trace curve data: an ASCII part, then binary samples with their scaling.
 
-Revision 1, no parameter ids in the fixed part::
+Revision 1, no parameter ids in the fixed part (the specification, Open
+Protocol 2.8.0, 5.27.1, Table 157)::
 
     result data identifier (10: the tightening id) | time stamp (19)
     | number of PID data fields (3) | PID data fields
@@ -13,32 +14,15 @@ Revision 1, no parameter ids in the fixed part::
     resolution field: first index (5) | last index (5) | length (3) | data type (2)
                       | unit (3) | time value (the time between two samples)
 
-Samples are signed 16-bit integers; a parameter data field gives their
-scaling: PID 02214 "coefficient", value = raw * coefficient, or PID 02213,
-value = raw / divisor. Time units: 200 s, 201 min, 202 ms, 203 h.
-
-Sources: the specification (Open Protocol 2.8.0, 5.27.1, Table 157: the layout
-above, a NUL before the samples, "divide by PID 02213 or multiply by PID
-02214"; its example's first samples are the bytes 0x01 0x02, 0x02 0x04, i.e.
-big-endian), node-open-protocol (the diwakrZha v2 fork's ``src/mid/0900.js``
-and ``helpers.js`` ``processTraceSamples``), OpenProtocolInterpreter's 0900
-(commit 7bcd0a4, never merged) and the Rust crate (``messages/
-tightening_result.rs``, ``types/trace.rs``). They agree on the layout and on
-big-endian samples; they disagree on the sign, which the specification does
-not state: the node fork reads signed 16-bit, OpenProtocolInterpreter's
-commit (``(short)hi << 8 | lo`` into a float: no sign extension) and the Rust
-crate (``u16``) unsigned. Signed is taken: a loosening or a rebound gives
-negative torque, and the node fork's ``src/MID0900_example.json``, a curve of
-a real controller parsed by it, has raw samples -1, 3, 9, 15... at coefficient 0.001417
-(read unsigned, the -1 would be 92.9 Nm before the rundown). No public example gives
-the bytes of a whole real 0900 (see tests/data/openprotocol/examples).
-Trace types (Rust crate ``TraceType``): 1 angle, 2 torque, 3 current,
-4 gradient, 5 stroke, 6 force.
-
-Variants read: samples big- or little-endian (``Dialect.trace_byte_order``,
-default big, as all three sources read them); a NUL between the ASCII part
-and the samples or none (the count of samples tells which); a NUL after the
-samples counted in the length or not.
+Samples are signed 16-bit integers, big-endian unless ``Dialect.trace_byte_order``
+says little; a parameter data field gives their scaling: PID 02214
+"coefficient", value = raw * coefficient, or PID 02213, value = raw / divisor.
+Time units: 200 s, 201 min, 202 ms, 203 h. Trace types (the Rust crate's
+``TraceType``): 1 angle, 2 torque, 3 current, 4 gradient, 5 stroke, 6 force.
+Read too: a NUL between the ASCII part and the samples or none (the count of
+samples tells which), a NUL after the samples counted in the length or not.
+Why signed and big-endian, from which sources (they disagree on the sign):
+``docs/explanation/openprotocol-bridge.md``, "Reading what the sources disagree on".
 """
 
 from __future__ import annotations

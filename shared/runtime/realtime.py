@@ -49,7 +49,7 @@ def use_realtime_priority(priority: int, what: str) -> bool:
     except (PermissionError, OSError, AttributeError) as err:
         LOG.warning(
             "%s: real-time priority refused (%s); running at normal priority, so stops on a "
-            "loaded machine come later (README, Stop path)",
+            "loaded machine come later (docs/how-to/real-can-station.md, Real time)",
             what,
             getattr(err, "strerror", None) or err,
         )

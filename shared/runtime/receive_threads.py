@@ -12,8 +12,8 @@ freed only when the process ends (zenoh's receive threads live as long as
 their runtime). On CPython only; elsewhere it does
 nothing (a fresh thread state per callback: slower, still correct).
 
-Measured in the README's benchmark table (``bench_line_inbox.py``, the
-predictor's inbox variants).
+The inbox variants measured side by side (``bench_line_inbox.py``):
+``docs/explanation/design.md``, "Receive threads and inboxes".
 
 :data:`ONE_RECEIVE_THREAD` is the ``ZENOH_RUNTIME`` a service sets (before
 its first session opens) so that callbacks never pass the GIL between two of

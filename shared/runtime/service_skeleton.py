@@ -102,9 +102,10 @@ class ServiceSkeleton:
             raise RuntimeError(f"{self.name}: no zenoh session opened yet")
         return self._session
 
-    def open_session(self, section: ZenohSection) -> zenoh.Session:
-        """The session of a station service (:func:`shared.runtime.zenoh_session.open_session`)."""
-        return self.own_session(open_session(section))
+    def open_session(self, section: ZenohSection, wait_for_router: bool = True) -> zenoh.Session:
+        """The session of a station service (:func:`shared.runtime.zenoh_session.open_session`;
+        ``wait_for_router`` False: a spooling service, which starts at once)."""
+        return self.own_session(open_session(section, wait_for_router))
 
     def open_session_from(self, config: zenoh.Config) -> zenoh.Session:
         """A session of a hand-made config (the router's)."""

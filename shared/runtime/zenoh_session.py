@@ -11,6 +11,14 @@ is back the session re-declares everything by itself. What is published in
 between has nowhere to go and is lost: :class:`RouterLink` tells the
 publisher so that it can count it. At open, a client waits
 ``connect/timeout_ms`` for its router (-1: for ever) and fails otherwise.
+
+A service that keeps what it measures in a spool (``[spool]``, store and
+forward) must not wait: an acquisition restarted while its cable is out
+would miss every run until the cable is back. A zenoh client cannot open
+without its router, so such a service opens as a peer that connects to the
+same endpoints and to nothing else (gossip off, listening nowhere): it opens
+at once, reaches its router in the background, and is on the line as a
+client is (``open_session(..., wait_for_router=False)``).
 """
 
 from __future__ import annotations
@@ -53,8 +61,12 @@ def zenoh_config(
     connect_timeout_ms: int = -1,
     reconnect_period_max_ms: int = RECONNECT_PERIOD_MAX_MS,
     tls: TlsFiles | None = None,
+    connect_only: bool = False,
 ) -> zenoh.Config:
     """A zenoh.Config with ``mode``, endpoints, and multicast scouting off.
+
+    ``connect_only``: a peer that reaches the line only through ``connect``
+    (gossip off: it learns of no other peer to connect to).
 
     A client waits ``connect_timeout_ms`` for its router at open (-1: for ever,
     so services may start before the router and survive its late start), and
@@ -73,6 +85,8 @@ def zenoh_config(
     config.insert_json5("connect/retry", json.dumps(retry))
     if mode == "client":
         config.insert_json5("connect/timeout_ms", json.dumps(connect_timeout_ms))
+    if connect_only:
+        config.insert_json5("scouting/gossip/enabled", "false")
     if tls is not None:
         _insert_tls(config, tls)
     return config
@@ -118,16 +132,19 @@ def _insert_tls(config: zenoh.Config, tls: TlsFiles) -> None:
     config.insert_json5("transport/link/tls/enable_mtls", json.dumps(tls.cert is not None))
 
 
-def section_config(section: ZenohSection) -> zenoh.Config:
-    """The zenoh.Config of a station's ``[zenoh]`` section."""
+def section_config(section: ZenohSection, wait_for_router: bool = True) -> zenoh.Config:
+    """The zenoh.Config of a station's ``[zenoh]`` section (``wait_for_router`` False: a
+    client opens as a peer connected to its router only, at once)."""
     timeout_ms = -1 if section.connect_timeout_s is None else round(section.connect_timeout_s * 1e3)
+    alone = section.mode == "client" and not wait_for_router
     return zenoh_config(
-        section.mode,
+        "peer" if alone else section.mode,
         section.connect,
         section.listen,
         connect_timeout_ms=timeout_ms,
         reconnect_period_max_ms=round(section.reconnect_period_max_s * 1e3),
         tls=_tls_files(section),
+        connect_only=alone,
     )
 
 
@@ -149,9 +166,17 @@ def client_config(
     )
 
 
-def open_session(section: ZenohSection) -> zenoh.Session:
-    """Open a session for a station service; errors name the endpoints tried."""
+def open_session(section: ZenohSection, wait_for_router: bool = True) -> zenoh.Session:
+    """Open a session for a station service; errors name the endpoints tried.
+    ``wait_for_router`` False: a client does not wait for its router (a spooling service)."""
     where = ", ".join(section.connect) or "(no connect endpoints)"
+    if section.mode == "client" and not wait_for_router:
+        LOG.info(
+            "reaching the zenoh router at %s in the background (the spool keeps "
+            "what is measured meanwhile)",
+            where,
+        )
+        return open_from(section_config(section, wait_for_router=False))
     if section.mode == "client":
         waiting = (
             "for ever"

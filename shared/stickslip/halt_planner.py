@@ -1,53 +1,14 @@
 """Torque target: where to halt in the stick phase now under way (torque-only stations).
 
-A halted tool keeps the torque it was halted at if the joint still sticks,
-but if the slip starts before the motor has stopped (the station's reaction,
-one sample) the torque falls by the drop ΔT (5-12 % of the target) and
-stays there. A slip *before* the decision costs nothing: the next stick
-phase starts below and climbs again. So in each stick phase the question is
-at which torque H to halt, knowing the slip level P of this phase only as a
-prediction (the line through the youngest peaks, Sec. 6.4) with a scatter σ
-(the friction scatters from phase to phase).
-
-With P ~ N(P̂, σ²) and the decision taken one ramp step r before the halt,
-the expected |settled torque − target| of halting at H is::
-
-    E(H) = Φ((H − r − P̂)/σ) · e_next              slipped before: next phase
-         + [Φ((H − P̂)/σ) − Φ((H − r − P̂)/σ)] · |H − ΔT − T*|   slip during the halt
-         + [1 − Φ((H − P̂)/σ)] · |H − T*|          sticks: halted at H
-
-e_next is the same minimum one phase later (its peak predicted one horizon
-further), and after the third horizon that of a clean crossing (r/4), plus
-:data:`WAIT_PENALTY` times the predicted peak step for each phase waited:
-a later phase sits on a higher plateau, so waiting costs preload, which a
-torque-only station cannot see but should not squander. The
-H of least E is searched on a grid of :data:`GRID_STEPS` points within
-±:data:`SEARCH_BAND` of the target, only when this phase's predicted peak
-is within reach of the target; far from it, H is the target itself.
-
-Inputs, all measured by the core: P̂ from the regression, plus r/2 because
-a detected peak is the highest *sample* before the slip, which lies on
-average half a step below it; σ from the RMS of the last
-:data:`RESIDUALS` errors of those predictions (never below
-:data:`MIN_SIGMA_FRACTION` of the target), with the sampling step's r²/12
-added; r the median rise per sample of the recent stick phases (trough to
-the next peak); ΔT the median recent drop. Guards: no plan before
-:data:`MIN_EVENTS` events, or when any input is not finite or not positive;
-the policy drops a plan that outlives its phase (see
-:meth:`~.stop_policy.StopPolicy.plan_halt`).
-
-Compared on tests/benchmarks/bench_predictor_accuracy.py (100 joints, seed
-2018, torque-only, |T_reached − T_target| mean / median / p95 %):
-conventional 1.48 / 0.32 / 10.14; the previous rule (hold the stop back to
-+1.5 % when the predicted peak is within 1.5 % of the target) 1.25 / 0.31 /
-7.91; halting on the target with the measured stick ramp (this module's
-rule with H = T*) 0.90 / 0.21 / 6.81; this module without the wait penalty
-0.32 / 0.17 / 1.19 but preload error 3.80 % (torque-only information row,
-conventional 2.52 %); with 0.25: 0.43 / 0.19 / 1.41 and preload 2.75 %;
-with 0.5: 0.53 / 0.22 / 1.43, 2.48 %; with 1: torque 1.94 / 0.72 / 10.29,
-worse than conventional. A σ floor of 0.8 % was never worse than 0.4 %
-over four seeds (2018, 1, 5, 7); scaling the measured σ by 1.5 or 2 was
-worse on three of them.
+A halted tool keeps its torque if the joint still sticks, but a slip that
+starts before the motor has stopped drops the torque by ΔT (5-12 % of the
+target), while a slip before the decision costs nothing. So in each stick
+phase the halt torque H is the one of least expected error
+(:func:`expected_error`) given the predicted slip level P̂ of this phase and
+its scatter σ, measured by the core; far from the target, H is the target
+itself, and no plan is made before :data:`MIN_EVENTS` events or with an input
+that is not finite. The reasoning and how it was chosen against other rules:
+``docs/explanation/algorithm.md``, "Stopping on a torque target: the halt plan".
 """
 
 from __future__ import annotations
@@ -79,7 +40,14 @@ def expected_error(
     target_nm: float,
     next_error_nm: float,
 ) -> float:
-    """E(H) of the module docstring, in Nm."""
+    """E(H), the expected |settled torque - target| of halting at H, in Nm.
+
+    With the slip level P ~ N(P̂, σ²) and the decision one ramp step r before the halt::
+
+        E(H) = Φ((H - r - P̂)/σ) · e_next                          slipped before: next phase
+             + [Φ((H - P̂)/σ) - Φ((H - r - P̂)/σ)] · |H - ΔT - T*|  slip during the halt
+             + [1 - Φ((H - P̂)/σ)] · |H - T*|                       sticks: halted at H
+    """
     before = _phi((halt_nm - rate_nm - peak_nm) / sigma_nm)
     by_halt = _phi((halt_nm - peak_nm) / sigma_nm)
     return (

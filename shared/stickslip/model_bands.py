@@ -1,55 +1,15 @@
 """Eq. 71 against the analytical model: K1-K3 of the configured joint (paper Sec. 3.3, 6.6).
 
 When the station names its joint, the model (:mod:`shared.model`) says before
-the first event where K1-K3 must lie (eqs. 34-39). A run whose constants sit
-outside those bands is not the joint the program was written for (wrong
-screw, wrong extension, damaged thread): eq. 71's ``constant_out_of_band``.
-
-Time origin. The bands hold at *model* time t, counted from the untwisted,
-unloaded joint (:mod:`shared.model.timing`), not from the run's first sample.
-A torque peak sits on the stick line, T_max = φ_m (1 − γ_stick) k_e (eqs. 16,
-19), so each event carries its own model time, force sensor or not::
-
-    t_j = T_max,j / (φ̇_m · k_e · (1 − γ_stick))
-    K1_j = f_ss,j · t_j,   K2_j = ΔF_j / Δt_j · φ̇_m,   K3_j = ΔT_j / t_j · φ̇_m
-
-Never a stop for no reason. What the model itself cannot see at 1 kHz
-(``boltwatch model --validate``) widens each band before it is used:
-
-- Δt is read to ±1 sample at each end (:data:`PERIOD_SLACK_SAMPLES`), so f_ss,
-  K1 and K2 are taken at their most favourable period Δt ± 2 ms;
-- ΔT is read low: the peak up to one sample before the slip (k_e φ̇_m · Δt
-  too low) and the trough can fall between samples (a slip lasts 1-2 ms), so
-  K3 has no lower bound here, only its upper one (plus the noise);
-- μ_stick scatters per event and the configured μ are nominal: every bound
-  is widened by the factor :data:`MODEL_SLACK`, and a missed event (a period
-  twice as long) stays inside it;
-- one odd event (a wiggle taken for a slip, a missed one) is not a joint: the
-  *median* of the last n_K events (``constant_window``) is what is judged,
-  and only once n_K events with the figure exist.
-
-Evidence. The bands are bands of *slips*, so the median is taken only over
-events that are evidence of one (the benchmark's three false stops, seeds
-1, 7 and 99, were all medians of non-slips):
-
-- the noise floor must have settled. The detector's floor (3 × a running
-  median of |d2|, :mod:`.extremum_tracker`) starts from the median of the
-  first ``SEED_SAMPLES`` |d2| and then moves by 2 % per sample. When it
-  started from a single |d2| it could sit far below the noise for the first
-  few hundred samples (0.013 Nm against 0.33 Nm on seed 1, joint 80), and
-  wiggles of a slow stick ramp passed as slips a few ms apart: K1 "too
-  high", a false stop. The seed removed most of that; this rule still
-  guards what is left (121 events left out over 100 joints, seed 2018).
-  While the estimate climbs it rises at every event; an event
-  whose estimate is not above the previous event's shows that it has
-  reached the noise median (:meth:`ModelBandCheck.on_event`), and only
-  events from then on are judged;
-- Δt must be one stick phase. Between a slip's trough and the next peak
-  the torque can rise at most at the stick rate k_e φ̇_m (the screw stands);
-  it rises at (1 − γ_slip) k_e φ̇_m while the screw slides smoothly. A
-  "period" whose rise is below :data:`MIN_STICK_SHARE` of the stick ramp
-  spans smooth sliding (two noise events 2.3 s apart on seed 7, joint 48:
-  K1 "too low"), not a stick-slip period, so it gives no K1 or K2.
+the first event where K1-K3 must lie (eqs. 34-39); a run whose constants sit
+outside those bands is not the joint the program was written for:
+``constant_out_of_band``. Each event is taken at its own model time
+(:meth:`ModelBandCheck.model_time_s`), every band is widened for what the
+model cannot see at 1 kHz (:data:`PERIOD_SLACK_SAMPLES`, :data:`MODEL_SLACK`),
+the median of the last n_K events is judged, and only events that are
+evidence of a slip count (the noise floor settled, a period of one stick
+phase: :data:`MIN_STICK_SHARE`). Why each rule, and what it prevented:
+``docs/explanation/algorithm.md``, "Eq. 71 against the joint model".
 """
 
 from __future__ import annotations
@@ -110,7 +70,11 @@ class ModelBandCheck:
         self.nearest_edge = {1: 0.0, 2: 0.0, 3: 0.0}
 
     def model_time_s(self, peak_torque_nm: float, motor_speed_rad_s: float) -> float:
-        """t_j of the module docstring: model time of a peak on the stick line."""
+        """t_j, the model time of a peak on the stick line (from the untwisted joint).
+
+        A peak sits on the stick line, T_max = φ_m (1 - γ_stick) k_e (eqs. 16, 19), so
+        t_j = T_max,j / (φ̇_m · k_e · (1 - γ_stick)), force sensor or not.
+        """
         return peak_torque_nm / (
             motor_speed_rad_s * self.constants.k_e_nm_per_rad * (1.0 - self.gamma_stick)
         )

@@ -1,47 +1,16 @@
 """Did the motor drive through a torque drop? What tells a slip from the tool letting go.
 
-A stick-slip event is a drop of the torque *under a driving motor*: the
-angle sensor reports the motor angle φ_m, which turns on at its speed
-through the stick phase, the slip and the next stick phase (paper Fig. 1,
-eqs. 9, 10: the screw stops and slides, the motor does not). The torque also
-drops, with no stick-slip at all, when
-
-- the tool lets go after its last step (its controller stops the motor and
-  the drive train unwinds: on a CS351 the "torsion release");
-- the controller pauses between tightening steps;
-- a step ends and the next one runs at a lower speed (the motor slows down
-  and the torque with it).
-
-In each of these the motor stands or slows down while the torque falls. So
-a drop counts as a slip only if the angle advanced from the peak to the
-sample that confirmed the slip (a renewed rise: the window's inclination
-turned positive again, eq. 47) by at least :data:`DRIVE_FRACTION` of what the
-motor's speed before the peak would have turned in that time::
-
-    |φ(now) - φ(peak)|  ≥  DRIVE_FRACTION · |ω_before| · (t_now - t_peak) - tolerance
-    ω_before = (φ(peak) - φ(peak - LOOKBACK)) / (t(peak) - t(peak - LOOKBACK))
-
-and only if the motor was turning before the peak at all (a drop while it
-stands is a pause). The tolerance is :data:`TOLERANCE_D2` medians of the
-angle's |second difference| over the look-back (the angle's noise: for a
-motor at constant speed d2 is noise only, see :mod:`.second_difference`):
-three σ of the difference of two noisy angles (1.65 σ per median; the
-difference of two has √2 σ), or about three steps of a quantized encoder.
-It is computed when a drop is judged, not per sample (drops above the noise
-floor are about 1 % of the samples). With two σ, one true slip
-in 7901 of the detection benchmark was refused (a slow motor, 0.14 rad/s,
-confirmed two samples after its peak: an angle advance of 0.016° expected
-against noise of 0.011°); with three, none. The direction of turning is the
-sign of ω_before, so an angle counted negative works alike.
-
-A station whose angle never moves (no encoder: the signal stays constant)
-gives no evidence either way: every drop above the noise floor is a slip, as
-before this check existed.
-
-Measured (``tests/benchmarks/bench_event_detection.py``, the rig's true
-slips): recall unchanged by this check; on real CS351 runs the tool's
-release and the steps' pauses and slow-downs no longer count (see the README).
-O(1) per sample (a ring of times and angles), O(LOOKBACK) per candidate slip.
+A stick-slip event is a drop of the torque *under a driving motor* (paper
+Fig. 1, eqs. 9, 10: the screw stops and slides, the motor does not); the tool
+letting go after its last step, a pause between steps and a step to a lower
+speed drop the torque with the motor standing or slowing down. So a drop
+counts as a slip only if the angle advanced from the peak to the sample that
+confirmed the slip by at least :data:`DRIVE_FRACTION` of what the motor's
+speed before the peak would have turned, less :data:`TOLERANCE_D2` medians of
+the angle's noise, and only if the motor was turning before the peak; an
+angle that never moves gives no evidence either way. O(1) per sample, the
+check only per candidate slip. The rule, its tolerance and what it changed
+on real runs: ``docs/explanation/algorithm.md``, "A slip needs a driving motor".
 """
 
 from __future__ import annotations
@@ -82,7 +51,13 @@ class MotorMotion:
         self.count += 1
 
     def drove_through(self, peak_index: int, now_index: int) -> bool:
-        """True if the motor drove from the peak to now as it drove before the peak.
+        """True if the motor drove from the peak to now as it drove before the peak::
+
+            |φ(now) - φ(peak)|  >=  DRIVE_FRACTION · |ω_before| · (t_now - t_peak) - tolerance
+            ω_before = (φ(peak) - φ(peak - LOOKBACK)) / (t(peak) - t(peak - LOOKBACK))
+
+        with the tolerance TOLERANCE_D2 medians of the angle's |second difference|
+        over the look-back (three σ of the difference of two noisy angles).
 
         True too when it cannot be judged: an angle that never moved, a held
         (not measured) angle since the look-back began, too few samples before

@@ -2,40 +2,13 @@
 
 The ledger adds up process intensities (eq. 69); one false figure falsifies
 a tool's total for ever. A summary is refused (and counted) when it is
-inconsistent in itself or its intensity is beyond what the joint's physics
-allows. The bound, from the paper's Section 6.6:
-
-- eq. 66/67: ``I_j = ΔT_j · |T_mean,j| · f_ss,j`` with ``ΔT_j = T_max,j − T_min,j``
-  and ``T_mean,j = (T_max,j + T_min,j)/2``, so
-  ``ΔT_j · |T_mean,j| = |T_max,j² − T_min,j²| / 2``;
-- torque cannot exceed the tool's torque limit ``T_lim`` (the program's
-  ``max_torque_nm``: above it the tool stops itself; with no program known,
-  the top of the sensor's range, :mod:`shared.contract.sensor_range`): ``|T| ≤ T_lim``
-  gives ``ΔT_j · |T_mean,j| ≤ T_lim² / 2``;
-- an event needs a peak and a trough sample, so two peaks are at least two
-  sample periods apart: ``f_ss,j ≤ f_s / 2`` = :data:`F_SS_MAX_HZ` (500 Hz at
-  the contract's 1 kHz);
-- so ``I_j ≤ T_lim² / 2 · f_max``. The ledger allows twice that,
-  ``T_lim² · f_max`` per event: it still holds for a torque up to √2·T_lim
-  (a tool overshooting its limit while it stops) or a period measured down to
-  one sample (two frames stamped bunched), so a true run is never refused;
-- eq. 68 sums from j = 2: ``I_process ≤ (n_ss − 1) · T_lim² · f_max``, and a
-  run of N samples has ``n_ss ≤ N/2`` events.
-
-Consistency (refused whatever the intensity): ended before started, negative
-counts, more events than samples/2, more samples than the run's duration
-carries at 1 kHz (with :data:`CLOCK_TOLERANCE` and :data:`EDGE_SAMPLES`), or
-than the program's ``max_time_s`` (plus :data:`END_GRACE_S`) allows.
-
-How loose it is: a simulated run of the paper's joint (program 1, 42 events,
-I_process 1.1e6) is about 2000 times below its bound of 41 × (320 Nm)² ×
-500 Hz = 2.1e9; the real CS351 runs are listed in the README. What it
-catches: a negative, infinite or NaN intensity, and any figure no tool could
-have taken (a forged 1e15, or 9e11 from random frames on a 320 Nm tool).
-A station the recorder has no file for, and a controller station (its
-psets carry no limits: the controller keeps them), are bounded by the
-sensor range and the run's own duration only: a loose bound; the answer to forged messages is TLS
-and access control (README, Security).
+inconsistent in itself (ended before started, negative counts, more events
+than samples/2, more samples than its duration or the program's
+``max_time_s`` allows) or its intensity is beyond what the joint's physics
+allows: ``I_process <= (n_ss - 1) * T_lim**2 * f_max``, with ``T_lim`` the
+program's torque limit (else the top of the sensor's range) and ``f_max`` =
+:data:`F_SS_MAX_HZ`. The derivation from eqs. 66-68 and how loose it is:
+``docs/explanation/algorithm.md``, "What a run can add to the wear ledger".
 """
 
 from __future__ import annotations

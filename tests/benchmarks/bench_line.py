@@ -27,7 +27,7 @@ of the per-second p50s of ``RecorderStats``) and p99 (of the per-second
 maxima: an upper bound), samples missing (``RecorderStats.missing_samples``,
 end to end), and st1's stop path p50/p90/p99. Exit status 1 when a sample is
 missing or a goal is missed: recorder <= 10 µs per sample; at N = 50 lag p99
-<= 1 s and the stop path p90 <= 2 ms (README, the edge stop path).
+<= 1 s and the stop path p90 <= 2 ms (docs/benchmarks.md).
 """
 
 from __future__ import annotations

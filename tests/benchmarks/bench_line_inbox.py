@@ -30,9 +30,9 @@ variants run in turns within one round, so a busy machine hurts them alike.
 - ``indirect``: like ``callback`` with ``indirect=True`` (zenoh runs each
   subscriber's callbacks on a thread of its own).
 
-The README's figures for the former inbox (one ``queue.Queue`` and a worker
-thread) and for the recorder's ``classify`` as it was were taken with copies
-of that code, since removed: compare with another checkout
+The figures for the former inbox (one ``queue.Queue`` and a worker thread)
+and for the recorder's ``classify`` as it was (in CHANGELOG.md) were taken
+with copies of that code, since removed: compare with another checkout
 (``recorder-at-before``) instead.
 """
 

@@ -8,7 +8,7 @@ show a result the test heard on zenoh (its run and its OK/NOK), then a newer
 one without a reload, the station's services alive, the tool's wear as due
 and the wear alert, and load nothing but from its own server. A screenshot
 goes to the test's folder (``BOLTWATCH_DOCS_IMAGES=1``: also to
-docs/images/dashboard.png, the README's picture).
+docs/images/dashboard.png, the picture of docs/how-to/line-page.md).
 
 Chromium comes from Debian's package (.ci/run installs it as root when
 missing); never ``playwright install``. Where it

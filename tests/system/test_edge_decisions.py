@@ -3,8 +3,8 @@
 With ``[predictor] placement = "edge"`` the station's predictor runs in its
 acquisition; a ``StopDecision`` put on ``boltwatch/<st>/decision`` by anyone
 else (a rogue node on a plain-tcp line, a stray line predictor) must not stop
-the tool, while the station's own predictor still does (README, "Where the
-decision runs" and Security).
+the tool, while the station's own predictor still does
+(docs/explanation/decisions/0001-edge-stop-decision.md, docs/reference/access-control.md).
 """
 
 from __future__ import annotations

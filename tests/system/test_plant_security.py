@@ -1,4 +1,4 @@
-"""Two lines' routers meshed with mutual TLS and access control (README, A plant of several lines).
+"""Two lines' routers meshed with mutual TLS and access control (docs/how-to/line-and-plant.md).
 
 One CA for the plant (config/security/make-certs.sh, ``ROUTER_NAME`` per line's
 router); each router's access control names the other line's router with

@@ -12,10 +12,13 @@ default). While every station tightens:
    then started again.
 
 Then every run of every station is in the recordings whole: its tool states,
-every sample once (sequences 0..n-1, n as its summary says), every event the
+every sample (sequences 0..n-1, n as its summary says), every event the
 summary counts, its decision, result and summary; the wear ledger counts
-every run once; the recorder says no sample is missing and every spool is
-empty. Skips, with the reason, where network namespaces cannot be made.
+every run once; the recorder says no sample is missing and no run waits in a
+spool. Once, except what the killed recorder had filed of a draining spool in
+its last 0.2 s (it acknowledges that often while a spool drains): sent again,
+that lands in a second file of its run (at least once, never lost).
+Skips, with the reason, where network namespaces cannot be made.
 """
 
 from __future__ import annotations
@@ -56,6 +59,7 @@ class RunRecord:
     """What the recordings hold of one run."""
 
     samples: Counter[int] = field(default_factory=Counter)  # sequence -> times recorded
+    files: set[Path] = field(default_factory=set)  # the files holding its samples
     topics: Counter[str] = field(default_factory=Counter)
     summary: dict[str, Any] | None = None
 
@@ -77,6 +81,7 @@ def read_recordings(folder: Path) -> dict[str, dict[int, RunRecord]]:
             record.topics[parts[2]] += 1
             if parts[2] == "samples":
                 record.samples[body["sequence"]] += 1
+                record.files.add(path)
             elif parts[2] == "runs":
                 record.summary = body
     return runs
@@ -207,16 +212,30 @@ def test_cables_cut_and_the_recorder_killed_lose_nothing(tmp_path: Path) -> None
     recordings = read_recordings(tmp_path / "recordings")
     with sqlite3.connect(ledger_path(tmp_path / "recordings")) as ledger:
         counted = Counter(ledger.execute("SELECT station FROM runs").fetchall())
+    twice: list[str] = []  # runs filed again after the recorder was killed
     for index in range(1, STATIONS + 1):
         station = f"st{index}"
         runs = recordings[station]
-        assert len(runs) >= RUNS, f"{station}: {len(runs)} runs recorded"
+        # the run station 2's acquisition was in when it was stopped ends there (its samples
+        # up to the stop, no summary: faults table, "acquisition killed mid-run")
+        cut_short = [run_id for run_id, record in runs.items() if record.summary is None]
+        assert len(cut_short) <= (1 if index == 2 else 0), f"{station}: no summary {cut_short}"
+        assert len(runs) - len(cut_short) >= RUNS - (3 if index == 2 else 0), (
+            f"{station}: {len(runs)} runs recorded"
+        )
         for run_id, record in runs.items():
             where = f"{station} run {run_id}"
-            assert record.summary is not None, f"{where}: no summary"
+            if record.summary is None:
+                assert sorted(record.samples) == list(range(len(record.samples))), where
+                continue
             count = record.summary["samples"]
             assert sorted(record.samples) == list(range(count)), f"{where}: samples missing"
+            if max(record.samples.values()) > 1:
+                twice.append(where)
+                assert len(record.files) == 2, f"{where}: {record.files}"
             assert record.topics["results"] >= 1 and record.topics["decision"] <= 1, where
             assert record.topics["events"] >= record.summary["events"], where
             assert record.topics["tool"] >= 2, f"{where}: tool states {record.topics}"
-        assert counted[(station,)] == len(runs), f"{station}: the wear ledger's runs"
+        summarized = len(runs) - len(cut_short)
+        assert counted[(station,)] == summarized, f"{station}: the wear ledger's runs"
+    assert len(twice) <= 2, f"filed twice, more than 0.2 s of a drain: {twice}"

@@ -2,7 +2,7 @@
 
 The issue's probe: a RunSummary with intensity 1e15 for a run that never ran,
 put on ``boltwatch/st1/runs`` by a client of the line's router while ``up``
-runs (plain tcp, as the README's default), went into the wear ledger and
+runs (plain tcp, the line's default), went into the wear ledger and
 counted toward ``up --runs``. Now ``up`` counts a summary only for a run it
 saw start on the station's tool channel, once; the recorder refuses the
 intensity (beyond what the program's 320 Nm tool can take).

@@ -20,7 +20,7 @@ bytes to the SDK, which copies them into each subscribed client's queue of
 :data:`CLIENT_BACKLOG_MESSAGES` and sends from its own (Rust) threads; a
 client too slow to keep up loses its oldest messages, never the recorder's
 time. With no client subscribed to a channel a log is a check and a return.
-The cost per sample with and without a client is in the README's Benchmarks
+The cost per sample with and without a client: ``docs/benchmarks.md``
 (``tests/benchmarks/bench_foxglove_live.py``).
 """
 

@@ -6,8 +6,9 @@ thread (``indirect=False``) and only appends ``(key, payload, receive time,
 attachment)`` to a pending list. The recorder's worker takes the whole list at once
 (:meth:`LineInbox.take`, every few milliseconds) and files it: one
 hand-over per batch instead of one per message (a ``FifoChannel`` read with
-a blocking ``recv()``, as before; measured side by side in the README's
-benchmark table: ``bench_line_inbox.py --variants recorder recorder-at-before``).
+a blocking ``recv()``; measured side by side with ``bench_line_inbox.py
+--variants recorder recorder-at-before``: ``docs/explanation/design.md``,
+"Receive threads and inboxes").
 The disk stays off the receive thread: a flush that waits for ``fsync``
 holds the worker, not zenoh.
 

@@ -2,35 +2,19 @@
 
 Lag is the receive time in the recorder minus ``Sample.time_ns`` (the CAN
 receive time stamped by the acquisition), measured when the recorder's worker
-files the sample: it includes the network and the wait in the inbox, so a
-recorder falling behind shows here before it loses anything. Each report
-covers the samples since the previous report (about one second); a station
-that sent no samples has no lag (None), not zero.
-
-``bad_payloads`` counts the payloads on a message key that the recorder
-refused (see :mod:`shared.recordings.received`) and recorded raw.
-
-Write health (``write_errors``, ``last_error``, ``recording``) is read from
-the :class:`~services.recorder.live.recorder.Recorder`'s ``write_errors``,
-``last_write_error`` and ``recording_ok`` attributes; until the Recorder
-has them (disk-fault handling lands separately) they read as healthy.
-
-Missing samples are counted end to end, whatever the transport did: each
-BusStats carries the acquisition's running count of samples it published
-(``BusStats.samples``), and the recorder counts the samples it received from
-that station. Both counts start at the first BusStats the recorder sees (what
-was published before the recorder listened is not a loss); the difference,
-recomputed at every BusStats, is ``missing_samples``. It is a level, not a sum
-of guesses: samples still in flight when a BusStats is read are counted
-missing for at most one report and drop out at the next. When the
-acquisition restarts (``BusStats.started_ns`` changes, or its count goes
-down) the loss so far is kept and the counting starts again at the new
-process's first BusStats (samples around a restart, before the new
-process's first report, are not judged). Samples a station's spool sends
-again after a cut count as received when the recorder files them
-(:meth:`RecorderHealth.refiled`): the level drops back to what the drain
-could not bring. This catches what no link-level counter can: a cable pulled for less than zenoh's
-lease loses samples while no session ever sees its router go.
+files the sample, over the samples since the previous report (None, not
+zero, for a station that sent none). ``bad_payloads`` counts the payloads the
+recorder refused (:mod:`shared.recordings.received`) and recorded raw; write
+health (``write_errors``, ``last_error``, ``recording``) is the
+:class:`~services.recorder.live.recorder.Recorder`'s. ``missing_samples`` is
+counted end to end: the acquisition's count of samples it published
+(``BusStats.samples``) less the samples received from that station, both
+from the first BusStats heard; when the acquisition restarts
+(``BusStats.started_ns``) the loss so far is kept and the counting starts
+again. Samples a station's spool sends again after a cut count as received
+when they are filed (:meth:`RecorderHealth.refiled`): the level drops back to
+what the drain could not bring. Why it is counted this way and what it catches:
+``docs/explanation/design.md``, "Loss counted end to end".
 """
 
 from __future__ import annotations

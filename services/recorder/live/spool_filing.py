@@ -35,6 +35,8 @@ class SpoolFiling:
         self._recorder = recorder
         self._file = file
         self._waiting: dict[tuple[str, str], WaitingLive[tuple[Received, SeqMark]]] = {}
+        #: a hole filed something since the last acknowledgement (a station drains its spool)
+        self.refiling = False
 
     def file(self, received: Received, mark: SeqMark, filed_ns: int) -> None:
         """File message ``mark.seq`` where its order says; then what waited for it."""
@@ -57,6 +59,7 @@ class SpoolFiling:
         """Flush the spooling stations' files; acknowledge what they hold."""
         recorder = self._recorder
         self.keeper.acknowledge(now_ns, lambda station: recorder.flush(station, now_ns), publish)
+        self.refiling = False
         self._close_holes()
 
     def waiting_full(self) -> int:
@@ -79,6 +82,7 @@ class SpoolFiling:
         if routing.caught_up and hole is not None and isinstance(hole.files, StationFiles):
             self._recorder.hand_back(hole.files)
         files = hole.files if routing.fate is Fate.HOLE and hole is not None else None
+        self.refiling = self.refiling or files is not None
         self._file(received, filed_ns, files)
         self.keeper.filed_as(station, mark, routing)
         self._close_holes()

@@ -1,7 +1,7 @@
 """The tightening results (and run summaries) of a station's recordings in a time range.
 
 Reads ``<recordings>/<station>/<YYYY-MM-DD>/*.mcap`` (the layout of
-:mod:`services.recorder.live.run_files`, dates in UTC) for the days of the
+:mod:`shared.recordings.layout`, dates in UTC) for the days of the
 range, every complete message of channels ``results`` and ``runs``, damaged
 files as far as they go (:class:`RecordingScan`, a warning each). A result
 is kept when it ended (``time_ns``) inside the range and matches the

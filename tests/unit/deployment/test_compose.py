@@ -157,7 +157,7 @@ PREDICTOR_PUTS = {
     channels.RESULTS.topic,  # issue 18: a run's TighteningResult
     channels.PREDICTOR.topic,
 }
-ROLE_PUTS = {  # what each role publishes (README, "Zenoh keys and payloads"), per station
+ROLE_PUTS = {  # what each role publishes (docs/reference/access-control.md), per station
     # the acquisition hosts the station's predictor (placement "edge") and publishes for it,
     # and its spool sends again what the line's recorder lacks (again/<topic>)
     "acquisition": set(channels.topics_of("acquisition")) | PREDICTOR_PUTS | {f"{keys.AGAIN}/**"},

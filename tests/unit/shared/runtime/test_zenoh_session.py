@@ -85,3 +85,34 @@ def test_router_link_follows_the_transport_down_and_up() -> None:
         link.close()
         client.close()
         router.close()
+
+
+def test_a_spooling_service_opens_without_its_router_and_reaches_it_later() -> None:
+    """A client that must not wait (its spool keeps what it measures) opens at once, reaches
+    the router when it comes, and is then on the line both ways, as a client is."""
+    endpoint = f"tcp/127.0.0.1:{free_tcp_port()}"
+    zenoh_section = section({"connect": [endpoint], "reconnect_period_max_s": 0.2})
+    station = open_session(zenoh_section, wait_for_router=False)
+    router = zenoh.open(zenoh_config("router", listen=[endpoint]))
+    other = zenoh.open(zenoh_config("client", [endpoint]))
+    heard: list[bytes] = []
+    told: list[bytes] = []
+    try:
+        link = RouterLink(station, lambda connected, outage_s: None)
+        deadline = time.monotonic() + 10
+        while not link.connected and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert link.connected
+        station.declare_subscriber("t/ack", lambda s: told.append(s.payload.to_bytes()))
+        other.declare_subscriber("t/data", lambda s: heard.append(s.payload.to_bytes()))
+        deadline = time.monotonic() + 10
+        while (not heard or not told) and time.monotonic() < deadline:
+            station.put("t/data", b"measured")
+            other.put("t/ack", b"filed")
+            time.sleep(0.1)
+        assert heard and told
+        link.close()
+    finally:
+        station.close()
+        other.close()
+        router.close()

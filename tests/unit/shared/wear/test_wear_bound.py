@@ -30,7 +30,7 @@ T_LIM_NM = 320.0  # program 1 of config/station.toml
 
 
 def simulated_run(**changes: object) -> RunSummary:
-    """A run of program 1 as the simulated station makes them (README's table)."""
+    """A run of program 1 as the simulated station makes them (``make run``'s table)."""
     run = RunSummary(
         "st1", 1795272478, 7, 1, "done", 56e3, 200.0, 55.93e3, 201.0, -0.12, 41,
         "plateau_closest", 1.03e6, 1677, T0_NS, T0_NS + 1_676_400_000,
