@@ -30,15 +30,14 @@ from shared.config import LoadedStation, load_station
 from shared.contract import (
     RunSummary,
     StationDatabase,
-    StopDecision,
     ToolRunState,
     channels,
-    decode,
     keys,
 )
 from shared.errors import TransportError
 from shared.recordings.mcap import RecordingScan
 from shared.runtime import open_bus, open_from, zenoh_config
+from tests.support.listener import Listener
 from tests.support.station_files import write_station
 
 STATION = "st1"
@@ -110,25 +109,6 @@ class CanWatch:
             self._bus.shutdown()
 
 
-class Heard:
-    """What the test's zenoh session heard on ``boltwatch/st1/*``."""
-
-    def __init__(self) -> None:
-        self.lock = threading.Lock()
-        self.summaries: list[RunSummary] = []
-        self.decisions: dict[int, list[StopDecision]] = defaultdict(list)
-
-    def on_sample(self, sample: zenoh.Sample) -> None:
-        topic = str(sample.key_expr).rsplit("/", 1)[-1]
-        payload = sample.payload.to_bytes()
-        with self.lock:
-            if topic == channels.RUNS.topic:
-                self.summaries.append(decode(RunSummary, payload))
-            elif topic == channels.DECISION.topic:
-                decision = decode(StopDecision, payload)
-                self.decisions[decision.run_id].append(decision)
-
-
 class LiveStation:
     """The station's processes; :meth:`close` stops them all and closes the watchers."""
 
@@ -149,14 +129,11 @@ class LiveStation:
         self.supervisor = StationSupervisor(self.station_file, folder / "logs")
         self.recorder_args = recorder_args
         self.restarts: dict[str, int] = defaultdict(int)
-        self.heard = Heard()
         self.can = CanWatch(self.loaded)
         endpoint = self.loaded.config.zenoh.connect[0]
         self.supervisor.start("router", ["--listen", endpoint])
         self.session = open_client(endpoint)
-        self._subscriber = self.session.declare_subscriber(
-            keys.station_key(STATION, "*"), self.heard.on_sample
-        )
+        self.heard = Listener(self.session, STATION, (channels.RUNS.topic, channels.DECISION.topic))
         processes = [s for s in SERVICES if placement == "line" or s != "predictor"]
         for service in processes:
             self.start(service)
@@ -211,12 +188,10 @@ class LiveStation:
             time.sleep(poll_s)
 
     def summaries(self) -> list[RunSummary]:
-        with self.heard.lock:
-            return list(self.heard.summaries)
+        return self.heard.of(channels.RUNS.topic)
 
     def decided(self, run_id: int) -> bool:
-        with self.heard.lock:
-            return bool(self.heard.decisions.get(run_id))
+        return any(d.run_id == run_id for d in self.heard.of(channels.DECISION.topic))
 
     def wait_runs_summarised(self, count: int, timeout_s: float = 30.0) -> list[RunSummary]:
         self.wait_for(lambda: len(self.summaries()) >= count, f"{count} run summaries", timeout_s)
@@ -231,8 +206,7 @@ class LiveStation:
 
     def close(self) -> None:
         """Stop the rig first, the recorder last (so its files are complete), then the rest."""
-        with contextlib.suppress(zenoh.ZError):
-            self._subscriber.undeclare()
+        self.heard.close()
         self.session.close()
         names = [m.name for m in self.supervisor.processes]
         order = [

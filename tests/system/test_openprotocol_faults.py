@@ -28,11 +28,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-import zenoh
 
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
 from services.rig.openprotocol.simulated_controller import LINGER_S
-from shared.contract import BridgeStats, channels, decode
+from shared.contract import BridgeStats, channels
+from tests.support.listener import Listener
 from tests.support.live_recorder import free_port
 from tests.support.live_station import open_client
 from tests.support.openprotocol_proxy import Damage, OpenProtocolProxy
@@ -79,10 +79,7 @@ class FaultStation:
         endpoint = f"tcp/127.0.0.1:{_zenoh_port(template)}"
         self.supervisor.start("router", ["--listen", endpoint])
         self.session = open_client(endpoint)
-        self.stats: list[BridgeStats] = []
-        self._subscriber = self.session.declare_subscriber(
-            channels.OPENPROTOCOL.key(STATION), self._heard
-        )
+        self.heard = Listener(self.session, STATION, (channels.OPENPROTOCOL.topic,))
         self.supervisor.start("recorder", ["--no-rerun"])
         self.bridges = 0
         self.start_bridge()
@@ -92,8 +89,10 @@ class FaultStation:
             config_paths=[self.files["controller"]],
         )
 
-    def _heard(self, sample: zenoh.Sample) -> None:
-        self.stats.append(decode(BridgeStats, sample.payload.to_bytes()))
+    @property
+    def stats(self) -> list[BridgeStats]:
+        """The bridge's BridgeStats heard so far."""
+        return self.heard.of(channels.OPENPROTOCOL.topic)
 
     def start_bridge(self) -> ManagedProcess:
         self.bridges += 1
@@ -142,8 +141,7 @@ class FaultStation:
         )
 
     def close(self) -> None:
-        with contextlib.suppress(zenoh.ZError):
-            self._subscriber.undeclare()
+        self.heard.close()
         self.session.close()
         names = [m.name for m in self.supervisor.processes]
         order = [

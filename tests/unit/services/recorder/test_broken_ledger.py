@@ -27,9 +27,10 @@ import zenoh
 
 from services.cli.main import main
 from shared.config import LoadedStation
-from shared.contract import RecorderStats, RunSummary, Sample, ToolState, channels, decode
+from shared.contract import RunSummary, Sample, ToolState, channels
 from shared.runtime import zenoh_config
 from shared.wear import CONTRACT_LIMITS, WearLedger
+from tests.support.listener import Listener
 from tests.support.live_recorder import RunningRecorder, publish, wait_until
 from tests.support.paths import REPO
 
@@ -196,12 +197,8 @@ def test_the_recorder_records_on_and_counts_the_waiting_runs_once_reset(
         breaks[when.split(maxsplit=1)[0]](ledger_file)
     recorder = RunningRecorder(station)
     session = zenoh.open(zenoh_config("peer", connect=station.config.zenoh.listen))
-    stats: list[RecorderStats] = []
     try:
-        subscriber = session.declare_subscriber(
-            channels.RECORDER.key("st1"),
-            lambda sample: stats.append(decode(RecorderStats, sample.payload.to_bytes())),
-        )
+        heard = Listener(session, "st1", (channels.RECORDER.topic,))
         wear = recorder.service.wear
         assert wear is not None
         if when == "emptied while running":
@@ -211,8 +208,10 @@ def test_the_recorder_records_on_and_counts_the_waiting_runs_once_reset(
         for run_id in (2, 3):
             publish(session, run_messages(run_id))
         wait_until(lambda: wear.waiting == 2, "the summaries waiting")
-        wait_until(lambda: any(s.waiting_summaries == 2 for s in stats), "RecorderStats")
-        last = stats[-1]
+        wait_until(
+            lambda: any(s.waiting_summaries == 2 for s in heard.of("recorder")), "RecorderStats"
+        )
+        last = heard.of("recorder")[-1]
         assert last.recording and last.last_error is not None
         assert last.last_error.startswith(f"wear ledger: {ledger_file}: not a usable wear ledger")
         assert "boltwatch wear reset" in last.last_error
@@ -222,10 +221,12 @@ def test_the_recorder_records_on_and_counts_the_waiting_runs_once_reset(
         done = reset(recordings)
         assert done.returncode == 0, done.stderr
         wait_until(lambda: wear.waiting == 0, "the waiting runs in the new ledger")
-        wait_until(lambda: any(s.last_error is None for s in stats[-2:]), "RecorderStats")
+        wait_until(
+            lambda: any(s.last_error is None for s in heard.of("recorder")[-2:]), "RecorderStats"
+        )
         publish(session, run_messages(4))
         wait_until(lambda: wear.counted == (4 if when == "emptied while running" else 3), "run 4")
-        subscriber.undeclare()
+        heard.close()
     finally:
         session.close()
         recorder.finish()
