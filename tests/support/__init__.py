@@ -8,7 +8,8 @@ with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
 :mod:`.foxglove_client` (the Foxglove WebSocket protocol),
 :mod:`.openprotocol_proxy` (a TCP proxy that damages what passes).
 
-- messages and data: :mod:`.factories` (messages with plausible values),
+- messages and data: :mod:`.factories` (run summaries, samples, events, results and
+  programs with plausible values, changed by keyword),
   :mod:`.synthetic_runs` (synthetic traces), :mod:`.recorded_runs` (a whole run
   as a station publishes it), :mod:`.openprotocol_golden`,
   :mod:`.openprotocol_examples` (Open Protocol messages with their bytes),

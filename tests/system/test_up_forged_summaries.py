@@ -18,7 +18,8 @@ from pathlib import Path
 
 import pytest
 
-from shared.contract import RunSummary, channels, encode
+from shared.contract import channels, encode
+from tests.support.factories import summary
 from tests.support.live_station import open_client
 from tests.support.paths import REPO
 from tests.support.station_files import write_station
@@ -30,13 +31,17 @@ RUNS = 3
 
 
 def forged(run_id: int, intensity: float) -> bytes:
+    """A summary of run ``run_id`` that just ended, as a predictor would put it."""
     now = time.time_ns()
-    return encode(
-        RunSummary(
-            "st1", run_id, 7, 1, "done", 56e3, 200.0, 56e3, 200.0, 0.0, 40, "plateau_closest",
-            intensity, 1700, now - 1_700_000_000, now,
-        )
-    )  # fmt: skip
+    run = summary(
+        run_id,
+        events=40,
+        process_intensity=intensity,
+        samples=1700,
+        started_ns=now - 1_700_000_000,
+        ended_ns=now,
+    )
+    return encode(run)
 
 
 def test_a_forged_summary_is_neither_a_run_of_up_nor_wear_in_the_ledger(tmp_path: Path) -> None:

@@ -17,7 +17,6 @@ from shared.config import LoadedStation
 from shared.contract import (
     Intensity,
     RunSummary,
-    Sample,
     StickSlipEvent,
     StopDecision,
     TighteningResult,
@@ -27,6 +26,7 @@ from shared.contract import (
 )
 from shared.errors import ConfigError
 from shared.runtime import ServiceSkeleton, zenoh_config
+from tests.support.factories import sample
 from tests.support.live_predictor import (
     PROGRAM_OF,
     START_NS,
@@ -123,7 +123,7 @@ def test_a_sample_naming_another_station_is_ignored(
     with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
         wait_for_token(session, keys.health_key("pt1", "predictor"))
         feed = StationFeed(session, "pt1")
-        wrong = Sample("pt2", 42, 0, START_NS, 1.0, 0.0, 1.0)
+        wrong = sample(42, 0, station="pt2", time_ns=START_NS)
         feed.samples.put(codec.encode(wrong))
         deadline = time.monotonic() + 10.0
         while service.bad_payloads == 0 and time.monotonic() < deadline:

@@ -27,9 +27,10 @@ import zenoh
 
 from services.cli.main import main
 from shared.config import LoadedStation
-from shared.contract import RunSummary, Sample, ToolState, channels
+from shared.contract import Sample, ToolState, channels
 from shared.runtime import zenoh_config
 from shared.wear import CONTRACT_LIMITS, WearLedger
+from tests.support.factories import summary
 from tests.support.listener import Listener
 from tests.support.live_recorder import RunningRecorder, publish, wait_until
 from tests.support.paths import REPO
@@ -48,11 +49,16 @@ def run_messages(run_id: int) -> list[tuple[str, Any]]:
         for n in range(SAMPLES)
     ]
     out.append(("tool", ToolState("st1", run_id, 7, 1, "done", end)))
-    summary = RunSummary(
-        "st1", run_id, 7, 1, "done", 56e3, None, 1.05e4, 99.0, -81.0, 4, None,
-        0.5 * run_id, SAMPLES, t, end,
-    )  # fmt: skip
-    return [*out, ("runs", summary)]
+    run = summary(
+        run_id,
+        events=4,
+        stop_reason=None,
+        process_intensity=0.5 * run_id,
+        samples=SAMPLES,
+        started_ns=t,
+        ended_ns=end,
+    )
+    return [*out, ("runs", run)]
 
 
 def healthy_ledger(path: Path, runs: int = 3) -> None:

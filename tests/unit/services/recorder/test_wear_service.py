@@ -11,6 +11,7 @@ from mcap.reader import make_reader
 
 from shared.config import LoadedStation, load_station
 from shared.contract import RunSummary, ToolState, channels, encode, keys
+from tests.support import factories
 from tests.support.listener import Listener
 from tests.support.live_recorder import (
     RunningRecorder,
@@ -36,12 +37,18 @@ def station(tmp_path: Path, endpoint: str) -> LoadedStation:
 
 
 def summary(run_id: int, intensity: float) -> bytes:
-    return encode(
-        RunSummary(
-            "st1", run_id, 7, 1, "done", 56e3, None, 55e3, 120.0, -1.8, 4, None, intensity,
-            3000, T0_NS + run_id * S_NS, T0_NS + run_id * S_NS + 3 * S_NS,
-        )
-    )  # fmt: skip
+    """Run ``run_id`` as put on zenoh: 3 s from T0 + ``run_id`` s, the tool stopped by itself."""
+    started = T0_NS + run_id * S_NS
+    run = factories.summary(
+        run_id,
+        events=4,
+        stop_reason=None,
+        process_intensity=intensity,
+        samples=3000,
+        started_ns=started,
+        ended_ns=started + 3 * S_NS,
+    )
+    return encode(run)
 
 
 def test_summaries_count_once_and_a_due_tool_raises_an_alert(
