@@ -65,7 +65,6 @@ from shared.contract import (
     keys,
 )
 from shared.runtime import declare_channel, zenoh_config
-from tests.benchmarks.bench_stop_path import serve_from
 from tests.benchmarks.line_station_runs import (
     SHORT_PROGRAM,
     TOPICS,
@@ -76,7 +75,7 @@ from tests.benchmarks.line_station_runs import (
 from tests.support.can_injector import StopListener
 from tests.support.fuzz.payloads import template
 from tests.support.listener import Listener
-from tests.support.station_files import free_tcp_port, write_station
+from tests.support.station_files import free_tcp_port, serve, write_station
 from tests.support.synthetic_runs import staircase
 
 REAL_STATION = "st1"
@@ -332,12 +331,12 @@ def bench(
     synthetic = [p.stem for p in paths[1:]]
     files = [str(p) for p in paths]
     try:
-        processes.append(serve_from(repo, ["router", "--listen", endpoint], folder / "router.log"))
+        processes.append(serve(["router", "--listen", endpoint], folder / "router.log", repo))
         recorder_args = ["recorder", "--config", *files] + ([] if rerun else ["--no-rerun"])
-        recorder = serve_from(repo, recorder_args, folder / "recorder.log")
+        recorder = serve(recorder_args, folder / "recorder.log", repo)
         processes.append(recorder)
         acquisition_args = ["acquisition", "--config", str(paths[0])]
-        processes.append(serve_from(repo, acquisition_args, folder / "acquisition.log"))
+        processes.append(serve(acquisition_args, folder / "acquisition.log", repo))
         with (
             zenoh.open(zenoh_config("client", [endpoint])) as session,
             StopListener(real.config.can, StationDatabase(real.dbc_path)) as listener,

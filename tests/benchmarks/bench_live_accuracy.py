@@ -99,10 +99,10 @@ from tests.benchmarks.bench_predictor_accuracy import (
     stats,
     torque_error,
 )
-from tests.benchmarks.bench_stop_path import serve_from, wait_alive
+from tests.benchmarks.bench_stop_path import wait_alive
 from tests.benchmarks.joint_files import joint_toml
 from tests.support.listener import Listener
-from tests.support.station_files import write_station
+from tests.support.station_files import serve, write_station
 
 STATION = "st1"
 #: the contract DBC's ranges: the drawn programs' limits are held inside them
@@ -274,17 +274,14 @@ def measure(args: argparse.Namespace, joints: list[Joint], folder: Path) -> int:
     station_file = write_files(folder, joints, args.placement, args.torque_only)
     station = load_station(station_file)
     endpoint = station.config.zenoh.connect[0]
-    processes = [serve_from(REPO, ["router", "--listen", endpoint], folder / "router.log")]
+    processes = [serve(["router", "--listen", endpoint], folder / "router.log", REPO)]
     started = time.monotonic()
     try:
         names = ["recorder", "acquisition"] + (["predictor"] if args.placement == "line" else [])
         for name in names:
             extra = ["--no-rerun"] if name == "recorder" else []
-            processes.append(
-                serve_from(
-                    REPO, [name, "--config", str(station_file), *extra], folder / f"{name}.log"
-                )
-            )
+            arguments = [name, "--config", str(station_file), *extra]
+            processes.append(serve(arguments, folder / f"{name}.log", REPO))
         with (
             zenoh.open(zenoh_config("client", [endpoint])) as session,
             Listener(session, STATION, (channels.DECISION.topic,)) as heard,

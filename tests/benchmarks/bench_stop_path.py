@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import os
 import statistics
 import subprocess
 import sys
@@ -65,6 +64,7 @@ from shared.runtime import zenoh_config
 from tests.support.can_injector import HeardStop, StopListener
 from tests.support.listener import Listener
 from tests.support.station_files import free_tcp_port, write_station
+from tests.support.station_files import serve as serve_process
 
 STATION = "st1"
 HARD_LIMIT_PROGRAM, PLATEAU_PROGRAM = 1, 2
@@ -121,17 +121,6 @@ def station_files(folder: Path, placement: str) -> tuple[Path, Path]:
         )
     )
     return services, rig
-
-
-def serve_from(repo: Path, args: list[str], log: Path) -> subprocess.Popen[bytes]:
-    with log.open("ab") as out:
-        return subprocess.Popen(
-            [sys.executable, "-m", "services.cli", "serve", *args],
-            cwd=repo,
-            env={**os.environ, "PYTHONPATH": str(repo)},
-            stdout=out,
-            stderr=subprocess.STDOUT,
-        )
 
 
 def cpu_times() -> tuple[int, int]:
@@ -215,7 +204,7 @@ class Line:
         return [load_station(path) for path in self.services_paths]
 
     def serve(self, name: str, arguments: list[str]) -> subprocess.Popen[bytes]:
-        process = serve_from(self.args.repo.resolve(), arguments, self.folder / f"{name}.log")
+        process = serve_process(arguments, self.folder / f"{name}.log", self.args.repo.resolve())
         self.processes.append(process)
         return process
 
