@@ -20,8 +20,6 @@ import json
 import os
 import re
 import signal
-import subprocess
-import sys
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -36,7 +34,7 @@ from tests.support.listener import Listener
 from tests.support.live_recorder import free_port
 from tests.support.live_station import open_client
 from tests.support.openprotocol_proxy import Damage, OpenProtocolProxy
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
 from tests.support.station_up import read_recordings
 
@@ -122,13 +120,9 @@ class FaultStation:
 
     def status(self) -> dict[str, Any]:
         """``boltwatch status``, as text and as JSON: the station's bridge and its text lines."""
-        command = [sys.executable, "-m", "services.cli", "status", "--config"]
-        command += [str(self.files["bridge"]), "--listen-s", "1.5"]
+        command = ["status", "--config", str(self.files["bridge"]), "--listen-s", "1.5"]
         text, as_json = (
-            subprocess.run(
-                command + extra, capture_output=True, text=True, timeout=30, cwd=REPO, check=True
-            ).stdout
-            for extra in ([], ["--json"])
+            boltwatch(*command, *extra, check=True).stdout for extra in ([], ["--json"])
         )
         bridge = json.loads(as_json)["stations"][STATION]["bridge"]
         bridge["text"] = text
@@ -177,14 +171,7 @@ def check_each_tightening_recorded_once(station: FaultStation, folder: Path) -> 
     assert summaries == list(range(1, RUNS + 1)), logs
     results = sorted(r["tightening_id"] for r in messages["boltwatch/st1/results"])
     assert results == list(range(1, RUNS + 1)), logs
-    wear = subprocess.run(
-        [sys.executable, "-m", "services.cli", "wear", "--config", str(station.files["bridge"])],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        cwd=REPO,
-        check=True,
-    )
+    wear = boltwatch("wear", "--config", str(station.files["bridge"]), timeout_s=60, check=True)
     (line,) = [row.split() for row in wear.stdout.splitlines() if row.split()[:1] == ["7"]]
     assert line[1:3] == ["SIM-7", str(RUNS)], wear.stdout
 

@@ -23,6 +23,7 @@ from tests.support.live_recorder import (
     write_station_file,
 )
 from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 
 pytestmark = pytest.mark.system
 
@@ -88,14 +89,7 @@ def test_status_shows_the_newest_active_quality_alert(
         as_json = status_during_an_alert(session, station_file, 11, "--json")
         # a status started after the alerts were put learns of them from RecorderStats
         command = ["status", "--config", str(station_file), "--listen-s", "2.5", "--json"]
-        later = subprocess.run(
-            [sys.executable, "-m", "services.cli", *command],
-            check=False,
-            cwd=REPO,
-            capture_output=True,
-            text=True,
-            timeout=30,
-        )
+        later = boltwatch(*command)
     finally:
         session.close()
         recorder.finish()

@@ -28,6 +28,7 @@ from shared.contract import RunSummary
 from shared.wear import CONTRACT_LIMITS, WearLedger
 from tests.support import factories
 from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 
 pytestmark = pytest.mark.system
 
@@ -212,11 +213,7 @@ def test_boltwatch_wear_reads_while_a_writer_holds_its_transaction(tmp_path: Pat
     assert writer.stdin is not None and writer.stdout is not None
     try:
         assert writer.stdout.readline().strip() == "holding"
-        result = subprocess.run(
-            [sys.executable, "-m", "services.cli", "wear", "--recordings", str(tmp_path),
-             "--station", "st2", "--json"],
-            capture_output=True, text=True, cwd=REPO, timeout=30, check=False,
-        )  # fmt: skip
+        result = boltwatch("wear", "--recordings", str(tmp_path), "--station", "st2", "--json")
     finally:
         writer.stdin.write("done\n")
         writer.stdin.close()

@@ -33,7 +33,7 @@ from shared.wear import CONTRACT_LIMITS, WearLedger
 from tests.support.factories import summary
 from tests.support.listener import Listener
 from tests.support.live_recorder import RunningRecorder, publish, wait_until
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 
 T0_NS = 1_700_000_000_000_000_000
 SAMPLES = 50
@@ -118,10 +118,7 @@ def test_boltwatch_wear_says_what_is_wrong_in_one_line(
 
 def reset(recordings: Path) -> subprocess.CompletedProcess[str]:
     """``boltwatch wear reset`` in its own process, as an operator runs it."""
-    return subprocess.run(
-        [sys.executable, "-m", "services.cli", "wear", "reset", "--recordings", str(recordings)],
-        capture_output=True, text=True, cwd=REPO, timeout=60, check=False,
-    )  # fmt: skip
+    return boltwatch("wear", "reset", "--recordings", str(recordings), timeout_s=60)
 
 
 @pytest.mark.parametrize("kind", list(BREAKS), ids=list(BREAKS))
