@@ -18,7 +18,7 @@ import signal
 import threading
 import time
 from collections import defaultdict
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -177,15 +177,7 @@ class LiveStation:
         timeout_s: float = 30.0,
         poll_s: float = 0.05,
     ) -> None:
-        deadline = time.monotonic() + timeout_s
-        while not condition():
-            for managed in self.supervisor.processes:
-                code = managed.exit_code()
-                if code is not None and code != -signal.SIGKILL:
-                    raise AssertionError(f"{managed.name} exited {code}:\n{managed.log_tail()}")
-            if time.monotonic() > deadline:
-                raise AssertionError(f"gave up waiting for {what}")
-            time.sleep(poll_s)
+        wait_supervised(self.supervisor, condition, what, timeout_s, poll_s)
 
     def summaries(self) -> list[RunSummary]:
         return self.heard.of(channels.RUNS.topic)
@@ -217,6 +209,30 @@ class LiveStation:
         ]
         self.supervisor.stop_all([*order, "router"])
         self.can.close()
+
+
+def wait_supervised(
+    supervisor: StationSupervisor,
+    condition: Callable[[], bool],
+    what: str,
+    timeout_s: float = 30.0,
+    poll_s: float = 0.05,
+    exits: Collection[int] = (-signal.SIGKILL,),
+    details: Callable[[], str] | None = None,
+) -> None:
+    """Poll ``condition`` until true; AssertionError as soon as one of ``supervisor``'s
+    processes exits with a code not in ``exits`` (SIGKILL: a test's own kill), or naming
+    ``what`` (and ``details()``) after ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        for managed in supervisor.processes:
+            code = managed.exit_code()
+            if code is not None and code not in exits:
+                raise AssertionError(f"{managed.name} exited {code}:\n{managed.log_tail()}")
+        if time.monotonic() > deadline:
+            said = f": {details()}" if details is not None else ""
+            raise AssertionError(f"gave up waiting for {what}{said}")
+        time.sleep(poll_s)
 
 
 def open_client(endpoint: str) -> zenoh.Session:

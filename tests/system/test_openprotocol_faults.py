@@ -32,7 +32,7 @@ from services.rig.openprotocol.simulated_controller import LINGER_S
 from shared.contract import BridgeStats, channels
 from tests.support.listener import Listener
 from tests.support.live_recorder import free_port
-from tests.support.live_station import open_client
+from tests.support.live_station import open_client, wait_supervised
 from tests.support.openprotocol_proxy import Damage, OpenProtocolProxy
 from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
@@ -99,15 +99,9 @@ class FaultStation:
         return self.bridge
 
     def wait_for(self, condition: Callable[[], bool], what: str) -> None:
-        deadline = time.monotonic() + DONE_TIMEOUT_S
-        while not condition():
-            for managed in self.supervisor.processes:
-                code = managed.exit_code()
-                if code not in (None, 0, -signal.SIGKILL):
-                    raise AssertionError(f"{managed.name} exited {code}:\n{managed.log_tail()}")
-            if time.monotonic() > deadline:
-                raise AssertionError(f"gave up waiting for {what}: {self.logs()}")
-            time.sleep(0.05)
+        """Until ``condition``; a process that ended by itself (exit 0) is no failure."""
+        exits = (0, -signal.SIGKILL)
+        wait_supervised(self.supervisor, condition, what, DONE_TIMEOUT_S, 0.05, exits, self.logs)
 
     def finish(self) -> BridgeStats:
         """Wait for the controller's N tightenings and the bridge to publish the last one."""
