@@ -65,11 +65,17 @@ from shared.contract import (
     keys,
 )
 from shared.runtime import declare_channel, zenoh_config
-from tests.benchmarks.bench_stop_path import serve_from
-from tests.benchmarks.line_station_runs import SHORT_PROGRAM, Heard, figures, tighten
+from tests.benchmarks.line_station_runs import (
+    SHORT_PROGRAM,
+    TOPICS,
+    figures,
+    summaries_of,
+    tighten,
+)
 from tests.support.can_injector import StopListener
 from tests.support.fuzz.payloads import template
-from tests.support.station_files import free_tcp_port, write_station
+from tests.support.listener import Listener
+from tests.support.station_files import free_tcp_port, serve, write_station
 from tests.support.synthetic_runs import staircase
 
 REAL_STATION = "st1"
@@ -321,24 +327,22 @@ def bench(
     real = load_station(paths[0])
     endpoint = f"tcp/127.0.0.1:{port}"
     processes: list[subprocess.Popen[bytes]] = []
-    heard, line = Heard(), RecorderHeard()
+    line = RecorderHeard()
     synthetic = [p.stem for p in paths[1:]]
     files = [str(p) for p in paths]
     try:
-        processes.append(serve_from(repo, ["router", "--listen", endpoint], folder / "router.log"))
+        processes.append(serve(["router", "--listen", endpoint], folder / "router.log", repo))
         recorder_args = ["recorder", "--config", *files] + ([] if rerun else ["--no-rerun"])
-        recorder = serve_from(repo, recorder_args, folder / "recorder.log")
+        recorder = serve(recorder_args, folder / "recorder.log", repo)
         processes.append(recorder)
         acquisition_args = ["acquisition", "--config", str(paths[0])]
-        processes.append(serve_from(repo, acquisition_args, folder / "acquisition.log"))
+        processes.append(serve(acquisition_args, folder / "acquisition.log", repo))
         with (
             zenoh.open(zenoh_config("client", [endpoint])) as session,
             StopListener(real.config.can, StationDatabase(real.dbc_path)) as listener,
         ):
-            subscribers = [
-                session.declare_subscriber(keys.station_key(REAL_STATION, "*"), heard.on_sample),
-                session.declare_subscriber(channels.RECORDER.key("*"), line.on_stats),
-            ]
+            heard = Listener(session, REAL_STATION, TOPICS)
+            subscriber = session.declare_subscriber(channels.RECORDER.key("*"), line.on_stats)
             expected = {(s, "recorder") for s in [REAL_STATION, *synthetic]}
             expected |= {(REAL_STATION, "acquisition"), (REAL_STATION, "predictor")}
             wait_alive(session, expected, processes, folder)
@@ -363,15 +367,14 @@ def bench(
             stop_process(generator, grace_s=10.0)
             time.sleep(3.0)  # the last batches filed, the last BusStats counted and reported
             cpu_used = cpu_s(recorder) - cpu_before
-            for subscriber in subscribers:
-                subscriber.undeclare()
+            heard.close()
+            subscriber.undeclare()
             stops = listener.heard
     finally:
         for process in reversed(processes):
             stop_process(process, grace_s=10.0)
-    with heard.lock:
-        rows, notes = figures(heard, stops)
-        real_samples = sum(s.samples for s in heard.summaries.values())
+    rows, notes = figures(heard, stops)
+    real_samples = sum(s.samples for s in summaries_of(heard).values())
     stop_ms = [r.stop_path_ms for r in rows]
     generator_note = (folder / "generator.log").read_text().strip()
     published = re.search(r"generator: (\d+) samples", generator_note)

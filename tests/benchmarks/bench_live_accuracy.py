@@ -68,12 +68,9 @@ from shared.config import (
     load_station,
 )
 from shared.contract import (
-    RunSummary,
     StationDatabase,
     StopDecision,
     channels,
-    decode,
-    keys,
     read_trace,
 )
 from shared.model import JointConstants
@@ -102,9 +99,10 @@ from tests.benchmarks.bench_predictor_accuracy import (
     stats,
     torque_error,
 )
-from tests.benchmarks.bench_stop_path import serve_from, wait_alive
+from tests.benchmarks.bench_stop_path import wait_alive
 from tests.benchmarks.joint_files import joint_toml
-from tests.support.station_files import write_station
+from tests.support.listener import Listener
+from tests.support.station_files import serve, write_station
 
 STATION = "st1"
 #: the contract DBC's ranges: the drawn programs' limits are held inside them
@@ -163,27 +161,8 @@ def write_files(folder: Path, joints: list[Joint], placement: str, torque_only: 
     return station
 
 
-class Heard:
-    """Decisions and summaries of the station, from zenoh."""
-
-    def __init__(self) -> None:
-        self.decisions: dict[int, StopDecision] = {}
-        self.summaries: dict[int, RunSummary] = {}
-        self.lock = threading.Lock()
-
-    def on_sample(self, sample: zenoh.Sample) -> None:
-        topic = str(sample.key_expr).rsplit("/", 1)[-1]
-        with self.lock:
-            if topic == channels.DECISION.topic:
-                decision = decode(StopDecision, sample.payload.to_bytes())
-                self.decisions.setdefault(decision.run_id, decision)
-            elif topic == channels.RUNS.topic:
-                summary = decode(RunSummary, sample.payload.to_bytes())
-                self.summaries[summary.run_id] = summary
-
-
 def tighten_live(
-    station_file: Path, joints: list[Joint], heard: Heard, folder: Path, torque_only: bool
+    station_file: Path, joints: list[Joint], heard: Listener, folder: Path, torque_only: bool
 ) -> list[LiveRun]:
     """Every joint once through the real rig code on the station's bus."""
     station = load_station(station_file)
@@ -208,8 +187,8 @@ def tighten_live(
             )
             time.sleep(0.05)
     time.sleep(2.0)  # the last decisions and summaries on their way
-    with heard.lock:
-        return [replace(r, decision=heard.decisions.get(r.run_id)) for r in out]
+    decisions = {d.run_id: d for d in reversed(heard.of(channels.DECISION.topic))}  # the first
+    return [replace(r, decision=decisions.get(r.run_id)) for r in out]
 
 
 def offline(
@@ -295,25 +274,20 @@ def measure(args: argparse.Namespace, joints: list[Joint], folder: Path) -> int:
     station_file = write_files(folder, joints, args.placement, args.torque_only)
     station = load_station(station_file)
     endpoint = station.config.zenoh.connect[0]
-    processes = [serve_from(REPO, ["router", "--listen", endpoint], folder / "router.log")]
-    heard = Heard()
+    processes = [serve(["router", "--listen", endpoint], folder / "router.log", REPO)]
     started = time.monotonic()
     try:
         names = ["recorder", "acquisition"] + (["predictor"] if args.placement == "line" else [])
         for name in names:
             extra = ["--no-rerun"] if name == "recorder" else []
-            processes.append(
-                serve_from(
-                    REPO, [name, "--config", str(station_file), *extra], folder / f"{name}.log"
-                )
-            )
-        with zenoh.open(zenoh_config("client", [endpoint])) as session:
-            subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard.on_sample)
-            try:
-                wait_alive(session, STATION, [folder])
-                live_runs = tighten_live(station_file, joints, heard, folder, args.torque_only)
-            finally:
-                subscriber.undeclare()
+            arguments = [name, "--config", str(station_file), *extra]
+            processes.append(serve(arguments, folder / f"{name}.log", REPO))
+        with (
+            zenoh.open(zenoh_config("client", [endpoint])) as session,
+            Listener(session, STATION, (channels.DECISION.topic,)) as heard,
+        ):
+            wait_alive(session, STATION, [folder])
+            live_runs = tighten_live(station_file, joints, heard, folder, args.torque_only)
     finally:
         for process in reversed(processes):
             stop_process(process, grace_s=10.0)

@@ -46,16 +46,23 @@ import argparse
 import copy
 import math
 import statistics
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO) not in sys.path:  # run as a script from anywhere
+    sys.path.insert(0, str(REPO))
 
 from services.rig.physics import Measurement, TighteningPhysics
 from shared.config import Program, RigSection
 from shared.model import JointConstants
 from shared.stickslip import PlateauMethod, PredictorCore, PredictorSettings
+from tests.support.model_band_runs import drawn_program
 
 SETTLE_SAMPLES = 300
 LATENCY_SAMPLES = 1  # samples the motor still turns after the sample that triggered the stop
@@ -100,17 +107,7 @@ def draw_joint(rng: np.random.Generator, seed: int) -> Joint:
     start = 0.25 * target
     # time to the target: twist of the extension plus turning of the screw (eqs. 27-29)
     expected_s = (target * r * mu_stick / k_e + (target - start) / k_s) / speed
-    program = Program(
-        id=1,
-        name="bench",
-        target_force_n=target,
-        motor_speed_rad_s=speed,
-        start_force_n=start,
-        max_torque_nm=10_000.0,
-        max_force_n=3.0 * target,
-        max_angle_deg=1e6,
-        max_time_s=3.0 * expected_s + 1.0,
-    )
+    program = drawn_program(speed, target, 3.0 * expected_s + 1.0)
     constants = JointConstants(k_e, k_s, r, mu_stick, mu_slip)
     return Joint(constants, program, target, target * r * mu_stick, seed)
 

@@ -58,9 +58,10 @@ import zenoh.ext
 
 from services.cli.station_supervisor import stop_process
 from shared.config import load_station
-from shared.contract import RecorderStats, SpoolStats, decode
+from shared.contract import RecorderStats, SpoolStats
 from shared.runtime import QueuedPublisher, zenoh_config
 from shared.spool import SeqRanges, Spooled, SpoolFile, StationSpool
+from tests.support.listener import Listener
 from tests.support.live_recorder import RunningRecorder, free_port, write_station_file
 from tests.support.station_files import serve, write_station
 
@@ -110,34 +111,10 @@ def cut_spool(path: Path, station: str, messages: list[Spooled], repeat: int) ->
     return StationSpool(station, "acquisition", spool, 1 << 40, 200.0, 1.0)
 
 
-class SpoolWatch:
-    """Every station's latest SpoolStats and RecorderStats, as the line hears them."""
-
-    def __init__(self, session: zenoh.Session) -> None:
-        self.spools: dict[str, SpoolStats] = {}
-        self.recorder: dict[str, list[RecorderStats]] = {}
-        self._lock = threading.Lock()
-        self._subscribers = [
-            session.declare_subscriber("boltwatch/*/spool", self._on_spool),
-            session.declare_subscriber("boltwatch/*/recorder", self._on_recorder),
-        ]
-
-    def _on_spool(self, sample: zenoh.Sample) -> None:
-        stats = decode(SpoolStats, sample.payload.to_bytes())
-        with self._lock:
-            self.spools[stats.station] = stats
-
-    def _on_recorder(self, sample: zenoh.Sample) -> None:
-        stats = decode(RecorderStats, sample.payload.to_bytes())
-        with self._lock:
-            self.recorder.setdefault(stats.station, []).append(stats)
-
-    def empty(self, stations: list[str]) -> bool:
-        with self._lock:
-            return all(
-                s in self.spools and self.spools[s].messages == 0 and self.spools[s].resent
-                for s in stations
-            )
+def spools_empty(heard: Listener, stations: list[str]) -> bool:
+    """Every station's latest SpoolStats: nothing waits, and something was sent again."""
+    latest: dict[str, SpoolStats] = {stats.station: stats for stats in heard.of("spool")}
+    return all(s in latest and latest[s].messages == 0 and latest[s].resent > 0 for s in stations)
 
 
 def drain(
@@ -161,7 +138,7 @@ def drain(
     repeat = max(1, round(cut_s / took_s))
     recorder = RunningRecorder(files)
     session = zenoh.open(zenoh_config("peer", connect=[endpoint]))
-    watch = SpoolWatch(session)
+    heard = Listener(session, "*", topics=["spool", "recorder"])
     publishers = []
     try:
         spools = [
@@ -177,7 +154,7 @@ def drain(
         if live:
             live_thread = threading.Thread(target=live_station, args=(session, stop_live))
             live_thread.start()
-        while not watch.empty(names):
+        while not spools_empty(heard, names):
             time.sleep(0.2)
             if time.monotonic() - started > 3 * HOUR_S:
                 raise AssertionError("the spools did not empty")
@@ -189,8 +166,12 @@ def drain(
         for publisher in publishers:
             publisher.close()
         recorder.finish()
+        heard.close()
         session.close()
-    return took, total, watch.recorder
+    recorder_stats: dict[str, list[RecorderStats]] = {}
+    for stats in heard.of("recorder"):
+        recorder_stats.setdefault(stats.station, []).append(stats)
+    return took, total, recorder_stats
 
 
 def live_station(session: zenoh.Session, stop: threading.Event) -> None:

@@ -37,12 +37,10 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import os
 import statistics
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from collections import Counter
 from dataclasses import dataclass, field
@@ -58,16 +56,15 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
 from services.cli.station_supervisor import stop_process
 from shared.config import LoadedStation, derive_stations, load_station
 from shared.contract import (
-    RunSummary,
     StationDatabase,
-    StopDecision,
     channels,
-    decode,
     keys,
 )
 from shared.runtime import zenoh_config
 from tests.support.can_injector import HeardStop, StopListener
+from tests.support.listener import Listener
 from tests.support.station_files import free_tcp_port, write_station
+from tests.support.station_files import serve as serve_process
 
 STATION = "st1"
 HARD_LIMIT_PROGRAM, PLATEAU_PROGRAM = 1, 2
@@ -100,24 +97,6 @@ RIG_TORQUE_LIMIT_NM = 320.0
 START_TIMEOUT_S = 30.0
 
 
-@dataclass
-class Heard:
-    decisions: dict[tuple[str, int], StopDecision] = field(default_factory=dict)
-    summaries: dict[tuple[str, int], RunSummary] = field(default_factory=dict)
-    lock: threading.Lock = field(default_factory=threading.Lock)
-
-    def on_sample(self, sample: zenoh.Sample) -> None:
-        topic = str(sample.key_expr).rsplit("/", 1)[-1]
-        payload = sample.payload.to_bytes()
-        with self.lock:
-            if topic == channels.DECISION.topic:
-                decision = decode(StopDecision, payload)
-                self.decisions.setdefault((decision.station, decision.run_id), decision)
-            elif topic == channels.RUNS.topic:
-                summary = decode(RunSummary, payload)
-                self.summaries[(summary.station, summary.run_id)] = summary
-
-
 def station_files(folder: Path, placement: str) -> tuple[Path, Path]:
     """(the services' station file, the rig's): the same station, the rig's limits higher."""
     port = free_tcp_port()
@@ -142,17 +121,6 @@ def station_files(folder: Path, placement: str) -> tuple[Path, Path]:
         )
     )
     return services, rig
-
-
-def serve_from(repo: Path, args: list[str], log: Path) -> subprocess.Popen[bytes]:
-    with log.open("ab") as out:
-        return subprocess.Popen(
-            [sys.executable, "-m", "services.cli", "serve", *args],
-            cwd=repo,
-            env={**os.environ, "PYTHONPATH": str(repo)},
-            stdout=out,
-            stderr=subprocess.STDOUT,
-        )
 
 
 def cpu_times() -> tuple[int, int]:
@@ -183,16 +151,19 @@ class Stop:
 
 
 def stops_of(
-    heard: Heard, stops: dict[str, list[HeardStop]], programs: dict[tuple[str, int], int]
+    heard: Listener, stops: dict[str, list[HeardStop]], programs: dict[tuple[str, int], int]
 ) -> tuple[list[Stop], list[str]]:
+    # the first decision of each run (the acquisition acts on the first), the last summary
+    decisions = {(d.station, d.run_id): d for d in reversed(heard.of(channels.DECISION.topic))}
+    summaries = {(s.station, s.run_id): s for s in heard.of(channels.RUNS.topic)}
     first: dict[tuple[str, int], HeardStop] = {}
     for station, heard_stops in stops.items():
         for stop in heard_stops:
             first.setdefault((station, stop.run_id), stop)
     out, lost = [], []
     for (station, run_id), program in sorted(programs.items()):
-        decision = heard.decisions.get((station, run_id))
-        summary = heard.summaries.get((station, run_id))
+        decision = decisions.get((station, run_id))
+        summary = summaries.get((station, run_id))
         if decision is None:
             state = summary.tool_state if summary else "?"
             lost.append(f"{station} run {run_id}: no decision ({state})")
@@ -219,14 +190,13 @@ def row(name: str, values: list[float]) -> str:
 
 @dataclass
 class Line:
-    """The benchmark's line: station files, services, what was heard."""
+    """The benchmark's line: station files, services, the programs of the runs."""
 
     args: argparse.Namespace
     folder: Path
     services_paths: list[Path]
     rig_paths: list[Path]
     processes: list[subprocess.Popen[bytes]] = field(default_factory=list)
-    heard: Heard = field(default_factory=Heard)
     programs: dict[tuple[str, int], int] = field(default_factory=dict)
 
     @property
@@ -234,7 +204,7 @@ class Line:
         return [load_station(path) for path in self.services_paths]
 
     def serve(self, name: str, arguments: list[str]) -> subprocess.Popen[bytes]:
-        process = serve_from(self.args.repo.resolve(), arguments, self.folder / f"{name}.log")
+        process = serve_process(arguments, self.folder / f"{name}.log", self.args.repo.resolve())
         self.processes.append(process)
         return process
 
@@ -288,10 +258,8 @@ def run(args: argparse.Namespace, folder: Path) -> int:
                 s.station_id: listening.enter_context(StopListener(s.config.can, database))
                 for s in stations
             }
-            subscriber = session.declare_subscriber(
-                keys.station_key("*", "*"), line.heard.on_sample
-            )
-            listening.callback(subscriber.undeclare)
+            topics = (channels.DECISION.topic, channels.RUNS.topic)
+            heard = listening.enter_context(Listener(session, "*", topics))
             for station in stations:
                 wait_alive(session, station.station_id, [folder])
             cpu_before, started = cpu_times(), time.monotonic()
@@ -301,8 +269,7 @@ def run(args: argparse.Namespace, folder: Path) -> int:
             heard_stops = {station_id: listener.heard for station_id, listener in listeners.items()}
     finally:
         line.stop()
-    with line.heard.lock:
-        stops, lost = stops_of(line.heard, heard_stops, line.programs)
+    stops, lost = stops_of(heard, heard_stops, line.programs)
     total, steal = (after - before for after, before in zip(cpu_after, cpu_before, strict=True))
     print(
         f"stop path, {len(stations)} station(s), placement {args.placement}, services from "

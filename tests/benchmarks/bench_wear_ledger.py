@@ -29,6 +29,7 @@ from shared.wear import (
     CONTRACT_LIMITS,
     WearLedger,
 )
+from tests.support.factories import summary
 
 T0_NS = 1_700_000_000_000_000_000
 S_NS = 1_000_000_000
@@ -38,11 +39,17 @@ ROUNDS = 5
 
 
 def run(run_id: int) -> RunSummary:
+    """A 1 s run of the tool, ended ``run_id`` seconds after T0."""
     ended_ns = T0_NS + run_id * S_NS
-    return RunSummary(
-        "st1", run_id, TOOL, 1, "done", 56e3, None, 55e3, 120.0, -1.8, 4,
-        "plateau_closest", 1.0e5, 1000, ended_ns - S_NS, ended_ns,
-    )  # fmt: skip
+    return summary(
+        run_id,
+        tool_id=TOOL,
+        events=4,
+        process_intensity=1.0e5,
+        samples=1000,
+        started_ns=ended_ns - S_NS,
+        ended_ns=ended_ns,
+    )
 
 
 def fill(path: Path, runs: int) -> None:

@@ -10,15 +10,13 @@ sample's receive time, both kernel timestamps).
 from __future__ import annotations
 
 import subprocess
-import threading
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
-import zenoh
-
-from shared.contract import RunSummary, StickSlipEvent, StopDecision, channels, decode
+from shared.contract import RunSummary, StickSlipEvent, StopDecision, channels
 from tests.support.can_injector import HeardStop
+from tests.support.listener import Listener
 from tests.support.station_files import serve
 
 #: The short program: program 1 of the embedded station, to a lower preload, faster.
@@ -31,33 +29,20 @@ SHORT_PROGRAM = {
 RUN_TIMEOUT_S = 15.0  # per run, generous on a loaded machine
 
 
-@dataclass
-class Heard:
-    decisions: dict[int, StopDecision] = field(default_factory=dict)
-    events: dict[int, list[StickSlipEvent]] = field(default_factory=dict)
-    summaries: dict[int, RunSummary] = field(default_factory=dict)
-    lock: threading.Lock = field(default_factory=threading.Lock)
+#: what the line benchmarks hear of the real station on zenoh (:class:`Listener`)
+TOPICS = (channels.DECISION.topic, channels.EVENTS.topic, channels.RUNS.topic)
 
-    def on_sample(self, sample: zenoh.Sample) -> None:
-        topic = str(sample.key_expr).rsplit("/", 1)[-1]
-        payload = sample.payload.to_bytes()
-        with self.lock:
-            if topic == channels.DECISION.topic:
-                decision = decode(StopDecision, payload)
-                self.decisions.setdefault(decision.run_id, decision)
-            elif topic == channels.EVENTS.topic:
-                event = decode(StickSlipEvent, payload)
-                self.events.setdefault(event.run_id, []).append(event)
-            elif topic == channels.RUNS.topic:
-                summary = decode(RunSummary, payload)
-                self.summaries[summary.run_id] = summary
+
+def summaries_of(heard: Listener) -> dict[int, RunSummary]:
+    """The summary of each run heard (the last, were one heard twice), by run id."""
+    return {summary.run_id: summary for summary in heard.of(channels.RUNS.topic)}
 
 
 def tighten(
     rig_args: list[str],
     log: Path,
     runs: int,
-    heard: Heard,
+    heard: Listener,
     processes: list[subprocess.Popen[bytes]],
     run_timeout_s: float = RUN_TIMEOUT_S,
 ) -> tuple[subprocess.Popen[bytes], float]:
@@ -68,7 +53,7 @@ def tighten(
     started = time.monotonic()
     rig.wait(timeout=run_timeout_s * runs)
     deadline = time.monotonic() + 5.0
-    while len(heard.summaries) < runs and time.monotonic() < deadline:
+    while len(summaries_of(heard)) < runs and time.monotonic() < deadline:
         time.sleep(0.1)
     return rig, time.monotonic() - started
 
@@ -92,7 +77,13 @@ def lead_ms(decision: StopDecision, events: list[StickSlipEvent], stop_s: float)
     return (min(ahead) - stop_s) * 1e3 if ahead else None
 
 
-def figures(heard: Heard, stops: list[HeardStop]) -> tuple[list[RunFigures], list[str]]:
+def figures(heard: Listener, stops: list[HeardStop]) -> tuple[list[RunFigures], list[str]]:
+    summaries = summaries_of(heard)
+    # the first decision of each run (the acquisition acts on the first)
+    decisions = {d.run_id: d for d in reversed(heard.of(channels.DECISION.topic))}
+    events: dict[int, list[StickSlipEvent]] = {}
+    for event in heard.of(channels.EVENTS.topic):
+        events.setdefault(event.run_id, []).append(event)
     out: list[RunFigures] = []
     notes: list[str] = []
     first_stop: dict[int, HeardStop] = {}
@@ -101,11 +92,11 @@ def figures(heard: Heard, stops: list[HeardStop]) -> tuple[list[RunFigures], lis
     extra = len(stops) - len(first_stop)
     if extra:
         notes.append(f"{extra} StopCommand(s) beyond one per run")
-    for run_id in sorted(heard.summaries):
-        decision = heard.decisions.get(run_id)
+    for run_id in sorted(summaries):
+        decision = decisions.get(run_id)
         heard_stop = first_stop.get(run_id)
         if decision is None or heard_stop is None:
-            ended = heard.summaries[run_id].tool_state
+            ended = summaries[run_id].tool_state
             notes.append(
                 f"run {run_id}: decision={decision is not None} stop heard="
                 f"{heard_stop is not None} ({ended})"
@@ -120,7 +111,7 @@ def figures(heard: Heard, stops: list[HeardStop]) -> tuple[list[RunFigures], lis
                 stop_path_ns / 1e6,
                 (decision.decided_ns - decision.time_ns) / 1e6,
                 (heard_stop.received_ns - decision.decided_ns) / 1e6,
-                lead_ms(decision, heard.events.get(run_id, []), stop_s),
+                lead_ms(decision, events.get(run_id, []), stop_s),
             )
         )
     return out, notes

@@ -8,7 +8,8 @@ with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
 :mod:`.foxglove_client` (the Foxglove WebSocket protocol),
 :mod:`.openprotocol_proxy` (a TCP proxy that damages what passes).
 
-- messages and data: :mod:`.factories` (messages with plausible values),
+- messages and data: :mod:`.factories` (run summaries, samples, events, results and
+  programs with plausible values, changed by keyword),
   :mod:`.synthetic_runs` (synthetic traces), :mod:`.recorded_runs` (a whole run
   as a station publishes it), :mod:`.openprotocol_golden`,
   :mod:`.openprotocol_examples` (Open Protocol messages with their bytes),
@@ -17,6 +18,8 @@ with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
 - stations and files: :mod:`.paths` (the repository's files), :mod:`.config_files`
   (station files written from the shipped one), :mod:`.station_files` (isolated
   station files for system tests), :mod:`.rig_fixtures` (rigs and programs)
+- on zenoh: :mod:`.listener` (a station's messages as a test hears them, decoded
+  by channel)
 - services in a test: :mod:`.live_recorder`, :mod:`.recorder_driver`,
   :mod:`.live_predictor`, :mod:`.bridge_harness`, :mod:`.tcp_controller` (a small
   controller built on the codec), :mod:`.simulated_controller` (the rig's

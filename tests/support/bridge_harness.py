@@ -2,15 +2,14 @@
 
 The bridge is the service's own (:class:`OpenProtocolBridge` with the
 station's queued publisher on a real zenoh peer session and the predictor's
-real replay); :class:`Heard` subscribes the station's keys on another session
-and decodes every message by its channel.
+real replay); a test hears what it published with
+:class:`~tests.support.listener.Listener` (batches as samples) on another session.
 """
 
 from __future__ import annotations
 
 import threading
 import tomllib
-from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +20,6 @@ from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.controller_tightening import Curve, ResultFigures
 from services.openprotocol.published_ids import position_path
 from shared.config import load_any_station, toml_writer
-from shared.contract import SampleBatch, channels, decode, keys
 from shared.runtime import QueuedPublisher
 from tests.support.live_recorder import write_station_file
 
@@ -41,36 +39,6 @@ def bridge_station_file(folder: Path, port: int, endpoint: str, **section: Any) 
     }
     path.write_text(toml_writer.dumps(data))
     return path
-
-
-class Heard:
-    """Every message of station ``st1`` heard on zenoh, by topic (batches as samples)."""
-
-    def __init__(self, session: zenoh.Session, station: str = "st1") -> None:
-        self.by_topic: dict[str, list[Any]] = defaultdict(list)
-        self._lock = threading.Lock()
-        self._subscriber = session.declare_subscriber(
-            keys.station_key(station, "**"), self._on_sample
-        )
-
-    def _on_sample(self, sample: zenoh.Sample) -> None:
-        _, topic = keys.split_key(str(sample.key_expr))
-        channel = channels.by_topic(topic)
-        if channel is None:
-            return
-        message = decode(channel.message_type, sample.payload.to_bytes())
-        with self._lock:
-            if isinstance(message, SampleBatch):
-                self.by_topic["samples"].extend(message.samples)
-            else:
-                self.by_topic[topic].append(message)
-
-    def of(self, topic: str) -> list[Any]:
-        with self._lock:
-            return list(self.by_topic[topic])
-
-    def close(self) -> None:
-        self._subscriber.undeclare()
 
 
 class RunningBridge:

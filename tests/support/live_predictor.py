@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Any
 
 import zenoh
 
 from shared.contract import Sample, StopReasonName, ToolState, channels, codec, keys
+from tests.support.live_recorder import has_subscribers, wait_until
 from tests.support.paths import REPO
 
 TARGET_N = 30_400.0
@@ -62,12 +62,7 @@ def wait_for_token(session: zenoh.Session, key: str) -> None:
 
 
 def wait_for_subscriber(publisher: zenoh.Publisher) -> None:
-    for _ in range(200):
-        status: Any = publisher.matching_status  # stubs say bool; it is a MatchingStatus
-        if status.matching:
-            return
-        time.sleep(0.02)
-    raise AssertionError(f"no subscriber for {publisher.key_expr}")
+    wait_until(lambda: has_subscribers(publisher), f"a subscriber for {publisher.key_expr}", 4.0)
 
 
 class StationFeed:

@@ -18,7 +18,7 @@ import signal
 import threading
 import time
 from collections import defaultdict
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -30,15 +30,14 @@ from shared.config import LoadedStation, load_station
 from shared.contract import (
     RunSummary,
     StationDatabase,
-    StopDecision,
     ToolRunState,
     channels,
-    decode,
     keys,
 )
 from shared.errors import TransportError
 from shared.recordings.mcap import RecordingScan
 from shared.runtime import open_bus, open_from, zenoh_config
+from tests.support.listener import Listener
 from tests.support.station_files import write_station
 
 STATION = "st1"
@@ -110,25 +109,6 @@ class CanWatch:
             self._bus.shutdown()
 
 
-class Heard:
-    """What the test's zenoh session heard on ``boltwatch/st1/*``."""
-
-    def __init__(self) -> None:
-        self.lock = threading.Lock()
-        self.summaries: list[RunSummary] = []
-        self.decisions: dict[int, list[StopDecision]] = defaultdict(list)
-
-    def on_sample(self, sample: zenoh.Sample) -> None:
-        topic = str(sample.key_expr).rsplit("/", 1)[-1]
-        payload = sample.payload.to_bytes()
-        with self.lock:
-            if topic == channels.RUNS.topic:
-                self.summaries.append(decode(RunSummary, payload))
-            elif topic == channels.DECISION.topic:
-                decision = decode(StopDecision, payload)
-                self.decisions[decision.run_id].append(decision)
-
-
 class LiveStation:
     """The station's processes; :meth:`close` stops them all and closes the watchers."""
 
@@ -149,14 +129,11 @@ class LiveStation:
         self.supervisor = StationSupervisor(self.station_file, folder / "logs")
         self.recorder_args = recorder_args
         self.restarts: dict[str, int] = defaultdict(int)
-        self.heard = Heard()
         self.can = CanWatch(self.loaded)
         endpoint = self.loaded.config.zenoh.connect[0]
         self.supervisor.start("router", ["--listen", endpoint])
         self.session = open_client(endpoint)
-        self._subscriber = self.session.declare_subscriber(
-            keys.station_key(STATION, "*"), self.heard.on_sample
-        )
+        self.heard = Listener(self.session, STATION, (channels.RUNS.topic, channels.DECISION.topic))
         processes = [s for s in SERVICES if placement == "line" or s != "predictor"]
         for service in processes:
             self.start(service)
@@ -200,23 +177,13 @@ class LiveStation:
         timeout_s: float = 30.0,
         poll_s: float = 0.05,
     ) -> None:
-        deadline = time.monotonic() + timeout_s
-        while not condition():
-            for managed in self.supervisor.processes:
-                code = managed.exit_code()
-                if code is not None and code != -signal.SIGKILL:
-                    raise AssertionError(f"{managed.name} exited {code}:\n{managed.log_tail()}")
-            if time.monotonic() > deadline:
-                raise AssertionError(f"gave up waiting for {what}")
-            time.sleep(poll_s)
+        wait_supervised(self.supervisor, condition, what, timeout_s, poll_s)
 
     def summaries(self) -> list[RunSummary]:
-        with self.heard.lock:
-            return list(self.heard.summaries)
+        return self.heard.of(channels.RUNS.topic)
 
     def decided(self, run_id: int) -> bool:
-        with self.heard.lock:
-            return bool(self.heard.decisions.get(run_id))
+        return any(d.run_id == run_id for d in self.heard.of(channels.DECISION.topic))
 
     def wait_runs_summarised(self, count: int, timeout_s: float = 30.0) -> list[RunSummary]:
         self.wait_for(lambda: len(self.summaries()) >= count, f"{count} run summaries", timeout_s)
@@ -231,8 +198,7 @@ class LiveStation:
 
     def close(self) -> None:
         """Stop the rig first, the recorder last (so its files are complete), then the rest."""
-        with contextlib.suppress(zenoh.ZError):
-            self._subscriber.undeclare()
+        self.heard.close()
         self.session.close()
         names = [m.name for m in self.supervisor.processes]
         order = [
@@ -243,6 +209,30 @@ class LiveStation:
         ]
         self.supervisor.stop_all([*order, "router"])
         self.can.close()
+
+
+def wait_supervised(
+    supervisor: StationSupervisor,
+    condition: Callable[[], bool],
+    what: str,
+    timeout_s: float = 30.0,
+    poll_s: float = 0.05,
+    exits: Collection[int] = (-signal.SIGKILL,),
+    details: Callable[[], str] | None = None,
+) -> None:
+    """Poll ``condition`` until true; AssertionError as soon as one of ``supervisor``'s
+    processes exits with a code not in ``exits`` (SIGKILL: a test's own kill), or naming
+    ``what`` (and ``details()``) after ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        for managed in supervisor.processes:
+            code = managed.exit_code()
+            if code is not None and code not in exits:
+                raise AssertionError(f"{managed.name} exited {code}:\n{managed.log_tail()}")
+        if time.monotonic() > deadline:
+            said = f": {details()}" if details is not None else ""
+            raise AssertionError(f"gave up waiting for {what}{said}")
+        time.sleep(poll_s)
 
 
 def open_client(endpoint: str) -> zenoh.Session:

@@ -12,9 +12,26 @@ from shared.stickslip import (
     PredictorCore,
     PredictorSettings,
 )
+from tests.support import factories
 
 #: the joint of synthetic.staircase()'s defaults
 TRACE_JOINT = JointConstants(600.0, 80_000.0, 0.01, 0.36, 0.33)
+
+
+def drawn_program(speed_rad_s: float, target_n: float, max_time_s: float) -> Program:
+    """The program of a joint the accuracy benchmark draws (bench_predictor_accuracy.py):
+    to ``target_n`` from a quarter of it, the hard limits far from the run."""
+    return factories.program(
+        name="bench",
+        target_force_n=target_n,
+        target_torque_nm=None,
+        motor_speed_rad_s=speed_rad_s,
+        start_force_n=0.25 * target_n,
+        max_torque_nm=10_000.0,
+        max_force_n=3.0 * target_n,
+        max_angle_deg=1e6,
+        max_time_s=max_time_s,
+    )
 
 
 def rig_decision(

@@ -8,12 +8,11 @@ from typing import Any
 from shared.config import LoadedStation
 from shared.contract import (
     Intensity,
-    RunSummary,
     Sample,
-    StickSlipEvent,
     StopDecision,
     ToolState,
 )
+from tests.support import factories
 
 T0_NS = 1_700_000_000_000_000_000
 
@@ -35,24 +34,17 @@ def run_messages(run_id: int, samples: int) -> list[tuple[str, Any]]:
         )
         if n % 100 == 99:
             j = n // 100 + 1
-            event = StickSlipEvent(
-                "st1",
+            event = factories.event(
                 run_id,
                 j,
-                t + n * 1_000_000,
-                n / 1000,
-                100.0,
-                90.0,
-                10.0,
-                20_000.0,
-                500.0,
-                0.1,
-                10.0,
-                1.0,
-                2.0,
-                3.0,
-                0.5,
-                0.5 * j,
+                time_ns=t + n * 1_000_000,
+                time_s=n / 1000,
+                peak_torque_nm=100.0,
+                min_torque_nm=90.0,
+                torque_drop_nm=10.0,
+                force_step_n=500.0,
+                period_s=0.1,
+                f_ss_hz=10.0,
             )
             out.append(("events", event))
             out.append(("intensity", Intensity("st1", run_id, t + n * 1_000_000, 0.5, 0.5 * j)))
@@ -78,23 +70,14 @@ def run_messages(run_id: int, samples: int) -> list[tuple[str, Any]]:
     out.append(
         (
             "runs",
-            RunSummary(
-                "st1",
+            factories.summary(
                 run_id,
-                7,
-                1,
-                "done",
-                56_000.0,
-                None,
-                55_000.0,
-                120.0,
-                -1.8,
-                EVENTS,
-                "plateau_closest",
-                1.5,
-                samples,
-                t,
-                end + 1,
+                events=EVENTS,
+                stop_reason="plateau_closest",
+                process_intensity=1.5,
+                samples=samples,
+                started_ns=t,
+                ended_ns=end + 1,
             ),
         )
     )

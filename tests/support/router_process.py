@@ -16,14 +16,18 @@ from tests.support.paths import REPO
 from tests.support.station_files import free_tcp_port
 
 
-def boltwatch(*args: str, timeout_s: float = 30) -> subprocess.CompletedProcess[str]:
+def boltwatch(
+    *args: str, timeout_s: float | None = 30, check: bool = False
+) -> subprocess.CompletedProcess[str]:
+    """``boltwatch ARGS`` run from the repository as a person runs it, its output as text;
+    ``check``: CalledProcessError unless it exits 0."""
     return subprocess.run(
         [sys.executable, "-m", "services.cli", *args],
         capture_output=True,
         text=True,
         timeout=timeout_s,
         cwd=REPO,
-        check=False,
+        check=check,
     )
 
 

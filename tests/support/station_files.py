@@ -55,12 +55,15 @@ def write_station(
     return path
 
 
-def serve(args: list[str], log: Path) -> subprocess.Popen[bytes]:
-    """``python -m services.cli serve ARGS`` from the repository, output appended to ``log``."""
+def serve(args: list[str], log: Path, repo: Path | None = None) -> subprocess.Popen[bytes]:
+    """``python -m services.cli serve ARGS`` from the repository, output appended to ``log``;
+    ``repo``: from that checkout instead, its code first on the path (a benchmark of another
+    commit)."""
     with log.open("ab") as out:
         return subprocess.Popen(
             [sys.executable, "-m", "services.cli", "serve", *args],
-            cwd=REPO,
+            cwd=repo or REPO,
+            env=None if repo is None else {**os.environ, "PYTHONPATH": str(repo)},
             stdout=out,
             stderr=subprocess.STDOUT,
         )

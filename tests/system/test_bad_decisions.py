@@ -13,7 +13,6 @@ traceback; a good decision afterwards still stops the tool, once.
 from __future__ import annotations
 
 import json
-import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -25,19 +24,15 @@ import zenoh
 from services.cli.station_supervisor import stop_process
 from shared.config import CanSection, load_station
 from shared.contract import (
-    BusStats,
     StationDatabase,
     StopDecision,
     ToolRunState,
-    ToolState,
     channels,
-    decode,
     encode,
-    keys,
 )
 from shared.runtime import zenoh_config
 from tests.support.can_injector import CanInjector, StopListener
-from tests.support.live_recorder import wait_until
+from tests.support.listener import Listener
 from tests.support.station_files import free_tcp_port, serve, write_station
 
 pytestmark = pytest.mark.system
@@ -100,37 +95,21 @@ def bad_decisions() -> list[bytes]:
 def test_bad_decisions_are_counted_never_stop_and_a_good_one_still_does(
     station: Station,
 ) -> None:
-    stats: list[BusStats] = []
-    states: list[ToolState] = []
-    lock = threading.Lock()
-
-    def heard(sample: zenoh.Sample) -> None:
-        topic = str(sample.key_expr).rsplit("/", 1)[-1]
-        with lock:
-            if topic == channels.BUS.topic:
-                stats.append(decode(BusStats, sample.payload.to_bytes()))
-            elif topic == channels.TOOL.topic:
-                states.append(decode(ToolState, sample.payload.to_bytes()))
-
-    def seen(condition: object) -> bool:
-        with lock:
-            return bool(condition() if callable(condition) else condition)
-
     bad = bad_decisions()
     with (
         zenoh.open(zenoh_config("client", [station.endpoint])) as session,
         StopListener(station.can, station.database) as stops,
         CanInjector(station.can, station.database) as bus,
     ):
-        subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard)
+        heard = Listener(session, STATION, (channels.BUS.topic, channels.TOOL.topic))
         decisions = session.declare_publisher(
             channels.DECISION.key(STATION),
             congestion_control=zenoh.CongestionControl.BLOCK,
         )
         try:
-            wait_until(lambda: seen(lambda: stats), "the acquisition's first BusStats", 20.0)
+            heard.wait(lambda: heard.of("bus"), "the acquisition's first BusStats", 20.0)
             bus.tool_status(RUN, ToolRunState.RUNNING)
-            wait_until(lambda: seen(lambda: states), "the run to start", 5.0)
+            heard.wait(lambda: heard.of("tool"), "the run to start", 5.0)
             for _ in range(5):  # a flood: five of each
                 for payload in bad:
                     decisions.put(payload)
@@ -145,14 +124,13 @@ def test_bad_decisions_are_counted_never_stop_and_a_good_one_still_does(
             assert "Traceback" not in log, log
             lines = [line for line in log.splitlines() if "bad decision payload" in line]
             assert len(lines) == 1, log  # rate-limited: the first at once, the next after 10 s
-            wait_until(
-                lambda: seen(lambda: stats[-1].stop_commands == 1),
+            heard.wait(
+                lambda: heard.of("bus")[-1].stop_commands == 1,
                 "BusStats after the stop",
                 5.0,
             )
         finally:
-            subscriber.undeclare()
+            heard.close()
             decisions.undeclare()
-    with lock:
-        last = stats[-1]
+    last = heard.of("bus")[-1]
     assert (last.bad_decisions, last.late_decisions) == (5 * len(bad), 0)

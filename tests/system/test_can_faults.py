@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import random
 import subprocess
-import threading
 import time
 import warnings
 from collections import Counter
@@ -29,19 +28,15 @@ from services.cli.station_supervisor import stop_process
 from shared.config import CanSection, load_station
 from shared.contract import (
     BusStats,
-    Sample,
     StationDatabase,
     StopDecision,
     ToolRunState,
-    ToolState,
     channels,
-    decode,
     encode,
-    keys,
 )
 from shared.runtime import zenoh_config
 from tests.support.can_injector import CanInjector, Pacer, StopListener
-from tests.support.live_recorder import wait_until
+from tests.support.listener import Listener
 from tests.support.station_files import free_tcp_port, serve, write_station
 
 pytestmark = pytest.mark.system
@@ -57,50 +52,26 @@ FLOOD_PER_SAMPLE = 10  # garbage frames per 1 ms tick: 10 kHz beside the 2 kHz o
 CONTRACT_IDS = (0x10, 0x80, 0x100, 0x101)
 
 
-@dataclass
-class Heard:
-    """What the test's zenoh session received from the acquisition."""
+#: what the test hears of the acquisition on zenoh
+TOPICS = (channels.SAMPLES.topic, channels.TOOL.topic, channels.BUS.topic)
 
-    samples: list[Sample] = field(default_factory=list)
-    states: list[ToolState] = field(default_factory=list)
-    stats: list[BusStats] = field(default_factory=list)
-    lock: threading.Lock = field(default_factory=threading.Lock)
 
-    def on_sample(self, sample: zenoh.Sample) -> None:
-        topic = str(sample.key_expr).rsplit("/", 1)[-1]
-        payload = sample.payload.to_bytes()
-        with self.lock:
-            if topic == channels.SAMPLES.topic:
-                self.samples.append(decode(Sample, payload))
-            elif topic == channels.TOOL.topic:
-                self.states.append(decode(ToolState, payload))
-            elif topic == channels.BUS.topic:
-                self.stats.append(decode(BusStats, payload))
-
-    def wait(self, what: str, done: Callable[[], object], timeout_s: float) -> None:
-        def locked() -> bool:
-            with self.lock:
-                return bool(done())
-
-        wait_until(locked, what, timeout_s)
-
-    def settled_stats(self, frames: int, dropped: Callable[[], int] = lambda: 0) -> BusStats:
-        """The first BusStats that counts ``frames`` frames, less those the kernel ``dropped``."""
-        try:
-            self.wait(
-                "BusStats",
-                lambda: self.stats[-1].frames + dropped() >= frames,
-                SETTLE_TIMEOUT_S,
-            )
-        except AssertionError:
-            with self.lock:
-                last = self.stats[-1] if self.stats else None
-            raise AssertionError(
-                f"{frames} frames sent, {dropped()} dropped by the kernel, counted: {last}"
-            ) from None
-        time.sleep(2 * STATS_INTERVAL_S)  # the counters of the last frames' effects
-        with self.lock:
-            return self.stats[-1]
+def settled_stats(heard: Listener, frames: int, dropped: Callable[[], int] = lambda: 0) -> BusStats:
+    """The first BusStats that counts ``frames`` frames, less those the kernel ``dropped``."""
+    try:
+        heard.wait(
+            lambda: heard.of("bus")[-1].frames + dropped() >= frames,
+            "BusStats",
+            SETTLE_TIMEOUT_S,
+        )
+    except AssertionError:
+        stats = heard.of("bus")
+        last = stats[-1] if stats else None
+        raise AssertionError(
+            f"{frames} frames sent, {dropped()} dropped by the kernel, counted: {last}"
+        ) from None
+    time.sleep(2 * STATS_INTERVAL_S)  # the counters of the last frames' effects
+    return heard.of("bus")[-1]
 
 
 @dataclass
@@ -280,21 +251,20 @@ def udp_drops(pid: int, port: int) -> int:
     return drops
 
 
-def states_of(heard: Heard) -> list[tuple[int, str]]:
-    return [(s.run_id, s.state) for s in heard.states]
+def states_of(heard: Listener) -> list[tuple[int, str]]:
+    return [(s.run_id, s.state) for s in heard.of("tool")]
 
 
 def test_bad_can_traffic_is_counted_and_never_stops_the_tool(station: Station) -> None:
-    heard = Heard()
     with (
         zenoh.open(zenoh_config("client", [station.endpoint])) as session,
         StopListener(station.can, station.database) as stops,
         CanInjector(station.can, station.database) as bus,
     ):
-        subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard.on_sample)
+        heard = Listener(session, STATION, TOPICS)
         decisions = session.declare_publisher(channels.DECISION.key(STATION))
         try:
-            heard.wait("the acquisition's first BusStats", lambda: bool(heard.stats), 20.0)
+            heard.wait(lambda: heard.of("bus"), "the acquisition's first BusStats", 20.0)
 
             def decide(run_id: int) -> None:
                 now = time.time_ns()
@@ -308,17 +278,17 @@ def test_bad_can_traffic_is_counted_and_never_stops_the_tool(station: Station) -
             expected = play_faulty_run(bus, midway=lambda: decide(NEXT_RUN))
             sent = Counter(bus.sent)
             pid, port = station.acquisition.pid, station.can.port or 0
-            stats = heard.settled_stats(bus.frames, lambda: udp_drops(pid, port))
+            stats = settled_stats(heard, bus.frames, lambda: udp_drops(pid, port))
             dropped = udp_drops(pid, port)
             heard.wait(
-                "the run to end", lambda: (RUN, "idle") in states_of(heard), SETTLE_TIMEOUT_S
+                lambda: (RUN, "idle") in states_of(heard), "the run to end", SETTLE_TIMEOUT_S
             )
             decide(RUN)  # the run is over: a late decision must not stop anything
             # The listener can hear a stop: a decision for the running run makes exactly one.
             bus.tool_status(NEXT_RUN, ToolRunState.RUNNING)
             heard.wait(
+                lambda: any(s.run_id == NEXT_RUN for s in heard.of("tool")),
                 "the next run to start",
-                lambda: any(s.run_id == NEXT_RUN for s in heard.states),
                 SETTLE_TIMEOUT_S,
             )
             decide(NEXT_RUN)
@@ -327,20 +297,20 @@ def test_bad_can_traffic_is_counted_and_never_stops_the_tool(station: Station) -
             time.sleep(0.3)  # room for a wrong second stop to show up
             bus.tool_status(NEXT_RUN, ToolRunState.DONE)
             heard.wait(
+                lambda: heard.of("bus")[-1].stop_commands == 1,
                 "stop_commands == 1",
-                lambda: heard.stats[-1].stop_commands == 1,
                 SETTLE_TIMEOUT_S,
             )
             assert station.acquisition.poll() is None, station.acquisition_log.read_text()
         finally:
-            subscriber.undeclare()
+            heard.close()
             decisions.undeclare()
         heard_stops = stops.heard
 
     log = station.acquisition_log.read_text()
     assert "Traceback" not in log, log
     frames_sent = sum(sent[k] for k in sent if k != "garbage_datagram")
-    samples = [s for s in heard.samples if s.run_id == RUN]
+    samples = [s for s in heard.of("samples") if s.run_id == RUN]
     if dropped:
         # The simulated bus lost datagrams: the acquisition's receive buffer overflowed
         # while the process was off the CPU (a loaded machine). Which frames were lost
@@ -391,14 +361,13 @@ def test_bad_can_traffic_is_counted_and_never_stops_the_tool(station: Station) -
 
 
 def test_a_corrupt_tool_status_does_not_restart_the_run(station: Station) -> None:
-    heard = Heard()
     with (
         zenoh.open(zenoh_config("client", [station.endpoint])) as session,
         CanInjector(station.can, station.database) as bus,
     ):
-        subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard.on_sample)
+        heard = Listener(session, STATION, TOPICS)
         try:
-            heard.wait("the acquisition's first BusStats", lambda: bool(heard.stats), 20.0)
+            heard.wait(lambda: heard.of("bus"), "the acquisition's first BusStats", 20.0)
             pacer = Pacer()
             bus.tool_status(RUN, ToolRunState.RUNNING)
             for counter in range(100):
@@ -409,9 +378,9 @@ def test_a_corrupt_tool_status_does_not_restart_the_run(station: Station) -> Non
                     bus.tool_status(RUN, ToolRunState.RUNNING)  # the 10 Hz repeat
                 pacer.wait()
             bus.tool_status(RUN, ToolRunState.DONE)
-            stats = heard.settled_stats(bus.frames)
+            stats = settled_stats(heard, bus.frames)
         finally:
-            subscriber.undeclare()
+            heard.close()
     assert stats.decode_errors == 1
-    assert [s.sequence for s in heard.samples] == list(range(100))
+    assert [s.sequence for s in heard.of("samples")] == list(range(100))
     assert states_of(heard) == [(RUN, "running"), (RUN, "done")]

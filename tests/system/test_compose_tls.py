@@ -22,7 +22,6 @@ import json
 import re
 import shutil
 import subprocess
-import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -47,7 +46,7 @@ from tests.support.compose_layout import (
     split_volume,
 )
 from tests.support.live_recorder import has_subscribers
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 from tests.support.station_files import free_tcp_port, free_udp_port, serve
 
 pytestmark = [
@@ -117,14 +116,7 @@ class ComposeLine:
         arguments = self.files(name).arguments(test[2:])
         if service is not None:
             arguments[1] = service
-        return subprocess.run(
-            [sys.executable, "-m", "services.cli", *arguments],
-            check=False,
-            cwd=REPO,
-            capture_output=True,
-            text=True,
-            timeout=30,
-        )
+        return boltwatch(*arguments)
 
     def session(self, name: str, identity: str | None = None) -> zenoh.Session:
         """A session as service ``name``'s container opens it (its station file's [zenoh])."""
@@ -172,14 +164,7 @@ def test_every_service_is_healthy_with_its_own_identity_and_status_sees_them(
     monitor_file = line.files("recorder", identity="line-monitor").host(
         f"{TLS_STATIONS}/station1.toml"
     )
-    status = subprocess.run(
-        [sys.executable, "-m", "services.cli", "status", "--config", str(monitor_file), "--json"],
-        check=True,
-        cwd=REPO,
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
+    status = boltwatch("status", "--config", str(monitor_file), "--json", timeout_s=60, check=True)
     services = json.loads(status.stdout)["stations"]["st1"]["services"]
     alive = {service for service, up in services.items() if up}
     assert {"acquisition", "predictor", "rig", "recorder"} <= alive

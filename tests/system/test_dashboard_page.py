@@ -19,14 +19,14 @@ from __future__ import annotations
 
 import os
 import shutil
-import threading
 import time
 import urllib.request
 from pathlib import Path
 
 import pytest
 
-from shared.contract import TighteningResult, channels, decode
+from shared.contract import channels
+from tests.support.listener import Listener
 from tests.support.live_recorder import free_port
 from tests.support.live_station import STATION, live_station
 from tests.support.paths import REPO
@@ -44,19 +44,6 @@ CHROMIUM_ARGS = [
 ]
 DOCS_IMAGE = REPO / "docs" / "images" / "dashboard.png"
 PAGE_TIMEOUT_MS = 60_000
-
-
-def _results_heard(station_session: object, results: list[TighteningResult]) -> object:
-    lock = threading.Lock()
-
-    def on_result(sample: object) -> None:
-        payload = sample.payload.to_bytes()  # type: ignore[attr-defined]
-        with lock:
-            results.append(decode(TighteningResult, payload))
-
-    return station_session.declare_subscriber(  # type: ignore[attr-defined]
-        channels.RESULTS.key(STATION), on_result
-    )
 
 
 def _wait_http(url: str, timeout_s: float = 30.0) -> None:
@@ -78,8 +65,7 @@ def test_the_line_page_shows_results_live_in_a_real_browser(tmp_path: Path) -> N
     sync_api = pytest.importorskip("playwright.sync_api")
     threshold = {"[recorder]\n": "[recorder]\nwear_service_threshold = 4.0e6\n"}
     with live_station(tmp_path, placement="edge", replacements=threshold) as station:
-        results: list[TighteningResult] = []
-        subscriber = _results_heard(station.session, results)
+        listener = Listener(station.session, STATION, (channels.RESULTS.topic,))
         port = free_port()
         dashboard = station.supervisor.start("dashboard", ["--listen", f"127.0.0.1:{port}"])
         url = f"http://127.0.0.1:{port}/"
@@ -94,10 +80,10 @@ def test_the_line_page_shows_results_live_in_a_real_browser(tmp_path: Path) -> N
             first_run = int(page.locator("tr.result").first.get_attribute("data-run") or "0")
             # the same result the line put on zenoh: its run, its verdict
             station.wait_for(
-                lambda: any(r.run_id == first_run for r in list(results)),
+                lambda: any(r.run_id == first_run for r in listener.of("results")),
                 f"result of run {first_run} heard by the test",
             )
-            heard = next(r for r in list(results) if r.run_id == first_run)
+            heard = next(r for r in listener.of("results") if r.run_id == first_run)
             row = page.locator(f"tr.result[data-run='{first_run}']")
             assert row.locator(".verdict").inner_text() == heard.result
             assert page.locator("#station-st1 h2").inner_text() == f"Station {STATION}"
@@ -126,7 +112,7 @@ def test_the_line_page_shows_results_live_in_a_real_browser(tmp_path: Path) -> N
             shot = tmp_path / "dashboard.png"
             page.screenshot(path=str(shot), full_page=True)
             browser.close()
-        subscriber.undeclare()  # type: ignore[attr-defined]
+        listener.close()
         assert station.supervisor.stop(dashboard) == 0, dashboard.log_tail()
     assert shot.stat().st_size > 10_000
     assert requests and all(u.startswith(url) for u in requests), requests

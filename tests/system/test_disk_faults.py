@@ -24,6 +24,7 @@ from services.recorder.live.recorder import RETRY_INTERVAL_NS
 from shared.contract import RunSummary
 from shared.recordings.mcap import RecordingScan
 from shared.wear import CONTRACT_LIMITS, WearLedger
+from tests.support import factories
 from tests.support.disk_faults import fill_up, read_only, tmpfs
 from tests.support.live_station import check_next_run_normal, live_station
 from tests.support.paths import REPO
@@ -170,8 +171,15 @@ def test_a_file_size_limit_gives_efbig_and_the_next_run_is_recorded(tmp_path: Pa
 
 
 def _summary(run_id: int) -> RunSummary:
-    return RunSummary(
-        "st1", run_id, 7, 1, "done", 4e4, None, 4.1e4, 150.0, 2.5, 12, None, 1e6, 1500, 0, 2 * 10**9
+    """A 2 s run of 12 events: the ledger counts it (within its tool's bound)."""
+    return factories.summary(
+        run_id,
+        events=12,
+        stop_reason=None,
+        process_intensity=1e6,
+        samples=1500,
+        started_ns=0,
+        ended_ns=2 * 10**9,
     )
 
 

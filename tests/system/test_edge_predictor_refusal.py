@@ -12,7 +12,6 @@ never disturbed. Real processes on loopback: a router, the acquisition, the pred
 from __future__ import annotations
 
 import subprocess
-import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -22,7 +21,7 @@ import pytest
 from services.cli.station_supervisor import stop_process
 from shared.contract import keys
 from shared.runtime import open_from, zenoh_config
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 from tests.support.station_files import serve, write_station
 
 pytestmark = pytest.mark.system
@@ -40,14 +39,7 @@ def refusal_line(station_file: Path) -> str:
 
 
 def serve_predictor(station_file: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "services.cli", "serve", "predictor", "--config", str(station_file)],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        cwd=REPO,
-        check=False,
-    )
+    return boltwatch("serve", "predictor", "--config", str(station_file), timeout_s=60)
 
 
 def assert_refused(station_file: Path) -> None:

@@ -13,14 +13,12 @@ and is left out, counted; none is expected on loopback.
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from shared.recordings.mcap import export_trace
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
 from tests.support.station_up import read_recordings, run_up
 
@@ -31,10 +29,9 @@ PROGRAM = 1
 
 
 def offline_stop(trace: Path, station: Path) -> dict[str, object] | None:
-    result = subprocess.run(
-        [sys.executable, "-m", "services.cli", "predict", str(trace), "--config", str(station),
-         "--program", str(PROGRAM)],
-        capture_output=True, text=True, cwd=REPO, check=True,
+    result = boltwatch(
+        "predict", str(trace), "--config", str(station), "--program", str(PROGRAM),
+        timeout_s=None, check=True,
     )  # fmt: skip
     records = [json.loads(line) for line in result.stdout.splitlines()]
     return next((r for r in records if r["type"] == "stop"), None)

@@ -20,23 +20,21 @@ import json
 import os
 import re
 import signal
-import subprocess
-import sys
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
-import zenoh
 
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
 from services.rig.openprotocol.simulated_controller import LINGER_S
-from shared.contract import BridgeStats, channels, decode
+from shared.contract import BridgeStats, channels
+from tests.support.listener import Listener
 from tests.support.live_recorder import free_port
-from tests.support.live_station import open_client
+from tests.support.live_station import open_client, wait_supervised
 from tests.support.openprotocol_proxy import Damage, OpenProtocolProxy
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
 from tests.support.station_up import read_recordings
 
@@ -79,10 +77,7 @@ class FaultStation:
         endpoint = f"tcp/127.0.0.1:{_zenoh_port(template)}"
         self.supervisor.start("router", ["--listen", endpoint])
         self.session = open_client(endpoint)
-        self.stats: list[BridgeStats] = []
-        self._subscriber = self.session.declare_subscriber(
-            channels.OPENPROTOCOL.key(STATION), self._heard
-        )
+        self.heard = Listener(self.session, STATION, (channels.OPENPROTOCOL.topic,))
         self.supervisor.start("recorder", ["--no-rerun"])
         self.bridges = 0
         self.start_bridge()
@@ -92,8 +87,10 @@ class FaultStation:
             config_paths=[self.files["controller"]],
         )
 
-    def _heard(self, sample: zenoh.Sample) -> None:
-        self.stats.append(decode(BridgeStats, sample.payload.to_bytes()))
+    @property
+    def stats(self) -> list[BridgeStats]:
+        """The bridge's BridgeStats heard so far."""
+        return self.heard.of(channels.OPENPROTOCOL.topic)
 
     def start_bridge(self) -> ManagedProcess:
         self.bridges += 1
@@ -102,15 +99,9 @@ class FaultStation:
         return self.bridge
 
     def wait_for(self, condition: Callable[[], bool], what: str) -> None:
-        deadline = time.monotonic() + DONE_TIMEOUT_S
-        while not condition():
-            for managed in self.supervisor.processes:
-                code = managed.exit_code()
-                if code not in (None, 0, -signal.SIGKILL):
-                    raise AssertionError(f"{managed.name} exited {code}:\n{managed.log_tail()}")
-            if time.monotonic() > deadline:
-                raise AssertionError(f"gave up waiting for {what}: {self.logs()}")
-            time.sleep(0.05)
+        """Until ``condition``; a process that ended by itself (exit 0) is no failure."""
+        exits = (0, -signal.SIGKILL)
+        wait_supervised(self.supervisor, condition, what, DONE_TIMEOUT_S, 0.05, exits, self.logs)
 
     def finish(self) -> BridgeStats:
         """Wait for the controller's N tightenings and the bridge to publish the last one."""
@@ -123,13 +114,9 @@ class FaultStation:
 
     def status(self) -> dict[str, Any]:
         """``boltwatch status``, as text and as JSON: the station's bridge and its text lines."""
-        command = [sys.executable, "-m", "services.cli", "status", "--config"]
-        command += [str(self.files["bridge"]), "--listen-s", "1.5"]
+        command = ["status", "--config", str(self.files["bridge"]), "--listen-s", "1.5"]
         text, as_json = (
-            subprocess.run(
-                command + extra, capture_output=True, text=True, timeout=30, cwd=REPO, check=True
-            ).stdout
-            for extra in ([], ["--json"])
+            boltwatch(*command, *extra, check=True).stdout for extra in ([], ["--json"])
         )
         bridge = json.loads(as_json)["stations"][STATION]["bridge"]
         bridge["text"] = text
@@ -142,8 +129,7 @@ class FaultStation:
         )
 
     def close(self) -> None:
-        with contextlib.suppress(zenoh.ZError):
-            self._subscriber.undeclare()
+        self.heard.close()
         self.session.close()
         names = [m.name for m in self.supervisor.processes]
         order = [
@@ -179,14 +165,7 @@ def check_each_tightening_recorded_once(station: FaultStation, folder: Path) -> 
     assert summaries == list(range(1, RUNS + 1)), logs
     results = sorted(r["tightening_id"] for r in messages["boltwatch/st1/results"])
     assert results == list(range(1, RUNS + 1)), logs
-    wear = subprocess.run(
-        [sys.executable, "-m", "services.cli", "wear", "--config", str(station.files["bridge"])],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        cwd=REPO,
-        check=True,
-    )
+    wear = boltwatch("wear", "--config", str(station.files["bridge"]), timeout_s=60, check=True)
     (line,) = [row.split() for row in wear.stdout.splitlines() if row.split()[:1] == ["7"]]
     assert line[1:3] == ["SIM-7", str(RUNS)], wear.stdout
 

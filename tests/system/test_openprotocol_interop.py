@@ -12,8 +12,6 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
-import subprocess
-import sys
 import time
 from collections import defaultdict
 from collections.abc import Iterator
@@ -24,7 +22,7 @@ import pytest
 
 from services.cli.station_supervisor import StationSupervisor
 from tests.support.openprotocol_controller import SpecController
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
 from tests.support.station_up import read_recordings
 
@@ -78,14 +76,7 @@ class PlantStation:
 
     def wear_runs(self) -> int:
         """The runs the wear ledger counted for the station's tool."""
-        wear = subprocess.run(
-            [sys.executable, "-m", "services.cli", "wear", "--config", str(self.station_file)],
-            capture_output=True,
-            text=True,
-            timeout=60,
-            cwd=REPO,
-            check=True,
-        )
+        wear = boltwatch("wear", "--config", str(self.station_file), timeout_s=60, check=True)
         rows = [row.split() for row in wear.stdout.splitlines() if row.split()[:1] == ["7"]]
         assert len(rows) == 1, wear.stdout
         return int(rows[0][2])

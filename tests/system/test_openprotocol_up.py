@@ -9,15 +9,13 @@ tool's serial from the controller's tool data.
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from collections import defaultdict
 from pathlib import Path
 
 import pytest
 
 from tests.support.live_recorder import free_port
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
 from tests.support.station_up import read_recordings, run_up
 
@@ -57,13 +55,6 @@ def test_up_with_an_open_protocol_controller_records_every_run(tmp_path: Path) -
         assert samples_by_run[summary["run_id"]] == summary["samples"] > 1000, summary
     assert messages["boltwatch/st1/tool_data"][-1]["tool_serial"] == "SIM-7"
 
-    wear = subprocess.run(
-        [sys.executable, "-m", "services.cli", "wear", "--config", str(station)],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        cwd=REPO,
-        check=True,
-    )
+    wear = boltwatch("wear", "--config", str(station), timeout_s=60, check=True)
     (line,) = [row.split() for row in wear.stdout.splitlines() if row.split()[:1] == ["7"]]
     assert line[1:3] == ["SIM-7", str(RUNS)], wear.stdout

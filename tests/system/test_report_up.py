@@ -8,14 +8,12 @@ the results read back from MCAP with the mcap library and json only.
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
 from tests.support.station_up import read_recordings, run_up
 
@@ -28,15 +26,8 @@ def test_report_over_runs_of_up(tmp_path: Path) -> None:
     station = write_station(tmp_path)
     run_up(station, runs=RUNS)
     out = tmp_path / "report"
-    command = [sys.executable, "-m", "services.cli", "report", "--config", str(station)]
-    report = subprocess.run(
-        [*command, "--subgroup-size", "2", "--out", str(out)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        cwd=REPO,
-        check=False,
-    )
+    command = ["report", "--config", str(station)]
+    report = boltwatch(*command, "--subgroup-size", "2", "--out", str(out), timeout_s=120)
     assert report.returncode == 0, report.stdout + report.stderr
     results = read_recordings(tmp_path / "recordings")["boltwatch/st1/results"]
     assert len(results) == RUNS

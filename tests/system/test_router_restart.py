@@ -22,21 +22,19 @@ from __future__ import annotations
 import re
 import signal
 import subprocess
-import threading
 import time
 from collections import Counter
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
-from shared.contract import BusStats, RecorderStats, RunSummary, Sample, channels, decode, keys
+from shared.contract import RunSummary, Sample, channels, decode
 from shared.recordings.mcap import RecordingScan
 from shared.runtime import zenoh_config
-from tests.support.live_recorder import wait_until
+from tests.support.listener import Listener
 from tests.support.station_files import free_tcp_port, serve, write_station
 
 pytestmark = pytest.mark.system
@@ -52,29 +50,8 @@ RIG_RUN = re.compile(r"run (\d+): (\w+) by (\w+), force (\d+) N, .* (\d+) sample
 LINK_EVENT_SAMPLES = 20  # 20 ms at 1 kHz: how far the link flag may lag the link
 
 
-@dataclass
-class Heard:
-    summaries: list[RunSummary] = field(default_factory=list)
-    stats: list[BusStats] = field(default_factory=list)
-    recorder: list[RecorderStats] = field(default_factory=list)
-    lock: threading.Lock = field(default_factory=threading.Lock)
-
-    def on_sample(self, sample: zenoh.Sample) -> None:
-        topic = str(sample.key_expr).rsplit("/", 1)[-1]
-        with self.lock:
-            if topic == channels.RUNS.topic:
-                self.summaries.append(decode(RunSummary, sample.payload.to_bytes()))
-            elif topic == channels.BUS.topic:
-                self.stats.append(decode(BusStats, sample.payload.to_bytes()))
-            elif topic == channels.RECORDER.topic:
-                self.recorder.append(decode(RecorderStats, sample.payload.to_bytes()))
-
-    def wait(self, what: str, done: Callable[[], object], timeout_s: float) -> None:
-        def locked() -> bool:
-            with self.lock:
-                return bool(done())
-
-        wait_until(locked, what, timeout_s)
+#: what the test hears of the station on zenoh
+TOPICS = (channels.RUNS.topic, channels.BUS.topic, channels.RECORDER.topic)
 
 
 @dataclass(frozen=True)
@@ -124,7 +101,6 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
     # exactly (with it, nothing is lost: tests/system/test_store_and_forward.py)
     path.write_text(path.read_text() + "\n[spool]\nenabled = false\n")
     logs = {n: tmp_path / f"{n}.log" for n in ("router", "recorder", "predictor", "acq", "rig")}
-    heard = Heard()
     router = serve(["router", "--listen", endpoint], logs["router"])
     services = [
         serve(["recorder", "--config", str(path)], logs["recorder"]),
@@ -137,57 +113,61 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
     )
     try:
         with zenoh.open(config) as session:
-            subscriber = session.declare_subscriber(keys.station_key(STATION, "*"), heard.on_sample)
+            heard = Listener(session, STATION, TOPICS)
             try:
-                heard.wait("the acquisition's BusStats", lambda: heard.stats, START_TIMEOUT_S)
+                heard.wait(lambda: heard.of("bus"), "the acquisition's BusStats", START_TIMEOUT_S)
                 # the recorder hears the station before the first run: what it counts
                 # from then on is the whole of what the recording lacks
                 heard.wait(
+                    lambda: any(stats.messages > 0 for stats in heard.of("recorder")),
                     "the recorder hearing the station",
-                    lambda: any(stats.messages > 0 for stats in heard.recorder),
                     START_TIMEOUT_S,
                 )
                 rig_args = ["rig", "--config", str(path), "--program", "1"]
                 rig = serve([*rig_args, "--first-run-id", str(FIRST_RUN)], logs["rig"])
                 heard.wait(
+                    lambda: any(s.stop_reason for s in heard.of("runs")),
                     "a run stopped by the predictor before the outage",
-                    lambda: any(s.stop_reason for s in heard.summaries),
                     RUN_TIMEOUT_S,
                 )
                 router.send_signal(signal.SIGKILL)
                 router.wait(10)
                 time.sleep(OUTAGE_S)  # the fault itself: the line has no router this long
                 router = serve(["router", "--listen", endpoint], logs["router"])
-                with heard.lock:
-                    before = len(heard.summaries)
+                before = len(heard.of("runs"))
                 heard.wait(
-                    "a run after the restart stopped early by the predictor (plateau_closest)",
                     lambda: any(
-                        s.stop_reason == "plateau_closest" for s in heard.summaries[before:]
+                        s.stop_reason == "plateau_closest" for s in heard.of("runs")[before:]
                     ),
+                    "a run after the restart stopped early by the predictor (plateau_closest)",
                     RUN_TIMEOUT_S * 2,
                 )
                 stop_process(rig, grace_s=10.0)
                 acquisition = services[-1]
                 stop_process(acquisition, grace_s=10.0)  # publishes its final BusStats
                 heard.wait(
+                    lambda: (
+                        heard.of("bus")[-1].samples > 0 and heard.of("bus")[-1].unsent_samples > 0
+                    ),
                     "the final BusStats",
-                    lambda: heard.stats[-1].samples > 0 and heard.stats[-1].unsent_samples > 0,
                     5.0,
                 )
-                final_bus_ns = heard.stats[-1].time_ns
+                final_bus_ns = heard.of("bus")[-1].time_ns
                 heard.wait(
+                    lambda: (
+                        heard.of("recorder")
+                        and heard.of("recorder")[-1].time_ns > final_bus_ns + 10**9
+                    ),
                     "the recorder's count after the final BusStats",
-                    lambda: heard.recorder and heard.recorder[-1].time_ns > final_bus_ns + 10**9,
                     5.0,
                 )
             finally:
-                subscriber.undeclare()
+                heard.close()
     finally:
         for process in [*([rig] if rig else []), *reversed(services), router]:
             stop_process(process, grace_s=10.0)
 
-    stats = heard.stats[-1]
+    stats = heard.of("bus")[-1]
     runs = {r: run for r, run in rig_runs(logs["rig"]).items() if run.stop_source != "service_stop"}
     sequences, summaries = recorded(tmp_path / "recordings")
     missing = {
@@ -197,7 +177,7 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
     print(
         f"unsent {stats.unsent_samples}, missing from the recording {sum(missing.values())} "
         f"in runs {outage_runs}; bus missed {stats.missed_samples}; "
-        f"recorder missing {heard.recorder[-1].missing_samples}; "
+        f"recorder missing {heard.of('recorder')[-1].missing_samples}; "
         f"stop sources {Counter(r.stop_source for r in runs.values())}"
     )
     print("acquisition:", *re.findall(r".*router back after.*", logs["acq"].read_text()))
@@ -220,7 +200,7 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
     assert all(lost >= 0 for lost in missing.values()), missing
     # The recorder counted the loss itself, to the sample, whatever the runs it fell in.
     recorded_samples = sum(len(set(run_sequences)) for run_sequences in sequences.values())
-    assert heard.recorder[-1].missing_samples == stats.samples - recorded_samples
+    assert heard.of("recorder")[-1].missing_samples == stats.samples - recorded_samples
     # No run tightened blind: the ones the predictor could not stop hit the shutoff at target.
     unstopped = [r for r in outage_runs if runs[r].stop_source != "stop_command"]
     assert unstopped, f"no run ended during the outage: {runs}"

@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import os
 import signal
-import subprocess
-import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -34,7 +32,7 @@ from tests.support.live_station import (
     live_station,
     recorded_sequences,
 )
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 
 pytestmark = pytest.mark.system
 
@@ -99,10 +97,7 @@ def wait_recording_settled(station: LiveStation, run_id: int) -> None:
 def recover_killed_file(station: LiveStation, run_id: int, recovered: Path) -> list[int]:
     """``boltwatch recover`` on the killed recorder's file; the recovered sample sequences."""
     (killed_file,) = sorted(station.recordings.rglob(f"st1_run{run_id}_*.mcap"))
-    command = [sys.executable, "-m", "services.cli", "recover", str(killed_file)]
-    result = subprocess.run(
-        [*command, "--out", str(recovered)], cwd=REPO, capture_output=True, text=True, check=False
-    )
+    result = boltwatch("recover", str(killed_file), "--out", str(recovered), timeout_s=None)
     assert result.returncode == 0, result.stderr
     with recovered.open("rb") as handle:  # the mcap library's own indexed reader: valid file
         return [

@@ -21,7 +21,6 @@ from services.cli.station_supervisor import stop_process
 from shared.contract import (
     BusStats,
     RunSummary,
-    Sample,
     StopDecision,
     ToolState,
     channels,
@@ -29,6 +28,7 @@ from shared.contract import (
     keys,
 )
 from shared.runtime import open_from, zenoh_config
+from tests.support import factories
 from tests.support.paths import REPO
 from tests.support.router_process import boltwatch
 from tests.support.station_files import free_tcp_port, write_station
@@ -70,9 +70,8 @@ class FakeStation:
         sequence = 0
         while not self.stop.is_set():
             now = time.time_ns()
-            self._put(
-                channels.SAMPLES.topic, Sample(STATION, 12, sequence, now, 150.0, 40.0, 42000.0)
-            )
+            sample = factories.sample(12, sequence, station=STATION, time_ns=now)
+            self._put(channels.SAMPLES.topic, sample)
             if sequence % 40 == 0:  # five times a second (the real ones: on change, 1 Hz)
                 self._put(channels.TOOL.topic, ToolState(STATION, 12, 7, 1, "running", now))
                 self._put(channels.BUS.topic, bus_stats(now, samples=sequence))
@@ -110,19 +109,15 @@ def decision(now_ns: int) -> StopDecision:
 
 
 def run_summary(now_ns: int) -> RunSummary:
-    return RunSummary(
+    """Run 11, ended now: 55.9 kN of 56 kN."""
+    return factories.summary(
+        11,
         station=STATION,
-        run_id=11,
-        tool_id=7,
-        program_id=1,
-        tool_state="done",
         target_force_n=56000.0,
-        target_torque_nm=200.0,
         reached_force_n=55900.0,
         reached_torque_nm=195.0,
         error_pct=-0.18,
         events=8,
-        stop_reason="plateau_closest",
         process_intensity=0.3,
         samples=2400,
         started_ns=now_ns - 3_000_000_000,

@@ -15,6 +15,7 @@ import zenoh
 from shared.config import load_station
 from shared.contract import JudgedFigure, TighteningResult, Verdict, channels, encode, keys
 from shared.runtime import open_from, zenoh_config
+from tests.support import factories
 from tests.support.live_recorder import (
     RunningRecorder,
     has_subscribers,
@@ -22,6 +23,7 @@ from tests.support.live_recorder import (
     write_station_file,
 )
 from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 
 pytestmark = pytest.mark.system
 
@@ -29,14 +31,17 @@ S_NS = 1_000_000_000
 
 
 def result(run_id: int, verdict: Verdict) -> TighteningResult:
-    force = JudgedFigure(52000.0, 53000.0, 59000.0, "ok" if verdict == "OK" else "low")
-    torque = JudgedFigure(210.0, 180.0, 240.0, "ok")
-    angle = JudgedFigure(47.0, 35.0, None, "ok")
-    reasons = "" if verdict == "OK" else "preload low: 52000.0"
-    return TighteningResult(
-        "st1", run_id, run_id, 7, 2, "P2", time.time_ns() - S_NS, None, None, torque, angle,
-        force, verdict, reasons, None, 40, 1e6, "predictor",
-    )  # fmt: skip
+    """A result of program 2 that ended a second ago: its preload 52 kN, ``verdict``."""
+    return factories.result(
+        run_id,
+        program_id=2,
+        time_ns=time.time_ns() - S_NS,
+        final_torque_nm=JudgedFigure(210.0, 180.0, 240.0, "ok"),
+        final_angle_deg=JudgedFigure(47.0, 35.0, None, "ok"),
+        final_force_n=JudgedFigure(52000.0, 53000.0, 59000.0, "ok" if verdict == "OK" else "low"),
+        result=verdict,
+        nok_reasons="" if verdict == "OK" else "preload low: 52000.0",
+    )
 
 
 def status_during_an_alert(
@@ -84,14 +89,7 @@ def test_status_shows_the_newest_active_quality_alert(
         as_json = status_during_an_alert(session, station_file, 11, "--json")
         # a status started after the alerts were put learns of them from RecorderStats
         command = ["status", "--config", str(station_file), "--listen-s", "2.5", "--json"]
-        later = subprocess.run(
-            [sys.executable, "-m", "services.cli", *command],
-            check=False,
-            cwd=REPO,
-            capture_output=True,
-            text=True,
-            timeout=30,
-        )
+        later = boltwatch(*command)
     finally:
         session.close()
         recorder.finish()

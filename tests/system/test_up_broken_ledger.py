@@ -15,27 +15,19 @@ from __future__ import annotations
 import json
 import os
 import subprocess
-import sys
 import time
 from collections import defaultdict
 from pathlib import Path
 
 import pytest
 
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
 from tests.support.station_up import UP_TIMEOUT_S, read_recordings, start_up, wait_for_first_run
 
 pytestmark = pytest.mark.system
 
 RUNS = 5
-
-
-def boltwatch(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "services.cli", *args],
-        capture_output=True, text=True, cwd=REPO, timeout=60, check=False,
-    )  # fmt: skip
 
 
 def read_rows(up: subprocess.Popen[str], count: int) -> list[str]:
@@ -66,14 +58,16 @@ def test_a_ledger_overwritten_under_up_is_reported_and_replaced_and_no_run_is_lo
             handle.write(os.urandom(64 * 1024))
         output += "".join(read_rows(up, 1))
 
-        wear = boltwatch("wear", "--recordings", str(recordings))
+        wear = boltwatch("wear", "--recordings", str(recordings), timeout_s=60)
         assert wear.returncode == 2
         (line,) = wear.stderr.splitlines()
         assert line.startswith(f"boltwatch wear: {ledger}: not a usable wear ledger: ")
         assert line.endswith(f"boltwatch wear reset --recordings {recordings}")
 
         deadline = time.monotonic() + 30
-        while (reset := boltwatch("wear", "reset", "--recordings", str(recordings))).returncode:
+        while (
+            reset := boltwatch("wear", "reset", "--recordings", str(recordings), timeout_s=60)
+        ).returncode:
             # the recorder lets go of the old file within its 2 s check
             assert "open in process" in reset.stderr, reset.stderr
             assert time.monotonic() < deadline, reset.stderr
@@ -98,7 +92,7 @@ def test_a_ledger_overwritten_under_up_is_reported_and_replaced_and_no_run_is_lo
 
     (kept,) = recordings.glob("wear.sqlite.broken-*Z")  # kept, not deleted
     assert kept.stat().st_size > 0
-    counted = boltwatch("wear", "--recordings", str(recordings), "--json")
+    counted = boltwatch("wear", "--recordings", str(recordings), "--json", timeout_s=60)
     assert counted.returncode == 0, counted.stderr
     (tool,) = json.loads(counted.stdout)
     # the first run may have gone into the old ledger before it was overwritten; every

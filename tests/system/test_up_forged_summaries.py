@@ -11,16 +11,15 @@ intensity (beyond what the program's 320 Nm tool can take).
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
 
-from shared.contract import RunSummary, channels, encode
+from shared.contract import channels, encode
+from tests.support.factories import summary
 from tests.support.live_station import open_client
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
 from tests.support.station_up import UP_TIMEOUT_S, read_recordings, start_up, wait_for_first_run
 
@@ -30,13 +29,17 @@ RUNS = 3
 
 
 def forged(run_id: int, intensity: float) -> bytes:
+    """A summary of run ``run_id`` that just ended, as a predictor would put it."""
     now = time.time_ns()
-    return encode(
-        RunSummary(
-            "st1", run_id, 7, 1, "done", 56e3, 200.0, 56e3, 200.0, 0.0, 40, "plateau_closest",
-            intensity, 1700, now - 1_700_000_000, now,
-        )
-    )  # fmt: skip
+    run = summary(
+        run_id,
+        events=40,
+        process_intensity=intensity,
+        samples=1700,
+        started_ns=now - 1_700_000_000,
+        ended_ns=now,
+    )
+    return encode(run)
 
 
 def test_a_forged_summary_is_neither_a_run_of_up_nor_wear_in_the_ledger(tmp_path: Path) -> None:
@@ -74,10 +77,7 @@ def test_a_forged_summary_is_neither_a_run_of_up_nor_wear_in_the_ledger(tmp_path
     recordings = tmp_path / "recordings"
     real = {s["run_id"] for s in read_recordings(recordings)["boltwatch/st1/samples"]}
     assert len(real) == RUNS and first_run_id in real
-    wear = subprocess.run(
-        [sys.executable, "-m", "services.cli", "wear", "--recordings", str(recordings), "--json"],
-        capture_output=True, text=True, cwd=REPO, timeout=60, check=False,
-    )  # fmt: skip
+    wear = boltwatch("wear", "--recordings", str(recordings), "--json", timeout_s=60)
     assert wear.returncode == 0, wear.stderr
     (tool,) = json.loads(wear.stdout)
     # 1e15 was refused by the ledger; the plausible forgery for a run that never ran is a

@@ -26,7 +26,9 @@ import pytest
 
 from shared.contract import RunSummary
 from shared.wear import CONTRACT_LIMITS, WearLedger
+from tests.support import factories
 from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 
 pytestmark = pytest.mark.system
 
@@ -41,15 +43,16 @@ WRITER = textwrap.dedent(
     import sys
     from shared.wear.wear_bound import CONTRACT_LIMITS
     from services.recorder.wear_watch import WearWatch
-    from shared.contract.messages import RunSummary
+    from tests.support.factories import summary as run
 
     path, first = sys.argv[1], int(sys.argv[2])
     watch = WearWatch(path, None, lambda alert: None, lambda summary: CONTRACT_LIMITS)
     run_id = first
     while True:
-        summary = RunSummary(
-            "st1" if run_id % 2 else "st2", run_id, 7, 1, "done", None, 20.0, None, 19.5,
-            -2.5, 3, None, run_id * 0.25, 1000, run_id * 10**10, run_id * 10**10 + 2 * 10**9,
+        summary = run(
+            run_id, station="st1" if run_id % 2 else "st2", events=3, stop_reason=None,
+            process_intensity=run_id * 0.25, samples=1000, started_ns=run_id * 10**10,
+            ended_ns=run_id * 10**10 + 2 * 10**9,
         )
         counted = watch.on_summary(summary, run_id)
         print(f"{'counted' if counted else 'repeated'} {run_id}", flush=True)
@@ -124,10 +127,18 @@ def test_kill_9_loses_at_most_the_run_being_written_and_never_counts_twice(
 
 
 def summary(run_id: int, station: str = "st1") -> RunSummary:
-    return RunSummary(
-        station, run_id, TOOL, 1, "done", None, 20.0, None, 19.5, -2.5, 3, None,
-        intensity(run_id), 1000, T0_NS + run_id * S_NS, T0_NS + run_id * S_NS + 2 * S_NS,
-    )  # fmt: skip
+    """A 2 s run of tool 7 from T0 + ``run_id`` s."""
+    return factories.summary(
+        run_id,
+        station=station,
+        tool_id=TOOL,
+        events=3,
+        stop_reason=None,
+        process_intensity=intensity(run_id),
+        samples=1000,
+        started_ns=T0_NS + run_id * S_NS,
+        ended_ns=T0_NS + run_id * S_NS + 2 * S_NS,
+    )
 
 
 HOLD_READ = textwrap.dedent(
@@ -202,11 +213,7 @@ def test_boltwatch_wear_reads_while_a_writer_holds_its_transaction(tmp_path: Pat
     assert writer.stdin is not None and writer.stdout is not None
     try:
         assert writer.stdout.readline().strip() == "holding"
-        result = subprocess.run(
-            [sys.executable, "-m", "services.cli", "wear", "--recordings", str(tmp_path),
-             "--station", "st2", "--json"],
-            capture_output=True, text=True, cwd=REPO, timeout=30, check=False,
-        )  # fmt: skip
+        result = boltwatch("wear", "--recordings", str(tmp_path), "--station", "st2", "--json")
     finally:
         writer.stdin.write("done\n")
         writer.stdin.close()

@@ -3,40 +3,33 @@
 from __future__ import annotations
 
 import json
-from dataclasses import replace
+from typing import Any
 
 from services.cli import run_table
 from services.cli.station_status_text import format_report
 from shared.contract import JudgedFigure, TighteningResult, channels, encode, keys
 from shared.line_status import StatusCollector, to_json
+from tests.support import factories
 from tests.support.factories import summary
 
 T0 = 1_800_000_000_000_000_000
 S = 1_000_000_000
 
 
-def result(run_id: int = 3, **changes: object) -> TighteningResult:
-    made = TighteningResult(
-        station="st1",
-        tightening_id=run_id,
-        run_id=run_id,
-        tool_id=7,
-        program_id=1,
-        program_name="M14 to 56 kN",
-        time_ns=T0,
-        part_id=None,
-        batch_counter=None,
-        final_torque_nm=JudgedFigure(190.0, 150.0, 250.0, "ok"),
-        final_angle_deg=JudgedFigure(61.0, None, None, "not_judged"),
-        final_force_n=JudgedFigure(52800.0, 53000.0, 59000.0, "low"),
-        result="NOK",
-        nok_reasons="preload low: 52800 N, window 53000 to 59000 N",
-        stop_reason="plateau_closest",
-        events=9,
-        process_intensity=0.4,
-        source="predictor",
-    )
-    return replace(made, **changes)  # type: ignore[arg-type]
+def result(run_id: int = 3, **changes: Any) -> TighteningResult:
+    """A NOK result: its preload low, its angle not judged."""
+    nok: dict[str, Any] = {
+        "program_name": "M14 to 56 kN",
+        "time_ns": T0,
+        "final_torque_nm": JudgedFigure(190.0, 150.0, 250.0, "ok"),
+        "final_angle_deg": JudgedFigure(61.0, None, None, "not_judged"),
+        "final_force_n": JudgedFigure(52800.0, 53000.0, 59000.0, "low"),
+        "result": "NOK",
+        "nok_reasons": "preload low: 52800 N, window 53000 to 59000 N",
+        "stop_reason": "plateau_closest",
+        "source": "predictor",
+    }
+    return factories.result(run_id, **{**nok, **changes})
 
 
 def test_the_up_table_has_a_result_column_with_ok_nok_or_a_dash() -> None:

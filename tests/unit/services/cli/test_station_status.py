@@ -10,7 +10,6 @@ from shared.contract import (
     BusStats,
     PredictorStats,
     RecorderStats,
-    Sample,
     StopDecision,
     ToolState,
     channels,
@@ -18,7 +17,7 @@ from shared.contract import (
     keys,
 )
 from shared.line_status import LastRun, StatusCollector, to_json
-from tests.support.factories import T0, S, summary
+from tests.support.factories import T0, S, sample, summary
 
 
 def bus(time_ns: int, samples: int, **counters: int) -> BusStats:
@@ -38,10 +37,6 @@ def bus(time_ns: int, samples: int, **counters: int) -> BusStats:
     }
     fields.update(counters)
     return BusStats(station="st1", time_ns=time_ns, samples=samples, **fields)
-
-
-def sample(run_id: int, sequence: int) -> Sample:
-    return Sample("st1", run_id, sequence, T0 + sequence * 1_000_000, 10.0, 1.0, 100.0)
 
 
 def feed(collector: StatusCollector, topic: str, message: Any, at_ns: int = T0) -> None:

@@ -20,7 +20,8 @@ from typing import Any
 import pytest
 import zenoh
 
-from tests.support.bridge_harness import Heard, RunningBridge, bridge_station_file
+from tests.support.bridge_harness import RunningBridge, bridge_station_file
+from tests.support.listener import Listener
 from tests.support.live_recorder import wait_until
 from tests.support.openprotocol_controller import SpecController
 from tests.support.openprotocol_results import last_result_fields
@@ -42,9 +43,9 @@ def controller() -> Iterator[SpecController]:
 @pytest.fixture
 def bridge(
     tmp_path: Path, controller: SpecController, sessions: tuple[zenoh.Session, zenoh.Session]
-) -> Iterator[tuple[RunningBridge, Heard]]:
+) -> Iterator[tuple[RunningBridge, Listener]]:
     served, feeding = sessions
-    heard = Heard(served)
+    heard = Listener(served, samples_from_batches=True)
     station_file = bridge_station_file(tmp_path, controller.port, "tcp/127.0.0.1:1")
     running = RunningBridge(station_file, feeding)
     assert controller.wait_subscribed(10.0, mids=(61, 900, 71))
@@ -54,7 +55,7 @@ def bridge(
     heard.close()
 
 
-def result_ids(heard: Heard) -> list[int]:
+def result_ids(heard: Listener) -> list[int]:
     return [result.tightening_id for result in heard.of("results")]
 
 
@@ -81,7 +82,7 @@ def bridge_log_lines(caplog: pytest.LogCaptureFixture) -> list[str]:
 
 def test_every_field_of_0061_bad_in_every_way_costs_that_message_never_a_tightening(
     controller: SpecController,
-    bridge: tuple[RunningBridge, Heard],
+    bridge: tuple[RunningBridge, Listener],
     caplog: pytest.LogCaptureFixture,
 ) -> None:
     """Each bad 0061 is of a tightening the controller keeps: refused (counted), it comes
@@ -132,7 +133,7 @@ def test_every_field_of_0061_bad_in_every_way_costs_that_message_never_a_tighten
     ids=lambda overrides: ",".join(f"{k}={v}" for k, v in overrides.items()),
 )
 def test_a_bad_0900_costs_its_curve_never_the_bridge_or_the_result(
-    controller: SpecController, bridge: tuple[RunningBridge, Heard], overrides: dict[str, Any]
+    controller: SpecController, bridge: tuple[RunningBridge, Listener], overrides: dict[str, Any]
 ) -> None:
     """Before: a 0900 without resolution fields or with a time step of 1e300 s stopped the
     bridge (exit 1); one of 1e-300 s was published and missing from the wear ledger."""
@@ -153,7 +154,7 @@ def test_a_bad_0900_costs_its_curve_never_the_bridge_or_the_result(
 
 
 def test_ids_that_wrap_after_9999999999_go_on_as_new_runs_each_once(
-    controller: SpecController, bridge: tuple[RunningBridge, Heard]
+    controller: SpecController, bridge: tuple[RunningBridge, Listener]
 ) -> None:
     """Before: the ids after the wrap were withheld while the link stayed up, then 997 old
     tightenings were published again under new run ids (counted twice by the ledger)."""
@@ -171,7 +172,7 @@ def test_ids_that_wrap_after_9999999999_go_on_as_new_runs_each_once(
 
 
 def test_a_repeat_is_counted_and_an_old_id_with_other_values_is_a_new_run(
-    controller: SpecController, bridge: tuple[RunningBridge, Heard]
+    controller: SpecController, bridge: tuple[RunningBridge, Listener]
 ) -> None:
     running, heard = bridge
     for _ in range(3):
@@ -192,7 +193,7 @@ def test_a_repeat_is_counted_and_an_old_id_with_other_values_is_a_new_run(
 
 def test_a_flood_of_3000_results_publishes_each_once_and_logs_a_few_lines(
     controller: SpecController,
-    bridge: tuple[RunningBridge, Heard],
+    bridge: tuple[RunningBridge, Listener],
     caplog: pytest.LogCaptureFixture,
 ) -> None:
     """Before: 1000 of 3000 were published ("more than 1000 results back: given up") and
@@ -210,7 +211,7 @@ def test_a_flood_of_3000_results_publishes_each_once_and_logs_a_few_lines(
 
 @pytest.mark.parametrize("stamp", ["9999-12-31:23:59:59", "1900-01-01:00:00:00"])
 def test_a_time_stamp_no_clock_holds_is_replaced_by_the_time_received(
-    controller: SpecController, bridge: tuple[RunningBridge, Heard], stamp: str
+    controller: SpecController, bridge: tuple[RunningBridge, Listener], stamp: str
 ) -> None:
     """Before: published, but such results never reached the wear ledger."""
     running, heard = bridge

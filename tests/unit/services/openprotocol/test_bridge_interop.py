@@ -18,7 +18,8 @@ from typing import Any
 import pytest
 import zenoh
 
-from tests.support.bridge_harness import Heard, RunningBridge, bridge_station_file
+from tests.support.bridge_harness import RunningBridge, bridge_station_file
+from tests.support.listener import Listener
 from tests.support.live_recorder import wait_until
 from tests.support.openprotocol_controller import SpecController
 from tests.support.openprotocol_core import AcceptNames
@@ -35,7 +36,7 @@ class Line:
         self, tmp_path: Path, controller: SpecController, sessions: tuple[Any, Any], **section: Any
     ) -> None:
         served, feeding = sessions
-        self.heard = Heard(served)
+        self.heard = Listener(served, samples_from_batches=True)
         self.station_file = bridge_station_file(
             tmp_path, controller.port, "tcp/127.0.0.1:1", **section
         )

@@ -9,7 +9,8 @@ import pytest
 import zenoh
 
 from services.openprotocol.published_ids import read_position
-from tests.support.bridge_harness import Heard, RunningBridge, bridge_station_file
+from tests.support.bridge_harness import RunningBridge, bridge_station_file
+from tests.support.listener import Listener
 from tests.support.live_recorder import wait_until
 from tests.support.tcp_controller import SAMPLES, TcpController
 
@@ -21,7 +22,7 @@ def controller() -> Iterator[TcpController]:
     served.close()
 
 
-def ids_of(heard: Heard, topic: str) -> list[int]:
+def ids_of(heard: Listener, topic: str) -> list[int]:
     return [message.run_id for message in heard.of(topic)]
 
 
@@ -29,7 +30,7 @@ def test_live_results_with_their_curves_become_runs_once_each(
     tmp_path: Path, controller: TcpController, sessions: tuple[zenoh.Session, zenoh.Session]
 ) -> None:
     served, feeding = sessions
-    heard = Heard(served)
+    heard = Listener(served, samples_from_batches=True)
     endpoint = "tcp/127.0.0.1:1"  # the sessions fixture's peers carry the messages
     station_file = bridge_station_file(tmp_path, controller.port, endpoint)
     bridge = RunningBridge(station_file, feeding)
@@ -65,7 +66,7 @@ def test_results_made_while_the_link_was_down_are_fetched_by_id_once(
     tmp_path: Path, controller: TcpController, sessions: tuple[zenoh.Session, zenoh.Session]
 ) -> None:
     served, feeding = sessions
-    heard = Heard(served)
+    heard = Listener(served, samples_from_batches=True)
     station_file = bridge_station_file(tmp_path, controller.port, "tcp/127.0.0.1:1")
     bridge = RunningBridge(station_file, feeding)
     try:
@@ -92,7 +93,7 @@ def test_revisions_fall_back_on_error_97(
 ) -> None:
     controller = TcpController(start_revision=1, result_revision=1, mirror=False)
     served, feeding = sessions
-    heard = Heard(served)
+    heard = Listener(served, samples_from_batches=True)
     station_file = bridge_station_file(tmp_path, controller.port, "tcp/127.0.0.1:1")
     bridge = RunningBridge(station_file, feeding)
     try:
@@ -113,7 +114,7 @@ def test_garbage_wrong_lengths_and_a_value_out_of_range_are_counted_and_nothing_
     tmp_path: Path, controller: TcpController, sessions: tuple[zenoh.Session, zenoh.Session]
 ) -> None:
     served, feeding = sessions
-    heard = Heard(served)
+    heard = Listener(served, samples_from_batches=True)
     station_file = bridge_station_file(tmp_path, controller.port, "tcp/127.0.0.1:1")
     bridge = RunningBridge(station_file, feeding)
     try:
@@ -144,7 +145,7 @@ def test_a_link_dropped_mid_trace_loses_no_result(
     tmp_path: Path, controller: TcpController, sessions: tuple[zenoh.Session, zenoh.Session]
 ) -> None:
     served, feeding = sessions
-    heard = Heard(served)
+    heard = Listener(served, samples_from_batches=True)
     station_file = bridge_station_file(tmp_path, controller.port, "tcp/127.0.0.1:1")
     bridge = RunningBridge(station_file, feeding, trace_timeout_s=0.5)
     try:
@@ -167,7 +168,7 @@ def test_a_controller_whose_ids_start_again_gets_run_ids_after_the_last(
     tmp_path: Path, sessions: tuple[zenoh.Session, zenoh.Session]
 ) -> None:
     served, feeding = sessions
-    heard = Heard(served)
+    heard = Listener(served, samples_from_batches=True)
     first = TcpController()
     station_file = bridge_station_file(tmp_path, first.port, "tcp/127.0.0.1:1")
     bridge = RunningBridge(station_file, feeding)

@@ -13,8 +13,9 @@ import pytest
 import zenoh
 
 from services.predictor.service import PredictorService
-from shared.contract import PredictorStats, RunSummary, Sample, StopDecision, codec, keys
+from shared.contract import PredictorStats, RunSummary, StopDecision, codec, keys
 from shared.runtime import zenoh_config
+from tests.support.factories import sample
 from tests.support.live_predictor import (
     PROGRAM_OF,
     START_NS,
@@ -70,8 +71,7 @@ def test_deep_nesting_and_impossible_times_are_counted_and_the_next_run_is_decid
             feed.tool.put(payload)
         for time_ns in (-1, 10**30):  # times no clock can hold: 0 to 2**63 - 1 ns
             feed.state(41, PROGRAM_OF["pt1"], "running", time_ns)
-            sample = Sample("pt1", 41, 0, time_ns, 1.0, 1.0, 1.0)
-            feed.samples.put(codec.encode(sample))
+            feed.samples.put(codec.encode(sample(41, 0, station="pt1", time_ns=time_ns)))
         play_run(feed, 42)
         by_key = collect(received, until={"pt1/runs"}, timeout_s=15.0)
         deadline = time.monotonic() + 5.0  # the next PredictorStats after the run

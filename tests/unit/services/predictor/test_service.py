@@ -7,8 +7,6 @@ pt3 is on the same zenoh network but not served (:mod:`.live_predictor`).
 
 from __future__ import annotations
 
-import time
-
 import pytest
 import zenoh
 
@@ -17,7 +15,6 @@ from shared.config import LoadedStation
 from shared.contract import (
     Intensity,
     RunSummary,
-    Sample,
     StickSlipEvent,
     StopDecision,
     TighteningResult,
@@ -27,6 +24,7 @@ from shared.contract import (
 )
 from shared.errors import ConfigError
 from shared.runtime import ServiceSkeleton, zenoh_config
+from tests.support.factories import sample
 from tests.support.live_predictor import (
     PROGRAM_OF,
     START_NS,
@@ -34,6 +32,7 @@ from tests.support.live_predictor import (
     collect,
     wait_for_token,
 )
+from tests.support.live_recorder import wait_until
 from tests.support.synthetic_runs import SyntheticTrace, staircase
 
 
@@ -123,11 +122,9 @@ def test_a_sample_naming_another_station_is_ignored(
     with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
         wait_for_token(session, keys.health_key("pt1", "predictor"))
         feed = StationFeed(session, "pt1")
-        wrong = Sample("pt2", 42, 0, START_NS, 1.0, 0.0, 1.0)
+        wrong = sample(42, 0, station="pt2", time_ns=START_NS)
         feed.samples.put(codec.encode(wrong))
-        deadline = time.monotonic() + 10.0
-        while service.bad_payloads == 0 and time.monotonic() < deadline:
-            time.sleep(0.02)
+        wait_until(lambda: service.bad_payloads > 0, "the sample counted bad", 10.0)
         feed.close()
     assert service.bad_payloads == 1
     assert service.dropped_samples == 0
@@ -156,9 +153,7 @@ def test_a_run_whose_end_never_arrived_is_forgotten_when_the_next_starts(
             feed.sample(41, i, row)
         feed.state(42, PROGRAM_OF["pt1"], "running", START_NS + 3_000_000_000)
         feed.sample(41, 50, rows[50])  # late: run 41 is gone
-        deadline = time.monotonic() + 10.0
-        while service.dropped_samples == 0 and time.monotonic() < deadline:
-            time.sleep(0.02)
+        wait_until(lambda: service.dropped_samples > 0, "the late sample dropped", 10.0)
         feed.close()
     assert service.unfinished_runs == 1
     assert service.dropped_samples == 1

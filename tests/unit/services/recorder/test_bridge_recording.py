@@ -36,6 +36,7 @@ from shared.wear import (
 )
 from shared.wear import COLUMNS as LEDGER_COLUMNS
 from shared.wear import CONTRACT_LIMITS as LIMITS
+from tests.support import factories
 from tests.support.fuzz.payloads import template
 from tests.support.live_recorder import RunningRecorder, publish, wait_until
 
@@ -51,11 +52,23 @@ def tool_data(time_ns: int = T0_NS, **changes: object) -> ToolData:
 
 
 def summary(run_id: int, intensity: float, station: str = "st1") -> RunSummary:
+    """A bridge's run to 1.4 Nm (no force sensor), ended ``run_id`` seconds after T0."""
     ended = T0_NS + run_id * S_NS
-    return RunSummary(
-        station, run_id, 7, 1, "done", None, 1.4, None, 1.42, 1.4, 4, None, intensity, 500,
-        ended - S_NS // 2, ended,
-    )  # fmt: skip
+    return factories.summary(
+        run_id,
+        station=station,
+        target_force_n=None,
+        target_torque_nm=1.4,
+        reached_force_n=None,
+        reached_torque_nm=1.42,
+        error_pct=1.4,
+        events=4,
+        stop_reason=None,
+        process_intensity=intensity,
+        samples=500,
+        started_ns=ended - S_NS // 2,
+        ended_ns=ended,
+    )
 
 
 def test_a_bridges_messages_are_recorded_with_their_schemas_and_its_tool_in_the_ledger(

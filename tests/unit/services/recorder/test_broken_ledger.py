@@ -27,11 +27,13 @@ import zenoh
 
 from services.cli.main import main
 from shared.config import LoadedStation
-from shared.contract import RecorderStats, RunSummary, Sample, ToolState, channels, decode
+from shared.contract import Sample, ToolState, channels
 from shared.runtime import zenoh_config
 from shared.wear import CONTRACT_LIMITS, WearLedger
+from tests.support.factories import summary
+from tests.support.listener import Listener
 from tests.support.live_recorder import RunningRecorder, publish, wait_until
-from tests.support.paths import REPO
+from tests.support.router_process import boltwatch
 
 T0_NS = 1_700_000_000_000_000_000
 SAMPLES = 50
@@ -47,11 +49,16 @@ def run_messages(run_id: int) -> list[tuple[str, Any]]:
         for n in range(SAMPLES)
     ]
     out.append(("tool", ToolState("st1", run_id, 7, 1, "done", end)))
-    summary = RunSummary(
-        "st1", run_id, 7, 1, "done", 56e3, None, 1.05e4, 99.0, -81.0, 4, None,
-        0.5 * run_id, SAMPLES, t, end,
-    )  # fmt: skip
-    return [*out, ("runs", summary)]
+    run = summary(
+        run_id,
+        events=4,
+        stop_reason=None,
+        process_intensity=0.5 * run_id,
+        samples=SAMPLES,
+        started_ns=t,
+        ended_ns=end,
+    )
+    return [*out, ("runs", run)]
 
 
 def healthy_ledger(path: Path, runs: int = 3) -> None:
@@ -111,10 +118,7 @@ def test_boltwatch_wear_says_what_is_wrong_in_one_line(
 
 def reset(recordings: Path) -> subprocess.CompletedProcess[str]:
     """``boltwatch wear reset`` in its own process, as an operator runs it."""
-    return subprocess.run(
-        [sys.executable, "-m", "services.cli", "wear", "reset", "--recordings", str(recordings)],
-        capture_output=True, text=True, cwd=REPO, timeout=60, check=False,
-    )  # fmt: skip
+    return boltwatch("wear", "reset", "--recordings", str(recordings), timeout_s=60)
 
 
 @pytest.mark.parametrize("kind", list(BREAKS), ids=list(BREAKS))
@@ -196,12 +200,8 @@ def test_the_recorder_records_on_and_counts_the_waiting_runs_once_reset(
         breaks[when.split(maxsplit=1)[0]](ledger_file)
     recorder = RunningRecorder(station)
     session = zenoh.open(zenoh_config("peer", connect=station.config.zenoh.listen))
-    stats: list[RecorderStats] = []
     try:
-        subscriber = session.declare_subscriber(
-            channels.RECORDER.key("st1"),
-            lambda sample: stats.append(decode(RecorderStats, sample.payload.to_bytes())),
-        )
+        heard = Listener(session, "st1", (channels.RECORDER.topic,))
         wear = recorder.service.wear
         assert wear is not None
         if when == "emptied while running":
@@ -211,8 +211,10 @@ def test_the_recorder_records_on_and_counts_the_waiting_runs_once_reset(
         for run_id in (2, 3):
             publish(session, run_messages(run_id))
         wait_until(lambda: wear.waiting == 2, "the summaries waiting")
-        wait_until(lambda: any(s.waiting_summaries == 2 for s in stats), "RecorderStats")
-        last = stats[-1]
+        wait_until(
+            lambda: any(s.waiting_summaries == 2 for s in heard.of("recorder")), "RecorderStats"
+        )
+        last = heard.of("recorder")[-1]
         assert last.recording and last.last_error is not None
         assert last.last_error.startswith(f"wear ledger: {ledger_file}: not a usable wear ledger")
         assert "boltwatch wear reset" in last.last_error
@@ -222,10 +224,12 @@ def test_the_recorder_records_on_and_counts_the_waiting_runs_once_reset(
         done = reset(recordings)
         assert done.returncode == 0, done.stderr
         wait_until(lambda: wear.waiting == 0, "the waiting runs in the new ledger")
-        wait_until(lambda: any(s.last_error is None for s in stats[-2:]), "RecorderStats")
+        wait_until(
+            lambda: any(s.last_error is None for s in heard.of("recorder")[-2:]), "RecorderStats"
+        )
         publish(session, run_messages(4))
         wait_until(lambda: wear.counted == (4 if when == "emptied while running" else 3), "run 4")
-        subscriber.undeclare()
+        heard.close()
     finally:
         session.close()
         recorder.finish()

@@ -23,6 +23,7 @@ from shared.contract import (
     decode,
     encode,
 )
+from tests.support import factories
 from tests.support.live_recorder import (
     RunningRecorder,
     has_subscribers,
@@ -47,14 +48,15 @@ def station(tmp_path: Path, endpoint: str) -> LoadedStation:
 
 def result(run_id: int, time_ns: int, force_n: float, verdict: Verdict = "OK") -> TighteningResult:
     """A result of program 1: torque and angle steady, the given preload, the given verdict."""
-    torque = JudgedFigure(210.0 + 0.1 * (run_id % 3), *TORQUE, "ok")
-    angle = JudgedFigure(47.0 + 0.05 * (run_id % 2), ANGLE_MIN, None, "ok")
-    force = JudgedFigure(force_n, *FORCE, "ok" if verdict == "OK" else "low")
-    reasons = "" if verdict == "OK" else f"preload low: {force_n:.1f}"
-    return TighteningResult(
-        "st1", run_id, run_id, 7, 1, "P1", time_ns, None, None, torque, angle, force,
-        verdict, reasons, None, 40, 1e6, "predictor",
-    )  # fmt: skip
+    return factories.result(
+        run_id,
+        time_ns=time_ns,
+        final_torque_nm=JudgedFigure(210.0 + 0.1 * (run_id % 3), *TORQUE, "ok"),
+        final_angle_deg=JudgedFigure(47.0 + 0.05 * (run_id % 2), ANGLE_MIN, None, "ok"),
+        final_force_n=JudgedFigure(force_n, *FORCE, "ok" if verdict == "OK" else "low"),
+        result=verdict,
+        nok_reasons="" if verdict == "OK" else f"preload low: {force_n:.1f}",
+    )
 
 
 def cpk(values: list[float], low: float, high: float) -> float:

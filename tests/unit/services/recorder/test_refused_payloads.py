@@ -20,8 +20,9 @@ import zenoh
 from mcap.reader import make_reader
 
 from shared.config import LoadedStation
-from shared.contract import RunSummary, Sample, StopDecision, ToolState, channels, encode, keys
+from shared.contract import Sample, StopDecision, ToolState, channels, encode, keys
 from shared.recordings.mcap import RAW_ENCODING
+from tests.support.factories import sample, summary
 from tests.support.live_recorder import RunningRecorder, publish, wait_until
 from tests.support.recorded_runs import recorded_files
 
@@ -38,24 +39,29 @@ def live_run(t0_ns: int, samples: int) -> tuple[list[tuple[str, Any]], list[tupl
         for n in range(samples)
     ]
     end_ns = t0_ns + samples * MS_NS
-    summary = RunSummary(
-        "st1", RUN, 7, 1, "done", 56_000.0, None, 55_000.0, 120.0, -1.8, 0, None, 1.5,
-        samples, t0_ns, end_ns,
-    )  # fmt: skip
-    rest = [("tool", ToolState("st1", RUN, 7, 1, "done", end_ns)), ("runs", summary)]
+    run = summary(
+        RUN,
+        events=0,
+        stop_reason=None,
+        process_intensity=1.5,
+        samples=samples,
+        started_ns=t0_ns,
+        ended_ns=end_ns,
+    )
+    rest = [("tool", ToolState("st1", RUN, 7, 1, "done", end_ns)), ("runs", run)]
     half = samples // 2
     return start + rows[:half], rows[half:] + rest
 
 
 def hostile(t0_ns: int) -> list[tuple[str, bytes]]:
     """The issue's probes, each a payload that must not reach a typed channel as it is."""
-    sample = Sample("st1", RUN, 9999, t0_ns, 1.0, 1.0, 1.0)
+    ahead = sample(RUN, 9999, time_ns=t0_ns)
     decision = StopDecision("st1", RUN, t0_ns, 0.1, "plateau_closest", "", 1.0, None, None, t0_ns)
     return [
         ("tool", encode(ToolState("st1", RUN, 7, 1, "running", -1))),
         ("tool", encode(ToolState("st1", RUN, 7, 1, "running", 10**30))),
-        ("samples", encode(Sample("st1", RUN, 9999, -1, 1.0, 1.0, 1.0))),
-        ("samples", encode(Sample("st1", RUN, 9999, 10**30, 1.0, 1.0, 1.0))),
+        ("samples", encode(sample(RUN, 9999, time_ns=-1))),
+        ("samples", encode(sample(RUN, 9999, time_ns=10**30))),
         (
             "decision",
             encode(
@@ -67,7 +73,7 @@ def hostile(t0_ns: int) -> list[tuple[str, bytes]]:
         ("runs", b'{"a":' * 10_000),
         (
             "samples",
-            json.dumps({**json.loads(encode(sample)), "time_ns": t0_ns + HOUR_NS}).encode(),
+            json.dumps({**json.loads(encode(ahead)), "time_ns": t0_ns + HOUR_NS}).encode(),
         ),
         ("decision", encode(decision).replace(b'"time_ns":', b'"time_ns":1', 1)),  # ~years ahead
     ]

@@ -10,8 +10,9 @@ from mcap.reader import make_reader
 
 from services.recorder.live.run_files import FileLimits, StationFiles
 from shared.config import LoadedStation
-from shared.contract import BusStats, RunSummary, Sample, ToolState, encode
+from shared.contract import BusStats, ToolState, encode
 from shared.recordings import FileMetadata, classify, file_path
+from tests.support import factories
 
 T0_NS = 1_700_000_000_000_000_000  # 2023-11-14T22:13:20Z
 SECOND_NS = 1_000_000_000
@@ -25,7 +26,9 @@ def tool(run_id: int, state: str, t_ns: int) -> bytes:
 
 
 def sample(run_id: int, n: int, t_ns: int) -> bytes:
-    return encode(Sample("st1", run_id, n, t_ns, 1.0, 2.0, None))
+    return encode(
+        factories.sample(run_id, n, time_ns=t_ns, torque_nm=1.0, angle_deg=2.0, force_n=None)
+    )
 
 
 def bus(t_ns: int) -> bytes:
@@ -34,11 +37,7 @@ def bus(t_ns: int) -> bytes:
 
 
 def summary(run_id: int, t_ns: int) -> bytes:
-    return encode(
-        RunSummary(
-            "st1", run_id, 7, 2, "done", 1.0, None, 1.0, 1.0, 0.0, 0, None, 0.0, 1, t_ns, t_ns
-        )
-    )
+    return encode(factories.summary(run_id, program_id=2, started_ns=t_ns, ended_ns=t_ns))
 
 
 def feed(files: StationFiles, items: list[tuple[str, bytes, int]]) -> None:

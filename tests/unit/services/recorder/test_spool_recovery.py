@@ -22,31 +22,20 @@ import zenoh
 from mcap.reader import make_reader
 
 from shared.config import LoadedStation
-from shared.contract import SpoolStats, channels, decode, to_dict
+from shared.contract import SpoolStats, channels, to_dict
 from shared.runtime import QueuedPublisher, zenoh_config
 from shared.spool import SpoolFile, StationSpool
+from tests.support.listener import Listener
 from tests.support.live_recorder import RunningRecorder, wait_until
 from tests.support.recorded_runs import run_messages
 
 SAMPLES = 400  # per run: eight batches of samples
 
 
-class SpoolWatch:
-    """The station's spool counters as the line hears them (``boltwatch/st1/spool``)."""
-
-    def __init__(self, session: zenoh.Session) -> None:
-        self.latest: SpoolStats | None = None
-        self._lock = threading.Lock()
-        self._subscriber = session.declare_subscriber(channels.SPOOL.key("st1"), self._on_stats)
-
-    def _on_stats(self, sample: zenoh.Sample) -> None:
-        with self._lock:
-            self.latest = decode(SpoolStats, sample.payload.to_bytes())
-
-    def emptied_through(self, head_seq: int) -> bool:
-        with self._lock:
-            stats = self.latest
-        return stats is not None and stats.head_seq >= head_seq and stats.messages == 0
+def emptied_through(heard: Listener, head_seq: int) -> bool:
+    """The station's spool, as the line hears it, gave ``head_seq`` and holds nothing."""
+    spools: list[SpoolStats] = heard.of(channels.SPOOL.topic)
+    return bool(spools) and spools[-1].head_seq >= head_seq and spools[-1].messages == 0
 
 
 @pytest.fixture
@@ -83,7 +72,7 @@ def test_a_run_put_while_the_recorder_was_down_is_recorded_whole_once_it_is_back
         resend_after_s=0.5,
     )
     publisher = QueuedPublisher(station_session, "st1", batch_samples=batch_samples, spool=spool)
-    watch = SpoolWatch(station_session)
+    heard = Listener(station_session, topics=[channels.SPOOL.topic])
     runs = {run_id: run_messages(run_id, SAMPLES) for run_id in (1, 2, 3, 4)}
     put = 0
 
@@ -97,7 +86,7 @@ def test_a_run_put_while_the_recorder_was_down_is_recorded_whole_once_it_is_back
     recorder = RunningRecorder(station)
     try:
         publish(runs[1])
-        wait_until(lambda: spool.stats().head_seq > 0 and watch.emptied_through(1), "run 1 acked")
+        wait_until(lambda: spool.stats().head_seq > 0 and emptied_through(heard, 1), "run 1 acked")
         recorder.finish()  # the line's recorder is down
         publish(runs[2])
         half = len(runs[3]) // 2
@@ -112,10 +101,11 @@ def test_a_run_put_while_the_recorder_was_down_is_recorded_whole_once_it_is_back
         publisher.call(head.set)
         wait_until(head.is_set, "the last puts")
         head_seq = spool.stats().head_seq
-        wait_until(lambda: watch.emptied_through(head_seq), "the spool emptied", timeout_s=60)
+        wait_until(lambda: emptied_through(heard, head_seq), "the spool emptied", timeout_s=60)
     finally:
         recorder.finish()
         publisher.close()
+        heard.close()
 
     files = read_back(station)
     by_run: dict[int, list[Path]] = defaultdict(list)

@@ -11,6 +11,8 @@ from mcap.reader import make_reader
 
 from shared.config import LoadedStation, load_station
 from shared.contract import RunSummary, ToolState, channels, encode, keys
+from tests.support import factories
+from tests.support.listener import Listener
 from tests.support.live_recorder import (
     RunningRecorder,
     has_subscribers,
@@ -35,12 +37,18 @@ def station(tmp_path: Path, endpoint: str) -> LoadedStation:
 
 
 def summary(run_id: int, intensity: float) -> bytes:
-    return encode(
-        RunSummary(
-            "st1", run_id, 7, 1, "done", 56e3, None, 55e3, 120.0, -1.8, 4, None, intensity,
-            3000, T0_NS + run_id * S_NS, T0_NS + run_id * S_NS + 3 * S_NS,
-        )
-    )  # fmt: skip
+    """Run ``run_id`` as put on zenoh: 3 s from T0 + ``run_id`` s, the tool stopped by itself."""
+    started = T0_NS + run_id * S_NS
+    run = factories.summary(
+        run_id,
+        events=4,
+        stop_reason=None,
+        process_intensity=intensity,
+        samples=3000,
+        started_ns=started,
+        ended_ns=started + 3 * S_NS,
+    )
+    return encode(run)
 
 
 def test_summaries_count_once_and_a_due_tool_raises_an_alert(
@@ -115,13 +123,7 @@ def test_summaries_beyond_their_bound_are_refused_counted_and_said_in_recorder_s
 ) -> None:
     """The issue's probes on a running recorder: negative intensity (-2e9) and 9e11 (random
     frames on the ToolSensors id), a forged 1e15: none in the ledger, each counted."""
-    from shared.contract import RecorderStats, decode
-
-    stats: list[RecorderStats] = []
-    subscriber = publisher_session.declare_subscriber(
-        channels.RECORDER.key("st1"),
-        lambda sample: stats.append(decode(RecorderStats, sample.payload.to_bytes())),
-    )
+    heard = Listener(publisher_session, "st1", (channels.RECORDER.topic,))
     runs = publisher_session.declare_publisher(channels.RUNS.key("st1"))
     wait_until(lambda: has_subscribers(runs), "the recorder")
     for run_id, intensity in ((1, 1.5), (2, -2e9), (3, 9e11), (4, 1e15), (5, 2.5)):
@@ -130,10 +132,10 @@ def test_summaries_beyond_their_bound_are_refused_counted_and_said_in_recorder_s
     assert wear is not None
     wait_until(lambda: wear.counted + sum(wear.refused.values()) == 5, "the summaries")
     assert (wear.counted, dict(wear.refused)) == (2, {"st1": 3})
-    wait_until(lambda: any(s.refused_summaries == 3 for s in stats), "RecorderStats")
+    wait_until(lambda: any(s.refused_summaries == 3 for s in heard.of("recorder")), "RecorderStats")
     replies = list(publisher_session.get(keys.station_key("st1", keys.WEAR), timeout=10))
     assert len(replies) == 1 and replies[0].ok is not None
     (line,) = json.loads(replies[0].ok.payload.to_bytes())["tools"]
     assert (line["runs"], line["total_intensity"]) == (2, 4.0)
-    subscriber.undeclare()
+    heard.close()
     runs.undeclare()

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from services.cli.main import main
-from shared.contract import JudgedFigure, Sample, StickSlipEvent, TighteningResult, encode
+from shared.contract import JudgedFigure, Sample, TighteningResult, encode
 from shared.offline.overlay import (
     Overlay,
     build_figure,
@@ -21,6 +21,7 @@ from shared.offline.overlay import (
 )
 from shared.recordings import classify, file_path
 from shared.recordings.mcap import McapSink
+from tests.support import factories
 from tests.support.station_files import write_station
 
 T0_NS = 1_790_000_000_000_000_000
@@ -32,14 +33,19 @@ def _result(
     run_id: int, program_id: int, verdict: str, windows: tuple[float | None, ...]
 ) -> TighteningResult:
     torque_min, torque_max, angle_min, angle_max, force_min, force_max = windows
-    return TighteningResult(
-        "st1", run_id, run_id, 7, program_id, f"program {program_id}", T0_NS, None, None,
-        JudgedFigure(1.0, torque_min, torque_max, "ok"),
-        JudgedFigure(1.0, angle_min, angle_max, "ok"),
-        JudgedFigure(1.0, force_min, force_max, "ok" if verdict == "OK" else "low"),
-        verdict, "" if verdict == "OK" else "preload low: 1 N, window 2 to 3 N",  # type: ignore[arg-type]
-        "plateau_closest", 1, 1.0, "predictor",
-    )  # fmt: skip
+    return factories.result(
+        run_id,
+        program_id=program_id,
+        program_name=f"program {program_id}",
+        time_ns=T0_NS,
+        final_torque_nm=JudgedFigure(1.0, torque_min, torque_max, "ok"),
+        final_angle_deg=JudgedFigure(1.0, angle_min, angle_max, "ok"),
+        final_force_n=JudgedFigure(1.0, force_min, force_max, "ok" if verdict == "OK" else "low"),
+        result=verdict,
+        nok_reasons="" if verdict == "OK" else "preload low: 1 N, window 2 to 3 N",
+        events=1,
+        process_intensity=1.0,
+    )
 
 
 def _record(
@@ -62,11 +68,13 @@ def _record(
                             float(angle_deg[n]), force, time_s=n / 1e3)  # fmt: skip
             sink.write(classify("boltwatch/st1/samples", encode(sample), t0_ns + n * MS_NS))
         if first_event is not None:
-            event = StickSlipEvent(
-                "st1", run_id, 1, t0_ns + first_event * MS_NS, first_event / 1e3,
-                float(torque_nm[first_event]), None, None, None, None, None, None, None, None,
-                None, None, 0.0,
-            )  # fmt: skip
+            event = factories.event(
+                run_id,
+                1,
+                time_ns=t0_ns + first_event * MS_NS,
+                time_s=first_event / 1e3,
+                peak_torque_nm=float(torque_nm[first_event]),
+            )
             sink.write(classify("boltwatch/st1/events", encode(event), t0_ns + first_event * MS_NS))
         if result is not None:
             sink.write(classify("boltwatch/st1/results", encode(result), t0_ns + 300 * MS_NS))

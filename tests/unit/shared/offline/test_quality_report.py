@@ -15,10 +15,11 @@ import numpy as np
 import pytest
 
 from services.cli.main import main
-from shared.contract import FigureStatus, JudgedFigure, RunSummary, TighteningResult, encode
+from shared.contract import FigureStatus, JudgedFigure, TighteningResult, encode
 from shared.quality import c4, control_chart
 from shared.recordings import classify, file_path
 from shared.recordings.mcap import McapSink
+from tests.support import factories
 from tests.support.live_recorder import write_station_file
 
 DAY1_NS = int(datetime(2026, 3, 2, 8, 0, tzinfo=UTC).timestamp() * 1e9)
@@ -50,22 +51,41 @@ def _result(
     reasons = [
         f"{name} {j.status}: {j.value:.1f}" for name, j in judged if j.status in ("low", "high")
     ]
-    return TighteningResult(
-        "st1", run_id, run_id, tool, program, f"P{program}", time_ns, None, None, t, a, f,
-        "NOK" if reasons else "OK", "; ".join(reasons),
-        "plateau_closest" if run_id % 3 else None, int(events), intensity, "predictor",
-    )  # fmt: skip
+    return factories.result(
+        run_id,
+        tool_id=tool,
+        program_id=program,
+        program_name=f"P{program}",
+        time_ns=time_ns,
+        final_torque_nm=t,
+        final_angle_deg=a,
+        final_force_n=f,
+        result="NOK" if reasons else "OK",
+        nok_reasons="; ".join(reasons),
+        stop_reason="plateau_closest" if run_id % 3 else None,
+        events=int(events),
+        process_intensity=intensity,
+    )
 
 
 def _write_run(folder: Path, result: TighteningResult) -> None:
     path = file_path(folder, "st1", result.run_id, result.time_ns)
     path.parent.mkdir(parents=True, exist_ok=True)
-    summary = RunSummary(
-        "st1", result.run_id, result.tool_id, result.program_id, "done", 56000.0, None,
-        result.final_force_n.value, result.final_torque_nm.value or 0.0, 0.1,
-        result.events or 0, result.stop_reason, result.process_intensity or 0.0, 10,
-        result.time_ns - 10**9, result.time_ns,
-    )  # fmt: skip
+    summary = factories.summary(
+        result.run_id,
+        tool_id=result.tool_id,
+        program_id=result.program_id,
+        target_torque_nm=None,
+        reached_force_n=result.final_force_n.value,
+        reached_torque_nm=result.final_torque_nm.value or 0.0,
+        error_pct=0.1,
+        events=result.events or 0,
+        stop_reason=result.stop_reason,
+        process_intensity=result.process_intensity or 0.0,
+        samples=10,
+        started_ns=result.time_ns - 10**9,
+        ended_ns=result.time_ns,
+    )
     with McapSink(path, {"station": {"station": "st1"}}, result.run_id, result.time_ns) as sink:
         sink.write(classify("boltwatch/st1/results", encode(result), result.time_ns))
         sink.write(classify("boltwatch/st1/runs", encode(summary), result.time_ns))

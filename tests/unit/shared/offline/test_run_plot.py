@@ -13,6 +13,7 @@ from shared.contract import Prediction, Sample, StickSlipEvent, StopDecision, en
 from shared.offline.post_mortem import build_figure, plateau_bars, prediction_errors, read_run
 from shared.recordings import classify, flatten
 from shared.recordings.mcap import McapSink
+from tests.support import factories
 from tests.support.paths import JOINT_5_2
 
 T0_NS = 1_700_000_000_000_000_000
@@ -129,10 +130,16 @@ def test_report_has_the_papers_panels_with_bounds(tmp_path: Path) -> None:
 
 def _event(index: int, time_s: float, torque_nm: float, force_n: float, period_s: float | None,
            predictions: list[Prediction]) -> StickSlipEvent:  # fmt: skip
-    return StickSlipEvent(
-        "st1", 1, index, T0_NS + round(time_s * 1e9), time_s, torque_nm, None, None, force_n,
-        None, period_s, None, None, None, None, None, 0.0, predictions,
-    )  # fmt: skip
+    return factories.event(
+        1,
+        index,
+        time_ns=T0_NS + round(time_s * 1e9),
+        time_s=time_s,
+        peak_torque_nm=torque_nm,
+        plateau_force_n=force_n,
+        period_s=period_s,
+        predictions=predictions,
+    )
 
 
 def test_every_error_is_measured_minus_predicted() -> None:

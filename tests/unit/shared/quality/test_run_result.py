@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import replace
 from typing import Any
 
 import pytest
@@ -12,6 +11,7 @@ import pytest
 from shared.config import Program
 from shared.contract import RunSummary, TighteningResult, decode, encode
 from shared.quality import tightening_result
+from tests.support import factories
 
 WINDOWS = {
     "torque_min_nm": 180.0,
@@ -24,41 +24,26 @@ WINDOWS = {
 
 
 def program(**windows: float) -> Program:
-    return Program(
-        id=1,
-        name="M14 to 56 kN",
-        target_force_n=56000.0,
-        target_torque_nm=200.0,
-        motor_speed_rad_s=0.5,
-        max_torque_nm=320.0,
-        max_force_n=75000.0,
-        max_angle_deg=150.0,
-        max_time_s=6.0,
-        **windows,
-    )
+    return factories.program(name="M14 to 56 kN", **windows)
 
 
 def summary(**changes: Any) -> RunSummary:
-    base = RunSummary(
-        station="st1",
-        run_id=1795272477,
-        tool_id=7,
-        program_id=1,
-        tool_state="done",
-        target_force_n=56000.0,
-        target_torque_nm=200.0,
-        reached_force_n=56100.0,
-        reached_torque_nm=201.5,
-        reached_angle_deg=61.0,
-        error_pct=0.18,
-        events=41,
-        stop_reason="plateau_closest",
-        process_intensity=1.03e6,
-        samples=1677,
-        started_ns=1_700_000_000_000_000_000,
-        ended_ns=1_700_000_001_700_000_000,
-    )
-    return replace(base, **changes)
+    """The run these tests judge: a simulated run of program 1 (README's table)."""
+    run: dict[str, Any] = {
+        "tool_id": 7,
+        "program_id": 1,
+        "reached_force_n": 56100.0,
+        "reached_torque_nm": 201.5,
+        "reached_angle_deg": 61.0,
+        "error_pct": 0.18,
+        "events": 41,
+        "stop_reason": "plateau_closest",
+        "process_intensity": 1.03e6,
+        "samples": 1677,
+        "started_ns": 1_700_000_000_000_000_000,
+        "ended_ns": 1_700_000_001_700_000_000,
+    }
+    return factories.summary(1795272477, **{**run, **changes})
 
 
 def test_a_run_in_every_window_is_ok_with_its_figures_windows_and_run() -> None:

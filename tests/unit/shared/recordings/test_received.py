@@ -14,8 +14,6 @@ from typing import Any
 
 from shared.contract import (
     Intensity,
-    RunSummary,
-    Sample,
     SampleBatch,
     StickSlipEvent,
     ToolState,
@@ -24,10 +22,13 @@ from shared.contract import (
     to_dict,
 )
 from shared.recordings import MAX_AHEAD_S, OTHER_STATION, classify
+from tests.support import factories
 from tests.support.fuzz.payloads import template
 
 T_NS = 1_700_000_000_000_000_000
-SAMPLE = Sample("st4", 9, 33, T_NS + 5, 80.0, 12.5, None)
+SAMPLE = factories.sample(
+    9, 33, station="st4", time_ns=T_NS + 5, torque_nm=80.0, angle_deg=12.5, force_n=None
+)
 
 
 def test_a_sample_is_filed_by_station_run_sequence_and_its_own_time() -> None:
@@ -56,13 +57,10 @@ def test_run_start_summary_and_nested_events() -> None:
         T_NS,
     )
     assert running.run_started and running.publish_time_ns == T_NS + 1
-    summary = RunSummary("st4", 9, 1, 2, "done", None, 9.0, None, 8.0, -1.0, 0, None, 0.0, 5, 6, 7)
+    summary = factories.summary(9, station="st4", started_ns=6, ended_ns=7)
     filed = classify(channels.RUNS.key("st4"), encode(summary), T_NS)
     assert filed.message == summary and filed.publish_time_ns == 7  # ended_ns
-    event = StickSlipEvent(
-        "st4", 9, 1, T_NS + 3, 0.1, 50.0, None, None, None, None, None, None, None, None,
-        None, None, 0.0, [],
-    )  # fmt: skip
+    event = factories.event(9, 1, station="st4", time_ns=T_NS + 3)
     nested = classify(channels.EVENTS.key("st4"), encode(event), T_NS)
     assert nested.message == event and nested.run_id == 9
 

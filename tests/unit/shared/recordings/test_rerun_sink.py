@@ -8,7 +8,6 @@ read back with :class:`rerun.chunk.RrdReader`.
 from __future__ import annotations
 
 import signal
-import socket
 import subprocess
 import sys
 import warnings
@@ -19,7 +18,6 @@ from typing import Any
 
 import pytest
 from rerun.chunk import RrdReader
-from tests.support.recorded_runs import T0_NS, run_messages
 
 from services.cli.main import main
 from services.cli.station_supervisor import stop_process
@@ -30,7 +28,8 @@ from shared.contract import Prediction, StickSlipEvent, encode, keys
 from shared.recordings import FileMetadata, Received, classify
 from shared.recordings.rerun import BLUEPRINT_FILE, RerunLive, RerunOptions, RerunSink
 from shared.recordings.rerun import rerun_blueprint as bp
-from tests.support.live_recorder import wait_until, write_station_file
+from tests.support.live_recorder import free_port, wait_until, write_station_file
+from tests.support.recorded_runs import T0_NS, run_messages
 
 RERUN_CLI = Path(sys.executable).parent / "rerun"
 SAMPLES = 1234  # not a multiple of the batch: the tail goes out at close
@@ -246,13 +245,6 @@ def test_boltwatch_recover_takes_a_cut_rrd(
     assert args.handler(args) == 0
     verify(tmp_path / "cut.recovered.rrd")
     assert "Missing RRD footer" in capsys.readouterr().out
-
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port: int = probe.getsockname()[1]
-        return port
 
 
 def test_live_only_streams_every_sample_to_the_viewer_and_writes_no_file(

@@ -2,23 +2,9 @@
 
 from __future__ import annotations
 
-import dataclasses
-
-from shared.contract import Intensity, Sample, StickSlipEvent
+from shared.contract import Intensity
 from shared.runtime import BATCH_PERIOD_S, MAX_BATCH_SAMPLES, SampleBatching
-from tests.support.fuzz.payloads import template
-
-T0_NS = 1_700_000_000_000_000_000
-MS_NS = 1_000_000
-
-
-def sample(run_id: int, n: int) -> Sample:
-    return Sample("st1", run_id, n, T0_NS + n * MS_NS, 10.0, 1.0, 2e4)
-
-
-def event(run_id: int, index: int) -> StickSlipEvent:
-    found: StickSlipEvent = template("events", "st1", T0_NS + index * MS_NS, run_id)
-    return dataclasses.replace(found, index=index)
+from tests.support.factories import MS, T0, event, sample
 
 
 def test_a_batch_goes_when_due_full_or_at_a_new_run() -> None:
@@ -39,7 +25,7 @@ def test_events_and_intensities_ride_in_the_batch_of_their_run_after_its_samples
     assert not batching.add_found(event(1, 1))  # no batch in progress: it goes alone
     batching.add(sample(1, 0), 0.0)
     assert not batching.add_found(event(2, 1))  # not this batch's run
-    figures = Intensity("st1", 1, T0_NS + MS_NS, 0.5, 0.5)
+    figures = Intensity("st1", 1, T0 + MS, 0.5, 0.5)
     assert batching.add_found(event(1, 1)) and batching.add_found(figures)
     batching.add(sample(1, 1), 0.001)
     batch = batching.take()

@@ -10,27 +10,12 @@ from __future__ import annotations
 
 import pytest
 
-from shared.config import Program, RigSection
+from shared.config import RigSection
 from shared.model import JointConstants, expected_constant_bands
 from shared.stickslip import MIN_STICK_SHARE, ModelBandCheck
-from tests.support.model_band_runs import TRACE_JOINT, rig_decision
+from tests.support.model_band_runs import TRACE_JOINT, drawn_program, rig_decision
 
 SPEED_RAD_S = 0.5
-
-
-def benchmark_program(speed_rad_s: float, target_n: float, max_time_s: float) -> Program:
-    """The accuracy benchmark's program of a drawn joint (draw_joint)."""
-    return Program(
-        id=1,
-        name="bench",
-        target_force_n=target_n,
-        motor_speed_rad_s=speed_rad_s,
-        start_force_n=0.25 * target_n,
-        max_torque_nm=10_000.0,
-        max_force_n=3.0 * target_n,
-        max_angle_deg=1e6,
-        max_time_s=max_time_s,
-    )
 
 
 # (k_e, k_s, r, mu_stick, mu_slip, speed, target, max_time_s, rig seed): benchmark draws
@@ -55,7 +40,7 @@ FALSE_STOP_JOINTS = {
 def test_the_benchmarks_false_stops_are_gone(name: str, torque_only: bool) -> None:
     k_e, k_s, r, mu_stick, mu_slip, speed, target, max_time_s, seed = FALSE_STOP_JOINTS[name]
     joint = JointConstants(k_e, k_s, r, mu_stick, mu_slip)
-    program = benchmark_program(speed, target, max_time_s)
+    program = drawn_program(speed, target, max_time_s)
     decision = rig_decision(joint, program, RigSection(), torque_only, seed)
     assert decision is not None, "no stop"
     assert decision.reason != "constant_out_of_band", decision.detail

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -21,6 +21,7 @@ from services.cli.main import main
 from shared.config import load_station
 from shared.contract import RunSummary
 from shared.wear import F_SS_MAX_HZ, RefusedSummaryError, StationLimits, WearLedger, refusal
+from tests.support import factories
 from tests.support.live_recorder import write_station_file
 from tests.support.paths import HANDBOOK_REAL_RUNS, PROJECT_REAL_RUNS
 
@@ -29,13 +30,20 @@ S_NS = 1_000_000_000
 T_LIM_NM = 320.0  # program 1 of config/station.toml
 
 
-def simulated_run(**changes: object) -> RunSummary:
+def simulated_run(**changes: Any) -> RunSummary:
     """A run of program 1 as the simulated station makes them (``make run``'s table)."""
-    run = RunSummary(
-        "st1", 1795272478, 7, 1, "done", 56e3, 200.0, 55.93e3, 201.0, -0.12, 41,
-        "plateau_closest", 1.03e6, 1677, T0_NS, T0_NS + 1_676_400_000,
-    )  # fmt: skip
-    return replace(run, **changes)  # type: ignore[arg-type]
+    run: dict[str, Any] = {
+        "run_id": 1795272478,
+        "reached_force_n": 55.93e3,
+        "reached_torque_nm": 201.0,
+        "error_pct": -0.12,
+        "events": 41,
+        "process_intensity": 1.03e6,
+        "samples": 1677,
+        "started_ns": T0_NS,
+        "ended_ns": T0_NS + 1_676_400_000,
+    }
+    return factories.summary(**{**run, **changes})
 
 
 @pytest.fixture

@@ -12,17 +12,25 @@ from shared.contract import RunSummary
 from shared.errors import InputError
 from shared.wear import CONTRACT_LIMITS as LIMITS
 from shared.wear import WearLedger, ledger_path
+from tests.support import factories
 
 T0_NS = 1_700_000_000_000_000_000
 S_NS = 1_000_000_000
 
 
 def summary(run_id: int, intensity: float, tool_id: int = 7, station: str = "st1") -> RunSummary:
+    """A half-second run ended ``run_id`` seconds after T0."""
     ended = T0_NS + run_id * S_NS
-    return RunSummary(
-        station, run_id, tool_id, 1, "done", 56e3, None, 55e3, 120.0, -1.8, 4,
-        "plateau_closest", intensity, 500, ended - S_NS // 2, ended,
-    )  # fmt: skip
+    return factories.summary(
+        run_id,
+        station=station,
+        tool_id=tool_id,
+        events=4,
+        process_intensity=intensity,
+        samples=500,
+        started_ns=ended - S_NS // 2,
+        ended_ns=ended,
+    )
 
 
 def test_totals_follow_eq_69_and_worst_runs_lead(tmp_path: Path) -> None:

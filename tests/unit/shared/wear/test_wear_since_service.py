@@ -17,6 +17,7 @@ import pytest
 from shared.contract import RunSummary
 from shared.wear import ADDED_SINCE, WearLedger
 from shared.wear import CONTRACT_LIMITS as LIMITS
+from tests.support import factories
 
 T0_NS = 1_700_000_000_000_000_000
 S_NS = 1_000_000_000
@@ -24,10 +25,17 @@ TOOLS = (7, 8, 9)
 
 
 def summary(run_id: int, tool_id: int, ended_ns: int, intensity: float) -> RunSummary:
-    return RunSummary(
-        f"st{tool_id}", run_id, tool_id, 1, "done", 56e3, None, 55e3, 120.0, -1.8, 4,
-        "plateau_closest", intensity, 500, ended_ns - S_NS // 2, ended_ns,
-    )  # fmt: skip
+    """A half-second run of ``tool_id`` at its own station."""
+    return factories.summary(
+        run_id,
+        station=f"st{tool_id}",
+        tool_id=tool_id,
+        events=4,
+        process_intensity=intensity,
+        samples=500,
+        started_ns=ended_ns - S_NS // 2,
+        ended_ns=ended_ns,
+    )
 
 
 def agrees(ledger: WearLedger, tool_id: int) -> None:

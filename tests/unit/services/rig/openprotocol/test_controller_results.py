@@ -4,8 +4,6 @@ curves, alarms (issue 18 §3)."""
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable
 from pathlib import Path
 
 from shared.openprotocol import (
@@ -31,6 +29,7 @@ from shared.openprotocol import (
     timestamp_ns,
     trace_extra_data,
 )
+from tests.support.live_recorder import wait_until
 from tests.support.simulated_controller import (
     FIRST_ID,
     RawIntegrator,
@@ -75,7 +74,7 @@ def test_each_result_is_pushed_with_its_curves_and_the_next_waits_for_the_ack(
                 assert 0 <= ended_s - timestamp_ns(torque.timestamp) / 1e9 <= run_s + 1
                 results.append(result)
                 integrator.send(ResultAcknowledge())
-            eventually(lambda: controller.state.counters.results_acked == 3)
+            wait_until(lambda: controller.state.counters.results_acked == 3, "3 results acked", 5.0)
         ids = [r.tightening_id for r in results]
         assert ids == [FIRST_ID, FIRST_ID + 1, FIRST_ID + 2]
         # program 2 has no windows: the hard limits are the windows, every run OK
@@ -128,7 +127,7 @@ def test_results_are_kept_while_nobody_is_connected_and_served_by_id(tmp_path: P
     station = write_controller_station(tmp_path, rig={"results_kept": 2})
     with running_controller(station, runs=3) as controller:
         # the tool works alone, at its own pace
-        eventually(lambda: controller.state.counters.tightenings == 3, timeout_s=20.0)
+        wait_until(lambda: controller.state.counters.tightenings == 3, "3 tightenings", 20.0)
         with RawIntegrator(controller.server.port) as integrator:
             integrator.request(CommunicationStart())
             newest = integrator.request(OldResultRequest(tightening_id=0))
@@ -167,10 +166,3 @@ def test_a_run_on_a_hard_limit_is_nok_and_raises_an_alarm(tmp_path: Path) -> Non
                 assert isinstance(status, AlarmStatus)
                 assert status.alarm_active and status.error_code == "E104"
         assert controller.state.counters.alarms == 1
-
-
-def eventually(condition: Callable[[], bool], timeout_s: float = 5.0) -> None:
-    deadline = time.monotonic() + timeout_s
-    while not condition():
-        assert time.monotonic() < deadline, "the condition never held"
-        time.sleep(0.02)

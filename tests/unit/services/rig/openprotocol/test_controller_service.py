@@ -3,32 +3,16 @@ across restarts."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 from services.rig.openprotocol.tightening_counter import TighteningCounter
-from tests.support.paths import REPO, STATION_FILE
+from tests.support.paths import STATION_FILE
+from tests.support.router_process import boltwatch
 
 
 def test_a_station_without_the_section_is_refused_in_one_line() -> None:
-    result = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "services.cli",
-            "serve",
-            "rig",
-            "--controller",
-            "openprotocol",
-            "--config",
-            str(STATION_FILE),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        cwd=REPO,
-        check=False,
+    result = boltwatch(
+        "serve", "rig", "--controller", "openprotocol", "--config", str(STATION_FILE), timeout_s=60
     )
     assert result.returncode == 2, result.stderr
     lines = [line for line in result.stderr.splitlines() if "openprotocol" in line]
