@@ -145,7 +145,7 @@ class SpoolSection(StrictModel):
         description="its bound (the messages as stored): past it the oldest samples go first",
     )
     drain_messages_per_s: float = Field(
-        default=200.0,
+        default=100.0,
         gt=0,
         le=100_000,
         description="what it sends again at most, a second (a batch of samples is one)",

@@ -12,18 +12,18 @@ Run on demand::
    Reported: spool bytes and messages per run, runs per hour at the rig's
    pace, and so bytes per station-hour (the default ``[spool] max_bytes``
    must hold 8 hours).
-2. **A cut of 10 minutes and of an hour.** What a spool holds after such a cut
-   (step 1's messages, repeated with fresh numbers: time compressed) drained
-   into a live recorder through real zenoh at the default rate
-   (``drain_messages_per_s``) and at a high one: messages per second and the
-   time to empty. The 1-hour drain is extrapolated from the rate measured on
-   the 10-minute one at the default rate (the rate is the bound, not the
-   recorder).
+2. **A cut of 10 minutes and of an hour.** What a spool holds after a
+   10-minute cut (step 1's messages, repeated with fresh numbers: time
+   compressed) drained into a live recorder through real zenoh at
+   ``--rate`` (the default ``drain_messages_per_s``) and at 2000/s:
+   messages per second and the time to empty; an hour's cut is six times
+   that (the rate is the bound, not the recorder).
 3. **A line coming back at once.** ``--stations`` spools, each holding a
-   10-minute cut, drained into one recorder at once, while one more station
-   publishes live: the recorder's lag (its RecorderStats ``lag_p50_ms`` /
-   ``lag_max_ms`` for the live station) during the drain, and the time until
-   every spool is empty.
+   10-minute cut, drained at once at ``--rate`` into a recorder process
+   (``serve recorder``) while a real station (``serve acquisition``, ``serve
+   rig``) tightens live: that station's recorder lag (its RecorderStats'
+   ``lag_p50_ms`` and ``lag_max_ms``) for 20 s before the drain and during
+   it, side by side, and the time until every spool is empty.
 4. **zenoh's AdvancedPublisher cache** (zenoh-ext, the alternative looked at
    first): the process's resident memory for a cache holding step 1's
    messages scaled to an hour (measured on 10 minutes), and whether a
@@ -39,13 +39,10 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import dataclasses
 import json
-import resource
 import statistics
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 
@@ -118,83 +115,130 @@ def spools_empty(heard: Listener, stations: list[str]) -> bool:
 
 
 def drain(
-    folder: Path,
-    messages: list[Spooled],
-    cut_s: float,
-    took_s: float,
-    stations: int,
-    rate: float,
-    live: bool,
-) -> tuple[float, int, dict[str, list[RecorderStats]]]:
-    """Spools of ``stations`` stations each holding ``cut_s`` of step 1, drained into one
-    recorder at ``rate``; (seconds to empty, messages, RecorderStats heard)."""
+    folder: Path, messages: list[Spooled], cut_s: float, took_s: float, rate: float
+) -> tuple[float, int]:
+    """Step 2: one station's spool holding ``cut_s`` of step 1, drained into a recorder (in
+    this process) at ``rate``; (seconds to empty, messages)."""
     endpoint = f"tcp/127.0.0.1:{free_port()}"
-    names = [f"st{n}" for n in range(1, stations + 1)]
-    files = []
-    for name in [*names, *(["live"] if live else [])]:
-        path = write_station_file(folder / f"{name}.toml", folder / "recordings", listen=[endpoint])
-        path.write_text(path.read_text().replace('id = "st1"', f'id = "{name}"'))
-        files.append(load_station(path))
-    repeat = max(1, round(cut_s / took_s))
-    recorder = RunningRecorder(files)
+    path = write_station_file(folder / "st1.toml", folder / "recordings", listen=[endpoint])
+    recorder = RunningRecorder(load_station(path))
     session = zenoh.open(zenoh_config("peer", connect=[endpoint]))
-    heard = Listener(session, "*", topics=["spool", "recorder"])
-    publishers = []
+    heard = Listener(session, "*", topics=["spool"])
+    spool = cut_spool(folder / "edge.sqlite", "st1", messages, max(1, round(cut_s / took_s)))
+    spool._rate = rate  # the benchmark's rate (the station file's drain_messages_per_s)
+    total = spool.stats().messages
+    started = time.monotonic()
+    publisher = QueuedPublisher(session, "st1", True, spool=spool)
     try:
-        spools = [
-            cut_spool(folder / "edge" / f"{name}.sqlite", name, messages, repeat) for name in names
-        ]
-        for spool in spools:
-            spool._rate = rate  # the benchmark's rate (the station file's drain_messages_per_s)
-        total = sum(spool.stats().messages for spool in spools)
-        started = time.monotonic()
-        publishers = [QueuedPublisher(session, s.station, True, spool=s) for s in spools]
-        stop_live = threading.Event()
-        live_thread = None
-        if live:
-            live_thread = threading.Thread(target=live_station, args=(session, stop_live))
-            live_thread.start()
-        while not spools_empty(heard, names):
+        while not spools_empty(heard, ["st1"]):
             time.sleep(0.2)
-            if time.monotonic() - started > 3 * HOUR_S:
-                raise AssertionError("the spools did not empty")
-        took = time.monotonic() - started
-        stop_live.set()
-        if live_thread is not None:
-            live_thread.join()
+        return time.monotonic() - started, total
     finally:
-        for publisher in publishers:
-            publisher.close()
+        publisher.close()
         recorder.finish()
         heard.close()
         session.close()
-    recorder_stats: dict[str, list[RecorderStats]] = {}
-    for stats in heard.of("recorder"):
-        recorder_stats.setdefault(stats.station, []).append(stats)
-    return took, total, recorder_stats
 
 
-def live_station(session: zenoh.Session, stop: threading.Event) -> None:
-    """One station publishing samples live at 1 kHz (batches of 50 every 50 ms) meanwhile."""
-    from tests.support.recorded_runs import run_messages
+def line_drain(
+    folder: Path, messages: list[Spooled], took_s: float, stations: int, rate: float
+) -> tuple[float, int, list[RecorderStats], list[RecorderStats]]:
+    """Step 3: ``stations`` spools of a 10-minute cut each drained at once into a recorder
+    process (``serve recorder``), while a real station (``serve acquisition`` and ``serve
+    rig``) tightens live; (seconds to empty, messages, the live station's RecorderStats
+    before the drain, during it)."""
+    port = free_port()
+    endpoint = f"tcp/127.0.0.1:{port}"
+    (folder / "live").mkdir()
+    live = write_station(folder / "live", zenoh_port=port, zenoh_mode="peer")
+    recordings = load_station(live).recordings_folder
+    names = [f"d{n}" for n in range(1, stations + 1)]
+    files = []
+    for name in names:
+        path = write_station_file(folder / f"{name}.toml", recordings, listen=[endpoint])
+        path.write_text(path.read_text().replace('id = "st1"', f'id = "{name}"'))
+        files.append(str(path))
+    logs = folder / "logs"
+    logs.mkdir()
+    processes = [serve(["recorder", "--config", *files, str(live)], logs / "recorder.log")]
+    time.sleep(3.0)
+    processes.append(serve(["acquisition", "--config", str(live)], logs / "acquisition.log"))
+    processes.append(serve(["rig", "--config", str(live)], logs / "rig.log"))
+    session = zenoh.open(zenoh_config("peer", connect=[endpoint]))
+    heard = Listener(session, "*", topics=["spool", "recorder"])
+    repeat = max(1, round(600.0 / took_s))
+    spools = [cut_spool(folder / f"{name}.sqlite", name, messages, repeat) for name in names]
+    for spool in spools:
+        spool._rate = rate
+    total = sum(spool.stats().messages for spool in spools)
+    publishers = []
+    try:
+        time.sleep(20.0)  # the live station alone: the lag before
+        before = len(heard.of("recorder"))
+        started = time.monotonic()
+        publishers = [QueuedPublisher(session, s.station, True, spool=s) for s in spools]
+        while not spools_empty(heard, names):
+            time.sleep(0.2)
+        took = time.monotonic() - started
+        during = len(heard.of("recorder"))
+    finally:
+        for publisher in publishers:
+            publisher.close()
+        for process in reversed(processes):
+            stop_process(process)
+        heard.close()
+        session.close()
+    every = heard.of("recorder")
+    alone = [s for s in every[:before] if s.station == "st1" and s.lag_p50_ms is not None]
+    draining = [s for s in every[before:during] if s.station == "st1" and s.lag_p50_ms is not None]
+    return took, total, alone, draining
 
-    publisher = QueuedPublisher(session, "live", batch_samples=True)
-    run_id = 1
-    while not stop.is_set():
-        for _topic, message in run_messages(run_id, 1000):
-            if stop.is_set():
-                break
-            publisher.publish(dataclasses.replace(message, station="live"))
-            if _topic == "samples":
-                time.sleep(0.001)
-        run_id += 1
-    publisher.close()
+
+def drain_line(folder: Path, messages: list[Spooled], took_s: float, rate: float) -> str:
+    """Step 2 at ``rate``, in one line."""
+    folder.mkdir()
+    seconds, total = drain(folder, messages, 600.0, took_s, rate)
+    return (
+        f"2. a 10-minute cut, drained at {rate:.0f}/s: {total} messages in {seconds:.1f} s "
+        f"({total / seconds:.0f} messages/s; an hour's cut: {6 * seconds / 60:.1f} min)"
+    )
+
+
+def line_line(
+    folder: Path, messages: list[Spooled], took_s: float, stations: int, rate: float
+) -> str:
+    """Step 3, in one line."""
+    folder.mkdir()
+    seconds, total, alone, draining = line_drain(folder, messages, took_s, stations, rate)
+    return (
+        f"3. {stations} stations, a 10-minute cut each, drained at once at {rate:.0f}/s "
+        f"each: {total} messages in {seconds:.1f} s; a live station's recorder lag alone: "
+        f"{lag_text(alone)}; while they drain: {lag_text(draining)}"
+    )
+
+
+def lag_text(stats: list[RecorderStats]) -> str:
+    lags = [s.lag_p50_ms for s in stats if s.lag_p50_ms is not None]
+    peaks = [s.lag_max_ms for s in stats if s.lag_max_ms is not None]
+    if not lags:
+        return "no lag heard"
+    return (
+        f"p50 {statistics.median(lags):.1f} ms (median of {len(lags)} s), max {max(peaks):.1f} ms"
+    )
+
+
+def resident_kb() -> int:
+    """This process's resident memory now (VmRSS), in kB."""
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1])
+    return 0
 
 
 def advanced_publisher(messages: list[Spooled], scale: int) -> None:
     """Step 4: zenoh-ext's cache, in this process's memory."""
     session = zenoh.open(zenoh_config("peer"))
-    before_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    before_kb = resident_kb()
     count = len(messages) * scale
     publishers: dict[str, zenoh.ext.AdvancedPublisher] = {}
     for message in messages:
@@ -213,7 +257,7 @@ def advanced_publisher(messages: list[Spooled], scale: int) -> None:
         for message in messages:
             publishers[message.topic].put(message.payload)
             payload_bytes += len(message.payload)
-    after_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    after_kb = resident_kb()
     got: list[int] = []
     subscriber = zenoh.ext.declare_advanced_subscriber(
         session,
@@ -230,7 +274,7 @@ def advanced_publisher(messages: list[Spooled], scale: int) -> None:
     session.close()
     print(
         f"4. AdvancedPublisher cache: {count} messages ({payload_bytes / 1e6:.0f} MB of "
-        f"payloads) raised this process's peak memory by {(after_kb - before_kb) / 1e3:.0f} MB "
+        f"payloads) took {(after_kb - before_kb) / 1e3:.0f} MB more of this process's memory "
         f"(in RAM, uncompressed, per key max_samples); a late-joining AdvancedSubscriber got "
         f"{len(got)} of {tool_puts} tool states from the running publisher's cache; "
         "a restarted publisher starts with an empty cache (nothing on disk)"
@@ -241,36 +285,25 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=20, help="real runs measured (20)")
     parser.add_argument("--stations", type=int, default=10, help="stations draining at once")
+    parser.add_argument(
+        "--rate", type=float, default=100.0, help="drain_messages_per_s (the default, 100)"
+    )
     parser.add_argument("--keep", type=Path, default=None, help="keep files here")
+    parser.add_argument(
+        "--steps", default="1234", help="which steps (1 always: the others use its messages)"
+    )
     args = parser.parse_args()
     with contextlib.ExitStack() as stack:
         folder = args.keep or Path(stack.enter_context(tempfile.TemporaryDirectory()))
         (folder / "station").mkdir(parents=True, exist_ok=True)
         messages, took_s = station_hour(folder / "station", args.runs)
-        for cut_s, rate in ((600.0, 200.0), (600.0, 2000.0)):
-            work = folder / f"drain-{cut_s:.0f}-{rate:.0f}"
-            work.mkdir()
-            seconds, total, _ = drain(work, messages, cut_s, took_s, 1, rate, live=False)
-            print(
-                f"2. a {cut_s / 60:.0f}-minute cut, drained at {rate:.0f}/s: {total} messages "
-                f"in {seconds:.1f} s ({total / seconds:.0f} messages/s; an hour's cut: "
-                f"{6 * total / (total / seconds) / 60:.1f} min)"
-            )
-        work = folder / "line"
-        work.mkdir()
-        seconds, total, heard = drain(
-            work, messages, 600.0, took_s, args.stations, 200.0, live=True
-        )
-        live = [s for s in heard.get("live", []) if s.lag_p50_ms is not None]
-        lags = [s.lag_p50_ms for s in live if s.lag_p50_ms is not None]
-        lag_p50 = statistics.median(lags) if lags else float("nan")
-        lag_max = max((s.lag_max_ms or 0.0) for s in live) if live else float("nan")
-        print(
-            f"3. {args.stations} stations, a 10-minute cut each, drained at once: {total} "
-            f"messages in {seconds:.1f} s; the live station's recorder lag meanwhile: "
-            f"p50 {lag_p50:.1f} ms (median of the seconds), max {lag_max:.1f} ms"
-        )
-        advanced_publisher(messages, max(1, round(600.0 / took_s)))
+        if "2" in args.steps:
+            for rate in (args.rate, 2000.0):
+                print(drain_line(folder / f"drain-{rate:.0f}", messages, took_s, rate))
+        if "3" in args.steps:
+            print(line_line(folder / "line", messages, took_s, args.stations, args.rate))
+        if "4" in args.steps:
+            advanced_publisher(messages, max(1, round(600.0 / took_s)))
         print(json.dumps({"runs": args.runs, "run_s": took_s / args.runs}))
     return 0
 

@@ -5,7 +5,10 @@ joined to it by a veth pair created straight into the two namespaces (no
 interface ever appears in the namespace the tests run in), so the line's
 addresses are private to the test and two tests never collide. Each station
 gets its own loopback with the multicast route the simulated CAN bus needs.
-``cut`` / ``reconnect`` take a station's cable out and put it back.
+``cut`` / ``reconnect`` take a station's cable out and put it back. The
+stations' files for such a line (:func:`line_station_files`), its status as
+the line server sees it (:func:`line_status`) and the wait for its services
+(:func:`wait_until_up`) are here too.
 
 Needs ``ip`` (iproute2) and the right to create namespaces (root or
 CAP_SYS_ADMIN); :func:`unavailable_reason` says why not, for a skip.
@@ -13,14 +16,20 @@ CAP_SYS_ADMIN); :func:`unavailable_reason` says why not, for a skip.
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
+import sys
+import time
 import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
+
+from tests.support.paths import REPO
+from tests.support.station_files import write_station
 
 SUBNET = "10.213.0"
 SERVER_ADDRESS = f"{SUBNET}.1"
@@ -141,3 +150,67 @@ class Line:
             timeout=timeout_s,
             check=False,
         )
+
+
+#: the line's router on the line server
+LINE_ENDPOINT = f"tcp/{SERVER_ADDRESS}:7447"
+_CLI = [sys.executable, "-m", "services.cli"]
+
+
+def line_station_files(
+    tmp_path: Path, stations: int, extra: str = "", placement: str | None = None
+) -> list[Path]:
+    """Station files ``st1``..``stN`` for a line's boxes: each a client of the line server's
+    router, its own tool and seed, the recordings in ``tmp_path/recordings``; ``extra``
+    appended to each (a section)."""
+    recordings = tmp_path / "recordings"
+    files = []
+    for index in range(1, stations + 1):
+        folder = tmp_path / f"st{index}"
+        folder.mkdir()
+        path = write_station(
+            folder,
+            zenoh_port=7447,
+            placement=placement,
+            replacements={
+                "tcp/127.0.0.1:7447": LINE_ENDPOINT,
+                'id = "st1"': f'id = "st{index}"',
+                "tool_id = 7": f"tool_id = {100 + index}",
+                "seed = 7": f"seed = {index}",
+            },
+        )
+        text = path.read_text().replace(str(folder / "recordings"), str(recordings))
+        path.write_text(text + extra.replace("{folder}", str(folder)))
+        files.append(path)
+    return files
+
+
+def line_status(line: Line) -> dict[str, dict[str, Any]]:
+    """``boltwatch status --json`` as seen from the line server ({} when it failed)."""
+    result = line.run(
+        line.server,
+        [*_CLI, "status", "--connect", LINE_ENDPOINT, "--listen-s", "1.5", "--json"],
+        cwd=REPO,
+    )
+    if result.returncode != 0:
+        return {}
+    stations: dict[str, dict[str, Any]] = json.loads(result.stdout)["stations"]
+    return stations
+
+
+def wait_until_up(
+    line: Line, stations: int, services: Sequence[str], timeout_s: float = 60.0
+) -> None:
+    """Until every station shows ``services`` alive in the line's status."""
+    deadline = time.monotonic() + timeout_s
+    status: dict[str, dict[str, Any]] = {}
+    while time.monotonic() < deadline:
+        status = line_status(line)
+        if all(
+            (status.get(f"st{i}", {}).get("services") or {}).get(service)
+            for i in range(1, stations + 1)
+            for service in services
+        ):
+            return
+        time.sleep(0.5)
+    raise AssertionError(f"not every station came up in {timeout_s} s: {status}")

@@ -28,9 +28,15 @@ import pytest
 from mcap.reader import make_reader
 
 from services.cli.station_supervisor import stop_process
-from tests.support.netns_line import SERVER_ADDRESS, Line, unavailable_reason
+from tests.support.netns_line import (
+    LINE_ENDPOINT,
+    Line,
+    line_station_files,
+    line_status,
+    unavailable_reason,
+    wait_until_up,
+)
 from tests.support.paths import REPO
-from tests.support.station_files import write_station
 
 WHY_NOT = unavailable_reason()
 pytestmark = pytest.mark.skipif(WHY_NOT is not None, reason=WHY_NOT or "")
@@ -40,7 +46,7 @@ CUT_STATION = 3
 RUNS = 16
 CUT_AFTER_S = 3.0
 CUT_FOR_S = 10.0
-ENDPOINT = f"tcp/{SERVER_ADDRESS}:7447"
+ENDPOINT = LINE_ENDPOINT
 CLI = [sys.executable, "-m", "services.cli"]
 
 
@@ -83,41 +89,10 @@ def read_recordings(folder: Path) -> dict[str, StationRecord]:
 
 
 def station_files(tmp_path: Path) -> list[Path]:
-    recordings = tmp_path / "recordings"
-    files = []
-    for index in range(1, STATIONS + 1):
-        folder = tmp_path / f"st{index}"
-        folder.mkdir()
-        path = write_station(
-            folder,
-            zenoh_port=7447,
-            placement="line",  # each station host runs its own predictor process
-            replacements={
-                "tcp/127.0.0.1:7447": ENDPOINT,
-                'id = "st1"': f'id = "st{index}"',
-                "tool_id = 7": f"tool_id = {100 + index}",
-                "seed = 7": f"seed = {index}",
-            },
-        )
-        text = path.read_text().replace(str(folder / "recordings"), str(recordings))
-        # the spool off: a cut's loss is counted exactly (with it, nothing is lost:
-        # tests/system/test_store_and_forward.py)
-        path.write_text(text + "\n[spool]\nenabled = false\n")
-        files.append(path)
-    return files
-
-
-def line_status(line: Line) -> dict[str, dict[str, object]]:
-    """``boltwatch status --json`` as seen from the line server."""
-    result = line.run(
-        line.server,
-        [*CLI, "status", "--connect", ENDPOINT, "--listen-s", "1.5", "--json"],
-        cwd=REPO,
-    )
-    if result.returncode != 0:
-        return {}
-    stations: dict[str, dict[str, object]] = json.loads(result.stdout)["stations"]
-    return stations
+    # each station host runs its own predictor process; the spool off: a cut's loss is
+    # counted exactly (with it, nothing is lost: tests/system/test_store_and_forward.py)
+    spool_off = "\n[spool]\nenabled = false\n"
+    return line_station_files(tmp_path, STATIONS, spool_off, placement="line")
 
 
 def recorder_counts(status: dict[str, dict[str, object]]) -> dict[str, tuple[object, object]]:
@@ -149,26 +124,6 @@ def settled_status(line: Line, timeout_s: float = 60.0) -> dict[str, dict[str, o
     return previous
 
 
-def alive(status: dict[str, object], service: str) -> bool:
-    services = status.get("services")
-    return isinstance(services, dict) and bool(services.get(service))
-
-
-def wait_until_all_up(line: Line, timeout_s: float = 60.0) -> None:
-    deadline = time.monotonic() + timeout_s
-    status: dict[str, dict[str, object]] = {}
-    while time.monotonic() < deadline:
-        status = line_status(line)
-        if all(
-            alive(status.get(f"st{i}", {}), service)
-            for i in range(1, STATIONS + 1)
-            for service in ("acquisition", "predictor", "recorder")
-        ):
-            return
-        time.sleep(0.5)
-    raise AssertionError(f"not every station came up in {timeout_s} s: {status}")
-
-
 def test_three_hosts_one_cut_off_for_ten_seconds(tmp_path: Path) -> None:
     files = station_files(tmp_path)
     logs = tmp_path / "logs"
@@ -190,7 +145,7 @@ def test_three_hosts_one_cut_off_for_ten_seconds(tmp_path: Path) -> None:
                 for service in ("acquisition", "predictor"):
                     args = ["serve", service, "--config", str(path)]
                     start(line, line.station(index), f"st{index}-{service}", args)
-            wait_until_all_up(line)
+            wait_until_up(line, STATIONS, ("acquisition", "predictor", "recorder"))
             rigs = [
                 start(
                     line,

@@ -39,9 +39,15 @@ import pytest
 from services.cli.station_supervisor import stop_process
 from shared.recordings.mcap import RecordingScan
 from shared.wear import ledger_path
-from tests.support.netns_line import SERVER_ADDRESS, Line, unavailable_reason
+from tests.support.netns_line import (
+    LINE_ENDPOINT,
+    Line,
+    line_station_files,
+    line_status,
+    unavailable_reason,
+    wait_until_up,
+)
 from tests.support.paths import REPO
-from tests.support.station_files import write_station
 
 WHY_NOT = unavailable_reason()
 pytestmark = pytest.mark.skipif(WHY_NOT is not None, reason=WHY_NOT or "")
@@ -50,7 +56,7 @@ STATIONS = 3
 #: about two seconds a run: the rigs tighten through both faults and some time after
 RUNS = 75
 CUT_S = 60.0
-ENDPOINT = f"tcp/{SERVER_ADDRESS}:7447"
+ENDPOINT = LINE_ENDPOINT
 CLI = [sys.executable, "-m", "services.cli"]
 
 
@@ -75,7 +81,7 @@ def read_recordings(folder: Path) -> dict[str, dict[int, RunRecord]]:
                 continue
             body = json.loads(message.data)
             run_id = body.get("run_id") if isinstance(body, dict) else None
-            if run_id is None:
+            if not run_id:  # none, or 0: a restarted acquisition's samples before it knows the run
                 continue
             record = runs[parts[1]][run_id]
             record.topics[parts[2]] += 1
@@ -88,39 +94,8 @@ def read_recordings(folder: Path) -> dict[str, dict[int, RunRecord]]:
 
 
 def station_files(tmp_path: Path) -> list[Path]:
-    recordings = tmp_path / "recordings"
-    files = []
-    for index in range(1, STATIONS + 1):
-        folder = tmp_path / f"st{index}"
-        folder.mkdir()
-        path = write_station(
-            folder,
-            zenoh_port=7447,
-            replacements={
-                "tcp/127.0.0.1:7447": ENDPOINT,
-                'id = "st1"': f'id = "st{index}"',
-                "tool_id = 7": f"tool_id = {100 + index}",
-                "seed = 7": f"seed = {index}",
-            },
-        )
-        text = path.read_text().replace(str(folder / "recordings"), str(recordings))
-        # the spool on the station's own box (its folder), not in the line's recordings
-        path.write_text(text + f'\n[spool]\nfolder = "{folder / "spool"}"\n')
-        files.append(path)
-    return files
-
-
-def line_status(line: Line) -> dict[str, dict[str, Any]]:
-    """``boltwatch status --json`` as seen from the line server ({} when it failed)."""
-    result = line.run(
-        line.server,
-        [*CLI, "status", "--connect", ENDPOINT, "--listen-s", "1.5", "--json"],
-        cwd=REPO,
-    )
-    if result.returncode != 0:
-        return {}
-    stations: dict[str, dict[str, Any]] = json.loads(result.stdout)["stations"]
-    return stations
+    # the spool on the station's own box (its folder), not in the line's recordings
+    return line_station_files(tmp_path, STATIONS, '\n[spool]\nfolder = "{folder}/spool"\n')
 
 
 def drained(status: dict[str, dict[str, Any]]) -> bool:
@@ -136,21 +111,6 @@ def drained(status: dict[str, dict[str, Any]]) -> bool:
         if recorder.get("missing_samples") != 0:
             return False
     return True
-
-
-def wait_until_up(line: Line, services: tuple[str, ...], timeout_s: float = 60.0) -> None:
-    deadline = time.monotonic() + timeout_s
-    status: dict[str, dict[str, Any]] = {}
-    while time.monotonic() < deadline:
-        status = line_status(line)
-        if all(
-            (status.get(f"st{i}", {}).get("services") or {}).get(service)
-            for i in range(1, STATIONS + 1)
-            for service in services
-        ):
-            return
-        time.sleep(0.5)
-    raise AssertionError(f"not every station came up in {timeout_s} s: {status}")
 
 
 def test_cables_cut_and_the_recorder_killed_lose_nothing(tmp_path: Path) -> None:
@@ -175,7 +135,7 @@ def test_cables_cut_and_the_recorder_killed_lose_nothing(tmp_path: Path) -> None
             for index, path in enumerate(files, start=1):
                 args = ["serve", "acquisition", "--config", str(path)]
                 start(line, line.station(index), f"st{index}-acquisition", args)
-            wait_until_up(line, ("acquisition", "recorder"))
+            wait_until_up(line, STATIONS, ("acquisition", "recorder"))
             for index, path in enumerate(files, start=1):
                 args = ["serve", "rig", "--config", str(path), "--runs", str(RUNS)]
                 start(line, line.station(index), f"st{index}-rig", args)
