@@ -20,9 +20,10 @@ Run on demand::
    that (the rate is the bound, not the recorder).
 3. **A line coming back at once.** ``--stations`` spools, each holding a
    10-minute cut, drained at once at ``--rate`` into a recorder process
-   (``serve recorder``) while a real station (``serve acquisition``, ``serve
-   rig``) tightens live: that station's recorder lag (its RecorderStats'
-   ``lag_p50_ms`` and ``lag_max_ms``) for 20 s before the drain and during
+   (``serve recorder --no-rerun``, as a line's server runs it) while a real
+   station (``serve acquisition``, ``serve rig``) tightens live: that
+   station's recorder lag (its RecorderStats' ``lag_p50_ms`` and
+   ``lag_max_ms``) for 20 s before the drain and during
    it, side by side, and the time until every spool is empty.
 4. **zenoh's AdvancedPublisher cache** (zenoh-ext, the alternative looked at
    first): the process's resident memory for a cache holding step 1's
@@ -150,17 +151,19 @@ def line_drain(
     port = free_port()
     endpoint = f"tcp/127.0.0.1:{port}"
     (folder / "live").mkdir()
-    live = write_station(folder / "live", zenoh_port=port, zenoh_mode="peer")
-    recordings = load_station(live).recordings_folder
+    live = write_station(folder / "live", zenoh_port=port)  # a client of the line's router
     names = [f"d{n}" for n in range(1, stations + 1)]
     files = []
-    for name in names:
-        path = write_station_file(folder / f"{name}.toml", recordings, listen=[endpoint])
-        path.write_text(path.read_text().replace('id = "st1"', f'id = "{name}"'))
+    for name in names:  # the same file but its id: one recorder serves files that agree
+        path = folder / f"{name}.toml"
+        path.write_text(live.read_text().replace('id = "st1"', f'id = "{name}"'))
         files.append(str(path))
     logs = folder / "logs"
     logs.mkdir()
-    processes = [serve(["recorder", "--config", *files, str(live)], logs / "recorder.log")]
+    processes = [serve(["router", "--listen", endpoint], logs / "router.log")]
+    time.sleep(2.0)
+    recorder = ["recorder", "--no-rerun", "--config", *files, str(live)]  # a line's server
+    processes.append(serve(recorder, logs / "recorder.log"))
     time.sleep(3.0)
     processes.append(serve(["acquisition", "--config", str(live)], logs / "acquisition.log"))
     processes.append(serve(["rig", "--config", str(live)], logs / "rig.log"))

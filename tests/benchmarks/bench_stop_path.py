@@ -26,6 +26,11 @@ Reported: p50 / p90 / p99 / max over all stops and per kind, the stops lost
 and what the machine itself lost meanwhile: the steal column of
 ``/proc/stat`` (the host's share of this VM's CPU time).
 
+``--backlog N``: each station's spool holds N old batches of samples at the
+start, never acknowledged: its acquisition sends them again (at
+``drain_messages_per_s``) while the stops are measured, the stop path
+beside a draining spool.
+
 ``--stations N``: a line of N stations (derived as ``boltwatch up
 --stations`` derives them), each with its own tool and bus, on one router
 and one recorder; the stops split evenly. ``--repo PATH`` starts the
@@ -58,10 +63,13 @@ from shared.config import LoadedStation, derive_stations, load_station
 from shared.contract import (
     StationDatabase,
     channels,
+    encode,
     keys,
 )
 from shared.runtime import zenoh_config
+from shared.spool import SpoolFile
 from tests.support.can_injector import HeardStop, StopListener
+from tests.support.fuzz.payloads import template
 from tests.support.listener import Listener
 from tests.support.station_files import free_tcp_port, write_station
 from tests.support.station_files import serve as serve_process
@@ -241,6 +249,17 @@ class Line:
             stop_process(process, grace_s=10.0)
 
 
+def fill_spool(station: LoadedStation, messages: int) -> None:
+    """``messages`` batches of samples an hour old in the station's spool, never acknowledged:
+    its acquisition sends them again while the stops are measured (a station draining)."""
+    spool = SpoolFile(station.spool_folder / f"{station.station_id}-acquisition.sqlite")
+    hour_ago_ns = time.time_ns() - 3600 * 1_000_000_000
+    for n in range(messages):
+        batch = template("sample_batches", station.station_id, hour_ago_ns + n * 50_000_000, 1)
+        spool.append("sample_batches", encode(batch), 0, 1, len(batch.samples), hour_ago_ns)
+    spool.close()
+
+
 def run(args: argparse.Namespace, folder: Path) -> int:
     services_file, rig_file = station_files(folder, args.placement)
     line = Line(args, folder, [services_file], [rig_file])
@@ -248,6 +267,8 @@ def run(args: argparse.Namespace, folder: Path) -> int:
         line.services_paths = derive_stations(services_file, args.stations, folder / "services")
         line.rig_paths = derive_stations(rig_file, args.stations, folder / "rigs")
     stations = line.stations
+    for station in stations if args.backlog else []:
+        fill_spool(station, args.backlog)
     database = StationDatabase(stations[0].dbc_path)
     endpoint = stations[0].config.zenoh.connect[0]
     try:
@@ -298,6 +319,13 @@ def print_table(stops: list[Stop], station_ids: list[str]) -> None:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--stops", type=int, default=1000, help="runs, each one stop (1000)")
+    parser.add_argument(
+        "--backlog",
+        type=int,
+        default=0,
+        help="messages in each station's spool at the start, sent again while the stops are "
+        "measured (a station draining after a cut; the spool is on by default)",
+    )
     parser.add_argument(
         "--placement",
         choices=("edge", "line", "before"),
