@@ -29,6 +29,8 @@ with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
   :mod:`.plant`, :mod:`.netns_line` (lines in network namespaces),
   :mod:`.can_injector` (frames on the CAN bus), :mod:`.disk_faults` (a full or
   read-only disk)
+- databases: :mod:`.postgres_server` (a throwaway PostgreSQL server; the fixtures
+  ``postgres_server`` and ``postgres_url`` in ``tests/conftest.py``)
 - deployment: :mod:`.compose_layout`, :mod:`.access_rules`
 - :mod:`.fuzz` (hostile payloads for the live services), :mod:`.bad_arguments`
   (every bad argument of every command)

@@ -1,1 +1,1 @@
-"""Tests of the test support: doubles that speak real protocols."""
+"""Tests of the test support: doubles that speak real protocols, a real PostgreSQL server."""
