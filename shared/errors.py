@@ -6,7 +6,8 @@
      ├── ConfigError        a configuration file is missing, unreadable or invalid
      ├── InputError         a data file (trace, recording, controller export) is unusable
      ├── CanDatabaseError   the DBC does not define what the contract needs
-     └── TransportError     zenoh or the CAN bus could not be opened
+     ├── TransportError     zenoh or the CAN bus could not be opened
+     └── StoreError         the results store cannot be opened, read or written
 
 Every error carries one line a person can act on: which file, which key,
 what was expected. Boundaries re-raise with ``raise X from err``.
@@ -41,6 +42,10 @@ class CanDatabaseError(BoltwatchError):
 
 class TransportError(BoltwatchError):
     """A zenoh session or CAN bus could not be opened."""
+
+
+class StoreError(BoltwatchError):
+    """The results store cannot be opened, read or written (the text says which and why)."""
 
 
 @contextlib.contextmanager

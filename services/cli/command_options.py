@@ -10,6 +10,7 @@ command that takes it:
   ``config/station.toml``;
 - ``--recordings DIR`` and ``--config FILE`` (wear, import): the recordings
   folder, by default the station file's ``recorder.folder``;
+- ``--since`` / ``--until`` (report, results): moments in UTC, a bare date a whole day;
 - a PNG to draw (inspect ``--out``, model ``--plot``/``--out``): checked
   before the work, see :func:`check_png_target`.
 
@@ -22,6 +23,7 @@ import argparse
 import errno
 import os
 import sys
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from shared.errors import InputError
@@ -101,3 +103,21 @@ def check_png_target(path: Path, what: str) -> None:
     if not path.parent.is_dir():
         code = errno.ENOTDIR if path.parent.exists() else errno.ENOENT
         raise OSError(code, os.strerror(code), str(path))
+
+
+def utc_moment(text: str) -> datetime:
+    """``2026-03-01`` (that day, 00:00 UTC) or ``2026-03-01T14:30`` (UTC unless an offset is
+    given): an argparse type."""
+    try:
+        moment = datetime.fromisoformat(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(
+            f"expected a date YYYY-MM-DD or a time YYYY-MM-DDTHH:MM (UTC), got {text!r}"
+        ) from err
+    return moment.replace(tzinfo=UTC) if moment.tzinfo is None else moment.astimezone(UTC)
+
+
+def utc_end(text: str) -> datetime:
+    """Like :func:`utc_moment`, but a bare date means the end of that day (it is included)."""
+    moment = utc_moment(text)
+    return moment + timedelta(days=1) if len(text.strip()) == len("YYYY-MM-DD") else moment

@@ -20,8 +20,9 @@ others (no other line's sample crosses to this line for it). No payload
 stops it: what it refuses (:mod:`shared.recordings.received`) is recorded
 raw and counted in the station's ``RecorderStats.bad_payloads``. Every
 TighteningResult it files feeds the quality alert
-(:mod:`services.recorder.quality_watch`, on ``quality/alert``), every
-RunSummary the wear ledger (``wear/alert``); a view-only recorder keeps neither.
+(:mod:`services.recorder.quality_watch`, on ``quality/alert``) and the results store
+(:mod:`services.recorder.results_watch`), every
+RunSummary the wear ledger (``wear/alert``); a view-only recorder keeps none of them.
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
@@ -43,6 +44,7 @@ import socket
 import threading
 import time
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import zenoh
@@ -56,6 +58,7 @@ from services.recorder.live.spool_filing import SpoolFiling
 from services.recorder.live.spool_keeper import SpoolKeeper
 from services.recorder.live_views import rerun_options, start_foxglove, start_rerun_live
 from services.recorder.quality_watch import QualityWatch
+from services.recorder.results_watch import ResultsWatch
 from services.recorder.served_stations import limits_of, served_stations
 from services.recorder.wear_watch import WearWatch
 from shared.config import AnyStation, load_any_line
@@ -71,6 +74,7 @@ from shared.contract import (
     parse_seq_attachment,
 )
 from shared.recordings import OTHER_STATION, FileMetadata, Received, classify
+from shared.results import store_target
 from shared.runtime import ServiceSkeleton, Stop
 from shared.wear import StationLimits, WearLedger, ledger_path
 
@@ -129,6 +133,7 @@ class RecorderService:
         self.foxglove = foxglove
         self.wear: WearWatch | None = None
         self.quality: QualityWatch | None = None
+        self.results: ResultsWatch | None = None
         #: what the line's recorder filed of the stations' spools (a view acknowledges nothing)
         self.spooling = (
             None
@@ -145,6 +150,12 @@ class RecorderService:
                 first.config.recorder.wear_service_threshold,
                 self._publish_alert,
                 StationLimits(stations).of,
+            )
+            self.results = ResultsWatch(
+                store_target(first.recordings_folder, first.config.recorder.results_database),
+                first.recordings_folder,
+                {station.station_id: station.config.station.line for station in stations},
+                self._host,
             )
         self._inbox = LineInbox(session, [station_keys(station) for station in self.station_ids])
         skeleton.on_stop(Stop.INPUT, self._inbox.close)
@@ -194,15 +205,20 @@ class RecorderService:
                 LOG.warning("not recorded, arrived while stopping: %d", self._inbox.after_close)
             if self.wear is not None:
                 self.wear.close()
+            if self.results is not None:
+                self.results.close()
             closed = self.recorder.close()
             LOG.info("recorder stopped: %d messages, %d files", self.recorder.messages, len(closed))
 
     def stats(self, now_ns: int) -> list[RecorderStats]:
         """RecorderStats of every station now (starts the next lag window)."""
-        recorder, wear = self.recorder, self.wear
+        recorder, wear, results = self.recorder, self.wear, self.results
         write_errors = recorder.write_errors + (wear.ledger_errors if wear else 0)
-        last_error = recorder.last_write_error or (
-            f"wear ledger: {wear.last_ledger_error}" if wear and wear.last_ledger_error else None
+        ledger_error = wear.last_ledger_error if wear else None
+        last_error = (
+            recorder.last_write_error
+            or (f"wear ledger: {ledger_error}" if ledger_error else None)
+            or (results.last_error if results else None)
         )
         if last_error is not None:
             last_error = last_error[:MAX_TEXT_CHARS]  # a long path must not make it unreadable
@@ -258,7 +274,7 @@ class RecorderService:
     ) -> None:
         """File one message (a batch's event too) into its run's file and its counts."""
         now_ns = received.log_time_ns
-        self.recorder.write(received, hole)
+        recording = self.recorder.write(received, hole)
         if self.foxglove is not None and hole is None:
             self.foxglove.log(received)
         if hole is not None and received.schema_name == _SAMPLE:
@@ -278,13 +294,24 @@ class RecorderService:
             return
         if self.spooling is not None and received.schema_name == _SPOOL:
             self.spooling.keeper.on_stats(received.message)
-        if self.quality is not None and received.schema_name == channels.RESULTS.schema_name:
-            self.quality.on_result(received.message)
-        if self.wear is not None:
-            if received.schema_name == channels.RUNS.schema_name:
-                self.wear.on_summary(received.message, now_ns)
-            elif received.schema_name == channels.TOOL_DATA.schema_name:
-                self.wear.on_tool_data(received.message, now_ns)
+        self._feed(received, recording, now_ns)
+
+    def _feed(self, received: Received, recording: Path | None, now_ns: int) -> None:
+        """A filed result or summary to the quality alert, the results store and the wear
+        ledger (``recording``: the file it went into)."""
+        schema, message = received.schema_name, received.message
+        if schema == channels.RESULTS.schema_name:
+            if self.quality is not None:
+                self.quality.on_result(message)
+            if self.results is not None:
+                self.results.on_result(message, recording, now_ns)
+        elif schema == channels.RUNS.schema_name:
+            if self.results is not None:
+                self.results.on_summary(message)
+            if self.wear is not None:
+                self.wear.on_summary(message, now_ns)
+        elif schema == channels.TOOL_DATA.schema_name and self.wear is not None:
+            self.wear.on_tool_data(message, now_ns)
 
     def _file_batch(self, batch: Received, filed_ns: int, hole: StationFiles | None) -> None:
         """Each sample of a batch, then its events and intensities, as if each had come alone

@@ -51,6 +51,12 @@ class StationIdentity(StrictModel):
         description="the tool's id: in ToolStatus on CAN; the id a controller station's "
         "runs and wear are counted under",
     )
+    line: str = Field(
+        default="",
+        max_length=64,
+        pattern=r"^[^\x00-\x1f]*$",
+        description="the line the station is on, as results and reports name it; '' none",
+    )
 
 
 class ZenohSection(StrictModel):
@@ -126,6 +132,13 @@ class RecorderSection(StrictModel):
         default=None,
         gt=0,
         description="intensity since last service (eq. 69) at which the recorder alerts",
+    )
+    results_database: str | None = Field(
+        default=None,
+        pattern=r"^postgres(ql)?://",
+        description="a plant's PostgreSQL for the results store, e.g. "
+        "postgresql://boltwatch@db.plant/boltwatch (password: PGPASSFILE); none: "
+        "results.sqlite in the recordings folder",
     )
 
 

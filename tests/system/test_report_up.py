@@ -31,7 +31,15 @@ def test_report_over_runs_of_up(tmp_path: Path) -> None:
     assert report.returncode == 0, report.stdout + report.stderr
     results = read_recordings(tmp_path / "recordings")["boltwatch/st1/results"]
     assert len(results) == RUNS
-    assert f"{RUNS} results from" in report.stdout
+    assert f"{RUNS} results (from the results store " in report.stdout
+    # the same figures from the recordings themselves
+    scan = boltwatch(
+        *command, "--from-recordings", "--subgroup-size", "2", "--out", str(tmp_path / "scan"),
+        timeout_s=120,
+    )  # fmt: skip
+    assert scan.returncode == 0, scan.stdout + scan.stderr
+    assert re.search(rf"^{RUNS} results \(from \d+ recordings\)$", scan.stdout, re.MULTILINE)
+    assert report.stdout.splitlines()[1:-1] == scan.stdout.splitlines()[1:-1]
     preload = [result["final_force_n"]["value"] for result in results]
     low, high = results[-1]["final_force_n"]["min"], results[-1]["final_force_n"]["max"]
     mean, sigma = np.mean(preload), np.std(preload, ddof=1)

@@ -55,7 +55,7 @@ pytestmark = pytest.mark.skipif(WHY_NOT is not None, reason=WHY_NOT or "")
 STATIONS = 3
 #: about two seconds a run: the rigs tighten through both faults and some time after
 RUNS = 75
-CUT_S = 60.0
+CUT_S = 30.0
 ENDPOINT = LINE_ENDPOINT
 CLI = [sys.executable, "-m", "services.cli"]
 

@@ -4,9 +4,12 @@
 
     boltwatch report [--config STATION ...] [--since DATE] [--until DATE]
                      [--program ID] [--tool ID] [--subgroup-size N] [--out FOLDER]
+                     [--from-recordings]
 
-Reads the tightening results of the station files' recordings that ended in
-the range (:mod:`services.recorder.quality`), writes ``FOLDER/report.html``
+Reads the tightening results of the station files' stations that ended in the
+range from the results store (:mod:`shared.results`; none there, or
+``--from-recordings``: from every recording in range,
+:mod:`shared.offline.report.recorded_results`), writes ``FOLDER/report.html``
 (one self-contained file) and ``FOLDER/report.png``, and prints a summary.
 No result in the range: one line, exit status 2.
 """
@@ -15,35 +18,21 @@ from __future__ import annotations
 
 import argparse
 import sys
-from datetime import UTC, datetime, timedelta
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from services.cli.command_options import add_station_file_option
+from services.cli.command_options import add_station_file_option, utc_end, utc_moment
 from shared.option_types import int_in
+
+if TYPE_CHECKING:
+    from shared.config import AnyStation
+    from shared.offline.report import RecordedResults, ResultFilter
 
 NAME = "report"
 HELP = "statistics per program over recorded results: X̄/R charts, Cp/Cpk, NOK Pareto (HTML, PNG)"
 
 #: the largest subgroup size of the control charts
 MAX_SUBGROUP = 50
-
-
-def utc_moment(text: str) -> datetime:
-    """``2026-03-01`` (that day, 00:00 UTC) or ``2026-03-01T14:30`` (UTC unless an offset is
-    given): an argparse type."""
-    try:
-        moment = datetime.fromisoformat(text)
-    except ValueError as err:
-        raise argparse.ArgumentTypeError(
-            f"expected a date YYYY-MM-DD or a time YYYY-MM-DDTHH:MM (UTC), got {text!r}"
-        ) from err
-    return moment.replace(tzinfo=UTC) if moment.tzinfo is None else moment.astimezone(UTC)
-
-
-def utc_end(text: str) -> datetime:
-    """Like :func:`utc_moment`, but a bare date means the end of that day (it is included)."""
-    moment = utc_moment(text)
-    return moment + timedelta(days=1) if len(text.strip()) == len("YYYY-MM-DD") else moment
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -80,6 +69,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="runs per control-chart subgroup (default 5; X̄/R up to 10, X̄/s above)",
     )
     parser.add_argument(
+        "--from-recordings",
+        action="store_true",
+        help="read every recording in range instead of the results store (slower; what the "
+        "store is checked against)",
+    )
+    parser.add_argument(
         "--out",
         type=Path,
         default=Path("report"),
@@ -90,31 +85,48 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from shared.config import load_any_station
-    from shared.offline.report import ResultFilter, write_report
+    from shared.offline.report import ResultFilter, terminal_lines, write_report
 
-    stations = []
-    for path in args.config:
-        loaded = load_any_station(path)
-        stations.append((loaded.station_id, loaded.recordings_folder))
+    stations = [load_any_station(path) for path in args.config]
     rule = ResultFilter(
-        stations=stations,
+        stations=[(loaded.station_id, loaded.recordings_folder) for loaded in stations],
         since=args.since,
         until=args.until,
         program_id=args.program,
         tool_id=args.tool,
     )
+    read, source = _read(rule, stations[0], args.from_recordings)
+    report = write_report(rule, read, args.out, args.subgroup_size, source)
+    for line in report.damaged:
+        print(f"boltwatch report: warning: {line}; read what is readable", file=sys.stderr)
+    print(f"{report.results} results ({source})")
+    for line in terminal_lines(report.programs):
+        print(line)
+    print(f"wrote {report.html_path} and {report.png_path}")
+    return 0
+
+
+def _read(
+    rule: ResultFilter, first: AnyStation, from_recordings: bool
+) -> tuple[RecordedResults, str]:
+    """The results in range and from where, in words: the first station file's results store,
+    or (none there, or ``--from-recordings``) every recording in range."""
+    from shared.errors import StoreError
+    from shared.offline.report import read_results, read_stored
+    from shared.results import ResultsStore, store_target
+
+    why = ""
+    if not from_recordings:
+        target = store_target(first.recordings_folder, first.config.recorder.results_database)
+        try:
+            with ResultsStore(target, create=False) as store:
+                return read_stored(store, rule), f"from the results store {target}"
+        except StoreError as err:
+            why = f"; {err}"
 
     def progress(done: int, total: int) -> None:
         if total >= 50:
             print(f"boltwatch report: read {done} of {total} files", file=sys.stderr)
 
-    report = write_report(rule, args.out, args.subgroup_size, progress)
-    for line in report.damaged:
-        print(f"boltwatch report: warning: {line}; read what is readable", file=sys.stderr)
-    from shared.offline.report import terminal_lines
-
-    print(f"{report.results} results from {report.files} files")
-    for line in terminal_lines(report.programs):
-        print(line)
-    print(f"wrote {report.html_path} and {report.png_path}")
-    return 0
+    read = read_results(rule, progress)
+    return read, f"from {read.files} recordings{why}"

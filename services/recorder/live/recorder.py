@@ -72,9 +72,10 @@ class Recorder:
         self._retry_at_ns = 0
         self._remind_at_ns = 0
 
-    def write(self, received: Received, files: StationFiles | None = None) -> None:
+    def write(self, received: Received, files: StationFiles | None = None) -> Path | None:
         """File one received message into its station's live files (or ``files``: the
-        files of a hole of the station's spool, :meth:`hole_files`)."""
+        files of a hole of the station's spool, :meth:`hole_files`); the file it went
+        into (None: dropped, the disk failing)."""
         files = files or self._files(received.station)
         if not received.decodable:
             self.refused[received.station] += 1
@@ -92,14 +93,15 @@ class Recorder:
         now_ns = received.log_time_ns
         if self._waits_for_retry(files, now_ns) and not received.run_started:
             self._drop(1, now_ns)
-            return
+            return None
         written_before = files.written
         try:
             files.write(received)
         except OSError as err:  # a message already in the file is counted by abandon()
             self._fault(files, err, now_ns, unwritten=int(files.written == written_before))
-            return
+            return None
         self._maybe_recovered(files, now_ns)
+        return files.last_path
 
     def write_samples(
         self, station: str, samples: Sequence[Received], files: StationFiles | None = None

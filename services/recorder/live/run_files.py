@@ -95,6 +95,7 @@ class StationFiles:
         self.closed_paths: list[Path] = []
         self.abandoned_paths: list[Path] = []
         self.written = 0  # messages handed to a file (flushed or not)
+        self.last_path: Path | None = None  # the file of the last message written
         self._resume: tuple[int | None, int] | None = None  # (run_id, part) after abandon()
         self._rerun = rerun
         self._rerun_sinks: dict[McapSink, RerunSink] = {}
@@ -120,6 +121,7 @@ class StationFiles:
         for target in self._sinks_of(sink):
             target.write(received)
         self.written += 1
+        self.last_path = sink.path
         if (
             sink is self.current
             and received.schema_name == channels.TOOL.schema_name

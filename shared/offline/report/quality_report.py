@@ -1,4 +1,5 @@
-"""``boltwatch report``'s work: results read, statistics per program, HTML and PNG written.
+"""``boltwatch report``'s work: statistics per program of the results read, HTML and PNG
+written.
 
 Writes ``<out>/report.html`` (self-contained) and ``<out>/report.png`` (the
 same charts). No result in the range is an :class:`InputError` (one line,
@@ -7,12 +8,11 @@ exit status 2), naming what was searched.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from shared.errors import InputError
-from shared.offline.report.recorded_results import ResultFilter, read_results
+from shared.offline.report.recorded_results import RecordedResults, ResultFilter
 from shared.offline.report.report_figure import build_figure, png_bytes
 from shared.offline.report.report_page import html_page
 from shared.quality import ProgramStatistics, program_statistics
@@ -51,16 +51,13 @@ def describe_scope(rule: ResultFilter, subgroup_size: int) -> list[str]:
 
 
 def write_report(
-    rule: ResultFilter,
-    out: Path,
-    subgroup_size: int,
-    progress: Callable[[int, int], None] | None = None,
+    rule: ResultFilter, read: RecordedResults, out: Path, subgroup_size: int, source: str
 ) -> WrittenReport:
-    """Read, compute, draw and write; InputError when no result is in range."""
-    read = read_results(rule, progress)
+    """Compute, draw and write what was read (``source``: from where, in words); InputError
+    when no result is in range."""
     if not read.results:
         searched = "; ".join(describe_scope(rule, subgroup_size)[:-1])
-        raise InputError(f"no tightening results in range ({searched}; {read.files} files read)")
+        raise InputError(f"no tightening results in range ({searched}; {source})")
     programs = program_statistics(read.results, subgroup_size, read.summaries)
     title = f"boltwatch report: {', '.join(station for station, _ in rule.stations)}"
     figure = build_figure(programs, title)
@@ -68,6 +65,6 @@ def write_report(
     out.mkdir(parents=True, exist_ok=True)
     png_path, html_path = out / PNG_NAME, out / HTML_NAME
     png_path.write_bytes(png)
-    scope = [*describe_scope(rule, subgroup_size), f"{len(read.results)} results"]
+    scope = [*describe_scope(rule, subgroup_size), f"{len(read.results)} results ({source})"]
     html_path.write_text(html_page(programs, title, scope, png), encoding="utf-8")
     return WrittenReport(html_path, png_path, programs, read.files, len(read.results), read.damaged)

@@ -1,4 +1,5 @@
-"""The tightening results (and run summaries) of a station's recordings in a time range.
+"""The tightening results (and run summaries) of stations in a time range: from the results
+store (:func:`read_stored`), or from the recordings themselves (:func:`read_results`).
 
 Reads ``<recordings>/<station>/<YYYY-MM-DD>/*.mcap`` (the layout of
 :mod:`shared.recordings.layout`, dates in UTC) for the days of the
@@ -6,7 +7,9 @@ range, every complete message of channels ``results`` and ``runs``, damaged
 files as far as they go (:class:`RecordingScan`, a warning each). A result
 is kept when it ended (``time_ns``) inside the range and matches the
 program / tool asked for. The same result seen twice (a file and its
-``.recovered`` copy) counts once.
+``.recovered`` copy) counts once. The store gives the same results, in the
+same order, each with the events of its run (what a summary adds to a
+result from the files), in one query instead of a read of every file.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from pathlib import Path
 from shared.contract import RunSummary, TighteningResult, channels, decode
 from shared.recordings import recording_files, station_days
 from shared.recordings.mcap import RecordingScan
+from shared.results import ResultsQuery, ResultsStore
 
 #: progress is told every this many files (when there are more)
 PROGRESS_EVERY_FILES = 50
@@ -102,3 +106,17 @@ def read_results(
             progress(done, len(files))
     read.results.sort(key=lambda result: (result.time_ns, result.station, result.run_id))
     return read
+
+
+def read_stored(store: ResultsStore, rule: ResultFilter) -> RecordedResults:
+    """Every result that ``rule`` keeps, from the results store, in the order the runs ended."""
+    query = ResultsQuery(
+        stations=[station for station, _ in rule.stations],
+        program_id=rule.program_id,
+        tool_id=rule.tool_id,
+        since_ns=None if rule.since is None else round(rule.since.timestamp() * 1e9),
+        until_ns=None if rule.until is None else round(rule.until.timestamp() * 1e9),
+        limit=None,
+        oldest_first=True,
+    )
+    return RecordedResults(results=[stored.result for stored in store.find(query)])

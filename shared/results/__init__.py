@@ -1,0 +1,44 @@
+"""The results store: every tightening result, findable in a second (by part, station,
+line, program, tool, time), in SQLite beside the recordings or a plant's PostgreSQL.
+
+- :mod:`.results_database` (one connection, SQLite or PostgreSQL, the same SQL;
+  :func:`store_target`: where a station file's store is)
+- :mod:`.results_schema` (the tables, their version, the migrations)
+- :mod:`.stored_result` (a result as a row, and back)
+- :mod:`.results_store` (add idempotently, find, what was read of which recording)
+- :mod:`.results_query` (which tightenings a question asks for)
+
+The recorder writes it (``services/recorder/results_watch.py``); ``boltwatch
+results`` reads it.
+"""
+
+from shared.results.results_database import (
+    SQLITE_FILE,
+    ResultsDatabase,
+    StoreError,
+    StoreTarget,
+    store_target,
+    without_password,
+)
+from shared.results.results_query import DEFAULT_LIMIT, ResultsQuery
+from shared.results.results_schema import MIGRATIONS, SCHEMA_VERSION, migrate, version_of
+from shared.results.results_store import ResultsStore
+from shared.results.stored_result import StoredResult, stored_result
+
+__all__ = [
+    "DEFAULT_LIMIT",
+    "MIGRATIONS",
+    "SCHEMA_VERSION",
+    "SQLITE_FILE",
+    "ResultsDatabase",
+    "ResultsQuery",
+    "ResultsStore",
+    "StoreError",
+    "StoreTarget",
+    "StoredResult",
+    "migrate",
+    "store_target",
+    "stored_result",
+    "version_of",
+    "without_password",
+]

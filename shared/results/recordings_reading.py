@@ -1,0 +1,117 @@
+"""Results from recordings into the store: ``boltwatch results rebuild``, and the
+recorder's catch-up at start.
+
+Each MCAP file is read once for its ``results`` (and ``runs``: the events of
+a result that has none) and every result stored (idempotent, so a file read
+again adds nothing twice). A file read whole is marked with its size and
+modification time in ``recordings_read``, so the next reading skips it
+unless it changed: a rebuild stopped halfway goes on where it stopped. A
+damaged file (a recorder killed mid-write, a cut cable) is read as far as it
+goes, warned of, and not marked: it is read again next time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from shared.contract import RunSummary, TighteningResult, channels, decode
+from shared.errors import InputError
+from shared.recordings import recording_files, station_days
+from shared.recordings.mcap import RecordingScan
+from shared.results.results_store import ResultsStore
+from shared.results.stored_result import StoredResult, stored_result
+
+_RESULTS = "/" + channels.RESULTS.topic
+_RUNS = "/" + channels.RUNS.topic
+
+
+@dataclass
+class FillCounts:
+    """What a reading of recordings did."""
+
+    files: int = 0  # files it was given
+    done: int = 0  # of them, looked at so far
+    read: int = 0  # files it read (not skipped as read before)
+    results: int = 0  # results found in what it read
+    new: int = 0  # of them, new to the store
+    damaged: list[str] = field(default_factory=list)  # one line per damaged file
+
+
+def station_recordings(folder: Path, stations: Iterable[str]) -> list[Path]:
+    """Every MCAP file of ``stations`` under the recordings ``folder``, oldest day first."""
+    return [
+        path
+        for station in stations
+        for _, day in station_days(folder, station)
+        for path in recording_files(day)
+    ]
+
+
+def results_of(
+    path: Path, lines: Mapping[str, str], host: str, now_ns: int
+) -> tuple[list[StoredResult], RecordingScan]:
+    """The results recorded in ``path`` (as far as it is readable), as the store keeps them:
+    the line of each station from ``lines``, the file as their recording."""
+    scan = RecordingScan(path)
+    results: list[TighteningResult] = []
+    summaries: dict[tuple[str, int], RunSummary] = {}
+    for _, channel, message in scan.messages():
+        if channel.topic.endswith(_RESULTS):
+            results.append(decode(TighteningResult, message.data))
+        elif channel.topic.endswith(_RUNS):
+            summary = decode(RunSummary, message.data)
+            summaries[(summary.station, summary.run_id)] = summary
+    recording = str(path.resolve())
+    stored = [
+        stored_result(
+            result,
+            lines.get(result.station, ""),
+            recording,
+            host,
+            now_ns,
+            summaries.get((result.station, result.run_id)),
+        )
+        for result in results
+    ]
+    return stored, scan
+
+
+def fill_from_recordings(
+    store: ResultsStore,
+    files: Sequence[Path],
+    lines: Mapping[str, str],
+    host: str,
+    clock_ns: Callable[[], int],
+    progress: Callable[[FillCounts], None] | None = None,
+) -> FillCounts:
+    """Store the results of ``files`` (those read whole before and unchanged since: skipped);
+    ``progress`` is told after each file."""
+    counts = FillCounts(files=len(files))
+    for path in files:
+        try:
+            stat = path.stat()
+        except FileNotFoundError:  # gone since it was listed (a retention policy, a person)
+            counts.done += 1
+            continue
+        recording = str(path.resolve())
+        if store.recording_read(host, recording) != (stat.st_size, stat.st_mtime_ns):
+            try:
+                stored, scan = results_of(path, lines, host, clock_ns())
+            except InputError as err:
+                counts.damaged.append(str(err))
+            else:
+                counts.read += 1
+                counts.results += len(stored)
+                counts.new += store.add(stored)
+                if scan.complete:
+                    store.mark_read(
+                        host, recording, stat.st_size, stat.st_mtime_ns, len(stored), clock_ns()
+                    )
+                else:
+                    counts.damaged.append(scan.describe())
+        counts.done += 1
+        if progress is not None:
+            progress(counts)
+    return counts

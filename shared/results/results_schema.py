@@ -1,0 +1,137 @@
+"""The results store's tables and their versions: one list of migrations for both databases.
+
+``tightenings``: one row per tightening, keyed by (station, run_id), so a
+result heard twice (a spool's resend, a rebuild over files already read) is
+one row. It holds what a quality engineer asks about: the part, the program,
+the tool, the line, when it ended, OK/NOK and why, the final torque, angle
+and preload each with its window and status, what stopped the tool, the
+stick-slip events and intensity, who judged it (``source``), and where its
+recording is (``recording``: the MCAP file's path on ``recording_host``).
+``tightening_steps``: the steps of a controller's program, one row each.
+``recordings_read``: which recordings ``results rebuild`` (and the
+recorder's catch-up at start) has read, so reading again skips them.
+``store_version``: the schema version.
+
+A store of an older version is brought up to :data:`SCHEMA_VERSION` by the
+first writer that opens it (:func:`migrate`), each step in one transaction
+under the store's lock, so two recorders starting at once migrate it once
+and nothing already stored is lost; a store of a newer version than this
+boltwatch knows is refused, never written into.
+"""
+
+from __future__ import annotations
+
+from shared.results.results_database import ResultsDatabase, StoreError
+
+#: the version this boltwatch writes; MIGRATIONS[v - 1] makes version v
+SCHEMA_VERSION = 1
+
+TIGHTENING_COLUMNS = (
+    "station", "run_id", "line", "tightening_id", "tool_id", "program_id", "program_name",
+    "part_id", "batch_counter", "ended_ns", "result", "nok_reasons",
+    "torque_nm", "torque_min_nm", "torque_max_nm", "torque_status",
+    "angle_deg", "angle_min_deg", "angle_max_deg", "angle_status",
+    "force_n", "force_min_n", "force_max_n", "force_status",
+    "stop_reason", "events", "process_intensity", "source",
+    "recording", "recording_host", "stored_ns",
+)  # fmt: skip
+STEP_COLUMNS = (
+    "station", "run_id", "step_index", "name", "function", "nominal", "actual", "status",
+)  # fmt: skip
+
+_VERSION_1 = (
+    """CREATE TABLE tightenings (
+        station TEXT NOT NULL,
+        run_id BIGINT NOT NULL,
+        line TEXT NOT NULL,
+        tightening_id BIGINT NOT NULL,
+        tool_id BIGINT NOT NULL,
+        program_id BIGINT NOT NULL,
+        program_name TEXT NOT NULL,
+        part_id TEXT,
+        batch_counter BIGINT,
+        ended_ns BIGINT NOT NULL,
+        result TEXT NOT NULL,
+        nok_reasons TEXT NOT NULL,
+        torque_nm DOUBLE PRECISION, torque_min_nm DOUBLE PRECISION,
+        torque_max_nm DOUBLE PRECISION, torque_status TEXT NOT NULL,
+        angle_deg DOUBLE PRECISION, angle_min_deg DOUBLE PRECISION,
+        angle_max_deg DOUBLE PRECISION, angle_status TEXT NOT NULL,
+        force_n DOUBLE PRECISION, force_min_n DOUBLE PRECISION,
+        force_max_n DOUBLE PRECISION, force_status TEXT NOT NULL,
+        stop_reason TEXT,
+        events BIGINT,
+        process_intensity DOUBLE PRECISION,
+        source TEXT NOT NULL,
+        recording TEXT,
+        recording_host TEXT,
+        stored_ns BIGINT NOT NULL,
+        PRIMARY KEY (station, run_id)
+    )""",
+    "CREATE INDEX tightenings_by_part ON tightenings (part_id, ended_ns)",
+    "CREATE INDEX tightenings_by_time ON tightenings (ended_ns)",
+    "CREATE INDEX tightenings_by_station ON tightenings (station, ended_ns)",
+    "CREATE INDEX tightenings_by_line ON tightenings (line, ended_ns)",
+    "CREATE INDEX tightenings_by_program ON tightenings (program_id, ended_ns)",
+    "CREATE INDEX tightenings_by_tool ON tightenings (tool_id, ended_ns)",
+    "CREATE INDEX tightenings_by_stored ON tightenings (stored_ns)",
+    """CREATE TABLE tightening_steps (
+        station TEXT NOT NULL,
+        run_id BIGINT NOT NULL,
+        step_index BIGINT NOT NULL,
+        name TEXT NOT NULL,
+        function TEXT NOT NULL,
+        nominal DOUBLE PRECISION,
+        actual DOUBLE PRECISION,
+        status TEXT NOT NULL,
+        PRIMARY KEY (station, run_id, step_index)
+    )""",
+    """CREATE TABLE recordings_read (
+        recording_host TEXT NOT NULL,
+        recording TEXT NOT NULL,
+        size_bytes BIGINT NOT NULL,
+        modified_ns BIGINT NOT NULL,
+        results BIGINT NOT NULL,
+        read_ns BIGINT NOT NULL,
+        PRIMARY KEY (recording_host, recording)
+    )""",
+)
+
+#: the statements that bring a store from version v - 1 to v, for v = 1, 2, ...
+MIGRATIONS: tuple[tuple[str, ...], ...] = (_VERSION_1,)
+
+
+def migrate(database: ResultsDatabase, migrations: tuple[tuple[str, ...], ...] = MIGRATIONS) -> int:
+    """Bring the store to the last version of ``migrations``; the version it had (0: new).
+    StoreError when it is newer than this boltwatch."""
+    known = len(migrations)
+    with database.transaction(lock=True):
+        database.execute("CREATE TABLE IF NOT EXISTS store_version (version BIGINT NOT NULL)")
+        found = database.rows("SELECT version FROM store_version")
+        if not found:
+            database.execute("INSERT INTO store_version (version) VALUES (0)")
+        had = int(found[0][0]) if found else 0
+        if had > known:
+            raise StoreError(
+                f"results store {database.target}: version {had} is newer than this "
+                f"boltwatch's {known}; upgrade boltwatch to write into it"
+            )
+        for version in range(had + 1, known + 1):
+            for statement in migrations[version - 1]:
+                database.execute(statement)
+            database.execute("UPDATE store_version SET version = ?", (version,))
+    return had
+
+
+def version_of(database: ResultsDatabase) -> int:
+    """The store's version without changing it (0: no store there yet)."""
+    with database.transaction():
+        tables = database.rows(
+            "SELECT name FROM sqlite_master WHERE name = 'store_version'"
+            if database.dialect == "sqlite"
+            else "SELECT tablename FROM pg_tables WHERE tablename = 'store_version'"
+        )
+        if not tables:
+            return 0
+        found = database.rows("SELECT version FROM store_version")
+    return int(found[0][0]) if found else 0

@@ -1,0 +1,159 @@
+"""The results store: every tightening's result, findable by part, station, line, program,
+tool and time (:mod:`.results_schema` its tables, :mod:`.results_database` SQLite or
+PostgreSQL).
+
+The recorder adds each result as it files it (``services/recorder/results_watch.py``),
+``boltwatch results rebuild`` those of existing recordings; both may write at once.
+:meth:`ResultsStore.add` is idempotent by (station, run_id): a result stored
+again is left as it is (the first one stored stays) and not counted as new.
+Readers (``boltwatch results``, ``report``) open it without making one:
+:class:`~.results_database.StoreError` says where none is and how one comes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from typing import Any
+
+from shared.contract import ResultStep
+from shared.results.results_database import ResultsDatabase, StoreError, StoreTarget
+from shared.results.results_query import ResultsQuery
+from shared.results.results_schema import (
+    SCHEMA_VERSION,
+    STEP_COLUMNS,
+    TIGHTENING_COLUMNS,
+    migrate,
+    version_of,
+)
+from shared.results.stored_result import StoredResult, from_row, step_of, step_rows, to_row
+
+#: (station, run_id) pairs per statement when the steps of found rows are read
+_KEYS_PER_QUERY = 500
+
+_INSERT_TIGHTENING = (
+    f"INSERT INTO tightenings ({', '.join(TIGHTENING_COLUMNS)}) "
+    f"VALUES ({', '.join('?' * len(TIGHTENING_COLUMNS))}) "
+    "ON CONFLICT (station, run_id) DO NOTHING"
+)
+_INSERT_STEP = (
+    f"INSERT INTO tightening_steps ({', '.join(STEP_COLUMNS)}) "
+    f"VALUES ({', '.join('?' * len(STEP_COLUMNS))}) "
+    "ON CONFLICT (station, run_id, step_index) DO NOTHING"
+)
+_SELECT = f"SELECT {', '.join(TIGHTENING_COLUMNS)} FROM tightenings"
+
+
+class ResultsStore:
+    """An open results store (a context manager)."""
+
+    def __init__(self, target: StoreTarget, *, create: bool = True, application: str = "") -> None:
+        """``create``: make the store when there is none (a writer); else StoreError.
+        An older store is migrated either way."""
+        self.target = target
+        nowhere = StoreError(
+            f"no results store at {target}: the line's recorder makes it, "
+            "'boltwatch results rebuild' fills it from existing recordings"
+        )
+        if not create and target.sqlite_path is not None and not target.sqlite_path.exists():
+            raise nowhere  # opening would make the file
+        self.database = ResultsDatabase(target, application or "boltwatch")
+        try:
+            if not create and version_of(self.database) == 0:
+                raise nowhere
+            self.migrated_from = migrate(self.database)
+        except BaseException:
+            self.database.close()
+            raise
+        self.version = SCHEMA_VERSION
+
+    def close(self) -> None:
+        self.database.close()
+
+    def __enter__(self) -> ResultsStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def add(self, results: Sequence[StoredResult]) -> int:
+        """Store ``results`` in one transaction; how many were new (not stored before)."""
+        new = 0
+        with self.database.transaction():
+            for stored in results:
+                if self.database.execute(_INSERT_TIGHTENING, to_row(stored)) == 1:
+                    new += 1
+                    self.database.execute_many(_INSERT_STEP, step_rows(stored))
+        return new
+
+    def find(self, query: ResultsQuery) -> list[StoredResult]:
+        """The tightenings ``query`` asks for, with their steps, in its order."""
+        where, parameters = query.where()
+        with self.database.transaction():
+            rows = self.database.rows(_SELECT + where + query.order(), parameters)
+            steps = self._steps_of([(row[0], row[1]) for row in rows])
+        return [from_row(row, steps.get((row[0], int(row[1])), ())) for row in rows]
+
+    def count(self, query: ResultsQuery) -> int:
+        """How many tightenings ``query`` asks for (its limit aside)."""
+        where, parameters = query.where()
+        with self.database.transaction():
+            (row,) = self.database.rows("SELECT COUNT(*) FROM tightenings" + where, parameters)
+        return int(row[0])
+
+    def recording_read(self, host: str, recording: str) -> tuple[int, int] | None:
+        """(size, modification time) of ``recording`` when it was last read; None: never."""
+        with self.database.transaction():
+            rows = self.database.rows(
+                "SELECT size_bytes, modified_ns FROM recordings_read "
+                "WHERE recording_host = ? AND recording = ?",
+                (host, recording),
+            )
+        return (int(rows[0][0]), int(rows[0][1])) if rows else None
+
+    def mark_read(
+        self,
+        host: str,
+        recording: str,
+        size_bytes: int,
+        modified_ns: int,
+        results: int,
+        now_ns: int,
+    ) -> None:
+        """``recording`` has been read whole at (size, modification time)."""
+        with self.database.transaction():
+            self.database.execute(
+                "INSERT INTO recordings_read (recording_host, recording, size_bytes, "
+                "modified_ns, results, read_ns) VALUES (?, ?, ?, ?, ?, ?) "
+                "ON CONFLICT (recording_host, recording) DO UPDATE SET "
+                "size_bytes = excluded.size_bytes, modified_ns = excluded.modified_ns, "
+                "results = excluded.results, read_ns = excluded.read_ns",
+                (host, recording, size_bytes, modified_ns, results, now_ns),
+            )
+
+    def last_stored_ns(self, stations: Sequence[str]) -> int | None:
+        """When the newest result of ``stations`` was stored; None: none stored."""
+        where, parameters = ResultsQuery(stations=stations).where()
+        with self.database.transaction():
+            (row,) = self.database.rows(
+                "SELECT MAX(stored_ns) FROM tightenings" + where, parameters
+            )
+        return None if row[0] is None else int(row[0])
+
+    def _steps_of(self, keys: list[tuple[Any, Any]]) -> dict[tuple[str, int], list[ResultStep]]:
+        steps: dict[tuple[str, int], list[ResultStep]] = {}
+        for chunk in _chunks(keys, _KEYS_PER_QUERY):
+            pairs = ", ".join("(?, ?)" for _ in chunk)
+            rows = self.database.rows(
+                "SELECT station, run_id, name, function, nominal, actual, status "
+                f"FROM tightening_steps WHERE (station, run_id) IN ({pairs}) "
+                "ORDER BY station, run_id, step_index",
+                [value for key in chunk for value in key],
+            )
+            for row in rows:
+                steps.setdefault((row[0], int(row[1])), []).append(step_of(row[2:]))
+        return steps
+
+
+def _chunks(items: list[tuple[Any, Any]], size: int) -> Iterator[list[tuple[Any, Any]]]:
+    for start in range(0, len(items), size):
+        yield items[start : start + size]

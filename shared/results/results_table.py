@@ -1,0 +1,107 @@
+"""Stored tightenings for people and programs: a table, CSV, JSON (``boltwatch results``).
+
+The table has one line per tightening, newest first, its last column the
+recording (``boltwatch inspect <it> --run <run>`` draws the run); CSV has
+every column of the store, JSON every field with the steps.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from collections.abc import Sequence
+from datetime import UTC, datetime
+from typing import Any
+
+from shared.contract import JudgedFigure, to_dict
+from shared.results.stored_result import StoredResult
+
+HEADER = (
+    "ended (UTC)", "station", "line", "run", "part", "program", "tool", "result",
+    "torque Nm", "angle deg", "preload kN", "stopped on", "events", "why NOK", "recording",
+)  # fmt: skip
+CSV_HEADER = (
+    "ended_utc", "station", "line", "run_id", "tightening_id", "part_id", "program_id",
+    "program_name", "tool_id", "batch_counter", "result", "nok_reasons",
+    "torque_nm", "torque_min_nm", "torque_max_nm", "torque_status",
+    "angle_deg", "angle_min_deg", "angle_max_deg", "angle_status",
+    "force_n", "force_min_n", "force_max_n", "force_status",
+    "stop_reason", "events", "process_intensity", "source", "recording", "recording_host",
+)  # fmt: skip
+
+
+def utc_text(time_ns: int) -> str:
+    return f"{datetime.fromtimestamp(time_ns / 1e9, UTC):%Y-%m-%d %H:%M:%S}"
+
+
+def _figure(figure: JudgedFigure, scale: float = 1.0) -> str:
+    if figure.value is None:
+        return "-"
+    mark = "" if figure.status in ("ok", "not_judged") else f" ({figure.status})"
+    return f"{figure.value / scale:.4g}{mark}"
+
+
+def row(stored: StoredResult) -> tuple[str, ...]:
+    r = stored.result
+    return (
+        utc_text(r.time_ns),
+        r.station,
+        stored.line or "-",
+        str(r.run_id),
+        r.part_id or "-",
+        f"{r.program_id} {r.program_name}".strip(),
+        str(r.tool_id),
+        r.result,
+        _figure(r.final_torque_nm),
+        _figure(r.final_angle_deg),
+        _figure(r.final_force_n, 1000.0),
+        r.stop_reason or "-",
+        "-" if r.events is None else str(r.events),
+        r.nok_reasons or "-",
+        stored.recording or "-",
+    )
+
+
+def format_table(results: Sequence[StoredResult]) -> str:
+    rows = [HEADER, *(row(stored) for stored in results)]
+    widths = [max(len(cells[i]) for cells in rows) for i in range(len(HEADER))]
+    return "\n".join(
+        "  ".join(cell.ljust(width) for cell, width in zip(cells, widths, strict=True)).rstrip()
+        for cells in rows
+    )
+
+
+def csv_row(stored: StoredResult) -> list[Any]:
+    r = stored.result
+    figures: list[Any] = []
+    for figure in (r.final_torque_nm, r.final_angle_deg, r.final_force_n):
+        figures += [figure.value, figure.min, figure.max, figure.status]
+    return [
+        utc_text(r.time_ns), r.station, stored.line, r.run_id, r.tightening_id, r.part_id,
+        r.program_id, r.program_name, r.tool_id, r.batch_counter, r.result, r.nok_reasons,
+        *figures, r.stop_reason, r.events, r.process_intensity, r.source, stored.recording,
+        stored.recording_host,
+    ]  # fmt: skip
+
+
+def format_csv(results: Sequence[StoredResult]) -> str:
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(CSV_HEADER)
+    writer.writerows(csv_row(stored) for stored in results)
+    return out.getvalue()
+
+
+def as_dict(stored: StoredResult) -> dict[str, Any]:
+    """A tightening as JSON: the TighteningResult's fields, its line and recording."""
+    document = to_dict(stored.result)
+    document["ended_utc"] = utc_text(stored.result.time_ns)
+    document["line"] = stored.line
+    document["recording"] = stored.recording
+    document["recording_host"] = stored.recording_host
+    return document
+
+
+def format_json(results: Sequence[StoredResult]) -> str:
+    return json.dumps([as_dict(stored) for stored in results], indent=1)

@@ -1,0 +1,105 @@
+"""A tightening as the results store keeps it: a :class:`TighteningResult`, where it was
+tightened (line), where its recording is, and when it was stored.
+
+:func:`stored_result` makes one from a result (and its run's summary: the
+events of a run whose result has none, as ``report`` counts them);
+:meth:`StoredResult.result` gives the TighteningResult back, equal to the
+one stored, so what reads the store (``report``) computes what it computed
+from the files. :func:`to_row` / :func:`from_row` are its rows, in the
+order of :data:`~shared.results.results_schema.TIGHTENING_COLUMNS`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+from shared.contract import JudgedFigure, ResultStep, RunSummary, TighteningResult
+
+
+@dataclass(frozen=True, slots=True)
+class StoredResult:
+    """One row of ``tightenings`` (the result's steps: its ``tightening_steps``)."""
+
+    result: TighteningResult
+    line: str = ""  # the station's line ("": none named)
+    recording: str | None = None  # the MCAP file's path on recording_host; None: unknown
+    recording_host: str | None = None
+    stored_ns: int = 0
+
+
+def stored_result(
+    result: TighteningResult,
+    line: str,
+    recording: str | None,
+    recording_host: str | None,
+    stored_ns: int,
+    summary: RunSummary | None = None,
+) -> StoredResult:
+    """``result`` to store; ``summary``: its run's, whose events count when it has none."""
+    if result.events is None and summary is not None and summary.run_id == result.run_id:
+        result = replace(result, events=summary.events)
+    return StoredResult(result, line, recording, recording_host, stored_ns)
+
+
+def to_row(stored: StoredResult) -> tuple[Any, ...]:
+    r = stored.result
+    torque, angle, force = r.final_torque_nm, r.final_angle_deg, r.final_force_n
+    return (
+        r.station, r.run_id, stored.line, r.tightening_id, r.tool_id, r.program_id,
+        r.program_name, r.part_id, r.batch_counter, r.time_ns, r.result, r.nok_reasons,
+        torque.value, torque.min, torque.max, torque.status,
+        angle.value, angle.min, angle.max, angle.status,
+        force.value, force.min, force.max, force.status,
+        r.stop_reason, r.events, r.process_intensity, r.source,
+        stored.recording, stored.recording_host, stored.stored_ns,
+    )  # fmt: skip
+
+
+def step_rows(stored: StoredResult) -> list[tuple[Any, ...]]:
+    r = stored.result
+    return [
+        (r.station, r.run_id, index, step.name, step.function, step.nominal, step.actual,
+         step.status)
+        for index, step in enumerate(r.steps)
+    ]  # fmt: skip
+
+
+def from_row(row: Sequence[Any], steps: Sequence[ResultStep] = ()) -> StoredResult:
+    (
+        station, run_id, line, tightening_id, tool_id, program_id, program_name, part_id,
+        batch_counter, ended_ns, verdict, nok_reasons,
+        torque, torque_min, torque_max, torque_status,
+        angle, angle_min, angle_max, angle_status,
+        force, force_min, force_max, force_status,
+        stop_reason, events, intensity, source, recording, recording_host, stored_ns,
+    ) = row  # fmt: skip
+    result = TighteningResult(
+        station=station,
+        tightening_id=int(tightening_id),
+        run_id=int(run_id),
+        tool_id=int(tool_id),
+        program_id=int(program_id),
+        program_name=program_name,
+        time_ns=int(ended_ns),
+        part_id=part_id,
+        batch_counter=None if batch_counter is None else int(batch_counter),
+        final_torque_nm=JudgedFigure(torque, torque_min, torque_max, torque_status),
+        final_angle_deg=JudgedFigure(angle, angle_min, angle_max, angle_status),
+        final_force_n=JudgedFigure(force, force_min, force_max, force_status),
+        result=verdict,
+        nok_reasons=nok_reasons,
+        stop_reason=stop_reason,
+        events=None if events is None else int(events),
+        process_intensity=intensity,
+        source=source,
+        steps=list(steps),
+    )
+    return StoredResult(result, line, recording, recording_host, int(stored_ns))
+
+
+def step_of(row: Sequence[Any]) -> ResultStep:
+    """A ``tightening_steps`` row (without its key columns) as a ResultStep."""
+    name, function, nominal, actual, status = row
+    return ResultStep(name, function, nominal, actual, status)

@@ -1,0 +1,148 @@
+"""The recorder puts every result it files into the results store, naming the file the run
+is in; while the store fails the results wait and go in when it works again; results a
+stopped recorder had not stored come from the recordings at its next start."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import zenoh
+
+from shared.config import LoadedStation, load_station
+from shared.contract import TighteningResult
+from shared.recordings.mcap import RecordingScan
+from shared.results import ResultsQuery, ResultsStore, StoredResult, store_target
+from shared.runtime import zenoh_config
+from tests.support import factories
+from tests.support.live_recorder import (
+    RunningRecorder,
+    free_port,
+    publish,
+    wait_until,
+    write_station_file,
+)
+from tests.support.postgres_server import (
+    PostgresServer,
+    PostgresUnavailableError,
+    start_postgres_server,
+)
+from tests.support.recorded_runs import T0_NS, run_messages
+
+WAIT_S = 30.0  # a bound: the writer stores every 0.2 s, retries a failing store every 5 s
+
+
+def _run_with_result(run_id: int, part_id: str) -> list[tuple[str, object]]:
+    """A whole run, then its result (as the predictor publishes them)."""
+    result = factories.result(run_id, part_id=part_id, time_ns=T0_NS + run_id * 10**10 + 10**6)
+    return [*run_messages(run_id, 50), ("results", result)]
+
+
+def _station(tmp_path: Path, database: str | None = None) -> LoadedStation:
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    recorder = {} if database is None else {"results_database": database}
+    path = write_station_file(
+        tmp_path / "station.toml", tmp_path / "recordings", listen=[endpoint], recorder=recorder
+    )
+    return load_station(path)
+
+
+def _stored(station: LoadedStation) -> list[StoredResult]:
+    target = store_target(station.recordings_folder, station.config.recorder.results_database)
+    try:
+        with ResultsStore(target, create=False) as store:
+            return store.find(ResultsQuery(oldest_first=True))
+    except Exception:
+        return []
+
+
+def _record(station: LoadedStation, runs: list[int]) -> RunningRecorder:
+    recorder = RunningRecorder(station)
+    session = zenoh.open(zenoh_config("peer", connect=station.config.zenoh.listen))
+    try:
+        for run_id in runs:
+            publish(session, _run_with_result(run_id, f"VIN{run_id:04d}"))
+    finally:
+        session.close()
+    return recorder
+
+
+def _results_in(path: Path) -> list[TighteningResult]:
+    from shared.contract import decode
+
+    return [
+        decode(TighteningResult, message.data)
+        for _, _, message in RecordingScan(path).messages("/results")
+    ]
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def station(request: pytest.FixtureRequest, tmp_path: Path) -> LoadedStation:
+    if request.param == "sqlite":
+        return _station(tmp_path)
+    return _station(tmp_path, request.getfixturevalue("postgres_url"))
+
+
+def test_each_result_is_stored_with_the_recording_it_is_in(station: LoadedStation) -> None:
+    recorder = _record(station, [1, 2, 3])
+    try:
+        wait_until(lambda: len(_stored(station)) == 3, "three results stored", WAIT_S)
+    finally:
+        recorder.finish()
+    stored = _stored(station)
+    assert [s.result.part_id for s in stored] == ["VIN0001", "VIN0002", "VIN0003"]
+    for row in stored:
+        assert row.recording is not None and row.line == ""
+        assert row.result in _results_in(Path(row.recording)), row.recording
+        assert f"_run{row.result.run_id}_" in Path(row.recording).name
+    if station.config.recorder.results_database is None:
+        assert (station.recordings_folder / "results.sqlite").is_file()
+
+
+@pytest.fixture
+def own_server(tmp_path: Path) -> PostgresServer:
+    try:
+        return start_postgres_server()
+    except PostgresUnavailableError as err:
+        pytest.skip(str(err))
+
+
+def test_a_store_down_keeps_results_waiting_and_the_next_start_finds_the_rest(
+    tmp_path: Path, own_server: PostgresServer
+) -> None:
+    """Down while runs 1-2 are recorded: they wait; it comes back: they go in. Down again
+    for runs 3-4 and the recorder stops: they are not lost, the next start reads them from
+    the recordings (the catch-up)."""
+    with own_server:
+        station = _station(tmp_path, own_server.url)
+        own_server.stop()
+        recorder = _record(station, [1, 2])
+        watch = recorder.service.results
+        assert watch is not None
+        try:
+            wait_until(lambda: watch.waiting == 2, "2 results waiting")
+            assert watch.last_error is not None
+            own_server.start()
+            wait_until(lambda: len(_stored(station)) == 2, "the waiting results stored", WAIT_S)
+            assert watch.last_error is None
+            own_server.stop()
+            session = zenoh.open(zenoh_config("peer", connect=station.config.zenoh.listen))
+            try:
+                for run_id in (3, 4):
+                    publish(session, _run_with_result(run_id, f"VIN{run_id:04d}"))
+            finally:
+                session.close()
+            wait_until(lambda: watch.waiting == 2, "runs 3-4 waiting")
+        finally:
+            recorder.finish()
+        own_server.start()
+        again = RunningRecorder(station)
+        try:
+            wait_until(lambda: len(_stored(station)) == 4, "runs 3-4 from the recordings", WAIT_S)
+        finally:
+            again.finish()
+        stored = _stored(station)
+        assert [s.result.part_id for s in stored] == [f"VIN{n:04d}" for n in (1, 2, 3, 4)]
+        for row in stored:
+            assert row.recording is not None
+            assert row.result in _results_in(Path(row.recording))

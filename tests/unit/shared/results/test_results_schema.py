@@ -1,0 +1,100 @@
+"""The store's versions: a new store is made whole, an older one migrated with nothing
+lost, a newer one refused, writers starting together migrate once, a damaged file is
+named and left as it is."""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import pytest
+
+from shared.errors import StoreError
+from shared.results import (
+    MIGRATIONS,
+    SCHEMA_VERSION,
+    ResultsDatabase,
+    ResultsQuery,
+    ResultsStore,
+    StoreTarget,
+    migrate,
+    stored_result,
+    version_of,
+)
+from tests.support import factories
+
+#: a later version, as the next boltwatch would bring one: a column added
+NEXT_VERSION = (*MIGRATIONS, ("ALTER TABLE tightenings ADD COLUMN operator TEXT",))
+
+
+def test_a_new_store_is_made_at_the_current_version(target: StoreTarget) -> None:
+    with ResultsStore(target) as store:
+        assert (store.migrated_from, store.version) == (0, SCHEMA_VERSION)
+    with ResultsStore(target) as store:  # opened again: nothing to do
+        assert store.migrated_from == SCHEMA_VERSION
+
+
+def test_an_older_store_is_migrated_and_keeps_its_results(target: StoreTarget) -> None:
+    with ResultsStore(target) as store:
+        store.add([stored_result(factories.result(run), "A", None, None, 1) for run in (1, 2)])
+    with ResultsDatabase(target) as database:
+        assert migrate(database, NEXT_VERSION) == SCHEMA_VERSION
+        assert version_of(database) == SCHEMA_VERSION + 1
+        with database.transaction():
+            assert database.rows("SELECT run_id, operator FROM tightenings ORDER BY run_id") == [
+                (1, None),
+                (2, None),
+            ]
+
+
+def test_a_store_of_a_newer_boltwatch_is_not_written_into(target: StoreTarget) -> None:
+    with ResultsStore(target) as store:
+        store.add([stored_result(factories.result(1), "A", None, None, 1)])
+    with ResultsDatabase(target) as database, database.transaction():
+        database.execute("UPDATE store_version SET version = ?", (SCHEMA_VERSION + 5,))
+    with pytest.raises(StoreError, match=r"version 6 is newer than this boltwatch's 1"):
+        ResultsStore(target)
+    with ResultsDatabase(target) as database:
+        assert version_of(database) == SCHEMA_VERSION + 5
+        with database.transaction():
+            assert database.rows("SELECT COUNT(*) FROM tightenings") == [(1,)]
+
+
+def test_writers_starting_together_migrate_once(target: StoreTarget) -> None:
+    errors: list[BaseException] = []
+    start = threading.Barrier(4)
+
+    def open_store() -> None:
+        start.wait()
+        try:
+            with ResultsStore(target) as store:
+                store.add([stored_result(factories.result(1), "A", None, None, 1)])
+        except BaseException as err:  # the test says which, below
+            errors.append(err)
+
+    threads = [threading.Thread(target=open_store) for _ in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert errors == []
+    with ResultsStore(target) as store:
+        assert store.count(ResultsQuery()) == 1
+
+
+def test_a_damaged_file_is_named_and_left_as_it_is(tmp_path: Path) -> None:
+    path = tmp_path / "results.sqlite"
+    damage = b"not a database at all " * 100
+    path.write_bytes(damage)
+    with pytest.raises(StoreError, match=rf"results store {path}: .*not a database"):
+        ResultsStore(StoreTarget(sqlite_path=path))
+    assert path.read_bytes() == damage
+
+
+def test_an_unreachable_server_is_one_line_without_its_password() -> None:
+    target = StoreTarget(postgres_url="postgresql://boltwatch:secret@127.0.0.1:1/results")
+    with pytest.raises(StoreError) as raised:
+        ResultsStore(target)
+    text = str(raised.value)
+    assert "secret" not in text and "\n" not in text
+    assert text.startswith("results store postgresql://boltwatch:***@127.0.0.1:1/results")
