@@ -3,7 +3,9 @@
 With several stations (``--stations N``) the first column names the station.
 The ``result`` column is the run's verdict (its ``TighteningResult`` on
 ``boltwatch/<st>/results``: OK, or NOK against the program's windows); ``-``
-when no result arrived for the run.
+when no result arrived for the run. The last column, ``part``, is the part
+the result names (the id the line scanned before the run, a controller's
+VIN), left-aligned as ids are read; ``-`` when it names none.
 """
 
 from __future__ import annotations
@@ -22,13 +24,15 @@ COLUMNS = (
     ("intensity", 10),
     ("samples", 7),
 )
+#: the last column, left-aligned, as wide as its part ids
+PART_TITLE = "part"
 
 
 STATION_WIDTH = 8
 
 
 def header(station_column: bool = False) -> str:
-    line = "  ".join(f"{title:>{width}}" for title, width in COLUMNS)
+    line = "  ".join(f"{title:>{width}}" for title, width in COLUMNS) + f"  {PART_TITLE}"
     if station_column:
         line = f"{'station':>{STATION_WIDTH}}  {line}"
     return f"{line}\n{'-' * len(line)}"
@@ -58,6 +62,8 @@ def row(
         str(summary.samples),
     )
     line = "  ".join(f"{cell:>{width}}" for cell, (_, width) in zip(cells, COLUMNS, strict=True))
+    part = result.part_id if result is not None and result.part_id else "-"
+    line = f"{line}  {part}"
     return f"{summary.station:>{STATION_WIDTH}}  {line}" if station_column else line
 
 
@@ -66,7 +72,7 @@ def _kilo(value: float | None, unit: str) -> str:
 
 
 def totals(summaries: list[RunSummary], results: list[TighteningResult] | None = None) -> str:
-    """One line: runs, mean and worst |error|, and how many were OK and NOK."""
+    """One line: runs, mean and worst |error|, how many were OK and NOK, on how many parts."""
     errors = [abs(s.error_pct) for s in summaries if s.error_pct is not None]
     line = f"{len(summaries)} runs"
     if errors:
@@ -76,6 +82,9 @@ def totals(summaries: list[RunSummary], results: list[TighteningResult] | None =
         line += f", {len(results) - nok} OK, {nok} NOK"
         if len(results) < len(summaries):
             line += f", {len(summaries) - len(results)} without a result"
+        parts = {result.part_id for result in results if result.part_id}
+        if parts:
+            line += f", {len(parts)} part{'s' if len(parts) != 1 else ''}"
     return line
 
 

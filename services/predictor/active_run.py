@@ -35,9 +35,17 @@ Outgoing = StickSlipEvent | Intensity | StopDecision
 class ActiveRun:
     """The core of one (station, run_id) and what the summary needs."""
 
-    def __init__(self, state: ToolState, program: Program, settings: PredictorSettings) -> None:
+    def __init__(
+        self,
+        state: ToolState,
+        program: Program,
+        settings: PredictorSettings,
+        part_id: str | None = None,
+    ) -> None:
+        """``part_id``: the part at the station when the run started (None: none scanned)."""
         self.state = state
         self.program = program
+        self.part_id = part_id
         self.settings = settings
         self.core = PredictorCore(settings)
         self.started_ns = state.time_ns

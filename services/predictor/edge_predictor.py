@@ -15,9 +15,17 @@ queued publisher: the CAN thread only queues. It holds the station's
 predictor, and a second predictor for the station (a line predictor) is
 refused, as two line predictors are.
 
+It hears the station's part on zenoh (``boltwatch/<st>/part``: the line's
+PLC or scanner) in its subscriber's callback, which only sets the station's
+current part; a run started on the CAN thread takes the part current then.
+A part scan that does not decode, or names another station, is counted as a
+bad payload. A part must reach the edge box before its run starts: one
+scanned while the box is cut off from the line never arrives, and the runs
+go on naming the part before.
+
 What it counts (samples its core could not use, runs that started again,
-...) goes out once a second as the station's ``PredictorStats``, from a
-timer thread of its own through the same queue.
+part scans refused, ...) goes out once a second as the station's
+``PredictorStats``, from a timer thread of its own through the same queue.
 
 It implements the acquisition's ``Decider`` protocol
 (``services/acquisition/decider.py``) by shape; the CLI joins the two.
@@ -30,12 +38,15 @@ import threading
 import time
 from collections.abc import Callable
 
+import zenoh
+
 from services.predictor.served_station import ServedStation
 from services.predictor.station_refusal import refuse_stations_served_elsewhere
 from services.predictor.station_runs import StationRuns
 from shared.config import LoadedStation
-from shared.contract import Sample, StopDecision, ToolState
-from shared.runtime import ServiceSkeleton
+from shared.contract import Sample, StopDecision, ToolState, channels
+from shared.errors import InputError
+from shared.runtime import RateLimitedLog, ServiceSkeleton
 
 LOG = logging.getLogger(__name__)
 
@@ -53,6 +64,9 @@ class EdgePredictor:
         refuse_stations_served_elsewhere(skeleton.session, [station.station_id])
         self._runs = StationRuns(ServedStation(station))
         self._publish = publish
+        self._log_bad_part = RateLimitedLog(LOG)
+        # before the health token: a predictor the line sees alive hears the station's parts
+        skeleton.subscriber(channels.PART.key(station.station_id), self._on_part)
         skeleton.health_token(station.station_id, "predictor")
         self._started_ns = time.time_ns()
         self._closed = threading.Event()
@@ -75,6 +89,24 @@ class EdgePredictor:
                 decision = message
             self._publish(message)
         return decision
+
+    def _on_part(self, sample: zenoh.Sample) -> None:
+        """A part scan of the station, on zenoh's receive thread: the current part only."""
+        runs = self._runs
+        try:
+            scan = runs.served.decode_part(sample.payload.to_bytes())
+            if scan.station != runs.served.station_id:
+                raise InputError(f"it names station {scan.station}")
+        except InputError as err:
+            runs.counts.bad_payloads += 1  # only this thread counts bad payloads at the edge
+            self._log_bad_part(
+                "ignored a part scan of %s (#%d): %s",
+                runs.served.station_id,
+                runs.counts.bad_payloads,
+                err,
+            )
+            return
+        runs.on_part(scan)
 
     @property
     def runs(self) -> StationRuns:

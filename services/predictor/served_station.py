@@ -4,7 +4,8 @@ A line predictor serves several stations; each run is predicted with the
 configuration of the station it belongs to, never another's. Its samples and
 tool states are decoded with ids only as wide as the station's DBC carries
 them (``RunId``, ``ToolId``, ``ProgramId`` of ``ToolStatus``): they come from
-its CAN bus, and a wider one is no run of this station.
+its CAN bus, and a wider one is no run of this station. Its part scans come
+from the line (``boltwatch/<st>/part``), decoded with the contract's bounds.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from shared.config import LoadedStation, Program
-from shared.contract import Sample, StationDatabase, ToolState, can_id_bounds, codec
+from shared.contract import PartScan, Sample, StationDatabase, ToolState, can_id_bounds, codec
 from shared.model import JointConstants
 from shared.stickslip import PredictorSettings
 
@@ -29,6 +30,7 @@ class ServedStation:
             Sample, {"run_id": ids["run_id"]}
         )
         self.decode_tool_state: Callable[[bytes], ToolState] = codec.decoder(ToolState, ids)
+        self.decode_part: Callable[[bytes], PartScan] = codec.decoder(PartScan)
 
     def program(self, program_id: int) -> Program:
         """The station's program; KeyError names the station and its known ids."""

@@ -1,10 +1,12 @@
 """``boltwatch serve predictor``: the predictor core wired to zenoh, for one or more stations.
 
 One process serves the stations named by ``--config FILE [FILE ...]`` and
-only those: per served station it subscribes to ``boltwatch/<st>/samples``
-and ``boltwatch/<st>/tool`` (never ``boltwatch/*/*``: another station's data
-must never reach this process's decisions); each message is handled in its
-zenoh callback, one at a time (:mod:`services.predictor.station_inbox`).
+only those: per served station it subscribes to ``boltwatch/<st>/samples``,
+``boltwatch/<st>/tool`` and ``boltwatch/<st>/part`` (never ``boltwatch/*/*``:
+another station's data must never reach this process's decisions, nor
+another station's part its results); each message is handled in its zenoh
+callback, one at a time (:mod:`services.predictor.station_inbox`), so a part
+scanned before a run's ``running`` is the part of that run.
 Each run is predicted with its own station's programs, force sensor, joint
 constants and ``[predictor]`` section. Out, per station: ``events`` and ``intensity``
 per stick-slip event, ``decision`` (REAL_TIME priority, express, blocking
@@ -131,6 +133,10 @@ class PredictorService:
                 state = served.decode_tool_state(payload)
                 if self._belongs(state.station, station_id, topic):
                     self._on_tool(runs, state)
+            elif topic == channels.PART.topic:
+                scan = served.decode_part(payload)
+                if self._belongs(scan.station, station_id, topic):
+                    runs.on_part(scan)
         except InputError as err:
             counts = runs.counts
             counts.bad_payloads += 1
@@ -169,6 +175,11 @@ class PredictorService:
     def counts(self) -> dict[str, StationCounts]:
         """What each served station's predictor counted (its PredictorStats)."""
         return {station_id: runs.counts for station_id, runs in self._runs.items()}
+
+    @property
+    def part_ids(self) -> dict[str, str | None]:
+        """The part at each served station: the last one scanned (None: none yet)."""
+        return {station_id: runs.part_id for station_id, runs in self._runs.items()}
 
     @property
     def bad_payloads(self) -> int:

@@ -1,7 +1,7 @@
-"""The predictor's inbox: every served station's samples and tool states, handled one at a time.
+"""The predictor's inbox: every served station's samples, tool states and part scans, one at a time.
 
-Each served station gets its own two subscribers (``samples`` and ``tool``)
-whose callbacks run on zenoh's receive thread (``indirect=False``), keep that
+Each served station gets its own subscribers (``samples``, ``tool`` and
+``part``) whose callbacks run on zenoh's receive thread (``indirect=False``), keep that
 thread's Python thread state (:func:`shared.runtime.receive_threads.keep_thread_state`)
 and handle the message right there, under one lock: decisions come from one
 message at a time, in arrival order, with no queue and no hand-over to a
@@ -54,7 +54,11 @@ class StationInbox:
         session: zenoh.Session,
         station_ids: Iterable[str],
         handle: Handler,
-        topics: tuple[str, ...] = (channels.SAMPLES.topic, channels.TOOL.topic),
+        topics: tuple[str, ...] = (
+            channels.SAMPLES.topic,
+            channels.TOOL.topic,
+            channels.PART.topic,
+        ),
     ) -> None:
         self._handle = handle
         self._lock = threading.Lock()

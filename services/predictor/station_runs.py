@@ -10,9 +10,12 @@ predictor (:mod:`.service`, fed from zenoh) and the edge predictor
 - a new run of the station ends its older ones, unheard (their ``done`` was
   lost in an outage: counted in :attr:`unfinished_runs`, no summary);
 - ``done`` / ``aborted`` ends a run: its :class:`TighteningResult` (the summary
-  judged against the program's windows: :mod:`.run_result`), then its
+  judged against the program's windows: :mod:`shared.quality.run_result`), then its
   :class:`RunSummary`;
-- a sample of no running run is dropped and counted.
+- a sample of no running run is dropped and counted;
+- a :class:`PartScan` makes its part the station's current part; a run takes
+  the part current when it starts, and its result names it (a part scanned
+  during a run belongs to the next run; none scanned yet: None).
 
 What it counts (:attr:`counts`, a :class:`~.station_counts.StationCounts`:
 runs that started again, runs whose end never arrived, samples of no
@@ -29,7 +32,7 @@ from collections import deque
 from services.predictor.active_run import ActiveRun, Outgoing
 from services.predictor.served_station import ServedStation
 from services.predictor.station_counts import StationCounts
-from shared.contract import RunSummary, Sample, TighteningResult, ToolState
+from shared.contract import PartScan, RunSummary, Sample, TighteningResult, ToolState
 from shared.quality import tightening_result
 from shared.runtime import RateLimitedLog
 
@@ -47,6 +50,8 @@ class StationRuns:
         self._runs: dict[int, ActiveRun] = {}
         self._started: deque[int] = deque(maxlen=STARTED_RUNS_KEPT)
         self.counts = StationCounts(served.station_id)
+        #: the part at the station: the last one scanned (None: none since the start)
+        self.part_id: str | None = None
         self._log_no_program = RateLimitedLog(LOG, logging.ERROR)
         self._log_unfinished = RateLimitedLog(LOG)
 
@@ -62,14 +67,15 @@ class StationRuns:
         if run is None:
             return []
         summary = run.summary(state)
-        result = tightening_result(summary, run.program)
+        result = tightening_result(summary, run.program, run.part_id)
         self.counts.run_ended(run.core.input_report)
         LOG.info(
-            "%s run %s %s %s: %d events, stop %s%s, error %s %%, %s",
+            "%s run %s %s %s, part %s: %d events, stop %s%s, error %s %%, %s",
             state.station,
             state.run_id,
             state.state,
             result.result,
+            run.part_id or "-",
             summary.events,
             summary.stop_reason or "by the tool",
             f" (late decision: {summary.late_decision})" if summary.late_decision else "",
@@ -77,6 +83,12 @@ class StationRuns:
             run.core.input_report.as_dict(),
         )
         return [result, summary]
+
+    def on_part(self, scan: PartScan) -> None:
+        """A part arrived at the station: the runs that start from now on tighten it."""
+        if scan.part_id != self.part_id:
+            LOG.info("%s: part %s at the station", scan.station, scan.part_id)
+        self.part_id = scan.part_id
 
     def on_sample(self, sample: Sample, wall_ns: int) -> list[Outgoing]:
         """Feed a sample to its run; the events, intensities and decision it produced."""
@@ -99,8 +111,15 @@ class StationRuns:
         except KeyError as err:
             self._log_no_program("run %s: %s; not predicting this run", state.run_id, err.args[0])
             return
-        self._runs[state.run_id] = ActiveRun(state, program, self.served.settings(program))
-        LOG.debug("%s run %s started (program %s)", state.station, state.run_id, program.id)
+        part_id = self.part_id  # read once: an edge predictor's scans come on another thread
+        self._runs[state.run_id] = ActiveRun(state, program, self.served.settings(program), part_id)
+        LOG.debug(
+            "%s run %s started (program %s, part %s)",
+            state.station,
+            state.run_id,
+            program.id,
+            part_id or "-",
+        )
 
     def _forget_unfinished_runs(self) -> None:
         """A new run starts: the older ones have ended, unheard (an outage)."""

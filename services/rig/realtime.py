@@ -10,6 +10,12 @@ More than 50 ms late: a warning, a count, and the schedule restarts from now.
 
 Seeds: run k (0-based) of a session uses ``seed + k``, so a session is
 reproducible from its seed and runs differ from each other.
+
+Parts: with a :class:`PartSource` (the line's part scanner,
+:mod:`services.rig.part_scanner`), each run that starts a part has the part
+announced before the pause that precedes it; the first run (no pause
+before it otherwise) waits the pause too, so a part always reaches the line
+before the tool starts on it.
 """
 
 from __future__ import annotations
@@ -19,6 +25,7 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol
 
 import can
 
@@ -60,6 +67,14 @@ class ToolIdentity:
     has_force_sensor: bool
 
 
+class PartSource(Protocol):
+    """Who announces the part a run tightens (the line's PLC or scanner)."""
+
+    def before_run(self, index: int, run_id: int) -> bool:
+        """Before run ``index`` (from 0) and its pause: True when the run starts a
+        new part (announced now)."""
+
+
 class RealtimeRig:
     """Runs tightenings one after another on ``bus`` (which the caller owns and closes)."""
 
@@ -87,15 +102,20 @@ class RealtimeRig:
         seed: int,
         stop: threading.Event,
         runs: int | None = None,
+        parts: PartSource | None = None,
     ) -> list[RunSummary]:
-        """``runs`` runs (None: until ``stop``), pausing ``pause_between_runs_s`` between."""
+        """``runs`` runs (None: until ``stop``), pausing ``pause_between_runs_s`` between;
+        ``parts``: told before each run (and its pause), announces each new part."""
         summaries: list[RunSummary] = []
         index = 0
         while not stop.is_set() and (runs is None or index < runs):
+            new_part = parts is not None and parts.before_run(index, first_run_id + index)
             if index > 0:
                 self._idle(self._rig.pause_between_runs_s, summaries[-1].run_id, program, stop)
-                if stop.is_set():
-                    break
+            elif new_part:  # the tool says nothing yet: it waits for the part to be known
+                stop.wait(self._rig.pause_between_runs_s)
+            if stop.is_set():
+                break
             summary = self.run_one(program, first_run_id + index, seed + index, stop)
             summaries.append(summary)
             LOG.info(

@@ -11,6 +11,11 @@ Like every service, the rig holds the liveliness token
 file, so ``boltwatch up`` and ``status`` see it. A rig on a ``virtual`` bus is
 the exception: that bus lives inside one process, no station service can
 reach the rig, so it announces nothing (and needs no zenoh: unit tests).
+
+On zenoh it also stands in for the line's PLC: the id of each part
+(``[rig] bolts_per_part`` runs each) goes on ``boltwatch/<station>/part``
+before the part's first run (:mod:`services.rig.part_scanner`), so the
+station's results name their parts. ``bolts_per_part = 0``: no parts.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ import threading
 import time
 
 from services.rig.frames import RigFrames
+from services.rig.part_scanner import PartScanner
 from services.rig.realtime import RealtimeRig, ToolIdentity
 from services.rig.selection import choose_program, choose_seed
 from shared.config import load_station
@@ -51,19 +57,24 @@ def main(args: argparse.Namespace) -> int:
         raise ConfigError(f"--first-run-id must keep run ids within 0..{RUN_ID_MAX}")
     frames = RigFrames(StationDatabase(station.dbc_path))
     constants = JointConstants.of(station.joint_of(program.id))
+    announces_parts = config.can.interface != "virtual" and config.rig.bolts_per_part > 0
     LOG.info(
-        "rig: station %s, program %d (%s), first run %d, seed %d, runs %s",
+        "rig: station %s, program %d (%s), first run %d, seed %d, runs %s, %s",
         config.station.id,
         program.id,
         program.name,
         first_run_id,
         seed,
         args.runs if args.runs is not None else "until stopped",
+        f"{config.rig.bolts_per_part} bolts per part" if announces_parts else "no part ids",
     )
     with ServiceSkeleton("rig") as skeleton:
         bus = skeleton.device(open_bus(config.can))
+        parts = None
         if config.can.interface != "virtual":
             skeleton.open_session(config.zenoh)
+            if announces_parts:
+                parts = PartScanner(skeleton, config.station.id, config.rig)
             skeleton.health_token(config.station.id, "rig")
         rig = RealtimeRig(
             bus,
@@ -76,6 +87,6 @@ def main(args: argparse.Namespace) -> int:
         def work(stop: threading.Event) -> None:
             # the tool is the reference a stop is measured against: it keeps its own pace
             use_realtime_priority(RIG_PRIORITY, "rig")
-            rig.run_many(program, first_run_id, seed, stop, runs=args.runs)
+            rig.run_many(program, first_run_id, seed, stop, runs=args.runs, parts=parts)
 
         return skeleton.run(work)

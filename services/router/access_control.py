@@ -17,6 +17,9 @@ may declare subscribers, queryables and liveliness tokens under
   station (``boltwatch serve openprotocol``: the run's samples, tool states,
   the advisory predictor's keys, the controller's result, tool data, alarms and
   its own stats; :func:`shared.contract.channels.topics_of` ``("openprotocol")``),
+- ``<st>-plc`` may put ``boltwatch/<st>/part`` (the line's PLC, or a scanner at the
+  station: the part that arrived), and so may ``<st>-rig`` (the simulated rig
+  stands in for the PLC),
 - ``line-recorder`` may put ``boltwatch/<st>/recorder``, ``quality/alert``,
   ``wear/**`` and ``spool/ack`` (what it has of a station's spool);
 - the station's spooling services (``acquisition``, ``openprotocol``) may put
@@ -54,6 +57,9 @@ AGAIN_TOPICS = (f"{keys.AGAIN}/**",)
 ACQUISITION_TOPICS = (*channels.topics_of("acquisition"), *AGAIN_TOPICS)
 PREDICTOR_TOPICS = channels.topics_of("predictor")
 BRIDGE_TOPICS = (*channels.topics_of("openprotocol"), *AGAIN_TOPICS)
+#: the part at a station: the line's PLC (or scanner), and the rig in its place
+PLC_TOPICS = channels.topics_of("plc")
+RIG_TOPICS = channels.topics_of("rig")
 #: its channels below ``wear/**`` (the alert) and the wear ledger's queryable
 RECORDER_TOPICS = (
     *(topic for topic in channels.topics_of("recorder") if not topic.startswith(keys.WEAR)),
@@ -75,7 +81,7 @@ _DECLARATIONS = [
 
 def station_subjects(station: str) -> dict[str, str]:
     """Role -> certificate common name of the services of ``station``."""
-    roles = ("acquisition", "predictor", "openprotocol", "rig")
+    roles = ("acquisition", "predictor", "openprotocol", "rig", "plc")
     return {role: f"{station}-{role}" for role in roles}
 
 
@@ -107,6 +113,8 @@ def line_access_control(
             ("acquisition", ACQUISITION_TOPICS + PREDICTOR_TOPICS),  # + the edge predictor
             ("predictor", PREDICTOR_TOPICS),
             ("openprotocol", BRIDGE_TOPICS),
+            ("plc", PLC_TOPICS),
+            ("rig", RIG_TOPICS),
         ):
             rule_id = f"{station}-{role}-puts"
             rules.append(
@@ -121,7 +129,14 @@ def line_access_control(
             keys.station_key(st, topic)
             for st in its_stations
             for topic in dict.fromkeys(
-                (*ACQUISITION_TOPICS, *PREDICTOR_TOPICS, *BRIDGE_TOPICS, *RECORDER_TOPICS)
+                (
+                    *ACQUISITION_TOPICS,
+                    *PREDICTOR_TOPICS,
+                    *BRIDGE_TOPICS,
+                    *PLC_TOPICS,
+                    *RIG_TOPICS,
+                    *RECORDER_TOPICS,
+                )
             )
         ]
         rules.append(_rule(rule_id, ["put"], ["ingress"], forwarded))

@@ -9,7 +9,8 @@ names), :func:`load_any_station` (a CAN or a controller station) or
   kind), :mod:`.common_sections` (what both have), :mod:`.program_windows` (a program's
   windows: where a run must end to be OK), :mod:`.openprotocol` (a controller that
   speaks Open Protocol, and the simulated one's side), :mod:`.quality` (when the
-  recorder raises a quality alert), :mod:`.joint` (the joint file),
+  recorder raises a quality alert), :mod:`.rig_parts` (the simulated line's parts: bolts
+  per part, their ids), :mod:`.joint` (the joint file),
   :mod:`.line` (a line: stations served together, stations derived from one)
 - :mod:`.loading` (TOML into a validated model, errors naming file and key),
   :mod:`.toml_writer` (the files boltwatch derives from others)

@@ -16,7 +16,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from shared.config.common_sections import (
     RecorderSection,
@@ -35,6 +35,7 @@ from shared.config.loading import StrictModel, read_toml, resolve_relative, vali
 from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
 from shared.config.program_windows import ProgramWindows
 from shared.config.quality import QualitySection
+from shared.config.rig_parts import DEFAULT_PART_PATTERN, check_part_pattern, part_id
 from shared.contract import SensorRange, StationDatabase
 from shared.errors import CanDatabaseError, ConfigError
 
@@ -159,10 +160,30 @@ class RigSection(StrictModel):
     settle_time_s: float = Field(default=0.03, gt=0, description="samples sent after the stop")
     pause_between_runs_s: float = Field(default=0.5, ge=0)
     seed: int | None = Field(default=None, description="none: a fresh seed per process")
+    bolts_per_part: int = Field(
+        default=4,
+        ge=0,
+        le=10_000,
+        description="runs per part: the rig puts each part's id on boltwatch/<st>/part "
+        "before its first run, as the line's PLC would; 0: no part ids",
+    )
+    part_pattern: str = Field(
+        default=DEFAULT_PART_PATTERN,
+        description="the id of each part: {station} and {first_run_id} (its first bolt's run)",
+    )
     openprotocol: RigOpenProtocolSection = Field(
         default_factory=RigOpenProtocolSection,
         description="the simulated controller toward an Open Protocol bridge",
     )
+
+    @field_validator("part_pattern")
+    @classmethod
+    def _part_pattern_fits(cls, pattern: str) -> str:
+        return check_part_pattern(pattern)
+
+    def part_id(self, station: str, first_run_id: int) -> str:
+        """The id of the part whose first bolt is run ``first_run_id``."""
+        return part_id(self.part_pattern, station, first_run_id)
 
 
 class StationConfig(StrictModel):

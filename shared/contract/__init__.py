@@ -11,6 +11,7 @@
   :mod:`.sensor_range` (what a station's sensors can measure)
 - :mod:`.trace` (the offline trace CSV), :mod:`.run_clock` (a run's clock: ns <-> s)
 - :mod:`.spool_messages` (what a station's spool and the recorder say to each other)
+- :mod:`.part_messages` (what the line says of the part at a station: its id)
 """
 
 from shared.contract.can_database import CONTRACT, COUNTER_MODULO, SAMPLE_RATE_HZ, StationDatabase
@@ -23,6 +24,8 @@ from shared.contract.message_fields import (
     FLOAT_MAX,
     INT64_MAX,
     MAX_TEXT_CHARS,
+    PART_ID,
+    PART_ID_CHARS,
     STATION_ID,
     NumberRange,
     TextRange,
@@ -38,6 +41,7 @@ from shared.contract.messages import (
     FigureStatus,
     Intensity,
     JudgedFigure,
+    PartScan,
     Prediction,
     PredictorStats,
     QualityAlert,
@@ -85,6 +89,8 @@ __all__ = [
     "INT64_MAX",
     "MAX_PAYLOAD_BYTES",
     "MAX_TEXT_CHARS",
+    "PART_ID",
+    "PART_ID_CHARS",
     "SAMPLE_RATE_HZ",
     "SCHEMA_TYPES",
     "STATION_ID",
@@ -99,6 +105,7 @@ __all__ = [
     "Intensity",
     "JudgedFigure",
     "NumberRange",
+    "PartScan",
     "Prediction",
     "PredictorStats",
     "QualityAlert",

@@ -1,6 +1,18 @@
 """What flows on a line, in one place: every channel of boltwatch and its contract.
 
 A channel is a key below a station, ``boltwatch/<station>/<topic>``
+(:mod:`shared.contract.keys`), carrying one message type of
+:mod:`shared.contract.messages` as JSON with the schema the codec derives
+(``boltwatch.<Type>``), put by one service (others that may put it in that
+service's place: :attr:`Channel.also_by`) with one :class:`Qos`. Publishers
+are declared from here; the recorder, ``boltwatch status``, the tests and the
+benchmarks look channels up here (:func:`by_topic`, :func:`of_message`,
+:data:`CHANNELS`). Adding a channel: its message type, its row below. The
+table as a page: ``docs/reference/channels.md`` (written from this module);
+why each channel is put as it is: ``docs/explanation/design.md``, "The line's
+channels".
+
+=================  ====================  ===========================================
 topic              publisher             message, when
 =================  ====================  ===========================================
 ``samples``        acquisition           :class:`Sample`, one per 1 kHz sample (placement
@@ -34,12 +46,20 @@ topic              publisher             message, when
                    (openprotocol)        station keeps until the line has it
 ``spool/ack``      recorder              :class:`SpoolAck`, once a second per spooling
                                          source: what it wrote to disk of the spool
+``part``           plc (rig)             :class:`PartScan`, when a part arrives at the
+                                         station: the runs that start after it tighten it
 =================  ====================  ===========================================
 
 In brackets: who else may put the channel (:attr:`Channel.also_by`). A
 controller bridge (``boltwatch serve openprotocol``, publisher
 ``openprotocol``) stands for a CAN station's acquisition and predictor: it
 publishes what they would, from what its controller says.
+
+A part's id comes from the line, not from the tool: the line's PLC (or a
+scanner at the station; publisher ``plc``, certificate ``<st>-plc``) puts it
+when the part arrives, and the simulated rig stands in for it
+(``[rig] bolts_per_part``). The station's predictor names the part in each
+result (:attr:`TighteningResult.part_id`).
 
 A station's samples go toward the line once, on one of the two sample
 channels: one message per sample where a line predictor decides on them
@@ -52,22 +72,12 @@ recorder's queryable of the wear ledger), in :mod:`shared.contract.keys`.
 Every channel is put with congestion control BLOCK: zenoh's default (DROP)
 lost events under load, silently, and loss is counted end to end. Samples
 and tool states share one priority, so a run's ``done`` never overtakes its
-samples; a decision is REAL_TIME. Samples, tool states and decisions are
-express (no batching in zenoh: latency counts). Sample batches are not: they
+samples; a decision is REAL_TIME. Samples, tool states, decisions and part
+scans are express (no batching in zenoh: latency counts; a part must reach
+the predictor before its first run starts). Sample batches are not: they
 are recorded, not decided on, and zenoh packs the batches of many stations
 into one frame toward the line's recorder (``bench_line.py`` at 50 stations:
 0.6 to 1.0 µs less of the recorder's CPU per sample, lag no worse).
-=======
-(:mod:`shared.contract.keys`), carrying one message type of
-:mod:`shared.contract.messages` as JSON with the schema the codec derives
-(``boltwatch.<Type>``), put by one service (others that may put it in that
-service's place: :attr:`Channel.also_by`) with one :class:`Qos`. Publishers
-are declared from here; the recorder, ``boltwatch status``, the tests and the
-benchmarks look channels up here (:func:`by_topic`, :func:`of_message`,
-:data:`CHANNELS`). Adding a channel: its message type, its row below. The
-table as a page: ``docs/reference/channels.md`` (written from this module);
-why each channel is put as it is: ``docs/explanation/design.md``, "The line's
-channels".
 """
 
 from __future__ import annotations
@@ -82,6 +92,7 @@ from shared.contract.messages import (
     ControllerAlarm,
     ControllerResult,
     Intensity,
+    PartScan,
     PredictorStats,
     QualityAlert,
     RecorderStats,
@@ -173,6 +184,8 @@ ALARMS = Channel("alarms", ControllerAlarm, "openprotocol")
 OPENPROTOCOL = Channel("openprotocol", BridgeStats, "openprotocol")
 SPOOL = Channel("spool", SpoolStats, "acquisition", also_by=_BRIDGE)
 SPOOL_ACK = Channel("spool/ack", SpoolAck, "recorder")
+#: the line's PLC or the station's scanner; the simulated rig stands in for it
+PART = Channel("part", PartScan, "plc", Qos(express=True), ("rig",))
 
 #: every channel, in the order of the table above
 CHANNELS: tuple[Channel[Any], ...] = (
@@ -195,6 +208,7 @@ CHANNELS: tuple[Channel[Any], ...] = (
     OPENPROTOCOL,
     SPOOL,
     SPOOL_ACK,
+    PART,
 )
 
 _BY_TOPIC: dict[str, Channel[Any]] = {channel.topic: channel for channel in CHANNELS}

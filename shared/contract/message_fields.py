@@ -32,6 +32,10 @@ Why these bounds:
   DBC, and the predictor's core must see an implausible sample to count it
   and, after a long stretch of them, stop the tool (``input_fault``);
 - station ids: the key chunk of the station files (:data:`STATION_ID`);
+- part ids: 1 to :data:`PART_ID_CHARS` printable ASCII characters, no space
+  at either end (:data:`PART_ID`): what a scanner reads off a part (a VIN
+  is 17 characters, Open Protocol's VIN field 25, its identifier download
+  MID 0150 up to 100); one scanner's padding must not make two parts of one;
 - texts: at most :data:`MAX_TEXT_CHARS` characters (a Linux path, PATH_MAX,
   fits in an error text).
 """
@@ -57,6 +61,10 @@ FLOAT_MAX = sys.float_info.max
 MAX_TEXT_CHARS = 4096
 #: a station id: a zenoh key chunk, as the station files require (``[station] id``)
 STATION_ID = re.compile(r"[A-Za-z0-9_-]{1,64}")
+#: a part id: printable ASCII (space to ``~``), neither starting nor ending with a space
+PART_ID = re.compile(r"[!-~](?:[ -~]*[!-~])?")
+#: the longest part id: the identifier of Open Protocol's MID 0150 (a VIN is 17)
+PART_ID_CHARS = 100
 
 
 @dataclass(frozen=True, slots=True)
@@ -102,6 +110,8 @@ Count = Annotated[int, NumberRange(0, INT64_MAX)]
 Measured = Annotated[float, NumberRange(-FLOAT_MAX, FLOAT_MAX, nan_ok=True)]
 #: a station id, the key chunk of ``boltwatch/<station>/...``
 StationId = Annotated[str, TextRange(64, STATION_ID)]
+#: a part's id (work piece, VIN) as the line scanned it
+PartId = Annotated[str, TextRange(PART_ID_CHARS, PART_ID)]
 
 DEFAULT_INT = NumberRange(INT64_MIN, INT64_MAX)
 DEFAULT_FLOAT = NumberRange(-FLOAT_MAX, FLOAT_MAX)

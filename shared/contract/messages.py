@@ -15,6 +15,8 @@ channel carries which message, who puts it and how: :mod:`shared.contract.channe
 What tool controllers say (a controller's result, its tool data and alarms, a
 controller bridge's counters) is in :mod:`shared.contract.controller_messages` and
 imported from here as every other message.
+What the line says of the part at a station (:class:`PartScan`) is in
+:mod:`shared.contract.part_messages`, imported from here too.
 """
 
 from __future__ import annotations
@@ -33,6 +35,9 @@ from shared.contract.controller_messages import (  # noqa: F401  (re-exported: o
     ToolData,
 )
 from shared.contract.message_fields import WIRE_CONFIG, Count, Id, Measured, StationId, TimeNs
+from shared.contract.part_messages import (  # noqa: F401  (re-exported: one import for every message)
+    PartScan,
+)
 from shared.contract.spool_messages import (  # noqa: F401  (re-exported: one import for every message)
     SeqRange,
     SpoolAck,
@@ -307,7 +312,8 @@ class PredictorStats:
     station: StationId
     time_ns: TimeNs
     started_ns: TimeNs  # when this predictor process started: a new value, a new process
-    # samples and tool payloads refused (not a valid message, or naming another station)
+    # samples, tool states and part scans refused (not a valid message, or naming another
+    # station)
     bad_payloads: Count
     # samples of ended runs the core could not use: a bad time (NaN, out of order, a jump of
     # more than its MAX_JUMP_S) or torque (NaN, outside the station's sensor range)
@@ -419,7 +425,9 @@ class TighteningResult:
     program_id: Id
     program_name: str  # "" when unknown
     time_ns: TimeNs  # when the run ended
-    part_id: str | None  # the part (work piece, VIN) tightened; None: unknown
+    # the part (work piece, VIN) tightened: a controller's VIN, or the part the line scanned
+    # (boltwatch/<st>/part) before the run started; None: unknown
+    part_id: str | None
     batch_counter: Count | None  # the run's count within its batch; None: no batch known
     final_torque_nm: JudgedFigure
     final_angle_deg: JudgedFigure  # since the run started (a controller: its last step's angle)

@@ -15,8 +15,10 @@ otherwise OK. A program with no window judges no figure: its runs are OK
 unless they aborted or ended on a fault.
 
 The tightening id of a live run is its run id (the tool controller's count
-of its tightenings, ``RunId`` on CAN); the part and the batch are unknown to
-the station (None).
+of its tightenings, ``RunId`` on CAN). The part is what the line scanned
+last before the run started (``boltwatch/<st>/part``), passed in by the
+caller; None when no part was scanned. The batch is unknown to the station
+(None).
 """
 
 from __future__ import annotations
@@ -29,8 +31,11 @@ from shared.quality.verdict import cut_text, figure_reasons, judge, reasons_text
 FAULT_STOPS = frozenset({"torque_limit", "force_limit", "angle_limit", "input_fault"})
 
 
-def tightening_result(summary: RunSummary, program: Program) -> TighteningResult:
-    """The result of the run of ``summary``, tightened with ``program``."""
+def tightening_result(
+    summary: RunSummary, program: Program, part_id: str | None = None
+) -> TighteningResult:
+    """The result of the run of ``summary``, tightened with ``program`` on part ``part_id``
+    (None: unknown)."""
     torque = judge(summary.reached_torque_nm, *program.window("torque"))
     angle = judge(summary.reached_angle_deg, *program.window("angle"))
     force = judge(summary.reached_force_n, *program.window("force"))
@@ -49,7 +54,7 @@ def tightening_result(summary: RunSummary, program: Program) -> TighteningResult
         program_id=summary.program_id,
         program_name=cut_text(program.name),
         time_ns=summary.ended_ns,
-        part_id=None,
+        part_id=part_id,
         batch_counter=None,
         final_torque_nm=torque,
         final_angle_deg=angle,

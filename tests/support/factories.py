@@ -16,6 +16,7 @@ from typing import Any
 from shared.config import Program
 from shared.contract import (
     JudgedFigure,
+    PartScan,
     RunSummary,
     Sample,
     StickSlipEvent,
@@ -124,6 +125,14 @@ def result(run_id: int, **changes: Any) -> TighteningResult:
     }
     fields.update(changes)
     return TighteningResult(**fields)
+
+
+def part_scan(part_id: str, **changes: Any) -> PartScan:
+    """The line's scan of part ``part_id`` at st1, 10 s before :data:`T0` (before the default
+    run started)."""
+    fields: dict[str, Any] = {"station": "st1", "part_id": part_id, "time_ns": T0 - 10 * S}
+    fields.update(changes)
+    return PartScan(**fields)
 
 
 def program(**changes: Any) -> Program:

@@ -35,7 +35,8 @@ pytestmark = pytest.mark.system
 
 
 def test_up_tightens_stops_and_records_every_sample(tmp_path: Path) -> None:
-    station = write_station(tmp_path)
+    # two bolts per part: the three runs tighten two parts (the rig puts each part's id)
+    station = write_station(tmp_path, replacements={"bolts_per_part = 4": "bolts_per_part = 2"})
     result = run_up(station, runs=3)
     assert "stop reason" in result.stdout and "recordings:" in result.stdout
 
@@ -91,6 +92,21 @@ def test_up_tightens_stops_and_records_every_sample(tmp_path: Path) -> None:
             judged["nok_reasons"] == ""
         )
         assert verdicts[summary["run_id"]] == judged["result"]  # up's table says the same
+
+    # Each result names the part the rig (the line's PLC) put before the run started:
+    # the first two runs one part, the third the next; up's table and totals say so
+    first = min(s["run_id"] for s in summaries)
+    scans = messages["boltwatch/st1/part"]
+    assert [scan["part_id"] for scan in scans] == [f"st1-P{first:06d}", f"st1-P{first + 2:06d}"]
+    parts = {run_id: judged["part_id"] for run_id, judged in results.items()}
+    assert parts == {
+        first: scans[0]["part_id"],
+        first + 1: scans[0]["part_id"],
+        first + 2: scans[1]["part_id"],
+    }
+    table = [row for row in rows if len(row) > 7 and row[7] in ("OK", "NOK")]
+    assert {int(row[0]): row[-1] for row in table} == parts
+    assert ", 2 parts" in result.stdout
 
 
 def test_killed_service_is_reported_and_the_rest_stop(tmp_path: Path) -> None:

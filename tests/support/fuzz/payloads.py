@@ -47,6 +47,7 @@ from shared.contract import (
     Intensity,
     JudgedFigure,
     NumberRange,
+    PartScan,
     Prediction,
     PredictorStats,
     QualityAlert,
@@ -243,6 +244,7 @@ def template(topic: str, station: str, now_ns: int, run_id: int = 1) -> Any:
             through=run_id,
             ranges=[SeqRange(run_id + 5, run_id + 9)],
         ),
+        "part": lambda: PartScan(station, f"{station}-P{run_id:06d}", now_ns),
     }
     return made[topic]()
 
@@ -316,7 +318,9 @@ def refused_values(message_type: type, name: str) -> list[Any]:
     text = bound if isinstance(bound, TextRange) else DEFAULT_TEXT
     wrong = [*values, 1, 1.5, True, "x" * (text.max_chars + 1)]
     if text.pattern is not None:
-        wrong += ["", "st 1", "st1\n", "stü", "a/b", "*", "x" * 65]
+        pattern = text.pattern
+        candidates = ["", "st 1", "st1\n", "stü", "a/b", "*", "x" * 65, " x", "x ", "a\x1db"]
+        wrong += [c for c in candidates if pattern.fullmatch(c) is None or len(c) > text.max_chars]
     return wrong
 
 

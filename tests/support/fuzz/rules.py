@@ -6,8 +6,8 @@ rules alone (the fuzz adds them to the contract's refusals):
 
 - acquisition (decision): the decision names its own station; its run id
   fits the DBC's 32-bit ``RunId``;
-- predictor (samples, tool): its own station; ids as wide as the station's
-  ``ToolStatus`` signals (RunId 32, ToolId 16, ProgramId 8 bits);
+- predictor (samples, tool, part): its own station; ids as wide as the
+  station's ``ToolStatus`` signals (RunId 32, ToolId 16, ProgramId 8 bits);
 - recorder (everything): the key's station; a message's own time neither
   negative nor more than five minutes ahead of its arrival; a sample's
   torque, angle and force within the sensor range (the shipped DBC's).
@@ -65,11 +65,10 @@ def _predictor_refuses(topic: str, field: str, value: Any) -> bool:
 
 def _predictor_extra(topic: str, message: Any) -> list[bytes]:
     fields = as_json(message)
-    wider = (
-        {"run_id": 2**32}
-        if topic == channels.SAMPLES.topic
-        else {"tool_id": 2**16, "program_id": 256}
-    )
+    wider: dict[str, int] = {
+        channels.SAMPLES.topic: {"run_id": 2**32},
+        channels.TOOL.topic: {"tool_id": 2**16, "program_id": 256},
+    }.get(topic, {})
     others = [dumps({**fields, name: value}) for name, value in wider.items()]
     return [dumps({**fields, "station": "pt2"}), *others]
 

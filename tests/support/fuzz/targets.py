@@ -10,8 +10,8 @@ number of payloads it has refused (``refused()``), whether it is alive, and
 - :class:`AcquisitionTarget`: :class:`Acquisition` on a python-can
   ``virtual`` bus, its decision subscriber (``decision_handler``); a good
   decision must become a ``StopCommand`` frame on the bus;
-- :class:`PredictorTarget`: :class:`PredictorService` for station pt1; a
-  good run must be decided;
+- :class:`PredictorTarget`: :class:`PredictorService` for station pt1 (its
+  samples, tool states and part scans); a good run must be decided;
 - :class:`RecorderTarget`: :class:`RecorderService` (``RunningRecorder``)
   writing MCAP into a folder; a good run must be read back from its file,
   and every refused payload from the raw channels, byte for byte.
@@ -213,7 +213,7 @@ class AcquisitionTarget(_Target):
 
 class PredictorTarget(_Target):
     station = "pt1"
-    channels = (channels.SAMPLES.topic, channels.TOOL.topic)
+    channels = (channels.SAMPLES.topic, channels.TOOL.topic, channels.PART.topic)
 
     def __init__(self, folder: Path) -> None:
         super().__init__()

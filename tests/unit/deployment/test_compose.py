@@ -162,6 +162,7 @@ ROLE_PUTS = {  # what each role publishes (docs/reference/access-control.md), pe
     # and its spool sends again what the line's recorder lacks (again/<topic>)
     "acquisition": set(channels.topics_of("acquisition")) | PREDICTOR_PUTS | {f"{keys.AGAIN}/**"},
     "predictor": PREDICTOR_PUTS,
+    "rig": {channels.PART.topic},  # it stands in for the line's PLC: each part's id
     "recorder": {
         channels.RECORDER.topic,
         channels.QUALITY_ALERT.topic,

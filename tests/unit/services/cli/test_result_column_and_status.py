@@ -40,11 +40,29 @@ def test_the_up_table_has_a_result_column_with_ok_nok_or_a_dash() -> None:
     nok = run_table.row(summary(4), result=result(4))
     missing = run_table.row(summary(5))
     assert ok.split()[7] == "OK" and nok.split()[7] == "NOK" and missing.split()[7] == "-"
-    assert len(ok) == len(nok) == len(missing) == len(header.splitlines()[0])
+    # the fixed columns line up; the part, last, is as wide as its id
+    fixed = len(header.splitlines()[0]) - len("part")
+    assert {len(row) - len(row.split()[-1]) for row in (ok, nok, missing)} == {fixed}
     line = run_table.totals(
         [summary(3), summary(4), summary(5)], [result(3, result="OK"), result(4)]
     )
     assert line.endswith("1 OK, 1 NOK, 1 without a result")
+
+
+def test_the_up_table_ends_with_the_part_each_result_names() -> None:
+    header = run_table.header(station_column=True).splitlines()[0]
+    assert header.split()[-1] == "part"
+    on_part = run_table.row(summary(3), True, result(3, part_id="WVWZZZ1JZXW000001"))
+    no_part = run_table.row(summary(4), True, result(4))
+    missing = run_table.row(summary(5), True)
+    assert on_part.split()[0] == "st1" and on_part.split()[-1] == "WVWZZZ1JZXW000001"
+    assert no_part.split()[-1] == "-" and missing.split()[-1] == "-"
+    assert on_part.index("WVWZZZ1JZXW000001") == header.index("part")
+    results = [result(n, part_id=part) for n, part in ((3, "P1"), (4, "P1"), (5, "P2"), (6, None))]
+    line = run_table.totals([summary(n) for n in (3, 4, 5, 6)], results)
+    assert line.endswith("0 OK, 4 NOK, 2 parts")
+    one = run_table.totals([summary(3)], [result(3, part_id="P1")])
+    assert one.endswith(", 1 part")
 
 
 def test_status_shows_the_last_result_its_verdict_why_and_figures() -> None:

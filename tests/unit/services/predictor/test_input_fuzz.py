@@ -1,7 +1,7 @@
-"""Fuzz of the predictor's channels (samples, tool): the real service over real zenoh.
+"""Fuzz of the predictor's channels (samples, tool, part): the real service over real zenoh.
 
 Random bytes, random JSON, deep nesting, huge documents and messages with a
-field out of bounds go to ``boltwatch/pt1/samples`` and ``/tool`` of a live
+field out of bounds go to ``boltwatch/pt1/samples``, ``/tool`` and ``/part`` of a live
 predictor (:class:`tests.support.fuzz.targets.PredictorTarget`); each is counted as
 a bad payload (and in PredictorStats), the log holds no traceback and no
 line per payload, and a good run afterwards is still decided. The long run:

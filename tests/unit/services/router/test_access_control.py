@@ -9,6 +9,7 @@ import pytest
 from services.router.access_control import (
     ACQUISITION_TOPICS,
     BRIDGE_TOPICS,
+    PLC_TOPICS,
     PREDICTOR_TOPICS,
     line_access_control,
 )
@@ -50,6 +51,23 @@ def test_an_open_protocol_bridge_may_put_what_a_bridge_publishes(station: str) -
 
 
 @pytest.mark.parametrize("station", STATIONS)
+def test_only_the_lines_plc_and_the_rig_in_its_place_may_put_a_stations_part(
+    station: str,
+) -> None:
+    """The part at a station names the part in every result: the line's PLC (or scanner)
+    presents ``<st>-plc``; the simulated rig stands in for it and may put nothing else."""
+    acl = line_access_control(STATIONS)
+    assert (channels.PART.topic,) == PLC_TOPICS
+    part = channels.PART.key(station)
+    for role in ("plc", "rig"):
+        assert put_keys_granted(acl, f"{station}-{role}") == {part}
+    putters = {name for name in common_names(acl) if part in put_keys_granted(acl, name)}
+    assert putters == {f"{station}-plc", f"{station}-rig"}
+    other = next(st for st in STATIONS if st != station)
+    assert channels.PART.key(other) not in put_keys_granted(acl, f"{station}-plc")
+
+
+@pytest.mark.parametrize("station", STATIONS)
 def test_no_other_identity_may_put_a_stations_decision(station: str) -> None:
     """The bridge's decisions are advisory: an acquisition never turns one into a stop."""
     acl = line_access_control(STATIONS)
@@ -75,6 +93,7 @@ def test_another_lines_router_may_forward_its_own_stations_only() -> None:
     granted = put_keys_granted(acl, "line2-router")
     assert channels.SAMPLES.key("st2") in granted
     assert channels.DECISION.key("st3") in granted
+    assert channels.PART.key("st2") in granted  # its PLC's (or rig's) parts
     assert keys.station_key("st3", f"{keys.WEAR}/**") in granted
     assert not any(key.startswith("boltwatch/st1/") for key in granted)
     line = next(policy for policy in acl["policies"] if policy["id"] == "line")

@@ -137,3 +137,12 @@ def test_a_window_with_no_measured_value_is_nok_and_the_result_holds_no_nan() ->
     assert b"NaN" not in payload and b"Infinity" not in payload
     assert decode(TighteningResult, payload) == result
     json.loads(payload)  # standard JSON
+
+
+def test_the_result_names_the_part_it_is_given_and_none_without() -> None:
+    """The part is the caller's (the line scanned it before the run): passed in, kept as is."""
+    assert tightening_result(summary(), program(**WINDOWS)).part_id is None
+    result = tightening_result(summary(), program(**WINDOWS), "WVWZZZ1JZXW000001")
+    assert result.part_id == "WVWZZZ1JZXW000001"
+    assert decode(TighteningResult, encode(result)) == result
+    assert (result.result, result.batch_counter) == ("OK", None)

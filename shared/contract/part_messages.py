@@ -1,0 +1,34 @@
+"""What the line says of the part at a station: which work piece the next runs tighten.
+
+Re-exported by :mod:`shared.contract.messages`. Same rules as every message
+there. A tool on CAN knows nothing of the part it tightens; the line does:
+its PLC, or a scanner at the station, reads the part's id (a serial number,
+a VIN, the text of a data matrix code) when the part arrives, and puts a
+:class:`PartScan` on ``boltwatch/<st>/part`` before the part's first run (as
+an Open Protocol VIN download, MID 0050, tells a tool controller). The
+station's predictor keeps the last one and names it in the result of every
+run that starts after it (``TighteningResult.part_id``), until the next.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from shared.contract.message_fields import WIRE_CONFIG, PartId, StationId, TimeNs
+
+
+@dataclass(frozen=True, slots=True)
+class PartScan:
+    """A part arrived at the station: the runs that start from now on tighten it.
+
+    Its id holds until the next scan: a part with four bolts is scanned once,
+    before its first run. A scan that arrives while a run is in progress
+    belongs to the next run (the one in progress started on the part before).
+    No scan since the predictor started: the results name no part (None).
+    """
+
+    __pydantic_config__ = WIRE_CONFIG
+
+    station: StationId
+    part_id: PartId  # as scanned: a serial number, a VIN, the text of a data matrix code
+    time_ns: TimeNs  # when it was scanned
