@@ -3,8 +3,12 @@
 
 The recorder's worker hands each result over (:meth:`ResultsWatch.on_result`,
 with the file it went into) and goes on: a slow or unreachable database (a
-plant's PostgreSQL across the network) never holds up the recording. The
-writer stores what waits every :data:`WRITE_INTERVAL_S`, in one transaction.
+plant's PostgreSQL across the network) never holds up the recording. A
+result is given to the writer (:meth:`ResultsWatch.release`) once the
+recorder has flushed its station's files, so the store never holds a result
+its recording lost (a recorder killed before the flush): after a kill and
+the next start's catch-up the store and the recordings agree. The writer
+stores what waits every :data:`WRITE_INTERVAL_S`, in one transaction.
 
 The store failing never stops the recorder, and loses no result:
 
@@ -69,6 +73,8 @@ class ResultsWatch:
         self._open_store = open_store
         self._store: ResultsStore | None = None
         self._waiting: deque[StoredResult] = deque()
+        #: filed, their files not flushed yet (the recorder's thread only)
+        self._unflushed: list[StoredResult] = []
         self._summaries: OrderedDict[tuple[str, int], RunSummary] = OrderedDict()
         self._lock = threading.Lock()
         self._wake = threading.Event()
@@ -99,15 +105,31 @@ class ResultsWatch:
             self._summaries.popitem(last=False)
 
     def on_result(self, result: TighteningResult, recording: Path | None, now_ns: int) -> None:
-        """Hand a filed result to the writer (``recording``: the file it went into)."""
-        stored = stored_result(
-            result,
-            self._lines.get(result.station, ""),
-            None if recording is None else str(recording.resolve()),
-            self._host,
-            now_ns,
-            self._summaries.get((result.station, result.run_id)),
+        """A filed result (``recording``: the file it went into), stored after
+        :meth:`release`."""
+        self._unflushed.append(
+            stored_result(
+                result,
+                self._lines.get(result.station, ""),
+                None if recording is None else str(recording.resolve()),
+                self._host,
+                now_ns,
+                self._summaries.get((result.station, result.run_id)),
+            )
         )
+
+    def unflushed_stations(self) -> set[str]:
+        """The stations whose filed results wait for their files to be flushed."""
+        return {stored.result.station for stored in self._unflushed}
+
+    def release(self) -> None:
+        """The files of every result filed so far are flushed: to the writer with them."""
+        for stored in self._unflushed:
+            self._wait(stored)
+        self._unflushed.clear()
+        self._wake.set()
+
+    def _wait(self, stored: StoredResult) -> None:
         with self._lock:
             if len(self._waiting) >= WAITING_LIMIT:
                 self._waiting.popleft()
@@ -123,7 +145,9 @@ class ResultsWatch:
             self._waiting.append(stored)
 
     def close(self) -> None:
-        """Store what waits (bounded by :data:`STOP_WAIT_S`), then close the store."""
+        """Store what waits (bounded by :data:`STOP_WAIT_S`), then close the store (the
+        recorder has finished its files: every result filed is released)."""
+        self.release()
         self._closing.set()
         self._wake.set()
         self._thread.join(STOP_WAIT_S)

@@ -91,6 +91,8 @@ REFILING_ACK_S = 0.2
 #: on 50 stations): MCAP log times are taken on arrival; lag (RecorderStats) is
 #: measured when a batch is filed, so it includes the wait in the inbox
 TAKE_INTERVAL_S = 0.005
+#: how often the files of newly filed results are flushed, and the results stored
+RESULTS_FLUSH_S = 0.5
 #: health role of a ``--view-only`` recorder (a live view, not the line's recorder)
 VIEWER = "viewer"
 _BUS_STATS = channels.BUS.schema_name
@@ -175,7 +177,7 @@ class RecorderService:
 
     def work(self, stop: threading.Event) -> None:
         """Record until ``stop`` is set, then file what was received and finish every file."""
-        next_tick = next_stats = next_ack = time.monotonic()
+        next_tick = next_stats = next_ack = next_results = time.monotonic()
         try:
             while not stop.is_set():
                 self._file(self._inbox.take(TAKE_INTERVAL_S))
@@ -186,6 +188,9 @@ class RecorderService:
                     # files again (twice) only what it filed since
                     self._acknowledge(time.time_ns())
                     next_ack = now + REFILING_ACK_S
+                if self.results is not None and now >= next_results:
+                    self._release_results(time.time_ns())
+                    next_results = now + RESULTS_FLUSH_S
                 if now >= next_tick:
                     self.recorder.tick(time.time_ns())
                     if self.wear is not None:
@@ -205,9 +210,9 @@ class RecorderService:
                 LOG.warning("not recorded, arrived while stopping: %d", self._inbox.after_close)
             if self.wear is not None:
                 self.wear.close()
-            if self.results is not None:
-                self.results.close()
             closed = self.recorder.close()
+            if self.results is not None:
+                self.results.close()  # after the files are finished
             LOG.info("recorder stopped: %d messages, %d files", self.recorder.messages, len(closed))
 
     def stats(self, now_ns: int) -> list[RecorderStats]:
@@ -329,6 +334,17 @@ class RecorderService:
                     self.foxglove.log(sample)
         for found in self._batches.found(batch):
             self._file_one(found, filed_ns, hole)
+
+    def _release_results(self, now_ns: int) -> None:
+        """Flush the files of the results filed since the last time; then they go to the
+        results store (a result stored is in a file on disk)."""
+        assert self.results is not None
+        stations = self.results.unflushed_stations()
+        if not stations:
+            return
+        for station in stations:
+            self.recorder.flush(station, now_ns)  # failing: the store keeps the result anyway
+        self.results.release()
 
     def _acknowledge(self, now_ns: int) -> None:
         """Flush the spooling stations' files; acknowledge what they hold."""

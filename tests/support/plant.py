@@ -111,19 +111,23 @@ class NamespacePlant:
         self._made.clear()
 
 
-def line_station(folder: Path, hosts: Hosts, line: int) -> Path:
-    """Station ``st<line>`` of line ``line``: its router, its recordings folder."""
+def line_station(folder: Path, hosts: Hosts, line: int, results_database: str | None) -> Path:
+    """Station ``st<line>`` of line ``line`` (``[station] line = "line<line>"``): its router,
+    its recordings folder, the plant's results store (none: its own, in its recordings)."""
     station = folder / f"line{line}"
     station.mkdir()
     port = free_tcp_port()
+    flush = "flush_interval_s = 1.0"
+    database = f'\nresults_database = "{results_database}"' if results_database else ""
     return write_station(
         station,
         zenoh_port=port,
         replacements={
             f"tcp/127.0.0.1:{port}": hosts.endpoint(line),
-            'id = "st1"': f'id = "st{line}"',
+            'id = "st1"': f'id = "st{line}"\nline = "line{line}"',
             "tool_id = 7": f"tool_id = {TOOL_ID}",
             "seed = 7": f"seed = {line}",
+            flush: flush + database,
         },
     )
 
@@ -134,6 +138,7 @@ class Plant:
 
     hosts: Hosts
     folder: Path
+    results_database: str | None = None  # the plant's PostgreSQL; none: a store per line
     stations: dict[int, Path] = field(default_factory=dict)
     processes: list[subprocess.Popen[bytes]] = field(default_factory=list)
 
@@ -141,7 +146,7 @@ class Plant:
         self.logs = self.folder / "logs"
         self.logs.mkdir(parents=True, exist_ok=True)
         for line in LINES:
-            self.stations[line] = line_station(self.folder, self.hosts, line)
+            self.stations[line] = line_station(self.folder, self.hosts, line, self.results_database)
 
     def recordings(self, line: int) -> Path:
         return self.stations[line].parent / "recordings"

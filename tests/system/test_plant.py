@@ -15,12 +15,14 @@ each line server in its own network namespace, the two joined by a veth pair
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 
+from tests.support.live_recorder import wait_until
 from tests.support.netns_line import unavailable_reason
 from tests.support.plant import (
     LINES,
@@ -31,6 +33,7 @@ from tests.support.plant import (
     Plant,
     recorded_topics,
 )
+from tests.support.router_process import boltwatch
 
 pytestmark = pytest.mark.system
 
@@ -46,16 +49,37 @@ def namespaces() -> Iterator[NamespacePlant]:
         yield hosts
 
 
-def test_two_lines_on_loopback(tmp_path: Path) -> None:
-    run_plant(LoopbackPlant(), tmp_path)
+def test_two_lines_on_loopback_into_one_postgresql(tmp_path: Path, postgres_url: str) -> None:
+    """Both lines' recorders write the plant's results store; ``results`` and ``report``
+    answer for either line and across both."""
+    run_plant(LoopbackPlant(), tmp_path, postgres_url)
+    stations = [str(tmp_path / f"line{line}" / "station.toml") for line in LINES]
+    for line in LINES:
+        found = _results("--database", postgres_url, "--line", f"line{line}")
+        assert [(row["station"], row["line"]) for row in found] == [
+            (f"st{line}", f"line{line}")
+        ] * RUNS
+    across = _results("--config", *stations)
+    assert sorted(row["station"] for row in across) == ["st1"] * RUNS + ["st2"] * RUNS
+    report = boltwatch("report", "--config", *stations, "--out", str(tmp_path / "report"))
+    assert report.returncode == 0, report.stdout + report.stderr
+    assert f"{2 * RUNS} results (from the results store postgresql://" in report.stdout
 
 
 def test_two_lines_in_network_namespaces(namespaces: NamespacePlant, tmp_path: Path) -> None:
     run_plant(namespaces, tmp_path)
 
 
-def run_plant(hosts: Hosts, folder: Path) -> None:
-    plant = Plant(hosts, folder)
+def _results(*arguments: str) -> list[dict[str, Any]]:
+    """``boltwatch results ARGUMENTS --json`` (none matching, or no store yet: [])."""
+    found = boltwatch("results", *arguments, "--json")
+    assert found.returncode in (0, 1), found.stdout + found.stderr
+    rows: list[dict[str, Any]] = json.loads(found.stdout or "[]")
+    return rows
+
+
+def run_plant(hosts: Hosts, folder: Path, results_database: str | None = None) -> None:
+    plant = Plant(hosts, folder, results_database)
     try:
         plant.start_lines()
         plant.wait_until_up()
@@ -63,6 +87,12 @@ def run_plant(hosts: Hosts, folder: Path) -> None:
             assert rig.wait(60) == 0, f"a rig failed; see {plant.logs}"
         status = _settled_status(plant)
         wear = {line: plant.wear(line) for line in LINES}
+        if results_database is not None:  # every result of the lines in the plant's store
+            wait_until(
+                lambda: len(_results("--database", results_database)) == 2 * RUNS,
+                "both lines' results in the plant's store",
+                30.0,
+            )
     finally:
         plant.stop()
 

@@ -1,4 +1,5 @@
-"""The recorder as a real process: kill -9 loses at most about a flush interval; SIGTERM nothing.
+"""The recorder as a real process: kill -9 loses at most about a flush interval; SIGTERM nothing;
+kill -9 while results arrive: after the restart the results store and the recordings agree.
 
 ``boltwatch serve recorder`` runs as a subprocess (a zenoh peer listening on
 a free loopback port); this test publishes a run at ~1 kHz into it.
@@ -9,6 +10,7 @@ from __future__ import annotations
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -17,9 +19,11 @@ import pytest
 import zenoh
 from mcap.reader import make_reader
 
-from shared.contract import Sample, ToolState, channels, encode
+from shared.contract import Sample, TighteningResult, ToolState, channels, decode, encode
 from shared.recordings.mcap import RecordingScan, recover
+from shared.results import ResultsQuery, ResultsStore, StoreTarget
 from shared.runtime import zenoh_config
+from tests.support import factories
 from tests.support.live_recorder import (
     free_port,
     has_subscribers,
@@ -36,7 +40,7 @@ FLUSH_INTERVAL_S = 1.0
 
 
 class RecorderProcess:
-    def __init__(self, tmp_path: Path) -> None:
+    def __init__(self, tmp_path: Path, log_name: str = "recorder.log") -> None:
         self.endpoint = f"tcp/127.0.0.1:{free_port()}"
         self.recordings = tmp_path / "recordings"
         station_file = write_station_file(
@@ -45,7 +49,7 @@ class RecorderProcess:
             listen=[self.endpoint],
             recorder={"flush_interval_s": FLUSH_INTERVAL_S},
         )
-        self.log = (tmp_path / "recorder.log").open("w")
+        self.log = (tmp_path / log_name).open("w")
         self.process = subprocess.Popen(
             [sys.executable, "-m", "services.cli", "serve", "recorder", "--config", station_file],
             cwd=REPO,
@@ -152,3 +156,70 @@ def test_sigterm_leaves_a_complete_file(
     assert len(recorded_sequences(scan)) == sent and scan.complete
     verify = [str(Path(sys.executable).parent / "rerun"), "rrd", "verify"]
     assert subprocess.run([*verify, str(path.with_suffix(".rrd"))], check=False).returncode == 0
+
+
+def publish_results(session: zenoh.Session, runs: range, stop: threading.Event) -> None:
+    """Short runs, each ended by its result, until ``stop`` (the recorder killed)."""
+    tool = session.declare_publisher(channels.TOOL.key("st1"))
+    results = session.declare_publisher(channels.RESULTS.key("st1"))
+    wait_until(lambda: has_subscribers(tool) and has_subscribers(results), "the recorder")
+    for run_id in runs:
+        if stop.is_set():
+            break
+        now_ns = time.time_ns()
+        tool.put(encode(ToolState("st1", run_id, 7, 1, "running", now_ns)))
+        tool.put(encode(ToolState("st1", run_id, 7, 1, "done", now_ns + 1000)))
+        results.put(encode(factories.result(run_id, time_ns=now_ns + 2000, part_id=f"P{run_id}")))
+        time.sleep(0.02)
+    tool.undeclare()
+    results.undeclare()
+
+
+def recorded_results(recordings: Path) -> dict[int, TighteningResult]:
+    """Every result in the recordings by run, damaged files read as far as they go."""
+    return {
+        result.run_id: result
+        for path in sorted(recordings.glob("st1/*/*.mcap"))
+        for _, _, message in RecordingScan(path).messages("/results")
+        for result in [decode(TighteningResult, message.data)]
+    }
+
+
+def stored_results(recordings: Path) -> dict[int, TighteningResult]:
+    target = StoreTarget(sqlite_path=recordings / "results.sqlite")
+    try:
+        with ResultsStore(target, create=False) as store:
+            found = store.find(ResultsQuery(limit=None))
+    except Exception:  # not made yet
+        return {}
+    return {stored.result.run_id: stored.result for stored in found}
+
+
+def test_kill_9_while_results_arrive_then_the_store_and_the_recordings_agree(
+    recorder_process: RecorderProcess, session: zenoh.Session, tmp_path: Path
+) -> None:
+    stop = threading.Event()
+    publisher = threading.Thread(target=publish_results, args=(session, range(1, 400), stop))
+    publisher.start()
+    try:
+        wait_until(lambda: len(stored_results(recorder_process.recordings)) >= 20, "20 stored")
+        recorder_process.process.send_signal(signal.SIGKILL)
+        recorder_process.process.wait(10)
+    finally:
+        stop.set()
+        publisher.join()
+    killed_store = stored_results(recorder_process.recordings)
+    recorded = recorded_results(recorder_process.recordings)
+    assert killed_store.items() <= recorded.items()  # a result stored is in a file on disk
+    print(f"kill -9: {len(recorded)} results recorded, {len(killed_store)} stored")
+
+    restarted = RecorderProcess(tmp_path, log_name="restarted.log")
+    try:
+        wait_until(
+            lambda: stored_results(restarted.recordings) == recorded,
+            "the restarted recorder to store what the killed one had not",
+            30.0,
+        )
+    finally:
+        restarted.stop()
+    assert recorded_results(restarted.recordings) == recorded
