@@ -38,12 +38,11 @@ the MCAP recording: it is logged and the recorder goes on without it.
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import socket
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -60,6 +59,7 @@ from services.recorder.live_views import rerun_options, start_foxglove, start_re
 from services.recorder.quality_watch import QualityWatch
 from services.recorder.results_watch import ResultsWatch
 from services.recorder.served_stations import limits_of, served_stations
+from services.recorder.wear_queryable import wear_replier
 from services.recorder.wear_watch import WearWatch
 from shared.config import AnyStation, load_any_line
 from shared.contract import (
@@ -76,7 +76,7 @@ from shared.contract import (
 from shared.recordings import OTHER_STATION, FileMetadata, Received, classify
 from shared.results import store_target
 from shared.runtime import ServiceSkeleton, Stop
-from shared.wear import StationLimits, WearLedger, ledger_path
+from shared.wear import StationLimits, ledger_path
 
 if TYPE_CHECKING:
     from services.recorder.foxglove_live.foxglove_server import FoxgloveLive
@@ -162,7 +162,10 @@ class RecorderService:
         self._inbox = LineInbox(session, [station_keys(station) for station in self.station_ids])
         skeleton.on_stop(Stop.INPUT, self._inbox.close)
         for station in [] if view_only else self.station_ids:
-            skeleton.queryable(keys.station_key(station, keys.WEAR), self._wear_replier(station))
+            skeleton.queryable(
+                keys.station_key(station, keys.WEAR),
+                wear_replier(self._ledger_file, self._host, station),
+            )
         for station in self.station_ids:
             skeleton.health_token(station, VIEWER if view_only else "recorder")
         LOG.info(
@@ -388,35 +391,6 @@ class RecorderService:
         )
         now_ns = time.time_ns()
         self._handle(key, payload, now_ns, now_ns)
-
-    def _wear_replier(self, station: str) -> Callable[[zenoh.Query], None]:
-        def reply(query: zenoh.Query) -> None:
-            # finalized on leaving (the querier's get ends now), not when the Query is freed:
-            # an error's traceback, kept by a log record, would keep it until its timeout
-            with query:
-                self._reply_wear(station, query)
-
-        return reply
-
-    def _reply_wear(self, station: str, query: zenoh.Query) -> None:
-        """``boltwatch/<station>/wear``: the lines of the tools that ran at ``station``."""
-        try:
-            with WearLedger(self._ledger_file, read_only=True) as ledger:
-                tools = [tool.to_dict() for tool in ledger.tools(station=station)]
-        except Exception as err:  # a reply, never a dead queryable thread
-            LOG.warning("wear query of %s failed: %s", station, err)
-            query.reply_err(str(err).encode())
-            return
-        reply = {
-            "station": station,
-            "ledger": str(self._ledger_file),
-            "host": self._host,
-            "tools": tools,
-        }
-        # on the station's own key, never the query's: a plant-wide get of
-        # boltwatch/*/wear would otherwise see every recorder's reply under one key,
-        # and zenoh's default consolidation keeps one of them
-        query.reply(keys.station_key(station, keys.WEAR), json.dumps(reply).encode())
 
 
 def station_keys(station: str) -> str:
