@@ -122,6 +122,8 @@ def _recorder_text(recorder: RecorderHealth | None) -> str:
     )
     if recorder.waiting_summaries:
         counts += f", {recorder.waiting_summaries} runs waiting for the wear ledger"
+    if recorder.waiting_results:
+        counts += f", {recorder.waiting_results} results waiting for the results store"
     counts += f", {recorder.age_s:.1f} s ago"
     if not recorder.recording:
         return f"NOT RECORDING: {recorder.last_error or 'write failing'} ({lag}, {counts})"

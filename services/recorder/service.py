@@ -237,6 +237,7 @@ class RecorderService:
             recorder.recording_ok,
             refused_summaries=wear.refused if wear else None,
             waiting_summaries=wear.waiting if wear else 0,
+            waiting_results=results.waiting if results else 0,
             quality_alerts=self.quality.active if self.quality else None,
         )
 

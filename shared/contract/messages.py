@@ -298,6 +298,8 @@ class RecorderStats:
     refused_summaries: Count = 0
     # runs (of every station) waiting in memory for the wear ledger (failing or broken)
     waiting_summaries: Count = 0
+    # results (of every station) waiting in memory for the results store (failing)
+    waiting_results: Count = 0
     # this station's quality alerts active now, newest first (each is put once, when it starts:
     # a status that listens later learns of it here)
     quality_alerts: list[QualityAlert] = field(default_factory=list)

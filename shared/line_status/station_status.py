@@ -166,6 +166,7 @@ class RecorderHealth:
     age_s: float  # since the latest RecorderStats was received
     refused_summaries: int = 0  # RunSummaries the wear ledger refused (beyond their bound)
     waiting_summaries: int = 0  # runs waiting in the recorder's memory for the wear ledger
+    waiting_results: int = 0  # results waiting in the recorder's memory for the results store
     bad_payloads: int = 0  # payloads it refused (recorded raw)
 
 
@@ -334,6 +335,7 @@ def _recorder_health(
         age_s=_age_s(received_ns, now_ns),
         refused_summaries=stats.refused_summaries,
         waiting_summaries=stats.waiting_summaries,
+        waiting_results=stats.waiting_results,
         bad_payloads=stats.bad_payloads,
     )
 

@@ -123,12 +123,14 @@ class RecorderHealth:
         recording: bool,
         refused_summaries: Mapping[str, int] | None = None,
         waiting_summaries: int = 0,
+        waiting_results: int = 0,
         quality_alerts: Callable[[str], list[QualityAlert]] | None = None,
     ) -> list[RecorderStats]:
         """One RecorderStats per station; starts the next lag window.
 
         ``refused_summaries``: per station, RunSummaries the wear ledger refused;
         ``waiting_summaries``: runs waiting in memory for the ledger (all stations);
+        ``waiting_results``: results waiting in memory for the results store (all stations);
         ``quality_alerts``: a station's quality alerts active now.
         """
         refused = refused_summaries or {}
@@ -149,6 +151,7 @@ class RecorderHealth:
                     missing_samples=counts.missing_samples,
                     refused_summaries=refused.get(station, 0),
                     waiting_summaries=waiting_summaries,
+                    waiting_results=waiting_results,
                     bad_payloads=counts.bad_payloads,
                     quality_alerts=quality_alerts(station) if quality_alerts else [],
                 )

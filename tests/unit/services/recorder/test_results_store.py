@@ -4,6 +4,7 @@ stopped recorder had not stored come from the recordings at its next start."""
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import pytest
@@ -121,7 +122,9 @@ def test_a_store_down_keeps_results_waiting_and_the_next_start_finds_the_rest(
         assert watch is not None
         try:
             wait_until(lambda: watch.waiting == 2, "2 results waiting")
-            assert watch.last_error is not None
+            (stats,) = recorder.service.stats(time.time_ns())
+            assert stats.waiting_results == 2 and stats.last_error is not None
+            assert stats.last_error.startswith(f"results store {own_server.url}")
             own_server.start()
             wait_until(lambda: len(_stored(station)) == 2, "the waiting results stored", WAIT_S)
             assert watch.last_error is None
