@@ -10,7 +10,11 @@ independence contract) and collects what ``boltwatch status`` collects
   results, stop reasons, alerts and wear per station)
 - :mod:`.board_feed` (zenoh: subscriptions, liveliness and wear queries per
   window, its health token)
-- :mod:`.web_app` (aiohttp: the page, ``/board.json``, server-sent ``/events``)
-- ``page/``: ``index.html``, ``dashboard.css``, ``dashboard.js`` (served by the
-  app; nothing from the internet)
+- :mod:`.web_app` (aiohttp: the page, ``/board.json``, server-sent ``/events``,
+  the part search ``/api/results``)
+- :mod:`.part_search` (a part's tightenings in the results stores of the
+  station files, in worker threads: :mod:`shared.results`)
+- ``page/``: ``index.html``, ``dashboard.css``, ``dashboard.js`` (the
+  stations), ``part_search.js`` (the search box) (served by the app; nothing
+  from the internet)
 """

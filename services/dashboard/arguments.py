@@ -23,8 +23,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.epilog = (
         "One web page for the line: per station the services alive, the sample rate, the "
         "last results (OK/NOK) and stop reasons, each tool's wear against "
-        "recorder.wear_service_threshold, and alerts; live, without reloading. Open "
-        "http://HOST:PORT/ in a browser; nothing on it comes from the internet."
+        "recorder.wear_service_threshold, and alerts; live, without reloading. Its search "
+        "box finds every tightening of a part (a VIN, a work piece) in the results store of "
+        "the station files. Open http://HOST:PORT/ in a browser; nothing on it comes from the "
+        "internet."
     )
     parser.add_argument(
         "--listen",

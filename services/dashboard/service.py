@@ -2,7 +2,8 @@
 
 Loads the station files (the stations shown, in their order; the first
 file's ``[zenoh]`` names the router, reached as that file's services reach
-it, with its TLS files), opens one zenoh session, feeds a
+it, with its TLS files; their results stores are where the part search looks,
+:func:`~.part_search.stores_of`), opens one zenoh session, feeds a
 :class:`~.line_board.LineBoard` (:class:`~.board_feed.BoardFeed`) and serves
 the page (:mod:`.web_app`) until SIGINT/SIGTERM. It meets the line's
 services on zenoh only.
@@ -19,6 +20,7 @@ from aiohttp import web
 
 from services.dashboard.board_feed import BoardFeed
 from services.dashboard.line_board import LineBoard, StationSetting
+from services.dashboard.part_search import PartSearch, stores_of
 from services.dashboard.web_app import Listeners, make_app
 from shared.config import load_any_line
 from shared.runtime import open_session
@@ -36,6 +38,7 @@ def main(args: argparse.Namespace) -> int:
         for station in stations
     ]
     board = LineBoard(settings, time.time_ns())
+    search = PartSearch(stores_of(stations))
     listeners = Listeners()
     host, port = args.listen
 
@@ -44,10 +47,11 @@ def main(args: argparse.Namespace) -> int:
         async def feed(_app: web.Application) -> AsyncIterator[None]:
             board_feed = BoardFeed(session, board, listeners.changed)
             LOG.info("the line's page of %s: http://%s:%d/", ", ".join(board.stations), host, port)
+            LOG.info("part search in %s", ", ".join(search.stores))
             yield
             board_feed.close()
 
-        app = make_app(board, listeners)
+        app = make_app(board, listeners, search)
         app.cleanup_ctx.append(feed)
         web.run_app(
             app,

@@ -6,7 +6,12 @@
 - ``GET /events``: server-sent events, one ``data:`` line with the board
   each time it changed (a result, a run's end, an alert; and every window),
   at most every :data:`MIN_INTERVAL_S`; the browser's EventSource reconnects
-  by itself when the server comes back.
+  by itself when the server comes back;
+- ``GET /api/results?part=ID[&limit=N]``: every tightening of a part in the
+  results store, newest first (:mod:`.part_search`): 200 with what was found
+  (and a line per store that could not answer), 503 when no store answered,
+  400 when the question cannot be asked (no part id, one too long, a bad
+  limit); always JSON, ``{"errors": [...]}`` saying why.
 
 zenoh calls :meth:`Listeners.changed` from its own threads; it wakes every
 open ``/events`` stream on the event loop.
@@ -22,6 +27,7 @@ from pathlib import Path
 from aiohttp import web
 
 from services.dashboard.line_board import LineBoard
+from services.dashboard.part_search import PartSearch, SearchRequestError, limit_of, part_of
 
 PAGE = Path(__file__).with_name("page")
 #: the shortest pause between two updates of one stream (a burst of results is one update)
@@ -30,6 +36,9 @@ MIN_INTERVAL_S = 0.2
 KEEP_ALIVE_S = 15.0
 
 BOARD_KEY = web.AppKey("board", LineBoard)
+SEARCH_KEY = web.AppKey("search", PartSearch)
+#: headers of every JSON reply: never cached, never read as anything but JSON
+JSON_HEADERS = {"Cache-Control": "no-store", "X-Content-Type-Options": "nosniff"}
 
 
 class Listeners:
@@ -70,13 +79,15 @@ class Listeners:
 LISTENERS_KEY = web.AppKey("listeners", Listeners)
 
 
-def make_app(board: LineBoard, listeners: Listeners) -> web.Application:
+def make_app(board: LineBoard, listeners: Listeners, search: PartSearch) -> web.Application:
     app = web.Application()
     app[BOARD_KEY] = board
     app[LISTENERS_KEY] = listeners
+    app[SEARCH_KEY] = search
     app.router.add_get("/", _index)
     app.router.add_get("/board.json", _board)
     app.router.add_get("/events", _events)
+    app.router.add_get("/api/results", _results)
     app.router.add_static("/page/", PAGE)
     app.on_startup.append(_bind_loop)
     app.on_shutdown.append(_end_streams)
@@ -93,6 +104,16 @@ async def _index(_request: web.Request) -> web.FileResponse:
 
 async def _board(request: web.Request) -> web.Response:
     return web.json_response(request.app[BOARD_KEY].snapshot(time.time_ns()))
+
+
+async def _results(request: web.Request) -> web.Response:
+    try:
+        part_id = part_of(request.query.get("part"))
+        limit = limit_of(request.query.get("limit"))
+    except SearchRequestError as err:
+        return web.json_response({"errors": [str(err)]}, status=400, headers=JSON_HEADERS)
+    found = await request.app[SEARCH_KEY].find(part_id, limit)
+    return web.json_response(found, status=200 if found["answered"] else 503, headers=JSON_HEADERS)
 
 
 async def _events(request: web.Request) -> web.StreamResponse:

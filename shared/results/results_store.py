@@ -48,7 +48,8 @@ class ResultsStore:
 
     def __init__(self, target: StoreTarget, *, create: bool = True, application: str = "") -> None:
         """``create``: make the store when there is none (a writer); else StoreError.
-        An older store is migrated either way."""
+        An older store is migrated either way; a reader (``create=False``) of a store at
+        this version changes nothing (no write lock: the recorder is never kept waiting)."""
         self.target = target
         nowhere = StoreError(
             f"no results store at {target}: the line's recorder makes it, "
@@ -58,9 +59,13 @@ class ResultsStore:
             raise nowhere  # opening would make the file
         self.database = ResultsDatabase(target, application or "boltwatch")
         try:
-            if not create and version_of(self.database) == 0:
-                raise nowhere
-            self.migrated_from = migrate(self.database)
+            if create:
+                self.migrated_from = migrate(self.database)
+            else:
+                found = version_of(self.database)
+                if found == 0:
+                    raise nowhere
+                self.migrated_from = found if found == SCHEMA_VERSION else migrate(self.database)
         except BaseException:
             self.database.close()
             raise

@@ -3,7 +3,8 @@
 The line layout: one router, one recorder for the line (every station file),
 an optional Rerun viewer (profile), and per station an acquisition (which
 holds the station's predictor: placement "edge") and a rig with that
-station's own file. Where each station's predictor runs:
+station's own file; the line's page searches the recorder's results store.
+Where each station's predictor runs:
 tests/unit/deployment/test_compose_placement.py.
 """
 
@@ -20,6 +21,7 @@ import pytest
 import yaml
 
 from services.cli.main import build_parser
+from services.dashboard.part_search import stores_of
 from services.router.access_control import line_access_control
 from services.router.service import router_config
 from shared.config import load_line, load_station, resolve_relative
@@ -127,6 +129,26 @@ def test_health_checks_parse_and_dependencies_wait_for_health(name: str) -> None
         assert dependency in SERVICES, f"{name} depends on unknown {dependency}"
         assert condition == {"condition": "service_healthy"}, f"{name} -> {dependency}"
         assert "healthcheck" in SERVICES[dependency], f"{dependency} has no health check"
+
+
+def test_the_page_searches_the_results_store_the_recorder_writes() -> None:
+    """The line's page finds a part's tightenings in the recorder's store: the same stores
+    of the same station files, on the same recordings volume, writable (a SQLite reader
+    in WAL mode writes the store's shared-memory file)."""
+    stores = {name: stores_of(load_line(station_files(name))) for name in ("recorder", "dashboard")}
+    assert stores["dashboard"] == stores["recorder"]
+    for target in stores["dashboard"]:
+        assert target.sqlite_path is not None, "the compose line keeps its store in SQLite"
+        mounts = {
+            name: [
+                volume
+                for volume in SERVICES[name]["volumes"]
+                if target.sqlite_path.is_relative_to(split_volume(volume)[1])
+            ]
+            for name in ("recorder", "dashboard")
+        }
+        assert mounts["dashboard"] == mounts["recorder"] != []
+        assert not any(volume.endswith(":ro") for volume in mounts["dashboard"])
 
 
 def test_required_variables_fail_loudly() -> None:

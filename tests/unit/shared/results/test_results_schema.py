@@ -1,6 +1,6 @@
 """The store's versions: a new store is made whole, an older one migrated with nothing
-lost, a newer one refused, writers starting together migrate once, a damaged file is
-named and left as it is."""
+lost, a newer one refused, a reader of a current one takes no lock, writers starting
+together migrate once, a damaged file is named and left as it is."""
 
 from __future__ import annotations
 
@@ -58,6 +58,23 @@ def test_a_store_of_a_newer_boltwatch_is_not_written_into(target: StoreTarget) -
         assert version_of(database) == SCHEMA_VERSION + 5
         with database.transaction():
             assert database.rows("SELECT COUNT(*) FROM tightenings") == [(1,)]
+
+
+def test_a_reader_of_a_current_store_waits_for_no_writer(target: StoreTarget) -> None:
+    with ResultsStore(target) as store:
+        store.add([stored_result(factories.result(1), "A", None, None, 1)])
+    found: list[int] = []
+
+    def read() -> None:
+        with ResultsStore(target, create=False) as reader:
+            found.append(len(reader.find(ResultsQuery())))
+
+    # a writer holds the store's lock (a recorder migrating, a rebuild writing)
+    with ResultsDatabase(target) as writer, writer.transaction(lock=True):
+        reader = threading.Thread(target=read, daemon=True)
+        reader.start()
+        reader.join(5.0)
+        assert found == [1]
 
 
 def test_writers_starting_together_migrate_once(target: StoreTarget) -> None:

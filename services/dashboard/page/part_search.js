@@ -1,0 +1,84 @@
+// The line's page, its part search: every tightening of a part (GET /api/results), newest
+// first, above the stations. Uses el, none and table of dashboard.js (loaded before it).
+// What the reply holds goes in as text only (el makes text nodes): a part id is never markup.
+"use strict";
+
+const SEARCH_LIMIT = 500;
+const searchForm = document.getElementById("part-search");
+const partInput = document.getElementById("part");
+const found = document.getElementById("found");
+let searches = 0; // the number of the latest search: a reply to an older one is dropped
+
+function judged(figure, digits, unit, scale = 1) {
+  if (!figure || figure.value === null) return "-";
+  const mark = figure.status === "ok" || figure.status === "not_judged" ? "" : ` (${figure.status})`;
+  return `${(figure.value / scale).toFixed(digits)}${unit}${mark}`;
+}
+
+function recording(r) {
+  if (!r.recording) return "-";
+  const where = el("code", { title: `boltwatch inspect ${r.recording} --run ${r.run_id}` },
+    r.recording);
+  return r.recording_host ? el("span", {}, where, el("span", { class: "host" }, ` on ${r.recording_host}`))
+    : where;
+}
+
+function tightenings(rows) {
+  return table(["ended (UTC)", "station", "line", "run", "program", "tool", "result", "torque",
+    "angle", "preload", "stopped on", "events", "recording"],
+  rows.map((r) => el("tr", { class: "found", "data-station": r.station, "data-run": r.run_id },
+    el("td", {}, r.ended_utc),
+    el("td", {}, r.station),
+    el("td", {}, r.line || "-"),
+    el("td", { class: "num" }, r.run_id),
+    el("td", { class: "program" }, `${r.program_id} ${r.program_name}`.trim()),
+    el("td", { class: "num" }, r.tool_id),
+    el("td", {}, el("span", { class: `verdict ${r.result}` }, r.result),
+      r.nok_reasons ? el("div", { class: "reasons" }, r.nok_reasons) : ""),
+    el("td", { class: "num" }, judged(r.final_torque_nm, 1, " Nm")),
+    el("td", { class: "num" }, judged(r.final_angle_deg, 0, "°")),
+    el("td", { class: "num" }, judged(r.final_force_n, 2, " kN", 1000)),
+    el("td", {}, r.stop_reason || "-"),
+    el("td", { class: "num" }, r.events === null ? "-" : r.events),
+    el("td", { class: "recording" }, recording(r)))));
+}
+
+function show(part, ...children) {
+  const close = el("button", { type: "button", class: "close" }, "close");
+  close.addEventListener("click", () => { searches += 1; found.hidden = true; found.replaceChildren(); });
+  found.replaceChildren(el("div", { class: "found-head" },
+    el("h2", {}, `Tightenings of part ${part}`), close), ...children);
+  found.hidden = false;
+}
+
+function answer(part, reply) {
+  const errors = (reply.errors || []).map((text) => el("p", { class: "store-error" }, text));
+  const rows = reply.results || [];
+  if (rows.length === 0) {
+    const stores = reply.stores ? ` in ${reply.stores.join(", ")}` : "";
+    show(part, ...errors, reply.answered ? none(`no tightening of part ${part}${stores}`) : "");
+    return;
+  }
+  const more = reply.total > rows.length ? `, the newest ${rows.length} of ${reply.total}` : "";
+  show(part, ...errors,
+    el("p", { class: "figures found-summary" },
+      `${rows.length} tightening${rows.length === 1 ? "" : "s"}, newest first${more}`),
+    el("div", { class: "wide" }, tightenings(rows)));
+}
+
+searchForm.addEventListener("submit", (event) => {
+  event.preventDefault();
+  const part = partInput.value.trim();
+  if (!part) return;
+  const search = ++searches;
+  show(part, none("searching…"));
+  fetch(`/api/results?${new URLSearchParams({ part, limit: SEARCH_LIMIT })}`)
+    .then((response) => response.json().catch(() => {
+      throw new Error(`the server answered HTTP ${response.status}`);
+    }))
+    .then((reply) => { if (search === searches) answer(part, reply); })
+    .catch((err) => {
+      const why = err instanceof TypeError ? "the page's server does not answer" : err.message;
+      if (search === searches) show(part, el("p", { class: "store-error" }, `search failed: ${why}`));
+    });
+});

@@ -1,0 +1,150 @@
+"""The page's part search: every tightening of a part in the results store, newest first.
+
+``GET /api/results?part=ID[&limit=N]`` (:mod:`.web_app`) asks
+:meth:`PartSearch.find`. The stores searched are those of the station files
+the page serves (:func:`stores_of`: ``[recorder] results_database``, else
+``results.sqlite`` in the recordings folder), each distinct store once: a
+line whose stations record into two folders has two, and a part's
+tightenings are gathered from both, newest first, at most ``limit``. A plant's
+PostgreSQL holds every line's results, so a part's tightenings on other lines
+show too (each row names its station and line).
+
+Each search opens each store, asks (:class:`~shared.results.ResultsQuery`:
+parameterised SQL, by the index of ``part_id``) and closes it, in a worker
+thread (``asyncio.to_thread``): a slow store, or a PostgreSQL that does not
+answer (up to its connect timeout of 5 s), never holds up the page's live
+updates. A store that is not there or cannot be read is one line in the
+reply (``errors``); what the other stores found is still shown. Nothing here
+makes a store: the line's recorder does.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from shared.config import AnyStation
+from shared.contract import PART_ID_CHARS
+from shared.errors import StoreError
+from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget, store_target
+from shared.results.results_table import as_dict
+
+LOG = logging.getLogger(__name__)
+
+#: tightenings a search gives when it names no limit, and the most it may ask for
+DEFAULT_LIMIT = 100
+MAX_LIMIT = 1000
+#: the application name a PostgreSQL store sees (its pg_stat_activity)
+APPLICATION = "boltwatch serve dashboard"
+
+
+class SearchRequestError(ValueError):
+    """The question cannot be asked (no part id, one too long, a bad limit): one line why."""
+
+
+def part_of(text: str | None) -> str:
+    """The part id asked for: ``text`` without spaces at either end (a part id has none,
+    a pasted one often does), 1 to :data:`~shared.contract.PART_ID_CHARS` characters."""
+    part_id = (text or "").strip()
+    if not part_id:
+        raise SearchRequestError("type a part id (a VIN, a work piece's serial number)")
+    if len(part_id) > PART_ID_CHARS:
+        raise SearchRequestError(
+            f"a part id has at most {PART_ID_CHARS} characters; this one has {len(part_id)}"
+        )
+    return part_id
+
+
+def limit_of(text: str | None) -> int:
+    """At most how many tightenings: ``text`` (None: :data:`DEFAULT_LIMIT`), 1 to
+    :data:`MAX_LIMIT`."""
+    if text is None:
+        return DEFAULT_LIMIT
+    digits = len(text) <= len(str(MAX_LIMIT)) and text.isascii() and text.isdigit()
+    if not digits or not 1 <= int(text) <= MAX_LIMIT:
+        raise SearchRequestError(f"limit: a number from 1 to {MAX_LIMIT} (got {text[:20]!r})")
+    return int(text)
+
+
+def stores_of(stations: Sequence[AnyStation]) -> list[StoreTarget]:
+    """The distinct results stores of the station files, in their order."""
+    targets: dict[str, StoreTarget] = {}
+    for station in stations:
+        target = store_target(
+            station.recordings_folder.resolve(), station.config.recorder.results_database
+        )
+        targets.setdefault(str(target), target)
+    return list(targets.values())
+
+
+@dataclass(frozen=True, slots=True)
+class _Answer:
+    """What one store said: its tightenings of the part (newest first) and how many it
+    holds in all, or why it could not say."""
+
+    found: list[StoredResult]
+    total: int
+    error: str | None = None
+
+
+class PartSearch:
+    """The part search over the stores of the page's station files."""
+
+    def __init__(self, targets: Sequence[StoreTarget]) -> None:
+        self.targets = list(targets)
+
+    @property
+    def stores(self) -> list[str]:
+        """The stores searched, as people read them (a PostgreSQL URL without its password)."""
+        return [str(target) for target in self.targets]
+
+    async def find(self, part_id: str, limit: int) -> dict[str, Any]:
+        """Every store asked at once, each in a worker thread; the page's reply: the
+        tightenings of ``part_id`` newest first (at most ``limit``), how many there are
+        in all, and one line per store that could not answer. ``answered``: some store did."""
+        started_s = time.monotonic()
+        answers = await asyncio.gather(
+            *(asyncio.to_thread(_ask, target, part_id, limit) for target in self.targets)
+        )
+        found: dict[tuple[str, int], StoredResult] = {}
+        for answer in answers:
+            for stored in answer.found:  # a result in two stores (copied over) shows once
+                found.setdefault((stored.result.station, stored.result.run_id), stored)
+        newest = sorted(
+            found.values(),
+            key=lambda s: (s.result.time_ns, s.result.station, s.result.run_id),
+            reverse=True,
+        )[:limit]
+        errors = [answer.error for answer in answers if answer.error is not None]
+        LOG.info(
+            "part %r: %d tightenings in %.0f ms%s",
+            part_id,
+            len(newest),
+            (time.monotonic() - started_s) * 1000,
+            "".join(f"; {error}" for error in errors),
+        )
+        return {
+            "part_id": part_id,
+            "limit": limit,
+            "total": max(len(newest), sum(answer.total for answer in answers)),
+            "results": [as_dict(stored) for stored in newest],
+            "stores": self.stores,
+            "errors": errors,
+            "answered": len(errors) < len(answers),
+        }
+
+
+def _ask(target: StoreTarget, part_id: str, limit: int) -> _Answer:
+    """One store's answer (in a worker thread: it opens, queries and closes the store)."""
+    query = ResultsQuery(part_id=part_id, limit=limit)
+    try:
+        with ResultsStore(target, create=False, application=APPLICATION) as store:
+            found = store.find(query)
+            total = store.count(query) if len(found) == limit else len(found)
+    except StoreError as err:
+        return _Answer([], 0, str(err))
+    return _Answer(found, total)
