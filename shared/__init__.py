@@ -6,8 +6,10 @@ move inside it breaks nobody. ``shared`` never imports ``services``;
 import-linter holds the layers in ``make lint`` (``pyproject.toml``):
 
 - :mod:`.offline`: after-the-fact work over recordings (post-mortem, overlay,
-  report, controller import)
-- :mod:`.stickslip`: the paper's predictor as a library (pure)
+  report, controller import); :mod:`.retention`: how long the recordings are
+  kept (the station file's ``[retention]``, never a file whose results are not stored)
+- :mod:`.stickslip`: the paper's predictor as a library (pure); :mod:`.results`: the
+  results store (every tightening's result, SQLite or PostgreSQL)
 - :mod:`.recordings` (where a run's files go, MCAP, Rerun), :mod:`.wear` (the
   ledger), :mod:`.quality` (OK/NOK, Cpk; pure), :mod:`.model` (the paper's
   analytical model; pure), :mod:`.runtime` (a service's life, zenoh, CAN, logging)

@@ -124,6 +124,13 @@ def _recorder_text(recorder: RecorderHealth | None) -> str:
         counts += f", {recorder.waiting_summaries} runs waiting for the wear ledger"
     if recorder.waiting_results:
         counts += f", {recorder.waiting_results} results waiting for the results store"
+    if recorder.recordings_deleted:
+        counts += f", {recorder.recordings_deleted} recordings deleted by the retention policy"
+    if recorder.recordings_kept_unstored:
+        counts += (
+            f", {recorder.recordings_kept_unstored} recordings past their time kept: "
+            "results not stored"
+        )
     counts += f", {recorder.age_s:.1f} s ago"
     if not recorder.recording:
         return f"NOT RECORDING: {recorder.last_error or 'write failing'} ({lag}, {counts})"

@@ -1,4 +1,5 @@
-"""The station files one recorder serves: they must agree on its folder and ``[recorder]``."""
+"""The station files one recorder serves: they must agree on its folder, ``[recorder]`` and
+``[retention]`` (one folder, one policy)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ from collections.abc import Sequence
 from services.recorder.live.run_files import FileLimits
 from shared.config import AnyStation, ControllerStation, LoadedStation
 from shared.errors import ConfigError
+from shared.retention import retention_scopes
 
 
 def limits_of(loaded: AnyStation) -> FileLimits:
@@ -20,7 +22,7 @@ def limits_of(loaded: AnyStation) -> FileLimits:
 
 def served_stations(loaded: AnyStation | Sequence[AnyStation]) -> list[AnyStation]:
     """The station files of one recorder (CAN or controller stations); ConfigError when their
-    [recorder] sections differ."""
+    [recorder] or [retention] sections differ."""
     stations = [loaded] if isinstance(loaded, LoadedStation | ControllerStation) else list(loaded)
     if not stations:
         raise ConfigError("the recorder needs at least one station file")
@@ -38,4 +40,5 @@ def served_stations(loaded: AnyStation | Sequence[AnyStation]) -> list[AnyStatio
                     f"{other.path}: recorder.{name}: {value} differs from {settings[name]} "
                     f"of {first.path}; one recorder has one [recorder] section"
                 )
+    retention_scopes(stations)  # the same folder: one [retention] section, or a ConfigError
     return stations

@@ -23,6 +23,9 @@ TighteningResult it files feeds the quality alert
 (:mod:`services.recorder.quality_watch`, on ``quality/alert``) and the results store
 (:mod:`services.recorder.results_watch`), every
 RunSummary the wear ledger (``wear/alert``); a view-only recorder keeps none of them.
+With a ``[retention]`` rule, a thread of its own deletes the recordings the policy lets
+go (:mod:`services.recorder.retention_watch`; the worker only tells it, at each tick,
+which files it has open).
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
@@ -58,6 +61,7 @@ from services.recorder.live.spool_keeper import SpoolKeeper
 from services.recorder.live_views import rerun_options, start_foxglove, start_rerun_live
 from services.recorder.quality_watch import QualityWatch
 from services.recorder.results_watch import ResultsWatch
+from services.recorder.retention_watch import RetentionWatch
 from services.recorder.served_stations import limits_of, served_stations
 from services.recorder.wear_queryable import wear_replier
 from services.recorder.wear_watch import WearWatch
@@ -75,6 +79,7 @@ from shared.contract import (
 )
 from shared.recordings import OTHER_STATION, FileMetadata, Received, classify
 from shared.results import store_target
+from shared.retention import retention_scopes
 from shared.runtime import ServiceSkeleton, Stop
 from shared.wear import StationLimits, ledger_path
 
@@ -136,6 +141,7 @@ class RecorderService:
         self.wear: WearWatch | None = None
         self.quality: QualityWatch | None = None
         self.results: ResultsWatch | None = None
+        self.retention: RetentionWatch | None = None
         #: what the line's recorder filed of the stations' spools (a view acknowledges nothing)
         self.spooling = (
             None
@@ -159,6 +165,9 @@ class RecorderService:
                 {station.station_id: station.config.station.line for station in stations},
                 self._host,
             )
+            (scope,) = retention_scopes(stations)  # one folder, one policy: served_stations
+            if scope.policy.deletes:
+                self.retention = RetentionWatch(scope)
         self._inbox = LineInbox(session, [station_keys(station) for station in self.station_ids])
         skeleton.on_stop(Stop.INPUT, self._inbox.close)
         for station in [] if view_only else self.station_ids:
@@ -196,6 +205,8 @@ class RecorderService:
                     next_results = now + RESULTS_FLUSH_S
                 if now >= next_tick:
                     self.recorder.tick(time.time_ns())
+                    if self.retention is not None:
+                        self.retention.open_files(self.recorder.open_paths())
                     if self.wear is not None:
                         self.wear.tick(time.time_ns())
                     next_tick = now + self._tick_s
@@ -213,6 +224,8 @@ class RecorderService:
                 LOG.warning("not recorded, arrived while stopping: %d", self._inbox.after_close)
             if self.wear is not None:
                 self.wear.close()
+            if self.retention is not None:
+                self.retention.close()
             closed = self.recorder.close()
             if self.results is not None:
                 self.results.close()  # after the files are finished
@@ -220,13 +233,14 @@ class RecorderService:
 
     def stats(self, now_ns: int) -> list[RecorderStats]:
         """RecorderStats of every station now (starts the next lag window)."""
-        recorder, wear, results = self.recorder, self.wear, self.results
+        recorder, wear, results, retention = self.recorder, self.wear, self.results, self.retention
         write_errors = recorder.write_errors + (wear.ledger_errors if wear else 0)
         ledger_error = wear.last_ledger_error if wear else None
         last_error = (
             recorder.last_write_error
             or (f"wear ledger: {ledger_error}" if ledger_error else None)
             or (results.last_error if results else None)
+            or (retention.last_error if retention else None)
         )
         if last_error is not None:
             last_error = last_error[:MAX_TEXT_CHARS]  # a long path must not make it unreadable
@@ -239,6 +253,8 @@ class RecorderService:
             waiting_summaries=wear.waiting if wear else 0,
             waiting_results=results.waiting if results else 0,
             quality_alerts=self.quality.active if self.quality else None,
+            recordings_deleted=retention.deleted if retention else None,
+            recordings_kept_unstored=retention.kept_not_stored if retention else None,
         )
 
     def _file(self, messages: list[Message]) -> None:

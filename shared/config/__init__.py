@@ -9,7 +9,8 @@ names), :func:`load_any_station` (a CAN or a controller station) or
   kind), :mod:`.common_sections` (what both have), :mod:`.program_windows` (a program's
   windows: where a run must end to be OK), :mod:`.openprotocol` (a controller that
   speaks Open Protocol, and the simulated one's side), :mod:`.quality` (when the
-  recorder raises a quality alert), :mod:`.rig_parts` (the simulated line's parts: bolts
+  recorder raises a quality alert), :mod:`.retention` (how long the recorder keeps the
+  recordings), :mod:`.rig_parts` (the simulated line's parts: bolts
   per part, their ids), :mod:`.joint` (the joint file),
   :mod:`.line` (a line: stations served together, stations derived from one)
 - :mod:`.loading` (TOML into a validated model, errors naming file and key),
@@ -34,6 +35,7 @@ from shared.config.line import (
 from shared.config.loading import resolve_relative
 from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
 from shared.config.quality import QualitySection
+from shared.config.retention import RetentionSection
 from shared.config.station import (
     CanSection,
     LoadedStation,
@@ -60,6 +62,7 @@ __all__ = [
     "PredictorSection",
     "Program",
     "QualitySection",
+    "RetentionSection",
     "RigOpenProtocolSection",
     "RigSection",
     "StationConfig",

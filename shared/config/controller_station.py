@@ -11,6 +11,7 @@ simulate (``config/controller-station.toml``)::
     [openprotocol]  host (port, timers, ...)         required
     [recorder]      folder (...)                     required
     [quality]       the recorder's quality alert     optional
+    [retention]     how long recordings are kept     optional
     [[programs]]    the controller's psets           optional: id (1-999, the pset
                     number), name, and the windows torque_min_nm / torque_max_nm,
                     angle_min_deg / angle_max_deg
@@ -65,6 +66,7 @@ from shared.config.loading import StrictModel, read_toml, validate
 from shared.config.openprotocol import OpenProtocolSection
 from shared.config.program_windows import ProgramWindows
 from shared.config.quality import QualitySection
+from shared.config.retention import RetentionSection
 from shared.contract import CONTRACT_RANGE, SensorRange
 from shared.errors import ConfigError
 
@@ -133,6 +135,7 @@ class ControllerStationConfig(StrictModel):
     recorder: RecorderSection
     spool: SpoolSection = SpoolSection()
     quality: QualitySection = QualitySection()
+    retention: RetentionSection = RetentionSection()
     programs: list[ControllerProgram] = Field(
         default_factory=list, description="the controller's psets, to name their runs"
     )

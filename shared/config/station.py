@@ -35,6 +35,7 @@ from shared.config.loading import StrictModel, read_toml, resolve_relative, vali
 from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
 from shared.config.program_windows import ProgramWindows
 from shared.config.quality import QualitySection
+from shared.config.retention import RetentionSection
 from shared.config.rig_parts import DEFAULT_PART_PATTERN, check_part_pattern, part_id
 from shared.contract import SensorRange, StationDatabase
 from shared.errors import CanDatabaseError, ConfigError
@@ -196,6 +197,7 @@ class StationConfig(StrictModel):
     recorder: RecorderSection
     spool: SpoolSection = SpoolSection()
     quality: QualitySection = QualitySection()
+    retention: RetentionSection = RetentionSection()
     openprotocol: OpenProtocolSection | None = Field(
         default=None, description="the station's tool controller speaks Open Protocol"
     )

@@ -303,6 +303,12 @@ class RecorderStats:
     # this station's quality alerts active now, newest first (each is put once, when it starts:
     # a status that listens later learns of it here)
     quality_alerts: list[QualityAlert] = field(default_factory=list)
+    # run files of this station the retention policy ([retention]) deleted since the recorder
+    # started
+    recordings_deleted: Count = 0
+    # run files of this station past their time that the last retention pass kept because
+    # their results are not in the results store
+    recordings_kept_unstored: Count = 0
 
 
 @dataclass(frozen=True, slots=True)

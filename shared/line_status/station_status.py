@@ -168,6 +168,8 @@ class RecorderHealth:
     waiting_summaries: int = 0  # runs waiting in the recorder's memory for the wear ledger
     waiting_results: int = 0  # results waiting in the recorder's memory for the results store
     bad_payloads: int = 0  # payloads it refused (recorded raw)
+    recordings_deleted: int = 0  # run files the retention policy deleted since it started
+    recordings_kept_unstored: int = 0  # past their time, kept: their results are not stored
 
 
 @dataclass(frozen=True)
@@ -337,6 +339,8 @@ def _recorder_health(
         waiting_summaries=stats.waiting_summaries,
         waiting_results=stats.waiting_results,
         bad_payloads=stats.bad_payloads,
+        recordings_deleted=stats.recordings_deleted,
+        recordings_kept_unstored=stats.recordings_kept_unstored,
     )
 
 

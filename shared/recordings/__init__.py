@@ -10,6 +10,8 @@
 
 from shared.recordings.file_metadata import FileMetadata, flatten
 from shared.recordings.layout import (
+    FileName,
+    file_name_of,
     file_path,
     recording_files,
     rerun_path,
@@ -23,11 +25,13 @@ from shared.recordings.sink import Sink
 
 __all__ = [
     "FileMetadata",
+    "FileName",
     "MAX_AHEAD_S",
     "OTHER_STATION",
     "Received",
     "Sink",
     "classify",
+    "file_name_of",
     "file_path",
     "flatten",
     "recording_files",

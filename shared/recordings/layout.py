@@ -12,14 +12,17 @@ safe already, so this changes nothing of a valid id. ``part`` counts the
 files of one run past the recorder's size or duration limit; ``copy`` a name
 taken already. Every writer (the recorder, ``boltwatch import``) names its
 files with :func:`file_path`, every reader (``inspect``, ``report``, the
-overlay, the import's look for a run it did already) finds them with the
-functions below; only regular files are ever returned.
+overlay, the import's look for a run it did already, the retention policy)
+finds them with the functions below; only regular files are ever returned.
+:func:`file_name_of` reads a file's name back: its run, when it was opened,
+its part and copy.
 """
 
 from __future__ import annotations
 
 import re
 from collections.abc import Iterator
+from dataclasses import dataclass
 from datetime import UTC, date, datetime
 from pathlib import Path
 from typing import Final
@@ -95,6 +98,44 @@ def run_files(folder: Path, station: str, run_id: int) -> list[Path]:
     """Every MCAP file of run ``run_id`` of ``station``, in any day folder, oldest first."""
     prefix = run_file_prefix(station, run_id)
     return [path for _, day in station_days(folder, station) for path in recording_files(day, prefix)]
+
+
+@dataclass(frozen=True, slots=True)
+class FileName:
+    """What a recording's name says: :func:`file_path` read back."""
+
+    run_id: int | None  # None: an idle file (before the station's first run)
+    opened: datetime  # UTC, to the second: its day folder and ``HHMMSS``
+    part: int  # 1, or N of ``_part<N>``
+    copy: int  # 1, or N of ``_<N>`` (a name taken already)
+
+    @property
+    def order(self) -> tuple[datetime, int, int]:
+        """Sorts a station's files in the order they were opened."""
+        return self.opened, self.part, self.copy
+
+
+def file_name_of(path: Path, station: str) -> FileName | None:
+    """What the name of ``path`` (in a day folder of ``station``) says; None: not a name
+    :func:`file_path` gives."""
+    safe_station = re.escape(station_folder_name(station))
+    found = re.fullmatch(
+        rf"{safe_station}_(?:idle|run(?P<run>\d+))_(?P<time>\d{{6}})"
+        rf"(?:_part(?P<part>\d+))?(?:_(?P<copy>\d+))?{re.escape(MCAP_SUFFIX)}",
+        path.name,
+    )
+    if found is None:
+        return None
+    try:
+        opened = datetime.strptime(f"{path.parent.name} {found['time']}", "%Y-%m-%d %H%M%S")
+    except ValueError:
+        return None
+    return FileName(
+        run_id=None if found["run"] is None else int(found["run"]),
+        opened=opened.replace(tzinfo=UTC),
+        part=int(found["part"] or 1),
+        copy=int(found["copy"] or 1),
+    )
 
 
 def glob_escape(text: str) -> str:

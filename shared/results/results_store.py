@@ -6,7 +6,9 @@ The recorder adds each result as it files it (``services/recorder/results_watch.
 ``boltwatch results rebuild`` those of existing recordings; both may write at once.
 :meth:`ResultsStore.add` is idempotent by (station, run_id): a result stored
 again is left as it is (the first one stored stays) and not counted as new.
-Readers (``boltwatch results``, ``report``) open it without making one:
+:meth:`ResultsStore.verdicts` says which runs are stored (the retention policy
+deletes no recording whose results are not). Readers (``boltwatch results``,
+``report``, ``recordings prune``) open it without making one:
 :class:`~.results_database.StoreError` says where none is and how one comes.
 """
 
@@ -143,6 +145,21 @@ class ResultsStore:
                 "SELECT MAX(stored_ns) FROM tightenings" + where, parameters
             )
         return None if row[0] is None else int(row[0])
+
+    def verdicts(self, keys: Sequence[tuple[str, int]]) -> dict[tuple[str, int], str]:
+        """The result (``OK``/``NOK``) of each of ``keys`` (station, run_id) that is stored;
+        a key not stored is not in the answer."""
+        found: dict[tuple[str, int], str] = {}
+        with self.database.transaction():
+            for chunk in _chunks(list(dict.fromkeys(keys)), _KEYS_PER_QUERY):
+                pairs = ", ".join("(?, ?)" for _ in chunk)
+                rows = self.database.rows(
+                    "SELECT station, run_id, result FROM tightenings "
+                    f"WHERE (station, run_id) IN ({pairs})",
+                    [value for key in chunk for value in key],
+                )
+                found.update({(row[0], int(row[1])): row[2] for row in rows})
+        return found
 
     def _steps_of(self, keys: list[tuple[Any, Any]]) -> dict[tuple[str, int], list[ResultStep]]:
         steps: dict[tuple[str, int], list[ResultStep]] = {}

@@ -100,12 +100,13 @@ def write_station_file(
     connect: Sequence[str] = (),
     recorder: Mapping[str, Any] | None = None,
     quality: Mapping[str, Any] | None = None,
+    retention: Mapping[str, Any] | None = None,
 ) -> Path:
     """A copy of config/station.toml as a zenoh peer on the given endpoints.
 
     ``can.dbc`` and ``station.joint`` point at the repository's files;
     ``recorder.folder`` is ``recordings``; ``recorder`` overrides recorder keys;
-    ``quality``: the ``[quality]`` section.
+    ``quality``: the ``[quality]`` section; ``retention``: the ``[retention]`` section.
     """
     with STATION_FILE.open("rb") as handle:
         data = tomllib.load(handle)
@@ -116,5 +117,7 @@ def write_station_file(
     data["recorder"] = {**data["recorder"], "folder": str(recordings), **(recorder or {})}
     if quality is not None:
         data["quality"] = dict(quality)
+    if retention is not None:
+        data["retention"] = dict(retention)
     path.write_text(toml_writer.dumps(data))
     return path

@@ -18,4 +18,6 @@ inside ``run`` so that ``boltwatch --help`` stays fast.
     import_runs  ``boltwatch import``: controller JSON runs as recordings or trace CSVs
     wear         the wear ledger per tool, a tool's service, a broken ledger replaced
     report       statistics per program over recorded results (X̄/R, Cp/Cpk, NOK Pareto)
+    results      tightenings found in the results store; the store rebuilt from recordings
+    recordings   the recordings' upkeep: ``prune`` applies the station file's ``[retention]``
 """

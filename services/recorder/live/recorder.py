@@ -193,6 +193,15 @@ class Recorder:
             )
         return closed
 
+    def open_paths(self) -> list[Path]:
+        """The MCAP files open now (every station's current and previous, every hole's)."""
+        return [
+            sink.path
+            for files in [*self._stations.values(), *self._holes]
+            for sink in (files.current, files.previous)
+            if sink is not None
+        ]
+
     @property
     def abandoned_files(self) -> list[Path]:
         """Files left incomplete by a write fault (``boltwatch recover`` makes them valid)."""

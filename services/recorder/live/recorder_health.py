@@ -125,15 +125,21 @@ class RecorderHealth:
         waiting_summaries: int = 0,
         waiting_results: int = 0,
         quality_alerts: Callable[[str], list[QualityAlert]] | None = None,
+        recordings_deleted: Mapping[str, int] | None = None,
+        recordings_kept_unstored: Mapping[str, int] | None = None,
     ) -> list[RecorderStats]:
         """One RecorderStats per station; starts the next lag window.
 
         ``refused_summaries``: per station, RunSummaries the wear ledger refused;
         ``waiting_summaries``: runs waiting in memory for the ledger (all stations);
         ``waiting_results``: results waiting in memory for the results store (all stations);
-        ``quality_alerts``: a station's quality alerts active now.
+        ``quality_alerts``: a station's quality alerts active now;
+        ``recordings_deleted`` / ``recordings_kept_unstored``: per station, what the
+        retention policy deleted since the start / kept at its last pass (results not stored).
         """
         refused = refused_summaries or {}
+        deleted = recordings_deleted or {}
+        kept_unstored = recordings_kept_unstored or {}
         out: list[RecorderStats] = []
         for station, counts in self._stations.items():
             p50_ms, max_ms = lag_figures_ms(counts.lags_ns)
@@ -154,6 +160,8 @@ class RecorderHealth:
                     waiting_results=waiting_results,
                     bad_payloads=counts.bad_payloads,
                     quality_alerts=quality_alerts(station) if quality_alerts else [],
+                    recordings_deleted=deleted.get(station, 0),
+                    recordings_kept_unstored=kept_unstored.get(station, 0),
                 )
             )
         return out

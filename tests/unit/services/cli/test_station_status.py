@@ -323,6 +323,22 @@ def test_summaries_the_wear_ledger_refused_show() -> None:
     assert to_json(report)["stations"]["st1"]["recorder"]["refused_summaries"] == 2
 
 
+def test_what_the_retention_policy_deleted_and_kept_shows() -> None:
+    collector = StatusCollector()
+    stats = recorder_stats(T0, recordings_deleted=212, recordings_kept_unstored=3)
+    feed(collector, channels.RECORDER.topic, stats)
+    report = collector.report("e", 2.0, T0)
+    text = format_report(report)
+    assert (
+        "212 recordings deleted by the retention policy, 3 recordings past their time kept: "
+        "results not stored, " in text
+    )
+    recorder = to_json(report)["stations"]["st1"]["recorder"]
+    assert (recorder["recordings_deleted"], recorder["recordings_kept_unstored"]) == (212, 3)
+    feed(collector, channels.RECORDER.topic, recorder_stats(T0 + S))
+    assert "retention" not in format_report(collector.report("e", 2.0, T0 + S))
+
+
 def test_what_each_service_refused_is_shown() -> None:
     """Bad decisions (BusStats), the predictor's bad payloads and samples (PredictorStats),
     the recorder's refused payloads (RecorderStats): counted where they were refused."""
