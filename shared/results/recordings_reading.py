@@ -7,7 +7,8 @@ again adds nothing twice). A file read whole is marked with its size and
 modification time in ``recordings_read``, so the next reading skips it
 unless it changed: a rebuild stopped halfway goes on where it stopped. A
 damaged file (a recorder killed mid-write, a cut cable) is read as far as it
-goes, warned of, and not marked: it is read again next time.
+goes, warned of, and not marked: it is read again next time. A payload the
+recorder refused (kept raw on the topic's raw channel) is no result.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from pathlib import Path
 from shared.contract import RunSummary, TighteningResult, channels, decode
 from shared.errors import InputError
 from shared.recordings import recording_files, station_days
-from shared.recordings.mcap import RecordingScan
+from shared.recordings.mcap import RAW_ENCODING, RecordingScan
 from shared.results.results_store import ResultsStore
 from shared.results.stored_result import StoredResult, stored_result
 
@@ -58,6 +59,8 @@ def results_of(
     results: list[TighteningResult] = []
     summaries: dict[tuple[str, int], RunSummary] = {}
     for _, channel, message in scan.messages():
+        if channel.message_encoding == RAW_ENCODING:
+            continue  # a payload the recorder refused, kept byte for byte: no result
         if channel.topic.endswith(_RESULTS):
             results.append(decode(TighteningResult, message.data))
         elif channel.topic.endswith(_RUNS):

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from shared.contract import RunSummary, TighteningResult, channels, decode
 from shared.recordings import recording_files, station_days
-from shared.recordings.mcap import RecordingScan
+from shared.recordings.mcap import RAW_ENCODING, RecordingScan
 from shared.results import ResultsQuery, ResultsStore
 
 #: progress is told every this many files (when there are more)
@@ -91,6 +91,8 @@ def read_results(
             topic = channel.topic.rsplit("/", 1)[-1]
             if not channel.topic.startswith(f"boltwatch/{station}/"):
                 continue
+            if channel.message_encoding == RAW_ENCODING:
+                continue  # a payload the recorder refused, kept raw: no result
             if topic == result_topic:
                 result = decode(TighteningResult, message.data)
                 key = (result.station, result.run_id, result.tool_id, result.time_ns)

@@ -13,7 +13,8 @@ import zenoh
 from shared.config import LoadedStation, load_station
 from shared.contract import TighteningResult
 from shared.recordings.mcap import RecordingScan
-from shared.results import ResultsQuery, ResultsStore, StoredResult, store_target
+from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget, store_target
+from shared.results.recordings_reading import fill_from_recordings
 from shared.runtime import zenoh_config
 from tests.support import factories
 from tests.support.live_recorder import (
@@ -149,3 +150,25 @@ def test_a_store_down_keeps_results_waiting_and_the_next_start_finds_the_rest(
         for row in stored:
             assert row.recording is not None
             assert row.result in _results_in(Path(row.recording))
+
+
+def test_a_refused_results_payload_costs_no_result_of_its_file(tmp_path: Path) -> None:
+    """A payload on ``results`` the recorder refused is kept raw in the run's file; reading
+    the file again (rebuild, the catch-up) stores the file's good results and marks it read."""
+    station = _station(tmp_path)
+    recorder = RunningRecorder(station)
+    session = zenoh.open(zenoh_config("peer", connect=station.config.zenoh.listen))
+    try:
+        run = _run_with_result(1, "VIN0001")
+        publish(session, [*run[:-1], ("results", b'{"station": "st1", "run_id": "no"}'), run[-1]])
+        wait_until(lambda: len(_stored(station)) == 1, "the good result stored", WAIT_S)
+    finally:
+        session.close()
+        recorder.finish()
+    (path,) = (row.recording for row in _stored(station))
+    assert path is not None
+    target = StoreTarget(sqlite_path=tmp_path / "again" / "results.sqlite")
+    with ResultsStore(target) as store:
+        counts = fill_from_recordings(store, [Path(path)], {"st1": ""}, "box", time.time_ns)
+        assert (counts.read, counts.results, counts.new, counts.damaged) == (1, 1, 1, [])
+        assert store.recording_read("box", path) is not None
