@@ -51,7 +51,7 @@ SUMMARIES_KEPT = 1000
 #: the catch-up reads recordings modified since the newest stored result less this
 CATCH_UP_MARGIN_NS = 120_000_000_000
 #: how long a stopping recorder waits for the writer's last transaction
-STOP_WAIT_S = 10.0
+STOP_WAIT_S = 2.0
 
 
 class ResultsWatch:

@@ -2,7 +2,8 @@
 
 - :mod:`.service_skeleton` (what a service opens and declares, and the order it
   stops in), :mod:`.service_runtime` (signals, the work thread, the exit status),
-  :mod:`.supervisor_link` (stop when ``boltwatch up`` dies)
+  :mod:`.supervisor_link` (stop when ``boltwatch up`` dies), :mod:`.stop_deadline`
+  (a stop that hangs ends the process, its threads' stacks logged; stacks on SIGUSR1)
 - :mod:`.zenoh_session` (sessions from configuration, the router link watched,
   a channel's publisher), :mod:`.receive_threads` (cheap callbacks on zenoh's threads)
 - :mod:`.queued_publisher` (publishing without waiting, in order, per station),

@@ -26,7 +26,9 @@ declared things in:
 Within one stage the last thing registered is closed first (an ExitStack).
 The stages run when the ``with`` block ends: after :meth:`run` has returned,
 so the work thread has already ended (or been given up on after its grace).
-A close that raises does not keep the later ones from running.
+A close that raises does not keep the later ones from running. Stages that
+take longer than :data:`~shared.runtime.stop_deadline.STOP_DEADLINE_S` end the
+process, every thread's stack in the log (:mod:`shared.runtime.stop_deadline`).
 
 :meth:`run` is :class:`~shared.runtime.service_runtime.ServiceRunner`: the work in a
 thread, SIGINT/SIGTERM on the main thread, exit status 0 or 1.
@@ -46,6 +48,7 @@ import zenoh
 from shared.config import ZenohSection
 from shared.contract import Channel, keys
 from shared.runtime.service_runtime import ServiceRunner
+from shared.runtime.stop_deadline import StopDeadline, dump_stacks_on_sigusr1
 from shared.runtime.zenoh_session import declare_channel, open_from, open_session
 
 T = TypeVar("T")
@@ -73,6 +76,7 @@ class ServiceSkeleton:
         for stage in sorted(Stop, reverse=True):  # the first stage is closed first
             self._stack.enter_context(self._stages[stage])
         self._session: zenoh.Session | None = None
+        self._deadline: StopDeadline | None = None
         if session is not None:
             self.own_session(session)
 
@@ -84,7 +88,11 @@ class ServiceSkeleton:
 
     def close(self) -> None:
         """Run the stop stages in order; safe to call twice."""
-        self._stack.close()
+        try:
+            self._stack.close()
+        finally:
+            if self._deadline is not None:
+                self._deadline.disarm()
 
     def on_stop(self, stage: Stop, callback: Callable[[], object]) -> None:
         """Call ``callback`` in ``stage`` of the stop."""
@@ -158,8 +166,12 @@ class ServiceSkeleton:
     ) -> int:
         """``work(stop)`` in a thread until it returns or SIGINT/SIGTERM; 0 clean, 1 failed
         (:class:`~shared.runtime.service_runtime.ServiceRunner`). The stop stages run after, when
-        the ``with`` block ends."""
-        return ServiceRunner(self.name, work, wake, grace_s).run()
+        the ``with`` block ends, within a deadline (:mod:`shared.runtime.stop_deadline`)."""
+        dump_stacks_on_sigusr1()
+        try:
+            return ServiceRunner(self.name, work, wake, grace_s).run()
+        finally:
+            self._deadline = StopDeadline(self.name)
 
 
 def _undeclare(entity: zenoh.LivelinessToken | zenoh.Subscriber[None] | Any) -> None:

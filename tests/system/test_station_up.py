@@ -171,6 +171,11 @@ def test_services_stop_cleanly_when_up_is_killed_outright(tmp_path: Path) -> Non
     report = "\n".join(process_report(pid) for pid in alive)
     kill_all(alive)
     assert alive == [], report
+    logs = list((tmp_path / "recordings" / "logs").rglob("*.log"))
+    assert len(logs) >= 4, logs
+    for log in logs:  # a stop that hung left at its deadline, its threads' stacks logged
+        text = log.read_text(errors="replace")
+        assert "its stop took more than" not in text, f"{log.name}:\n{text[-6000:]}"
     recordings = list((tmp_path / "recordings").rglob("*.mcap"))
     assert recordings
     for path in recordings:
