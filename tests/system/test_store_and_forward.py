@@ -53,9 +53,10 @@ WHY_NOT = unavailable_reason()
 pytestmark = pytest.mark.skipif(WHY_NOT is not None, reason=WHY_NOT or "")
 
 STATIONS = 3
-#: about two seconds a run: the rigs tighten through both faults and some time after
-RUNS = 75
 CUT_S = 30.0
+#: about two seconds a run: the rigs tighten through both faults (5 s + 2 CUT_S + 10 s)
+#: and some time after
+RUNS = 45
 ENDPOINT = LINE_ENDPOINT
 CLI = [sys.executable, "-m", "services.cli"]
 
