@@ -58,8 +58,9 @@ def _station_lines(status: StationStatus) -> list[str]:
     rate = f"{status.samples_per_s:.0f} received"
     if status.bus_samples_per_s is not None:
         rate += f" (bus {status.bus_samples_per_s:.0f})"
+    on_line = f" (line {status.recorder.line})" if status.recorder and status.recorder.line else ""
     out = [
-        f"station {status.station}",
+        f"station {status.station}{on_line}",
         line("services", services),
         line("samples/s", rate),
         *_unless_bridge(status, status.bus, line("bus", _bus_text(status.bus))),

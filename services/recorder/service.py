@@ -131,7 +131,9 @@ class RecorderService:
         self.station_ids = metadata.station_ids
         self._sensor_ranges = {station.station_id: station.sensor_range for station in stations}
         self.recorder = Recorder(first.recordings_folder, limits_of(first), metadata, rerun)
-        self.health = RecorderHealth(self.station_ids)
+        #: the line of each served station (results, RecorderStats)
+        self._lines = {station.station_id: station.config.station.line for station in stations}
+        self.health = RecorderHealth(self.station_ids, self._lines)
         self._batches = BatchSamples()
         self._ledger_file = ledger_path(first.recordings_folder)
         #: with the ledger's path, which ledger a wear reply comes from (a plant has several)
@@ -162,7 +164,7 @@ class RecorderService:
             self.results = ResultsWatch(
                 store_target(first.recordings_folder, first.config.recorder.results_database),
                 first.recordings_folder,
-                {station.station_id: station.config.station.line for station in stations},
+                self._lines,
                 self._host,
             )
             (scope,) = retention_scopes(stations)  # one folder, one policy: served_stations

@@ -300,6 +300,8 @@ class RecorderStats:
     waiting_summaries: Count = 0
     # results (of every station) waiting in memory for the results store (failing)
     waiting_results: Count = 0
+    # the station's line, as its station file names it (``[station] line``; "": none)
+    line: str = ""
     # this station's quality alerts active now, newest first (each is put once, when it starts:
     # a status that listens later learns of it here)
     quality_alerts: list[QualityAlert] = field(default_factory=list)

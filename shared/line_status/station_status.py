@@ -167,6 +167,7 @@ class RecorderHealth:
     refused_summaries: int = 0  # RunSummaries the wear ledger refused (beyond their bound)
     waiting_summaries: int = 0  # runs waiting in the recorder's memory for the wear ledger
     waiting_results: int = 0  # results waiting in the recorder's memory for the results store
+    line: str = ""  # the station's line, as the recorder's station file names it
     bad_payloads: int = 0  # payloads it refused (recorded raw)
     recordings_deleted: int = 0  # run files the retention policy deleted since it started
     recordings_kept_unstored: int = 0  # past their time, kept: their results are not stored
@@ -338,6 +339,7 @@ def _recorder_health(
         refused_summaries=stats.refused_summaries,
         waiting_summaries=stats.waiting_summaries,
         waiting_results=stats.waiting_results,
+        line=stats.line,
         bad_payloads=stats.bad_payloads,
         recordings_deleted=stats.recordings_deleted,
         recordings_kept_unstored=stats.recordings_kept_unstored,

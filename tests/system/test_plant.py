@@ -64,6 +64,8 @@ def test_two_lines_on_loopback_into_one_postgresql(tmp_path: Path, postgres_url:
     report = boltwatch("report", "--config", *stations, "--out", str(tmp_path / "report"))
     assert report.returncode == 0, report.stdout + report.stderr
     assert f"{2 * RUNS} results (from the results store postgresql://" in report.stdout
+    line_2 = boltwatch("report", "--config", *stations, "--line", "line2", "--out", str(tmp_path))
+    assert f"{RUNS} results (from the results store postgresql://" in line_2.stdout, line_2
 
 
 def test_two_lines_in_network_namespaces(namespaces: NamespacePlant, tmp_path: Path) -> None:
@@ -103,6 +105,7 @@ def run_plant(hosts: Hosts, folder: Path, results_database: str | None = None) -
         assert all(station["services"][s] for s in ("acquisition", "predictor", "recorder"))
         recorder = station["recorder"]
         assert recorder is not None, station
+        assert recorder["line"] == f"line{line}", recorder  # its station file's [station] line
         assert recorder["recording"] and recorder["bad_payloads"] == 0, recorder
         assert recorder["missing_samples"] == 0, recorder
     # wear from either line: the tool's runs on both lines, from both ledgers

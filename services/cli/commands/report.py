@@ -2,7 +2,7 @@
 
 ::
 
-    boltwatch report [--config STATION ...] [--since DATE] [--until DATE]
+    boltwatch report [--config STATION ...] [--line L] [--since DATE] [--until DATE]
                      [--program ID] [--tool ID] [--subgroup-size N] [--out FOLDER]
                      [--from-recordings]
 
@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from services.cli.command_options import add_station_file_option, utc_end, utc_moment
+from shared.errors import ConfigError
 from shared.option_types import int_in
 
 if TYPE_CHECKING:
@@ -59,6 +60,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="DATE",
         help="last day, included (YYYY-MM-DD), or moment, excluded; UTC (default: now)",
     )
+    parser.add_argument(
+        "--line", default=None, metavar="L", help="only the stations on line L (station.line)"
+    )
     parser.add_argument("--program", type=int_in(0, 65535, "a program id"), default=None)
     parser.add_argument("--tool", type=int_in(0, 65535, "a tool id"), default=None)
     parser.add_argument(
@@ -88,6 +92,10 @@ def run(args: argparse.Namespace) -> int:
     from shared.offline.report import ResultFilter, terminal_lines, write_report
 
     stations = [load_any_station(path) for path in args.config]
+    if args.line is not None:
+        stations = [loaded for loaded in stations if loaded.config.station.line == args.line]
+        if not stations:
+            raise ConfigError(f"--line {args.line}: no station of the station files is on it")
     rule = ResultFilter(
         stations=[(loaded.station_id, loaded.recordings_folder) for loaded in stations],
         since=args.since,

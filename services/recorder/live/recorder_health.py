@@ -58,8 +58,10 @@ class _StationCounts:
 class RecorderHealth:
     """Per-station message counts and sample lags, turned into RecorderStats on demand."""
 
-    def __init__(self, stations: list[str]) -> None:
+    def __init__(self, stations: list[str], lines: Mapping[str, str] | None = None) -> None:
+        """``lines``: the line of each served station (its station file's)."""
         self._stations: dict[str, _StationCounts] = {name: _StationCounts() for name in stations}
+        self._lines = dict(lines or {})
 
     @property
     def stations(self) -> list[str]:
@@ -158,6 +160,7 @@ class RecorderHealth:
                     refused_summaries=refused.get(station, 0),
                     waiting_summaries=waiting_summaries,
                     waiting_results=waiting_results,
+                    line=self._lines.get(station, ""),
                     bad_payloads=counts.bad_payloads,
                     quality_alerts=quality_alerts(station) if quality_alerts else [],
                     recordings_deleted=deleted.get(station, 0),

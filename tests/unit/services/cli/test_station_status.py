@@ -339,6 +339,18 @@ def test_what_the_retention_policy_deleted_and_kept_shows() -> None:
     assert "retention" not in format_report(collector.report("e", 2.0, T0 + S))
 
 
+def test_the_stations_line_and_the_results_waiting_for_their_store_show() -> None:
+    collector = StatusCollector()
+    feed(collector, channels.RECORDER.topic, recorder_stats(T0, line="B", waiting_results=7))
+    report = collector.report("e", 2.0, T0)
+    text = format_report(report)
+    assert "station st1 (line B)\n" in text
+    assert ", 7 results waiting for the results store" in text
+    assert to_json(report)["stations"]["st1"]["recorder"]["line"] == "B"
+    feed(collector, channels.RECORDER.topic, recorder_stats(T0 + S))
+    assert "station st1\n" in format_report(collector.report("e", 2.0, T0 + S))
+
+
 def test_what_each_service_refused_is_shown() -> None:
     """Bad decisions (BusStats), the predictor's bad payloads and samples (PredictorStats),
     the recorder's refused payloads (RecorderStats): counted where they were refused."""
