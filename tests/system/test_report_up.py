@@ -7,6 +7,7 @@ the results read back from MCAP with the mcap library and json only.
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -40,6 +41,15 @@ def test_report_over_runs_of_up(tmp_path: Path) -> None:
     assert scan.returncode == 0, scan.stdout + scan.stderr
     assert re.search(rf"^{RUNS} results \(from \d+ recordings\)$", scan.stdout, re.MULTILINE)
     assert report.stdout.splitlines()[1:-1] == scan.stdout.splitlines()[1:-1]
+    # a part's tightenings found in the store, the runs whose results name it
+    part = results[0]["part_id"]
+    runs_of_part = sorted(r["run_id"] for r in results if r["part_id"] == part)
+    assert part and len(runs_of_part) >= 2, results  # the rig's parts have several bolts
+    found = boltwatch("results", "--config", str(station), "--part", part, "--json")
+    assert found.returncode == 0, found.stdout + found.stderr
+    rows = json.loads(found.stdout)
+    assert sorted(row["run_id"] for row in rows) == runs_of_part
+    assert all(Path(row["recording"]).is_file() for row in rows)
     preload = [result["final_force_n"]["value"] for result in results]
     low, high = results[-1]["final_force_n"]["min"], results[-1]["final_force_n"]["max"]
     mean, sigma = np.mean(preload), np.std(preload, ddof=1)
