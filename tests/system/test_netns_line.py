@@ -3,7 +3,7 @@
 The line server runs the zenoh router and the recorder; each station box runs
 its own simulated rig on its own CAN bus (multicast on the box's loopback),
 its acquisition and its predictor, all zenoh clients of the router over the
-box's own cable. Every station tightens; station 3's cable is pulled for ten
+box's own cable. Every station tightens; station 3's cable is pulled for twelve
 seconds in the middle; the stations' spools are off (store and forward, on by default,
 loses nothing: ``test_store_and_forward.py``). The other two must be untouched (every run recorded,
 no sample lost); station 3 must be reported down while cut off, its lost
@@ -43,9 +43,9 @@ pytestmark = pytest.mark.skipif(WHY_NOT is not None, reason=WHY_NOT or "")
 
 STATIONS = 3
 CUT_STATION = 3
-RUNS = 12  # about two seconds a run: well past the cut (3 s + 10 s)
+RUNS = 16  # about two seconds a run: well past the cut (3 s + 12 s)
 CUT_AFTER_S = 3.0
-CUT_FOR_S = 10.0
+CUT_FOR_S = 12.0
 ENDPOINT = LINE_ENDPOINT
 CLI = [sys.executable, "-m", "services.cli"]
 
@@ -128,7 +128,7 @@ def settled_status(line: Line, timeout_s: float = 60.0) -> dict[str, dict[str, o
     raise AssertionError(f"the line did not settle in {timeout_s} s: {json.dumps(previous)[:3000]}")
 
 
-def test_three_hosts_one_cut_off_for_ten_seconds(tmp_path: Path) -> None:
+def test_three_hosts_one_cut_off_for_twelve_seconds(tmp_path: Path) -> None:
     files = station_files(tmp_path)
     logs = tmp_path / "logs"
     logs.mkdir()
@@ -162,7 +162,9 @@ def test_three_hosts_one_cut_off_for_ten_seconds(tmp_path: Path) -> None:
             time.sleep(CUT_AFTER_S)
             line.cut(CUT_STATION)
             cut_at = time.monotonic()
-            time.sleep(CUT_FOR_S * 0.4)
+            # the status is asked late in the cut: a router that lags under load still hands
+            # on what the cut station sent before its cable went (seen: 53 samples/s at 4 s)
+            time.sleep(CUT_FOR_S * 0.5)
             during_cut: dict[str, dict[str, object]] = {}
             # a status that failed or heard nothing of the line under load is asked again,
             # while the cut lasts (each takes its 1.5 s window and a process start)
