@@ -53,10 +53,10 @@ WHY_NOT = unavailable_reason()
 pytestmark = pytest.mark.skipif(WHY_NOT is not None, reason=WHY_NOT or "")
 
 STATIONS = 3
-CUT_S = 30.0
+CUT_S = 20.0
 #: about two seconds a run: the rigs tighten through both faults (5 s + 2 CUT_S + 10 s)
 #: and some time after
-RUNS = 45
+RUNS = 40
 ENDPOINT = LINE_ENDPOINT
 CLI = [sys.executable, "-m", "services.cli"]
 
