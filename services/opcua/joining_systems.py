@@ -8,7 +8,9 @@ JointManagement, MachineryBuildingBlocks, ResultManagement with its methods and
 its ``Results`` folder). What :meth:`JoiningSystem.publish` does with a result:
 
 - ``ResultManagement/Results``: a variable of ``JoiningSystemResultType``
-  (data type ``ResultDataType``) named by the result's ResultId; the newest
+  (data type ``ResultDataType``) named ``Result_<run id>`` (a browse name
+  without ``/``, which browse paths use), its node id
+  ``s=<station>/results/<ResultId>``; the newest
   :data:`KEPT_RESULTS` stay, the oldest go (a client reads the latest there);
 - a ``JoiningSystemResultReadyEventType`` event from the joining system, its
   ``Result`` the same ``ResultDataType`` (a client subscribes to the joining
@@ -29,7 +31,7 @@ from typing import Any
 from asyncua import Server, ua
 from asyncua.common.node import Node
 
-from services.opcua.nodeset_loading import IJT_BASE, MACHINERY_RESULT
+from services.opcua.nodeset_loading import IJT_BASE, MACHINERY_RESULT, node_id
 
 LOG = logging.getLogger(__name__)
 
@@ -46,10 +48,17 @@ RESULT_DATA_TYPE = 3008
 MACHINERY = "http://opcfoundation.org/UA/Machinery/"
 
 
+def result_browse_name(run_id: int) -> str:
+    """The browse name of a run's result in its station's Results folder."""
+    return f"Result_{run_id}"
+
+
 class JoiningSystem:
     """A station's joining system in the address space, with its event generator."""
 
-    def __init__(self, station: str, node: Node, results: Node, events: Any, names: Any) -> None:
+    def __init__(
+        self, station: str, node: Node, results: Node, events: Any, names: tuple[int, int, int]
+    ) -> None:
         self.station = station
         self.node = node
         self._results = results
@@ -63,32 +72,30 @@ class JoiningSystem:
         ijt = await server.get_namespace_index(IJT_BASE)
         machinery = await server.get_namespace_index(MACHINERY)
         result_ns = await server.get_namespace_index(MACHINERY_RESULT)
-        machines = server.get_node(ua.NodeId(MACHINES_FOLDER, machinery))
+        machines = server.get_node(node_id(MACHINES_FOLDER, machinery))
         node = await machines.add_object(
-            ua.NodeId(station, ours),
+            node_id(station, ours),
             ua.QualifiedName(station, ours),
-            objecttype=ua.NodeId(JOINING_SYSTEM_TYPE, ijt),
+            objecttype=node_id(JOINING_SYSTEM_TYPE, ijt),
         )
-        results = await node.get_child(
-            [f"{result_ns}:ResultManagement", f"{result_ns}:Results"]
-        )
+        results = await node.get_child([f"{result_ns}:ResultManagement", f"{result_ns}:Results"])
         events = await server.get_event_generator(
-            ua.NodeId(RESULT_READY_EVENT_TYPE, ijt), emitting_node=node.nodeid
+            node_id(RESULT_READY_EVENT_TYPE, ijt), emitting_node=node.nodeid
         )
         names = (ours, ijt, result_ns)
         LOG.info("joining system %s at %s", station, node.nodeid.to_string())
         return cls(station, node, results, events, names)
 
-    async def publish(self, result_id: str, result: Any, message: str) -> None:
+    async def publish(self, result_id: str, run_id: int, result: Any, message: str) -> None:
         """``result`` (a ``ua.ResultDataType``) into Results, then the result-ready event."""
         ours, ijt, result_ns = self._names
         variable = await self._results.add_variable(
-            ua.NodeId(f"{self.station}/results/{result_id}", ours),
-            ua.QualifiedName(result_id, ours),
+            node_id(f"{self.station}/results/{result_id}", ours),
+            ua.QualifiedName(result_browse_name(run_id), ours),
             ua.Variant(result, ua.VariantType.ExtensionObject),
-            datatype=ua.NodeId(RESULT_DATA_TYPE, result_ns),
+            datatype=node_id(RESULT_DATA_TYPE, result_ns),
         )
-        await _set_type_definition(variable, ua.NodeId(JOINING_SYSTEM_RESULT_TYPE, ijt))
+        await _set_type_definition(variable, node_id(JOINING_SYSTEM_RESULT_TYPE, ijt))
         self._kept.append(variable)
         while len(self._kept) > KEPT_RESULTS:
             await self._kept.popleft().delete()

@@ -30,7 +30,8 @@ PACKAGE = "node-opcua-nodesets"
 VERSION = "2.185.0"
 #: ``dist.integrity`` of that version's tarball on the npm registry
 INTEGRITY = (
-    "sha512-7qDwdkYRKIGRBk0gKhY5C3olQ0wRHTCoZj4FbzD1GmXF5xGaZcv/OatvFa73H7yyq3LxWxTKVteELlbbyziyLg=="
+    "sha512-"
+    "7qDwdkYRKIGRBk0gKhY5C3olQ0wRHTCoZj4FbzD1GmXF5xGaZcv/OatvFa73H7yyq3LxWxTKVteELlbbyziyLg=="
 )
 #: the models in the order they are imported (each needs the ones before it)
 NODESET_FILES = (

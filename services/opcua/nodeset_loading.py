@@ -42,12 +42,13 @@ import time
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from asyncua import Server, ua
 from asyncua.common.structures104 import load_data_type_definitions, make_structure
 
 from services.opcua.nodeset_files import FETCH_COMMAND, NODESET_FILES, missing_files
+from shared.errors import ConfigError
 
 LOG = logging.getLogger(__name__)
 
@@ -69,7 +70,12 @@ MODEL_URIS = (
 )
 
 
-class ModelLoadError(RuntimeError):
+def node_id(identifier: int | str, namespace: int = 0) -> ua.NodeId:
+    """``ua.NodeId`` of plain values (asyncua types its arguments as its own NewTypes)."""
+    return ua.NodeId(cast(Any, identifier), cast(Any, namespace))
+
+
+class ModelLoadError(ConfigError):
     """The models cannot be loaded (files missing, a node the server needs refused)."""
 
 
@@ -153,7 +159,7 @@ async def _import_di(server: Server, text: str) -> None:
         importer_log.setLevel(level)
     di = await server.get_namespace_index(MODEL_URIS[0])
     wanted = [
-        ua.NodeId(int(item.get("NodeId", "").rsplit("=", 1)[-1]), di)
+        node_id(int(item.get("NodeId", "").rsplit("=", 1)[-1]), di)
         for item in ET.fromstring(text)
         if item.get("NodeId", "").startswith("ns=1;i=")
     ]
@@ -187,7 +193,7 @@ async def complete_structures(server: Server, subtyped: dict[str, set[str]]) -> 
                 fields = list(definition.Fields or [])
             await walk(child, fields)
 
-    await walk(server.get_node(ua.NodeId(ua.ObjectIds.Structure)), [])
+    await walk(server.get_node(node_id(ua.ObjectIds.Structure)), [])
 
 
 async def _definition_of(node: Any) -> ua.StructureDefinition | None:
@@ -225,21 +231,22 @@ async def generate_classes(server: Server, subtyped: dict[str, set[str]]) -> Non
     ours = {await server.get_namespace_index(uri) for uri in MODEL_URIS}
     for name, value in list(vars(ua).items()):
         data_type = getattr(value, "data_type", None)
-        if isinstance(value, type) and isinstance(data_type, ua.NodeId):
-            if data_type.NamespaceIndex in ours:
-                delattr(ua, name)
+        ours_too = isinstance(data_type, ua.NodeId) and data_type.NamespaceIndex in ours
+        if isinstance(value, type) and ours_too:
+            delattr(ua, name)
     await load_data_type_definitions(server, overwrite_existing=True)
     for name in subtyped:
         cls = getattr(ua, name, None)
         if cls is None:
             continue
-        node = server.get_node(cls.data_type)
-        definition = await node.read_data_type_definition()
+        definition = await _definition_of(server.get_node(cls.data_type))
+        if definition is None:
+            continue
         encoding_fields = []
         for item in definition.Fields:
             copy = ua.StructureField(**{k: getattr(item, k) for k in item.__dataclass_fields__})
             if item.IsOptional:  # allows subtypes: any structure, as an ExtensionObject
-                copy.DataType = ua.NodeId(ua.ObjectIds.Structure)
+                copy.DataType = node_id(ua.ObjectIds.Structure)
                 copy.IsOptional = False
             encoding_fields.append(copy)
         encoding = ua.StructureDefinition(

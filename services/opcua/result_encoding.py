@@ -14,6 +14,7 @@ from asyncua import ua
 
 from services.opcua.result_values import UNECE_NAMESPACE, EngineeringUnit
 
+
 def model_class(name: str) -> Any:
     """A class the models' load generated (``ua.<name>``; mypy cannot see them)."""
     return getattr(ua, name)

@@ -108,7 +108,7 @@ class OpcuaService:
             return
         served.add(identifier)
         message = f"{identifier} {result.result}"
-        await system.publish(identifier, result_data(result_values(result)), message)
+        await system.publish(identifier, result.run_id, result_data(result_values(result)), message)
         LOG.info("result %s served", message)
 
     def _newest(self) -> list[TighteningResult]:

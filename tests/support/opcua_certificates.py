@@ -52,8 +52,21 @@ def make_opcua_certificates(
     )
     _openssl("genrsa", "-out", "ca.key", "2048", cwd=folder)
     _openssl(
-        "req", "-x509", "-new", "-key", "ca.key", "-days", "2", "-subj", "/CN=boltwatch test CA",
-        "-extensions", "v3", "-config", str(_config(folder, ca_ext)), "-out", "trusted/ca.pem",
+        "req",
+        "-x509",
+        "-new",
+        "-key",
+        "ca.key",
+        "-days",
+        "2",
+        "-subj",
+        "/CN=boltwatch test CA",
+        "-extensions",
+        "v3",
+        "-config",
+        str(_config(folder, ca_ext)),
+        "-out",
+        "trusted/ca.pem",
         cwd=folder,
     )
     server_ext = _extensions(
@@ -68,9 +81,22 @@ def make_opcua_certificates(
     )
     _openssl("genrsa", "-out", "server.key", "2048", cwd=folder)
     _openssl(
-        "req", "-x509", "-new", "-key", "server.key", "-days", "2", "-subj",
-        "/CN=boltwatch test server", "-extensions", "v3", "-config",
-        str(_config(folder, server_ext)), "-out", "server.pem", cwd=folder,
+        "req",
+        "-x509",
+        "-new",
+        "-key",
+        "server.key",
+        "-days",
+        "2",
+        "-subj",
+        "/CN=boltwatch test server",
+        "-extensions",
+        "v3",
+        "-config",
+        str(_config(folder, server_ext)),
+        "-out",
+        "server.pem",
+        cwd=folder,
     )
     made: dict[str, tuple[Path, Path]] = {}
     for name in (*clients, *untrusted):
@@ -87,19 +113,52 @@ def make_opcua_certificates(
         _openssl("genrsa", "-out", f"{name}.key", "2048", cwd=folder)
         if name in untrusted:
             _openssl(
-                "req", "-x509", "-new", "-key", f"{name}.key", "-days", "2", "-subj",
-                f"/CN={name}", "-extensions", "v3", "-config", str(_config(folder, ext)),
-                "-out", f"{name}.pem", cwd=folder,
+                "req",
+                "-x509",
+                "-new",
+                "-key",
+                f"{name}.key",
+                "-days",
+                "2",
+                "-subj",
+                f"/CN={name}",
+                "-extensions",
+                "v3",
+                "-config",
+                str(_config(folder, ext)),
+                "-out",
+                f"{name}.pem",
+                cwd=folder,
             )
         else:
             _openssl(
-                "req", "-new", "-key", f"{name}.key", "-subj", f"/CN={name}", "-out",
-                f"{name}.csr", cwd=folder,
+                "req",
+                "-new",
+                "-key",
+                f"{name}.key",
+                "-subj",
+                f"/CN={name}",
+                "-out",
+                f"{name}.csr",
+                cwd=folder,
             )
             _openssl(
-                "x509", "-req", "-in", f"{name}.csr", "-CA", "trusted/ca.pem", "-CAkey",
-                "ca.key", "-CAcreateserial", "-days", "2", "-extfile", str(ext), "-out",
-                f"{name}.pem", cwd=folder,
+                "x509",
+                "-req",
+                "-in",
+                f"{name}.csr",
+                "-CA",
+                "trusted/ca.pem",
+                "-CAkey",
+                "ca.key",
+                "-CAcreateserial",
+                "-days",
+                "2",
+                "-extfile",
+                str(ext),
+                "-out",
+                f"{name}.pem",
+                cwd=folder,
             )
         made[name] = (folder / f"{name}.pem", folder / f"{name}.key")
     return OpcuaCertificates(folder / "server.pem", folder / "server.key", trusted, made)
@@ -108,7 +167,5 @@ def make_opcua_certificates(
 def _config(folder: Path, extensions: Path) -> Path:
     """An openssl req config whose ``v3`` section is ``extensions``."""
     path = folder / f"{extensions.stem}.cnf"
-    path.write_text(
-        "[req]\ndistinguished_name = dn\n[dn]\n[v3]\n" + extensions.read_text()
-    )
+    path.write_text("[req]\ndistinguished_name = dn\n[dn]\n[v3]\n" + extensions.read_text())
     return path

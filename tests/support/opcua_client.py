@@ -35,8 +35,16 @@ def node_opcua_client() -> tuple[Path | None, str]:
         return modules, ""
     CACHE.mkdir(parents=True, exist_ok=True)
     done = subprocess.run(
-        ["npm", "install", "--prefix", str(CACHE), "--no-audit", "--no-fund", "--silent",
-         f"{PACKAGE}@{VERSION}"],
+        [
+            "npm",
+            "install",
+            "--prefix",
+            str(CACHE),
+            "--no-audit",
+            "--no-fund",
+            "--silent",
+            f"{PACKAGE}@{VERSION}",
+        ],
         capture_output=True,
         text=True,
         timeout=INSTALL_TIMEOUT_S,

@@ -7,8 +7,9 @@ by the CA the server trusts (Basic256Sha256, sign and encrypt), browses to the
 station's joining system (Objects/Machines/st1), subscribes to its events before
 the first run, and receives one result-ready event per run whose Result equals
 the results store's tightening: its ResultId, part, program, verdict, creation
-time and final torque, angle and preload with their windows and units. A client without a certificate
-(security None) and a client whose certificate the CA did not sign are refused.
+time and final torque, angle and preload with their windows and units. A client
+without a certificate (security None) and a client whose certificate the CA did
+not sign are refused.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from typing import Any
 
 import pytest
 
+from services.opcua.joining_systems import result_browse_name
 from services.opcua.nodeset_files import missing_files, nodeset_folder
 from services.opcua.result_values import DEGREE, NEWTON, NEWTON_METRE, result_id
 from shared.results import ResultsQuery, ResultsStore, store_target
@@ -164,7 +166,7 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
             assert value["engineeringUnits"]["unitId"] == unit.unit_id
         assert _value(values, "StickSlipEvents")["measuredValue"] == expected.events
     [folder] = [line for line in lines if line["type"] == "results_folder"]
-    assert folder["names"] == [result_id(STATION, r.run_id) for r in stored]
+    assert folder["names"] == [result_browse_name(r.run_id) for r in stored]
 
     assert [line["type"] for line in refused] == ["refused"], refused
     assert [line["type"] for line in stranger] == ["refused"], stranger
@@ -182,4 +184,3 @@ def test_serve_opcua_says_what_security_it_needs(tmp_path: Path) -> None:
     assert done.returncode != 0
     assert "--certificate, --private-key, --trusted-clients" in done.stderr, done.stderr
     assert "--anonymous-read-only" in done.stderr
-
