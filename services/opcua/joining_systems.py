@@ -19,7 +19,7 @@ its ``Results`` folder). What :meth:`JoiningSystem.publish` does with a result:
 
 The methods of ResultManagement and the other management objects are in the
 address space as the type has them, without an implementation (a call answers
-``BadNotImplemented``).
+``BadNothingToDo``, asyncua's answer for a method without one).
 """
 
 from __future__ import annotations
