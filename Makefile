@@ -5,7 +5,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test lint docs bench clean
+.PHONY: run test lint docs bench clean opcua-nodesets
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -13,7 +13,12 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	@touch $(STAMP)
 
-run: $(STAMP)
+# The OPC UA models of `boltwatch serve opcua` (node-opcua-nodesets, pinned and checked,
+# into .cache/opcua-nodesets/; without npm it says so and the rest goes on).
+opcua-nodesets: $(STAMP)
+	@$(BIN)/python -m services.opcua.nodeset_files
+
+run: $(STAMP) opcua-nodesets
 	$(BIN)/boltwatch up $(ARGS)
 
 lint: $(STAMP)
@@ -23,7 +28,7 @@ lint: $(STAMP)
 	$(BIN)/lint-imports
 	$(BIN)/python -m tests.support.import_rules
 
-test: lint
+test: lint opcua-nodesets
 	$(BIN)/pytest
 
 # docs/ as a site in site/: the generated reference pages written again, then built with

@@ -25,6 +25,7 @@ CHECKED_SERVICES = (
     "recorder",
     "viewer",
     "dashboard",
+    "opcua",
 )
 CONNECT_TIMEOUT_MS = 2000
 LIVELINESS_TIMEOUT_S = 2.0

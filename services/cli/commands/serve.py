@@ -17,6 +17,7 @@ from types import ModuleType
 from services.acquisition import arguments as acquisition_arguments
 from services.cli.command_options import add_station_file_option
 from services.dashboard import arguments as dashboard_arguments
+from services.opcua import arguments as opcua_arguments
 from services.openprotocol import arguments as openprotocol_arguments
 from services.predictor import arguments as predictor_arguments
 from services.recorder import arguments as recorder_arguments
@@ -26,7 +27,7 @@ from services.router import arguments as router_arguments
 NAME = "serve"
 HELP = (
     "run one long-running service (rig, acquisition, predictor, recorder, router, openprotocol, "
-    "dashboard)"
+    "dashboard, opcua)"
 )
 
 #: service name -> its arguments module (light: no heavy imports, so ``--help`` is fast)
@@ -38,12 +39,13 @@ SERVICES: dict[str, ModuleType] = {
     "router": router_arguments,
     "openprotocol": openprotocol_arguments,
     "dashboard": dashboard_arguments,
+    "opcua": opcua_arguments,
 }
 
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR")
 
 #: services of the line that one process runs for several stations (``--config A B ...``)
-MULTI_STATION = ("predictor", "recorder", "dashboard")
+MULTI_STATION = ("predictor", "recorder", "dashboard", "opcua")
 
 SERVICE_HELP = {
     "rig": "the simulated tool controller and sensors on the CAN bus",
@@ -54,6 +56,8 @@ SERVICE_HELP = {
     "openprotocol": "a tightening controller's results and curves over Open Protocol (TCP), "
     "published as the station's runs",
     "dashboard": "the line's web page: services, results, stop reasons, tool wear, alerts, live",
+    "opcua": "the line's results over OPC UA for industrial joining (IJT): one joining system "
+    "per station, results and result-ready events",
 }
 
 
@@ -113,6 +117,10 @@ def _service_main(service: str) -> Callable[[argparse.Namespace], int]:
         from services.dashboard.service import main as dashboard_main
 
         return dashboard_main
+    if service == "opcua":
+        from services.opcua.service import main as opcua_main
+
+        return opcua_main
     from services.router.service import main as router_main
 
     return router_main

@@ -1,0 +1,19 @@
+"""``boltwatch serve opcua``: the line's results over OPC UA for industrial joining (IJT).
+
+A service of its own: it meets the others on zenoh only (import-linter's
+independence contract) and reads the results stores (:mod:`shared.results`).
+The address space is built from the OPC Foundation's NodeSet2 files (IJT Base
+1.01.0, IJT Tightening 2.00.1 and what they need), never from a copy of them.
+
+- :mod:`.arguments` (its options, light), :mod:`.service` (``main``: files,
+  session, the asyncio loop of the server)
+- :mod:`.nodeset_files` (the pinned npm package of the models, fetched and
+  checked: ``make opcua-nodesets``), :mod:`.nodeset_loading` (the models into
+  asyncua, and the four gaps of asyncua's reader handled)
+- :mod:`.server_security` (endpoints, certificates, trusted clients)
+- :mod:`.joining_systems` (one JoiningSystemType per station; a result into its
+  ResultManagement and the result-ready event)
+- :mod:`.result_values` (a TighteningResult as IJT field values, pure),
+  :mod:`.result_encoding` (those values as asyncua's classes)
+- :mod:`.result_inbox` (``boltwatch/<st>/results`` from zenoh, to the loop)
+"""

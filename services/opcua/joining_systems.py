@@ -1,0 +1,113 @@
+"""One IJT joining system per station, and a result put into it.
+
+Each station served is an instance of IJT Base's ``JoiningSystemType`` in
+Machinery's ``Machines`` folder, its node id ``ns=<boltwatch>;s=<station>``
+and its browse name the station's id. asyncua instantiates the type's mandatory
+children (AssetManagement, Identification, JoiningProcessManagement,
+JointManagement, MachineryBuildingBlocks, ResultManagement with its methods and
+its ``Results`` folder). What :meth:`JoiningSystem.publish` does with a result:
+
+- ``ResultManagement/Results``: a variable of ``JoiningSystemResultType``
+  (data type ``ResultDataType``) named ``Result_<run id>`` (a browse name
+  without ``/``, which browse paths use), its node id
+  ``s=<station>/results/<ResultId>``; the newest
+  :data:`KEPT_RESULTS` stay, the oldest go (a client reads the latest there);
+- a ``JoiningSystemResultReadyEventType`` event from the joining system, its
+  ``Result`` the same ``ResultDataType`` (a client subscribes to the joining
+  system's events). The model marks the type abstract; IJT's own servers send
+  it as it is, and so does this one.
+
+The methods of ResultManagement and the other management objects are in the
+address space as the type has them, without an implementation (a call answers
+``BadNothingToDo``, asyncua's answer for a method without one).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import deque
+from typing import Any
+
+from asyncua import Server, ua
+from asyncua.common.node import Node
+
+from services.opcua.nodeset_loading import IJT_BASE, MACHINERY_RESULT, node_id
+
+LOG = logging.getLogger(__name__)
+
+#: the application's own namespace (its joining systems and results)
+BOLTWATCH_NAMESPACE = "urn:boltwatch:opcua"
+#: results kept per station in ResultManagement/Results
+KEPT_RESULTS = 20
+#: numeric ids in IJT Base, Machinery and Machinery/Result
+JOINING_SYSTEM_TYPE = 1005
+JOINING_SYSTEM_RESULT_TYPE = 2014
+RESULT_READY_EVENT_TYPE = 1007
+MACHINES_FOLDER = 1001
+RESULT_DATA_TYPE = 3008
+MACHINERY = "http://opcfoundation.org/UA/Machinery/"
+
+
+def result_browse_name(run_id: int) -> str:
+    """The browse name of a run's result in its station's Results folder."""
+    return f"Result_{run_id}"
+
+
+class JoiningSystem:
+    """A station's joining system in the address space, with its event generator."""
+
+    def __init__(
+        self, station: str, node: Node, results: Node, events: Any, names: tuple[int, int, int]
+    ) -> None:
+        self.station = station
+        self.node = node
+        self._results = results
+        self._events = events
+        self._names = names
+        self._kept: deque[Node] = deque()
+
+    @classmethod
+    async def create(cls, server: Server, station: str) -> JoiningSystem:
+        ours = await server.register_namespace(BOLTWATCH_NAMESPACE)
+        ijt = await server.get_namespace_index(IJT_BASE)
+        machinery = await server.get_namespace_index(MACHINERY)
+        result_ns = await server.get_namespace_index(MACHINERY_RESULT)
+        machines = server.get_node(node_id(MACHINES_FOLDER, machinery))
+        node = await machines.add_object(
+            node_id(station, ours),
+            ua.QualifiedName(station, ours),
+            objecttype=node_id(JOINING_SYSTEM_TYPE, ijt),
+        )
+        results = await node.get_child([f"{result_ns}:ResultManagement", f"{result_ns}:Results"])
+        events = await server.get_event_generator(
+            node_id(RESULT_READY_EVENT_TYPE, ijt), emitting_node=node.nodeid
+        )
+        names = (ours, ijt, result_ns)
+        LOG.info("joining system %s at %s", station, node.nodeid.to_string())
+        return cls(station, node, results, events, names)
+
+    async def publish(self, result_id: str, run_id: int, result: Any, message: str) -> None:
+        """``result`` (a ``ua.ResultDataType``) into Results, then the result-ready event."""
+        ours, ijt, result_ns = self._names
+        variable = await self._results.add_variable(
+            node_id(f"{self.station}/results/{result_id}", ours),
+            ua.QualifiedName(result_browse_name(run_id), ours),
+            ua.Variant(result, ua.VariantType.ExtensionObject),
+            datatype=node_id(RESULT_DATA_TYPE, result_ns),
+        )
+        await _set_type_definition(variable, node_id(JOINING_SYSTEM_RESULT_TYPE, ijt))
+        self._kept.append(variable)
+        while len(self._kept) > KEPT_RESULTS:
+            await self._kept.popleft().delete()
+        self._events.event.Result = ua.Variant(result, ua.VariantType.ExtensionObject)
+        self._events.event.Severity = 100
+        await self._events.trigger(message=message)
+
+
+async def _set_type_definition(variable: Node, type_definition: ua.NodeId) -> None:
+    """add_variable gives BaseDataVariableType; the result variable is a
+    JoiningSystemResultType (its sub-variables are not instantiated)."""
+    old = await variable.read_type_definition()
+    if old is not None:
+        await variable.delete_reference(old, ua.ObjectIds.HasTypeDefinition)
+    await variable.add_reference(type_definition, ua.ObjectIds.HasTypeDefinition)

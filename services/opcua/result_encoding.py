@@ -1,0 +1,77 @@
+"""The field values of :mod:`.result_values` as asyncua's classes of the IJT model.
+
+The classes (``ua.ResultDataType``, ``ua.JoiningResultMetaDataType``,
+``ua.JoiningResultDataType``, ``ua.ResultValueDataType``) exist once the models
+are loaded (:func:`~.nodeset_loading.load_models`); before that, this module
+cannot be used.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from asyncua import ua
+
+from services.opcua.result_values import UNECE_NAMESPACE, EngineeringUnit
+
+
+def model_class(name: str) -> Any:
+    """A class the models' load generated (``ua.<name>``; mypy cannot see them)."""
+    return getattr(ua, name)
+
+
+#: fields that are LocalizedText in the model (plain text in :mod:`.result_values`)
+LOCALIZED = frozenset({"JoiningTechnology", "Description", "ResultEvaluationDetails"})
+
+
+def result_data(values: dict[str, Any]) -> Any:
+    """A ``ua.ResultDataType`` (Machinery/Result) of ``values``: its ResultMetaData a
+    ``JoiningResultMetaDataType``, its ResultContent one ``JoiningResultDataType``."""
+    meta = dict(values["ResultMetaData"])
+    extended = meta.pop("ExtendedMetaData", {})
+    for name in LOCALIZED & meta.keys():
+        meta[name] = ua.LocalizedText(meta[name])
+    meta["ExtendedMetaData"] = [  # IJT's KeyValueDataType: a TrimmedString key
+        model_class("KeyValueDataType")(Key=key, Value=ua.Variant(text, ua.VariantType.String))
+        for key, text in extended.items()
+    ]
+    for name in ("SequenceNumber",):
+        if name in meta:
+            meta[name] = ua.UInt64(meta[name])
+    for name in ("Classification",):
+        if name in meta:
+            meta[name] = ua.Byte(meta[name])
+    content = [
+        ua.Variant(
+            model_class("JoiningResultDataType")(
+                OverallResultValues=[_value(item) for item in joining["OverallResultValues"]]
+            ),
+            ua.VariantType.ExtensionObject,
+        )
+        for joining in values["ResultContent"]
+    ]
+    return model_class("ResultDataType")(
+        ResultMetaData=model_class("JoiningResultMetaDataType")(**meta), ResultContent=content
+    )
+
+
+def _value(fields: dict[str, Any]) -> Any:
+    fields = dict(fields)
+    unit = fields.pop("EngineeringUnits", None)
+    if "ResultEvaluation" in fields:
+        fields["ResultEvaluation"] = model_class("ResultEvaluationEnum")(fields["ResultEvaluation"])
+    if "PhysicalQuantity" in fields:
+        fields["PhysicalQuantity"] = ua.Byte(fields["PhysicalQuantity"])
+    if unit is not None:
+        fields["EngineeringUnits"] = eu_information(unit)
+    return model_class("ResultValueDataType")(**fields)
+
+
+def eu_information(unit: EngineeringUnit) -> ua.EUInformation:
+    """OPC 10000-8's EUInformation of a UNECE unit."""
+    return ua.EUInformation(
+        NamespaceUri=UNECE_NAMESPACE,
+        UnitId=unit.unit_id,
+        DisplayName=ua.LocalizedText(unit.display_name),
+        Description=ua.LocalizedText(unit.description),
+    )

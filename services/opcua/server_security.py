@@ -1,0 +1,137 @@
+"""Who may connect to the OPC UA server, from the command line's options, checked at start.
+
+By default (:class:`SecuritySettings` with ``anonymous_read_only`` False) the only
+endpoint is Basic256Sha256 Sign & Encrypt: the server shows its own certificate
+(``--certificate``, RSA, PEM or DER, its subjectAltName naming the server's
+application URI as ``URI:...``) and key (``--private-key``, PEM), and accepts a
+client only when the client's application instance certificate is in, or signed
+by a CA in, ``--trusted-clients DIR`` (PEM or DER files), is within its validity,
+names the client's application URI, and allows client authentication and the
+key usages OPC UA asks (digitalSignature, nonRepudiation, keyEncipherment,
+dataEncipherment). The session's user is anonymous over that channel (user
+names and passwords are not offered). A client without a certificate finds no
+endpoint it can use and is refused.
+
+``--anonymous-read-only`` adds an endpoint without security (None) and the
+anonymous user: anyone who reaches the port reads the address space. Nothing in
+it is writable by a client in either mode.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from asyncua import Server, ua
+from asyncua.crypto.truststore import TrustStore
+from asyncua.crypto.validator import CertificateValidator, CertificateValidatorOptions
+from cryptography import x509
+from cryptography.hazmat.primitives.asymmetric import rsa
+
+from shared.errors import ConfigError
+
+
+@dataclass(frozen=True, slots=True)
+class SecuritySettings:
+    """The files and the mode the options name."""
+
+    certificate: Path | None
+    private_key: Path | None
+    trusted_clients: Path | None
+    anonymous_read_only: bool = False
+
+    def check(self) -> None:
+        """ConfigError naming the option when the settings cannot make a server."""
+        given = {
+            "--certificate": self.certificate,
+            "--private-key": self.private_key,
+            "--trusted-clients": self.trusted_clients,
+        }
+        if not self.anonymous_read_only:
+            missing = [name for name, path in given.items() if path is None]
+            if missing:
+                raise ConfigError(
+                    f"give {', '.join(missing)} (Basic256Sha256 sign and encrypt, the "
+                    "default), or --anonymous-read-only for a server anyone may read"
+                )
+        if (self.certificate is None) != (self.private_key is None):
+            raise ConfigError("give --certificate and --private-key together")
+        for name, path in given.items():
+            if path is None:
+                continue
+            wanted_dir = name == "--trusted-clients"
+            if not (path.is_dir() if wanted_dir else path.is_file()):
+                kind = "a folder" if wanted_dir else "a file"
+                raise ConfigError(f"{name} {path}: not {kind}")
+
+    @property
+    def secure(self) -> bool:
+        return self.certificate is not None
+
+
+def application_uri_of(certificate: Path) -> str:
+    """The URI in the certificate's subjectAltName (the server's application URI); ConfigError
+    when it has none or its key is not RSA (Basic256Sha256 needs RSA)."""
+    data = certificate.read_bytes()
+    try:
+        cert = (
+            x509.load_pem_x509_certificate(data)
+            if b"-----BEGIN" in data
+            else x509.load_der_x509_certificate(data)
+        )
+    except ValueError as err:
+        raise ConfigError(f"--certificate {certificate}: not a PEM or DER certificate") from err
+    if not isinstance(cert.public_key(), rsa.RSAPublicKey):
+        raise ConfigError(f"--certificate {certificate}: Basic256Sha256 needs an RSA key")
+    try:
+        names = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName)
+    except x509.ExtensionNotFound as err:
+        raise ConfigError(
+            f"--certificate {certificate}: no subjectAltName (it names the application URI)"
+        ) from err
+    uris = names.value.get_values_for_type(x509.UniformResourceIdentifier)
+    if not uris:
+        raise ConfigError(
+            f"--certificate {certificate}: its subjectAltName has no URI:... (the "
+            "server's application URI)"
+        )
+    return str(uris[0])
+
+
+async def apply(server: Server, settings: SecuritySettings) -> None:
+    """Endpoints, user tokens, certificate and client validation of ``server``."""
+    settings.check()
+    policies: list[ua.SecurityPolicyType] = []
+    tokens: list[type] = [ua.AnonymousIdentityToken]
+    if settings.secure:
+        assert settings.certificate is not None and settings.private_key is not None
+        await server.set_application_uri(application_uri_of(settings.certificate))
+        try:
+            await server.load_certificate(
+                str(settings.certificate), format=_format_of(settings.certificate)
+            )
+            await server.load_private_key(
+                str(settings.private_key), format=_format_of(settings.private_key)
+            )
+        except ValueError as err:
+            raise ConfigError(f"--private-key {settings.private_key}: {err}") from err
+        policies.append(ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt)
+        if settings.trusted_clients is not None:
+            store = TrustStore([settings.trusted_clients], [])
+            await store.load()
+            server.set_certificate_validator(
+                CertificateValidator(
+                    CertificateValidatorOptions.TRUSTED_VALIDATION
+                    | CertificateValidatorOptions.PEER_CLIENT,
+                    store,
+                )
+            )
+    if settings.anonymous_read_only:
+        policies.append(ua.SecurityPolicyType.NoSecurity)
+    server.set_security_policy(policies)
+    server.set_identity_tokens(tokens)
+
+
+def _format_of(path: Path) -> str:
+    """asyncua guesses a file's format from its name; the content says it (PEM or DER)."""
+    return "pem" if path.read_bytes().lstrip().startswith(b"-----BEGIN") else "der"

@@ -1,0 +1,138 @@
+"""``boltwatch serve opcua --config STATION... [--listen opc.tcp://HOST:PORT]``: the line's
+OPC UA server for industrial joining.
+
+Loads the station files (the stations served, in their order; the first file's
+``[zenoh]`` names the router), checks the security options
+(:mod:`.server_security`), and runs, in its work thread, one asyncio loop with
+the asyncua server: the models (:mod:`.nodeset_loading`), a joining system per
+station (:mod:`.joining_systems`), then each result into it. Once the OPC UA
+server listens, the zenoh session is opened (clients may connect and subscribe
+before the line's router is there); then results come from
+``boltwatch/<st>/results`` (:class:`~.result_inbox.ResultInbox`) and, once
+subscribed, the newest :data:`STARTUP_RESULTS` per station from the stations'
+results stores (:mod:`shared.results`), oldest first, so a client finds the last
+result at once. A result already served (the same ResultId) is not served twice.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import logging
+import threading
+from collections.abc import Sequence
+
+from asyncua import Server
+
+from services.opcua.joining_systems import JoiningSystem
+from services.opcua.nodeset_files import nodeset_folder
+from services.opcua.nodeset_loading import load_models
+from services.opcua.result_encoding import result_data
+from services.opcua.result_inbox import ResultInbox
+from services.opcua.result_values import result_id, result_values
+from services.opcua.server_security import SecuritySettings, apply
+from shared.config import AnyStation, load_any_line
+from shared.contract import TighteningResult
+from shared.errors import StoreError
+from shared.results import ResultsQuery, ResultsStore, store_target
+from shared.runtime import ServiceSkeleton
+
+LOG = logging.getLogger(__name__)
+
+#: results per station read from the results store at start
+STARTUP_RESULTS = 5
+#: how often the loop looks at the inbox and the stop flag, seconds
+POLL_S = 0.05
+SERVER_NAME = "boltwatch IJT server"
+#: its health token, boltwatch/<st>/health/opcua
+HEALTH = "opcua"
+APPLICATION = "boltwatch serve opcua"
+
+
+class OpcuaService:
+    """The asyncua server of the stations, fed from zenoh and the results stores."""
+
+    def __init__(
+        self,
+        stations: Sequence[AnyStation],
+        skeleton: ServiceSkeleton,
+        listen: str,
+        security: SecuritySettings,
+    ) -> None:
+        self._stations = list(stations)
+        self._skeleton = skeleton
+        self._listen = listen
+        self._security = security
+        self._served: dict[str, set[str]] = {s.station_id: set() for s in self._stations}
+
+    def work(self, stop: threading.Event) -> None:
+        if not LOG.isEnabledFor(logging.DEBUG):  # asyncua logs each node of its own at INFO
+            logging.getLogger("asyncua").setLevel(logging.WARNING)
+        asyncio.run(self._serve(stop))
+
+    async def _serve(self, stop: threading.Event) -> None:
+        server = Server()
+        await server.init()
+        server.set_endpoint(self._listen)
+        server.set_server_name(SERVER_NAME)
+        await apply(server, self._security)
+        await load_models(server, nodeset_folder())
+        systems = {
+            station.station_id: await JoiningSystem.create(server, station.station_id)
+            for station in self._stations
+        }
+        async with server:
+            LOG.info("OPC UA server of %s at %s", ", ".join(systems), self._listen)
+            # the line after the server: a client may connect and subscribe before the router
+            # is there (the session waits for it, as [zenoh] connect_timeout_s says)
+            await asyncio.to_thread(self._skeleton.open_session, self._stations[0].config.zenoh)
+            inbox = ResultInbox(self._skeleton, list(systems))
+            for station in systems:
+                self._skeleton.health_token(station, HEALTH)
+            for stored in await asyncio.to_thread(self._newest):  # after subscribing: no gap
+                await self._publish(systems, stored)
+            while not stop.is_set():
+                result = inbox.next()
+                if result is None:
+                    await asyncio.sleep(POLL_S)
+                    continue
+                await self._publish(systems, result)
+
+    async def _publish(self, systems: dict[str, JoiningSystem], result: TighteningResult) -> None:
+        system = systems.get(result.station)
+        if system is None:
+            return
+        identifier = result_id(result.station, result.run_id)
+        served = self._served[result.station]
+        if identifier in served:
+            return
+        served.add(identifier)
+        message = f"{identifier} {result.result}"
+        await system.publish(identifier, result.run_id, result_data(result_values(result)), message)
+        LOG.info("result %s served", message)
+
+    def _newest(self) -> list[TighteningResult]:
+        """The newest results of each station in its results store, oldest first."""
+        found: list[TighteningResult] = []
+        for station in self._stations:
+            target = store_target(
+                station.recordings_folder.resolve(), station.config.recorder.results_database
+            )
+            query = ResultsQuery(stations=[station.station_id], limit=STARTUP_RESULTS)
+            try:
+                with ResultsStore(target, create=False, application=APPLICATION) as store:
+                    found.extend(reversed([stored.result for stored in store.find(query)]))
+            except StoreError as err:
+                LOG.info("no results of %s from %s yet: %s", station.station_id, target, err)
+        return found
+
+
+def main(args: argparse.Namespace) -> int:
+    stations = load_any_line(args.config)
+    security = SecuritySettings(
+        args.certificate, args.private_key, args.trusted_clients, args.anonymous_read_only
+    )
+    security.check()
+    with ServiceSkeleton("opcua") as skeleton:
+        service = OpcuaService(stations, skeleton, args.listen, security)
+        return skeleton.run(service.work)

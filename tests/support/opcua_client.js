@@ -1,0 +1,133 @@
+// An OPC UA client of another implementation than the server's (node-opcua), for the tests.
+//
+//   node opcua_client.js '{"endpoint": "opc.tcp://127.0.0.1:4840", "certificate": "c.pem",
+//                          "privateKey": "c.key", "applicationUri": "urn:...",
+//                          "security": "SignAndEncrypt" | "None", "stations": ["st1"],
+//                          "results": 5, "timeoutMs": 60000}'
+//
+// Prints JSON lines on stdout: {"type": "connected"} or {"type": "refused", "reason"};
+// per station {"type": "system", "station", "nodeId"} once it browsed to its joining
+// system (Objects/Machines/<station>) and subscribed to its events; {"type": "subscribed"}
+// once every station is; one {"type": "result", "station", "eventType", "message",
+// "result"} per result-ready event (the Result field as JSON); at the end, per station,
+// {"type": "results_folder", "station", "names"} (the browse names in
+// ResultManagement/Results); then {"type": "done"}. Exit status 0, or 1 on an error
+// (its line: {"type": "error", "message"}).
+"use strict";
+const {
+    OPCUAClient,
+    MessageSecurityMode,
+    SecurityPolicy,
+    AttributeIds,
+    TimestampsToReturn,
+    makeBrowsePath,
+    constructEventFilter,
+    UserTokenType,
+} = require("node-opcua-client");
+
+const options = JSON.parse(process.argv[2]);
+const say = (object) => process.stdout.write(JSON.stringify(object) + "\n");
+
+function plain(value) {
+    return JSON.parse(
+        JSON.stringify(value, (_key, item) => (typeof item === "bigint" ? item.toString() : item)),
+    );
+}
+
+async function main() {
+    const secure = options.security === "SignAndEncrypt";
+    const client = OPCUAClient.create({
+        applicationName: "boltwatch test client",
+        applicationUri: options.applicationUri,
+        securityMode: secure ? MessageSecurityMode.SignAndEncrypt : MessageSecurityMode.None,
+        securityPolicy: secure ? SecurityPolicy.Basic256Sha256 : SecurityPolicy.None,
+        certificateFile: options.certificate,
+        privateKeyFile: options.privateKey,
+        endpointMustExist: false,
+        connectionStrategy: { maxRetry: options.connectRetries ?? 40, initialDelay: 250, maxDelay: 500 },
+        requestedSessionTimeout: 60000,
+    });
+    client.on("backoff", () => {});
+    let session;
+    try {
+        await client.connect(options.endpoint);
+        session = await client.createSession({ type: UserTokenType.Anonymous });
+    } catch (err) {
+        say({ type: "refused", reason: String(err && err.message ? err.message : err) });
+        await client.disconnect().catch(() => {});
+        return;
+    }
+    say({ type: "connected", securityMode: secure ? "SignAndEncrypt" : "None" });
+
+    const namespaces = await session.readNamespaceArray();
+    const index = (uri) => namespaces.indexOf(uri);
+    const machinery = index("http://opcfoundation.org/UA/Machinery/");
+    const result = index("http://opcfoundation.org/UA/Machinery/Result/");
+    const ours = index("urn:boltwatch:opcua");
+
+    const subscription = await session.createSubscription2({
+        requestedPublishingInterval: 100,
+        requestedMaxKeepAliveCount: 20,
+        requestedLifetimeCount: 600,
+        publishingEnabled: true,
+    });
+    const filter = constructEventFilter(["EventType", "SourceName", "Message", `${result}:Result`]);
+    const systems = {};
+    let received = 0;
+    let finish;
+    const finished = new Promise((resolve) => (finish = resolve));
+    for (const station of options.stations) {
+        const path = makeBrowsePath("ObjectsFolder", `/${machinery}:Machines/${ours}:${station}`);
+        const found = await session.translateBrowsePath(path);
+        if (!found.targets || found.targets.length === 0) {
+            throw new Error(`no joining system ${station}: ${found.statusCode.toString()}`);
+        }
+        const nodeId = found.targets[0].targetId;
+        systems[station] = nodeId;
+        const item = await subscription.monitor(
+            { nodeId, attributeId: AttributeIds.EventNotifier },
+            { samplingInterval: 0, queueSize: 100, filter, discardOldest: false },
+            TimestampsToReturn.Both,
+        );
+        item.on("changed", (fields) => {
+            const [eventType, sourceName, message, value] = fields;
+            say({
+                type: "result",
+                station,
+                eventType: eventType.value ? eventType.value.toString() : null,
+                sourceName: sourceName.value,
+                message: message.value ? message.value.text : null,
+                result: plain(value.value),
+            });
+            received += 1;
+            if (received >= options.results) finish();
+        });
+        say({ type: "system", station, nodeId: nodeId.toString() });
+    }
+    say({ type: "subscribed" });
+    const timer = setTimeout(finish, options.timeoutMs ?? 60000);
+    await finished;
+    clearTimeout(timer);
+    for (const [station, nodeId] of Object.entries(systems)) {
+        const path = makeBrowsePath(nodeId, `/${result}:ResultManagement/${result}:Results`);
+        const folder = await session.translateBrowsePath(path);
+        const browsed = await session.browse(folder.targets[0].targetId);
+        say({
+            type: "results_folder",
+            station,
+            names: browsed.references.map((ref) => ref.browseName.name),
+        });
+    }
+    await subscription.terminate();
+    await session.close();
+    await client.disconnect();
+    say({ type: "done" });
+}
+
+main().then(
+    () => process.exit(0),
+    (err) => {
+        say({ type: "error", message: String(err && err.stack ? err.stack : err) });
+        process.exit(1);
+    },
+);

@@ -1,0 +1,70 @@
+"""The models loaded into a real asyncua server (no network), and a result through them.
+
+Needs the fetched NodeSet2 files (``make opcua-nodesets``); skipped with the
+reason without them.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from typing import Any
+
+import pytest
+from asyncua import Server, ua
+from asyncua.ua.ua_binary import struct_from_binary, struct_to_binary
+
+from services.opcua.joining_systems import JoiningSystem
+from services.opcua.nodeset_files import missing_files, nodeset_folder
+from services.opcua.nodeset_loading import load_models, node_id
+from services.opcua.result_encoding import model_class, result_data
+from services.opcua.result_values import result_values
+from tests.support import factories
+
+if missing_files(nodeset_folder()):
+    pytest.skip(
+        "the OPC UA models are not fetched (`make opcua-nodesets` needs npm)",
+        allow_module_level=True,
+    )
+
+
+async def _loaded() -> Server:
+    server = Server()
+    await server.init()
+    await load_models(server, nodeset_folder())
+    return server
+
+
+def test_the_models_load_and_a_result_round_trips_with_its_joining_metadata() -> None:
+    async def scenario() -> tuple[Any, Any, list[Any], list[Any]]:
+        server = await _loaded()
+        ijt = await server.get_namespace_index("http://opcfoundation.org/UA/IJT/Base/")
+        event_type = server.get_node(node_id(1007, ijt))
+        event_fields = [
+            (await child.read_browse_name()).Name for child in await event_type.get_children()
+        ]
+        data = result_data(result_values(factories.result(7, part_id="VIN-7")))
+        decoded = struct_from_binary(
+            model_class("ResultDataType"), ua.utils.Buffer(struct_to_binary(data))
+        )
+        system = await JoiningSystem.create(server, "st1")
+        await system.publish("st1/7", 7, data, "st1/7 OK")
+        names = [(await node.read_browse_name()).Name for node in await system.node.get_children()]
+        return data, decoded, names, event_fields
+
+    data, decoded, names, event_fields = asyncio.run(scenario())
+    assert "Result" in event_fields  # lost without the dropped default values
+    meta = decoded.ResultMetaData
+    assert type(meta).__name__ == "JoiningResultMetaDataType"  # a subtype, as the model allows
+    assert meta.ResultId == "st1/7"
+    assert meta.PartId == "VIN-7"  # inherited from ResultMetaDataType (completed definition)
+    assert meta.Classification == 1
+    assert meta.Name == data.ResultMetaData.Name
+    assert {pair.Key for pair in meta.ExtendedMetaData} >= {"StopReason", "Station"}
+    [content] = decoded.ResultContent
+    torque = content.Value.OverallResultValues[0]
+    assert (torque.Name, torque.MeasuredValue, torque.EngineeringUnits.UnitId) == (
+        "Torque",
+        190.0,
+        20053,
+    )
+    assert "ResultManagement" in names and "AssetManagement" in names
