@@ -14,7 +14,7 @@ deletes no recording whose results are not). Readers (``boltwatch results``,
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 from shared.contract import ResultStep
@@ -29,8 +29,8 @@ from shared.results.results_schema import (
 )
 from shared.results.stored_result import StoredResult, from_row, step_of, step_rows, to_row
 
-#: (station, run_id) pairs per statement when the steps of found rows are read
-_KEYS_PER_QUERY = 500
+#: run ids of one station per statement when the steps of found rows are read
+_RUNS_PER_QUERY = 500
 
 _INSERT_TIGHTENING = (
     f"INSERT INTO tightenings ({', '.join(TIGHTENING_COLUMNS)}) "
@@ -162,20 +162,22 @@ class ResultsStore:
         return found
 
     def _steps_of(self, keys: list[tuple[Any, Any]]) -> dict[tuple[str, int], list[ResultStep]]:
+        """The steps of the tightenings ``keys`` ((station, run_id) pairs): per station, its run
+        ids by :data:`_RUNS_PER_QUERY`, each found by the primary key. (A list of pairs,
+        ``(station, run_id) IN ((?, ?), ...)``, is not: SQLite reads every step for it.)"""
+        runs: dict[str, list[int]] = {}
+        for station, run_id in keys:
+            runs.setdefault(station, []).append(int(run_id))
         steps: dict[tuple[str, int], list[ResultStep]] = {}
-        for chunk in _chunks(keys, _KEYS_PER_QUERY):
-            pairs = ", ".join("(?, ?)" for _ in chunk)
-            rows = self.database.rows(
-                "SELECT station, run_id, name, function, nominal, actual, status "
-                f"FROM tightening_steps WHERE (station, run_id) IN ({pairs}) "
-                "ORDER BY station, run_id, step_index",
-                [value for key in chunk for value in key],
-            )
-            for row in rows:
-                steps.setdefault((row[0], int(row[1])), []).append(step_of(row[2:]))
+        for station, run_ids in runs.items():
+            for start in range(0, len(run_ids), _RUNS_PER_QUERY):
+                chunk = run_ids[start : start + _RUNS_PER_QUERY]
+                rows = self.database.rows(
+                    "SELECT run_id, name, function, nominal, actual, status FROM tightening_steps "
+                    f"WHERE station = ? AND run_id IN ({', '.join('?' * len(chunk))}) "
+                    "ORDER BY run_id, step_index",
+                    [station, *chunk],
+                )
+                for row in rows:
+                    steps.setdefault((station, int(row[0])), []).append(step_of(row[1:]))
         return steps
-
-
-def _chunks(items: list[tuple[Any, Any]], size: int) -> Iterator[list[tuple[Any, Any]]]:
-    for start in range(0, len(items), size):
-        yield items[start : start + size]

@@ -3,7 +3,8 @@
 :func:`start_postgres_server` finds the server's programs (on ``PATH``, else in Debian's
 ``/usr/lib/postgresql/<version>/bin``, newest first), runs ``initdb`` into a new
 temporary folder and starts the server with ``pg_ctl -w`` on 127.0.0.1 and a unix socket
-in that folder. It is a test server: trust authentication, ``fsync`` off, small buffers.
+in that folder. It is a test server: trust authentication, ``fsync`` off, small buffers
+(:data:`SETTINGS`; a benchmark passes its own over them, e.g. ``fsync`` on).
 
 ``initdb`` refuses to run as root: as root, the programs run as Debian's ``postgres``
 user and the folder is handed to it. When the server cannot start (no programs, no
@@ -19,7 +20,7 @@ import re
 import shutil
 import subprocess
 import tempfile
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from types import TracebackType
 from typing import Literal
@@ -89,13 +90,18 @@ class PostgresServer:
     127.0.0.1:``port``. :func:`start_postgres_server` makes and starts one; ``close()``
     stops it and removes the folder. ``stop()`` and ``close()`` are safe to call twice."""
 
-    def __init__(self, binaries: Path, folder: Path, port: int) -> None:
+    def __init__(
+        self, binaries: Path, folder: Path, port: int, settings: Mapping[str, str] | None = None
+    ) -> None:
+        """``settings``: postgresql.conf values over :data:`SETTINGS` (as the file spells
+        them: ``"on"``, ``"'256MB'"``)."""
         self.binaries = binaries
         self.folder = folder
         self.port = port
         self.data = folder / "data"
         self.log_path = folder / "server.log"
         self.running = False
+        self.settings = {**SETTINGS, **(settings or {})}
         self._os_user: pwd.struct_passwd | None = None
         if os.geteuid() == 0:
             try:
@@ -134,8 +140,7 @@ class PostgresServer:
         )
 
     def init(self) -> None:
-        """``initdb`` into ``folder/data``, then the test settings appended to its
-        postgresql.conf."""
+        """``initdb`` into ``folder/data``, then its settings appended to its postgresql.conf."""
         done = self._run(
             "initdb",
             f"--pgdata={self.data}",
@@ -150,7 +155,7 @@ class PostgresServer:
                 f"initdb failed (exit {done.returncode}):\n{tail(done.stdout + done.stderr)}"
             )
         settings = {
-            **SETTINGS,
+            **self.settings,
             "port": str(self.port),
             "unix_socket_directories": f"'{self.folder}'",
         }
@@ -241,14 +246,17 @@ class PostgresServer:
         self.close()
 
 
-def start_postgres_server(folders: Iterable[Path] | None = None) -> PostgresServer:
+def start_postgres_server(
+    folders: Iterable[Path] | None = None, settings: Mapping[str, str] | None = None
+) -> PostgresServer:
     """A running server in a new temporary folder, with an empty database
     :data:`DATABASE` (its url: ``server.url``); PostgresUnavailableError says why not.
-    ``folders``: where to look for the programs (default :func:`binary_folders`)."""
+    ``folders``: where to look for the programs (default :func:`binary_folders`);
+    ``settings``: postgresql.conf values over :data:`SETTINGS`."""
     binaries = find_binaries(binary_folders() if folders is None else folders)
     folder = Path(tempfile.mkdtemp(prefix="boltwatch-postgres-"))
     try:
-        server = PostgresServer(binaries, folder, free_port())
+        server = PostgresServer(binaries, folder, free_port(), settings)
     except BaseException:
         shutil.rmtree(folder, ignore_errors=True)
         raise

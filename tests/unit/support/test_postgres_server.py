@@ -93,6 +93,19 @@ def test_close_removes_the_folder(own_server: PostgresServer) -> None:
     own_server.close()  # safe twice
 
 
+def test_settings_given_replace_the_test_servers() -> None:
+    try:
+        server = start_postgres_server(settings={"fsync": "on", "shared_buffers": "'32MB'"})
+    except PostgresUnavailableError as err:
+        pytest.skip(str(err))
+    with server, psycopg.connect(server.url) as connection:
+        row = connection.execute(
+            "SELECT current_setting('fsync'), current_setting('shared_buffers'), "
+            "current_setting('synchronous_commit')"
+        ).fetchone()
+    assert row == ("on", "32MB", "off")
+
+
 def test_no_programs_is_a_reason_to_skip(tmp_path: Path) -> None:
     with pytest.raises(PostgresUnavailableError, match="install Debian's postgresql package"):
         start_postgres_server(folders=[tmp_path])

@@ -64,6 +64,25 @@ def test_a_controller_result_comes_back_whole_with_its_steps(target: StoreTarget
     assert found.result == result
 
 
+def test_many_results_of_several_stations_come_back_each_with_its_own_steps(
+    target: StoreTarget,
+) -> None:
+    # more runs of a station than one statement reads the steps of, the same run ids at
+    # two stations, results with and without steps
+    def result(station: str, run_id: int) -> TighteningResult:
+        steps = [
+            ResultStep(f"{station} run {run_id} step {index}", "TF Torque", 25.0, run_id, "OK")
+            for index in range(run_id % 4)
+        ]
+        return _result(run_id, station=station, source="controller", steps=steps)
+
+    made = [result(station, run_id) for run_id in range(1, 1202) for station in ("st1", "st2")]
+    with ResultsStore(target) as store:
+        _store(store, *made)
+        found = store.find(ResultsQuery(limit=None, oldest_first=True))
+    assert [stored.result for stored in found] == made
+
+
 def test_each_criterion_finds_its_tightenings_newest_first(target: StoreTarget) -> None:
     with ResultsStore(target) as store:
         _store(store, _result(1, part_id="P1"), _result(2, part_id="P1", program_id=3))
