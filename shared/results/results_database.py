@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import re
 import sqlite3
+import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -171,12 +172,27 @@ def _open_sqlite(path: Path) -> sqlite3.Connection:
         path, timeout=SQLITE_BUSY_TIMEOUT_S, isolation_level=None, check_same_thread=False
     )
     try:
-        connection.execute("PRAGMA journal_mode=WAL")
+        _wal_mode(connection)
         connection.execute("PRAGMA synchronous=FULL")
     except sqlite3.Error:
         connection.close()
         raise
     return connection
+
+
+def _wal_mode(connection: sqlite3.Connection) -> None:
+    """WAL mode, asked again while another connection holds the lock: SQLite answers "database
+    is locked" at once, without its busy handler, to a change of journal mode that meets one
+    (several writers opening a new store together)."""
+    deadline_s = time.monotonic() + SQLITE_BUSY_TIMEOUT_S
+    while True:
+        try:
+            connection.execute("PRAGMA journal_mode=WAL")
+            return
+        except sqlite3.OperationalError as err:
+            if "locked" not in str(err) or time.monotonic() > deadline_s:
+                raise
+            time.sleep(0.01)
 
 
 def one_line(err: BaseException) -> str:

@@ -14,7 +14,7 @@ deletes no recording whose results are not). Readers (``boltwatch results``,
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from typing import Any
 
 from shared.contract import ResultStep
@@ -29,7 +29,7 @@ from shared.results.results_schema import (
 )
 from shared.results.stored_result import StoredResult, from_row, step_of, step_rows, to_row
 
-#: run ids of one station per statement when the steps of found rows are read
+#: run ids of one station per statement when rows are read by key (steps, verdicts)
 _RUNS_PER_QUERY = 500
 
 _INSERT_TIGHTENING = (
@@ -151,33 +151,37 @@ class ResultsStore:
         a key not stored is not in the answer."""
         found: dict[tuple[str, int], str] = {}
         with self.database.transaction():
-            for chunk in _chunks(list(dict.fromkeys(keys)), _KEYS_PER_QUERY):
-                pairs = ", ".join("(?, ?)" for _ in chunk)
+            for station, run_ids in _runs_by_station(keys):
                 rows = self.database.rows(
-                    "SELECT station, run_id, result FROM tightenings "
-                    f"WHERE (station, run_id) IN ({pairs})",
-                    [value for key in chunk for value in key],
+                    "SELECT run_id, result FROM tightenings "
+                    f"WHERE station = ? AND run_id IN ({', '.join('?' * len(run_ids))})",
+                    [station, *run_ids],
                 )
-                found.update({(row[0], int(row[1])): row[2] for row in rows})
+                found.update({(station, int(row[0])): row[1] for row in rows})
         return found
 
     def _steps_of(self, keys: list[tuple[Any, Any]]) -> dict[tuple[str, int], list[ResultStep]]:
-        """The steps of the tightenings ``keys`` ((station, run_id) pairs): per station, its run
-        ids by :data:`_RUNS_PER_QUERY`, each found by the primary key. (A list of pairs,
-        ``(station, run_id) IN ((?, ?), ...)``, is not: SQLite reads every step for it.)"""
-        runs: dict[str, list[int]] = {}
-        for station, run_id in keys:
-            runs.setdefault(station, []).append(int(run_id))
+        """The steps of the tightenings ``keys`` ((station, run_id) pairs)."""
         steps: dict[tuple[str, int], list[ResultStep]] = {}
-        for station, run_ids in runs.items():
-            for start in range(0, len(run_ids), _RUNS_PER_QUERY):
-                chunk = run_ids[start : start + _RUNS_PER_QUERY]
-                rows = self.database.rows(
-                    "SELECT run_id, name, function, nominal, actual, status FROM tightening_steps "
-                    f"WHERE station = ? AND run_id IN ({', '.join('?' * len(chunk))}) "
-                    "ORDER BY run_id, step_index",
-                    [station, *chunk],
-                )
-                for row in rows:
-                    steps.setdefault((station, int(row[0])), []).append(step_of(row[1:]))
+        for station, run_ids in _runs_by_station(keys):
+            rows = self.database.rows(
+                "SELECT run_id, name, function, nominal, actual, status FROM tightening_steps "
+                f"WHERE station = ? AND run_id IN ({', '.join('?' * len(run_ids))}) "
+                "ORDER BY run_id, step_index",
+                [station, *run_ids],
+            )
+            for row in rows:
+                steps.setdefault((station, int(row[0])), []).append(step_of(row[1:]))
         return steps
+
+
+def _runs_by_station(keys: Sequence[tuple[Any, Any]]) -> Iterator[tuple[str, list[int]]]:
+    """``keys`` ((station, run_id) pairs, each once) as (station, up to :data:`_RUNS_PER_QUERY`
+    of its run ids): what a statement asks, each found by the primary key. (A list of pairs,
+    ``(station, run_id) IN ((?, ?), ...)``, is not: SQLite reads the whole table for it.)"""
+    runs: dict[str, list[int]] = {}
+    for station, run_id in dict.fromkeys(keys):
+        runs.setdefault(station, []).append(int(run_id))
+    for station, run_ids in runs.items():
+        for start in range(0, len(run_ids), _RUNS_PER_QUERY):
+            yield station, run_ids[start : start + _RUNS_PER_QUERY]
