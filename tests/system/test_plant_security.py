@@ -102,7 +102,8 @@ def plant(tmp_path: Path) -> Iterator[SecurePlant]:
 
 def test_line_two_reaches_line_one_with_its_own_stations_keys_only(plant: SecurePlant) -> None:
     heard = listen_on_line_one(plant, send_forged=True)
-    assert heard == {channels.SAMPLES.key("st2"): [b"st2-own"]}
+    assert list(heard) == [channels.SAMPLES.key("st2")], heard
+    assert set(heard[channels.SAMPLES.key("st2")]) == {b"st2-own"}
 
 
 def test_without_the_peer_rule_line_one_takes_nothing_from_line_two(tmp_path: Path) -> None:
@@ -136,11 +137,16 @@ def listen_on_line_one(
         while not has_subscribers(own):
             assert time.monotonic() < deadline, "line 1's subscriber never matched on line 2"
             time.sleep(0.05)
-        if send_forged:
-            st2.put(channels.DECISION.key("st1"), b"forged")  # line 2 refuses it
-        own.put(b"st2-own")  # after it on the same links: heard, so the one before was handled
-        with arrived:
-            assert arrived.wait_for(lambda: bool(heard), timeout=10.0), "nothing arrived"
+        # the pair again until one arrives: a route just matched may drop the first puts
+        # (seen once under load); each own sample heard follows a forged one on the same links
+        for _attempt in range(20):
+            if send_forged:
+                st2.put(channels.DECISION.key("st1"), b"forged")  # line 2 refuses it
+            own.put(b"st2-own")  # after it on the same links: heard, so the one before was handled
+            with arrived:
+                if arrived.wait_for(lambda: bool(heard), timeout=0.5):
+                    break
+        assert heard, "nothing arrived"
         time.sleep(0.3)
         own.undeclare()
         subscriber.undeclare()
