@@ -19,7 +19,7 @@ keeps in its own settings:
 - ``ack_timeout_s`` / ``result_resends``: a pushed result (MID 0061) not
   acknowledged (0062) within ``ack_timeout_s`` is sent again, at most
   ``result_resends`` times; then the link is dropped with every subscription
-  (3 re-sends as the issue and controller manuals say: the Sturtevant Richmont
+  (3 re-sends as controller manuals say: the Sturtevant Richmont
   Global 400 manual's Open Protocol settings give retries 3, ack timeout 10 s).
 - ``link_timeout_s``: a link silent this long is dropped (15 s, the specification).
 - ``mirror_keep_alive``: answer an integrator's keep-alive (9999) with one

@@ -1,7 +1,7 @@
 """One station's runs through the real processes, as the line benchmarks drive them.
 
-What ``bench_line.py`` and ``bench_line_inbox.py`` share (until session 5 these
-lived in ``bench_stop_path.py``, whose stop path is now measured on its own):
+What ``bench_line.py`` and ``bench_line_inbox.py`` share (the stop path is measured on
+its own by ``bench_stop_path.py``):
 a short program, what is heard of each run on zenoh, the rig driven for N
 runs, and the stop path per run (StopCommand heard minus the deciding
 sample's receive time, both kernel timestamps).

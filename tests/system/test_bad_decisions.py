@@ -74,7 +74,7 @@ def decision_fields(run_id: int) -> dict[str, object]:
 
 
 def bad_decisions() -> list[bytes]:
-    """What a hostile client sends for the running run; the issue's two probes first."""
+    """What a hostile client sends for the running run; the two probes a plant reported first."""
     fields = decision_fields(RUN)
     changes: list[dict[str, object]] = [
         {"reason": "stop_now_please"},

@@ -1,4 +1,4 @@
-"""Issue 19 §3: a station's runs live in Foxglove, through a real WebSocket on loopback.
+"""A station's runs live in Foxglove, through a real WebSocket on loopback.
 
 ``boltwatch up`` runs a real station (router, recorder, acquisition with its
 predictor, rig on a CAN bus); beside it a viewer (``serve recorder

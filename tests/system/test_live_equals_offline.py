@@ -1,6 +1,6 @@
 """Live = offline: the station's decision is the one ``boltwatch predict`` makes on the recording.
 
-Issue 16, item 2. ``boltwatch up`` tightens a handful of runs with the
+``boltwatch up`` tightens a handful of runs with the
 station's predictor on the acquisition's CAN thread (placement edge); each
 run's recorded samples are exported (``boltwatch export``: the sample clock
 the predictor decided on) and predicted again offline with the station's

@@ -1,4 +1,4 @@
-"""The bridge's faults as a plant has them (issue 18 §3): real processes, real TCP, a real proxy.
+"""The bridge's faults as a plant has them: real processes, real TCP, a real proxy.
 
 Router, recorder, the simulated controller (``serve rig --controller
 openprotocol --runs N``) and the bridge (``serve openprotocol``) run as the

@@ -1,4 +1,4 @@
-"""``boltwatch up --controller openprotocol``: the station without CAN, end to end (issue 18).
+"""``boltwatch up --controller openprotocol``: the station without CAN, end to end.
 
 Real processes as ``up`` runs them: router, recorder, the bridge (``serve
 openprotocol``) and the rig as an Open Protocol controller over real TCP on

@@ -131,7 +131,7 @@ def test_a_service_killed_mid_run(station: LiveStation, service: str, tmp_path: 
 def test_a_predictor_paused_mid_run_is_a_late_decision_not_the_stop_reason(
     station: LiveStation,
 ) -> None:
-    """Issue 15: a predictor paused 3 s (SIGSTOP / SIGCONT): the tool stopped by its own
+    """A predictor paused 3 s (SIGSTOP / SIGCONT): the tool stopped by its own
     shutoff and the acquisition ignored the late decision, but the summary said
     ``plateau_closest``. What stopped the tool is the acquisition's word now."""
     run_id = wait_mid_run(station)
@@ -139,7 +139,7 @@ def test_a_predictor_paused_mid_run_is_a_late_decision_not_the_stop_reason(
     os.kill(predictor.pid, signal.SIGSTOP)
     try:
         station.wait_for(lambda: station.can.runs()[run_id].ended, f"run {run_id} to end")
-        time.sleep(3.0)  # the issue's probe: paused for 3 s
+        time.sleep(3.0)  # paused for 3 s
     finally:
         os.kill(predictor.pid, signal.SIGCONT)
     assert_tool_stopped_safely(station, run_id)
@@ -162,7 +162,7 @@ def test_an_edge_station_whose_acquisition_dies_stops_by_the_tool_and_comes_back
 ) -> None:
     """The edge layout: the station's predictor lives in its acquisition, so killing that
     process kills both; the tool stops by its own shutoff (never blind), and the restarted
-    acquisition decides the next run again (issue 16: the fault table still holds)."""
+    acquisition decides the next run again (the fault table still holds)."""
     with live_station(tmp_path_factory.mktemp("edge-kill"), placement="edge") as station:
         station.wait_runs_summarised(1)
         killed_run = kill_mid_run(station, "acquisition")

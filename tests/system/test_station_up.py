@@ -71,7 +71,7 @@ def test_up_tightens_stops_and_records_every_sample(tmp_path: Path) -> None:
         indexes = sorted(e["index"] for e in events if e["run_id"] == summary["run_id"])
         assert indexes == list(range(1, summary["events"] + 1)), summary["run_id"]
 
-    # Issue 18: one TighteningResult per run on its channel, in the run's file, judged
+    # one TighteningResult per run on its channel, in the run's file, judged
     # against program 1's windows in the station file; its OK/NOK in up's table
     results = {r["run_id"]: r for r in messages["boltwatch/st1/results"]}
     assert len(messages["boltwatch/st1/results"]) == 3

@@ -1,4 +1,4 @@
-"""``boltwatch status`` shows the recorder's quality alert (issue 19 §1): a real router, a
+"""``boltwatch status`` shows the recorder's quality alert: a real router, a
 real recorder fed real TighteningResults (3 NOK in a row), and status as a real process."""
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The wear ledger overwritten with random bytes while ``boltwatch up`` runs: recording goes on.
 
-The issue's probe: ``recordings/wear.sqlite`` replaced by random bytes under a
+The probe: ``recordings/wear.sqlite`` replaced by random bytes under a
 running station made the recorder exit at the next run summary, and all
 recording stopped. Now, with the real processes of ``up``: every run is
 still recorded whole in MCAP and ``up`` exits 0 with all its runs;

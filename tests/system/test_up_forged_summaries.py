@@ -1,6 +1,6 @@
 """A forged RunSummary is not a tightening: ``boltwatch up`` and the wear ledger both say no.
 
-The issue's probe: a RunSummary with intensity 1e15 for a run that never ran,
+The probe: a RunSummary with intensity 1e15 for a run that never ran,
 put on ``boltwatch/st1/runs`` by a client of the line's router while ``up``
 runs (plain tcp, the line's default), went into the wear ledger and
 counted toward ``up --runs``. Now ``up`` counts a summary only for a run it

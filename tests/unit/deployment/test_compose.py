@@ -176,7 +176,7 @@ PREDICTOR_PUTS = {
     channels.INTENSITY.topic,
     channels.DECISION.topic,
     channels.RUNS.topic,
-    channels.RESULTS.topic,  # issue 18: a run's TighteningResult
+    channels.RESULTS.topic,  # a run's TighteningResult
     channels.PREDICTOR.topic,
 }
 ROLE_PUTS = {  # what each role publishes (docs/reference/access-control.md), per station

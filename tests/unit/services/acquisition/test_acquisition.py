@@ -156,7 +156,7 @@ def test_torque_only_station_publishes_without_force(buses: tuple[can.BusABC, ca
 def test_a_run_id_starts_once_however_its_state_flips(
     buses: tuple[can.BusABC, can.BusABC],
 ) -> None:
-    """Issue 15: ToolStatus flipping every 5 ms for one run id gave 63 rows and 69 files."""
+    """ToolStatus flipping every 5 ms for one run id gave 63 rows and 69 files."""
     tool, station = buses
     outlet = ListOutlet()
     acquisition = Acquisition("st1", False, station, DATABASE, outlet)
@@ -176,7 +176,7 @@ def test_a_run_id_starts_once_however_its_state_flips(
 def test_the_done_state_says_whether_boltwatch_stopped_the_tool(
     buses: tuple[can.BusABC, can.BusABC],
 ) -> None:
-    """Issue 15: a run summary must say what actually stopped the tool."""
+    """A run summary must say what actually stopped the tool."""
     tool, station = buses
     outlet = ListOutlet()
     acquisition = Acquisition("st1", False, station, DATABASE, outlet)
@@ -219,7 +219,7 @@ def play(tool: can.BusABC, samples: int) -> None:
 def test_an_edge_decision_goes_out_on_the_can_thread_at_its_sample(
     buses: tuple[can.BusABC, can.BusABC],
 ) -> None:
-    """Issue 16: the stop path of one sample: the decider's decision is a StopCommand
+    """The stop path of one sample: the decider's decision is a StopCommand
     within the call that handled its sample, before the sample is published."""
     tool, station = buses
     outlet = ListOutlet()

@@ -118,7 +118,7 @@ def test_any_frame_sequence_yields_strictly_increasing_sequences(
 
 
 def test_a_jump_the_time_cannot_explain_is_a_fault_not_a_gap() -> None:
-    """Issue 15: random frames on the sensor id counted '264 255 710 missed in 16 092 gaps'."""
+    """Random frames on the sensor id counted '264 255 710 missed in 16 092 gaps'."""
     assembler = SampleAssembler(has_force_sensor=False)
     out = assembler.tool_frame(10, 1.0, 0.0, 0)
     out += assembler.tool_frame(20_000, 9.9, 0.0, 200_000)  # 0.2 ms later: cannot be a gap

@@ -1,8 +1,8 @@
 """What a plant engineer reads when a path or a value is wrong: one line naming the file (or
-the option), what is wrong and why, exit status 2 (issue 14, item 5).
+the option), what is wrong and why, exit status 2.
 
 The no-traceback tests (``test_no_traceback.py``) drive every command with every kind of
-bad value; these pin the words for the cases the issue names and for each mechanism:
+bad value; these pin the words for the cases a person meets most and for each mechanism:
 OSErrors told by ``services/cli/error_lines.py``, numbers refused while parsing
 (``shared/option_types.py``), endpoints, station files that are not text.
 """

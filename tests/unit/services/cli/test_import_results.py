@@ -1,4 +1,4 @@
-"""Issue 18: an imported CS351 run gets its TighteningResult from the controller's own values.
+"""An imported CS351 run gets its TighteningResult from the controller's own values.
 
 The real runs shipped in ``tests/data/cs351-real-runs`` (all OK by their
 controller and the data set's labels) are imported; the result on

@@ -159,7 +159,7 @@ def test_any_mix_of_bad_arguments_ends_in_one_line(
 
 
 def test_every_command_is_driven() -> None:
-    """The parser is walked: the commands of the issue are all found (a new one is added)."""
+    """The parser is walked: the commands named here are all found (a new one is driven too)."""
     names = {" ".join(command) for command in COMMANDS}
     expected = {
         "up", "health", "predict", "simulate", "import", "model", "recover", "export",

@@ -99,7 +99,7 @@ def strict_json(text: str) -> object:
 def test_an_absurd_sample_is_counted_and_the_output_stays_json(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], absurd: float
 ) -> None:
-    """Issue 14 item 3: one 1e300 sample silenced the run and --summary printed Infinity."""
+    """One 1e300 sample silenced the run and --summary printed Infinity."""
     rows = staircase(torque_noise_nm=0.2, force_noise_n=30.0).csv_rows()
     clean, damaged = tmp_path / "clean.csv", tmp_path / "damaged.csv"
     write_trace(clean, rows)

@@ -1,4 +1,4 @@
-"""Issue 18: ``up`` prints each run's OK/NOK; ``status`` shows the last result and why."""
+"""``up`` prints each run's OK/NOK; ``status`` shows the last result and why."""
 
 from __future__ import annotations
 

@@ -25,7 +25,7 @@ from tests.support.live_predictor import (
 )
 from tests.support.synthetic_runs import staircase
 
-DEEP = 100_000  # the probe: [[[[...]]]] 100 000 deep (200 kB)
+DEEP = 100_000  # [[[[...]]]] 100 000 deep (200 kB)
 DEEP_WITHIN_SIZE = 30_000  # 60 kB: under the size bound, so the parser itself must cope
 HOUR_NS = 3_600_000_000_000
 

@@ -64,7 +64,7 @@ def check_run(
     assert summary.samples == len(trace.rows())  # no sample of another station counted
     assert summary.error_pct is not None
     assert summary.reached_force_n == pytest.approx(trace.force_n[-1])
-    # issue 18: the run's result, published before its summary, on its own channel
+    # the run's result, published before its summary, on its own channel
     (result,) = [codec.decode(TighteningResult, p) for p in by_key[f"{station}/results"]]
     assert (result.station, result.run_id, result.source) == (station, 42, "predictor")
     assert result.final_force_n.value == summary.reached_force_n
@@ -162,7 +162,7 @@ def test_a_run_whose_end_never_arrived_is_forgotten_when_the_next_starts(
 def test_a_run_id_counts_once_however_its_state_flips(
     service: PredictorService, endpoint: str
 ) -> None:
-    """Issue 15: a ToolStatus flipping for one run id gave a row (a summary) per flip."""
+    """A ToolStatus flipping for one run id gave a row (a summary) per flip."""
     rows = staircase().rows()
     with zenoh.open(zenoh_config("peer", connect=[endpoint])) as session:
         wait_for_token(session, keys.health_key("pt1", "predictor"))

@@ -1,4 +1,4 @@
-"""What a controller bridge publishes, recorded (issue 18 §2): its tool data, alarms and
+"""What a controller bridge publishes, recorded: its tool data, alarms and
 counters into MCAP with their schemas, the tool data into the wear ledger beside the runs
 (an older ledger migrated without losing it), shown by ``boltwatch wear``."""
 

@@ -1,4 +1,4 @@
-"""The recorder's quality alert (issue 19 §1): real TighteningResults on zenoh into a real
+"""The recorder's quality alert: real TighteningResults on zenoh into a real
 recorder; the alert comes back on ``boltwatch/st1/quality/alert``, once when a condition
 starts, once when it clears; its Cpk checked against numpy; recorded in the MCAP files."""
 

@@ -54,7 +54,7 @@ def live_run(t0_ns: int, samples: int) -> tuple[list[tuple[str, Any]], list[tupl
 
 
 def hostile(t0_ns: int) -> list[tuple[str, bytes]]:
-    """The issue's probes, each a payload that must not reach a typed channel as it is."""
+    """The probes, each a payload that must not reach a typed channel as it is."""
     ahead = sample(RUN, 9999, time_ns=t0_ns)
     decision = StopDecision("st1", RUN, t0_ns, 0.1, "plateau_closest", "", 1.0, None, None, t0_ns)
     return [

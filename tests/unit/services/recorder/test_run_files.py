@@ -131,7 +131,7 @@ def test_a_file_over_its_byte_limit_continues(tmp_path: Path, station: LoadedSta
 def test_a_run_id_is_one_file_however_its_state_flips(
     tmp_path: Path, station: LoadedStation
 ) -> None:
-    """Issue 15: ToolStatus flipping every 5 ms for one run id made 69 MCAP files."""
+    """ToolStatus flipping every 5 ms for one run id made 69 MCAP files."""
     files = StationFiles("st1", tmp_path, LIMITS, FileMetadata(station))
     t = T0_NS
     items = []

@@ -121,7 +121,7 @@ def test_a_ledger_that_cannot_be_written_keeps_the_runs_until_it_can(tmp_path: P
 def test_summaries_beyond_their_bound_are_refused_counted_and_said_in_recorder_stats(
     recorder: RunningRecorder, publisher_session: zenoh.Session
 ) -> None:
-    """The issue's probes on a running recorder: negative intensity (-2e9) and 9e11 (random
+    """The probes on a running recorder: negative intensity (-2e9) and 9e11 (random
     frames on the ToolSensors id), a forged 1e15: none in the ledger, each counted."""
     heard = Listener(publisher_session, "st1", (channels.RECORDER.topic,))
     runs = publisher_session.declare_publisher(channels.RUNS.key("st1"))

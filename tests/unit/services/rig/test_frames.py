@@ -17,7 +17,7 @@ from tests.support.paths import DBC_FILE
 def test_a_reading_beyond_the_signal_saturates_instead_of_failing(
     tmp_path: Path, torque_nm: float, sent_nm: float
 ) -> None:
-    """Issue 15: a DBC scaling too narrow for the torque was an OverflowError in the rig."""
+    """A DBC scaling too narrow for the torque was an OverflowError in the rig."""
     narrow = tmp_path / "narrow.dbc"
     narrow.write_text(
         DBC_FILE.read_text().replace(

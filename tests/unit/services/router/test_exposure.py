@@ -32,7 +32,7 @@ def test_only_a_plain_endpoint_beyond_loopback_is_exposed(
 
 
 def test_the_router_warns_at_start_when_it_listens_unprotected() -> None:
-    """Issue 15: consider making a line on a non-loopback address warn loudly without TLS."""
+    """Consider making a line on a non-loopback address warn loudly without TLS."""
     endpoint = f"tcp/0.0.0.0:{free_port()}"
     router = subprocess.Popen(
         [sys.executable, "-m", "services.cli", "serve", "router", "--listen", endpoint],

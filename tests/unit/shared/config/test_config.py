@@ -101,7 +101,7 @@ def test_joint_file_checks_physics(tmp_path: Path) -> None:
 def test_a_program_that_cannot_work_is_refused_at_start(
     tmp_path: Path, old: str, new: str, expected: str
 ) -> None:
-    """Issue 15: max_force_n below the target was accepted and every run ended on force_limit."""
+    """Max_force_n below the target was accepted and every run ended on force_limit."""
     path = write_station(tmp_path, "")
     path.write_text(path.read_text().replace(old, new, 1))
     with pytest.raises(ConfigError, match=r"^" + re.escape(f"{path}: {expected}")):
@@ -109,7 +109,7 @@ def test_a_program_that_cannot_work_is_refused_at_start(
 
 
 def test_a_dbc_scaling_that_cannot_carry_the_limits_is_refused_at_start(tmp_path: Path) -> None:
-    """Issue 15: a DBC scaling too narrow for the torque crashed the rig (OverflowError)."""
+    """A DBC scaling too narrow for the torque crashed the rig (OverflowError)."""
     narrow = tmp_path / "narrow.dbc"
     narrow.write_text(
         (CONFIG / "can" / "station.dbc")
@@ -132,7 +132,7 @@ def test_a_dbc_scaling_that_cannot_carry_the_limits_is_refused_at_start(tmp_path
 def test_a_recordings_folder_that_cannot_be_made_is_refused_naming_the_key(
     tmp_path: Path,
 ) -> None:
-    """Issue 15: ``[recorder] folder`` under a file was a NotADirectoryError traceback."""
+    """``[recorder] folder`` under a file was a NotADirectoryError traceback."""
     (tmp_path / "afile").write_text("not a folder")
     path = write_station(tmp_path, "")
     text = path.read_text()

@@ -1,4 +1,4 @@
-"""The ``[openprotocol]`` section of a station file (issue 18 §2): optional, defaults stated,
+"""The ``[openprotocol]`` section of a station file: optional, defaults stated,
 the shipped example loads, each bad value refused naming the file and the key."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 18: a program's windows in the station file; a window that cannot work is refused."""
+"""A program's windows in the station file; a window that cannot work is refused."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Issue 18: a live run's TighteningResult, its summary judged against its program's windows."""
+"""A live run's TighteningResult, its summary judged against its program's windows."""
 
 from __future__ import annotations
 

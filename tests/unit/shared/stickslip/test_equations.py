@@ -163,5 +163,5 @@ def test_force_history_means() -> None:
 
 
 def test_an_event_around_negative_torque_wears_the_tool_too() -> None:
-    """Issue 15: random frames gave a negative process intensity (-2e9) in the wear ledger."""
+    """Random frames gave a negative process intensity (-2e9) in the wear ledger."""
     assert event_intensity(2.0, -3.0, 4.0) == event_intensity(2.0, 3.0, 4.0) == 24.0

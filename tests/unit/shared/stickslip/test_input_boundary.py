@@ -1,4 +1,4 @@
-"""Missing and absurd input is resolved once, at the core's boundary (issue 14, items 2 and 3).
+"""Missing and absurd input is resolved once, at the core's boundary.
 
 A lost first ``JointSensors`` frame used to poison the force sums for the
 whole run (no plateau, so no eq. 65 decision); one finite but absurd value

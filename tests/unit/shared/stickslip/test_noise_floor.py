@@ -3,7 +3,7 @@
 A slow stick ramp with white noise and no slip at all: whatever the detector
 reports is a false event. Started from a single |d2|, the running median
 could sit 10-25 times below the noise for hundreds of samples, and the ramp's
-wiggles passed as slips there (issue 4: seed 1, joint 80 of the accuracy
+wiggles passed as slips there (seed 1, joint 80 of the accuracy
 benchmark). Fixed seeds, so the counts are exact, not a flaky statistic.
 """
 

@@ -1,6 +1,6 @@
 """Real controller runs: intensity comes from stick-slip, not from the tool letting go.
 
-Issue 14, item 1: summed over 16 real CS351 runs, 78 % of the process
+Summed over 16 real CS351 runs, 78 % of the process
 intensity came from events at or after the run's torque peak (the tool's
 release after its last step; the pauses between steps), which the run
 summary and the wear ledger took as vibration. Each run here is replayed

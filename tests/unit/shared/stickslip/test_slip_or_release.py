@@ -1,6 +1,6 @@
 """A slip is a drop under a driving motor; the tool letting go, a pause or a slow-down is not.
 
-Issue 14, item 1: on real controller runs the tool's release after its last
+On real controller runs the tool's release after its last
 step, and the pauses between steps, were detected as the run's biggest
 slips and carried most of its intensity. Constructed traces here (the
 paper's staircase with the motor angle of eq. 9); the real runs are in

@@ -3,7 +3,7 @@
 The bound (shared/wear/wear_bound.py): I_process ≤ (n_ss − 1) · T_lim² ·
 f_s/2, with T_lim the program's max_torque_nm, n_ss ≤ samples/2 and the
 samples within what the run's duration (and the program's max_time_s)
-carries at 1 kHz. The issue's probes (a negative intensity and 9e11 from
+carries at 1 kHz. The probes (a negative intensity and 9e11 from
 random frames on the ToolSensors id, a forged 1e15) are refused; real runs,
 the shipped CS351 ones and the handbook's, are counted.
 """
@@ -57,7 +57,7 @@ def limits(tmp_path: Path) -> StationLimits:
 BOUND_41_EVENTS = 40 * T_LIM_NM**2 * F_SS_MAX_HZ  # 2.05e9
 
 REFUSED: dict[str, tuple[dict[str, object], str]] = {
-    # the issue's probes
+    # the probes that found it
     "negative (random frames)": ({"process_intensity": -2e9}, "is negative"),
     "9e11 (random frames)": ({"process_intensity": 9e11}, "beyond what 41 events can carry"),
     "forged 1e15": ({"process_intensity": 1e15}, "beyond what 41 events can carry"),

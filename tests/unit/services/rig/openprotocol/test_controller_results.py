@@ -1,6 +1,6 @@
 """The simulated Open Protocol controller's results over real TCP: push and acknowledge,
 three re-sends then a drop, results kept while nobody is connected and served by id,
-curves, alarms (issue 18 §3)."""
+curves, alarms."""
 
 from __future__ import annotations
 

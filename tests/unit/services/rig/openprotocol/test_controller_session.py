@@ -1,5 +1,5 @@
 """The simulated Open Protocol controller's session over real TCP: start, revisions,
-refusals, keep-alive, stop, a silent link, a TCP read split anywhere (issue 18 §3)."""
+refusals, keep-alive, stop, a silent link, a TCP read split anywhere."""
 
 from __future__ import annotations
 
