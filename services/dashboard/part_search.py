@@ -30,7 +30,7 @@ from typing import Any
 from shared.config import AnyStation
 from shared.contract import PART_ID_CHARS
 from shared.errors import StoreError
-from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget, store_target
+from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget, station_store
 from shared.results.results_table import as_dict
 
 LOG = logging.getLogger(__name__)
@@ -74,9 +74,7 @@ def stores_of(stations: Sequence[AnyStation]) -> list[StoreTarget]:
     """The distinct results stores of the station files, in their order."""
     targets: dict[str, StoreTarget] = {}
     for station in stations:
-        target = store_target(
-            station.recordings_folder.resolve(), station.config.recorder.results_database
-        )
+        target = station_store(station)
         targets.setdefault(str(target), target)
     return list(targets.values())
 

@@ -34,7 +34,7 @@ from services.opcua.server_security import SecuritySettings, apply
 from shared.config import AnyStation, load_any_line
 from shared.contract import TighteningResult
 from shared.errors import StoreError
-from shared.results import ResultsQuery, ResultsStore, store_target
+from shared.results import ResultsQuery, ResultsStore, station_store
 from shared.runtime import ServiceSkeleton
 
 LOG = logging.getLogger(__name__)
@@ -115,9 +115,7 @@ class OpcuaService:
         """The newest results of each station in its results store, oldest first."""
         found: list[TighteningResult] = []
         for station in self._stations:
-            target = store_target(
-                station.recordings_folder.resolve(), station.config.recorder.results_database
-            )
+            target = station_store(station)
             query = ResultsQuery(stations=[station.station_id], limit=STARTUP_RESULTS)
             try:
                 with ResultsStore(target, create=False, application=APPLICATION) as store:

@@ -78,7 +78,7 @@ from shared.contract import (
     parse_seq_attachment,
 )
 from shared.recordings import OTHER_STATION, FileMetadata, Received, classify
-from shared.results import store_target
+from shared.results import station_store
 from shared.retention import retention_scopes
 from shared.runtime import ServiceSkeleton, Stop
 from shared.wear import StationLimits, ledger_path
@@ -162,7 +162,7 @@ class RecorderService:
                 StationLimits(stations).of,
             )
             self.results = ResultsWatch(
-                store_target(first.recordings_folder, first.config.recorder.results_database),
+                station_store(first),
                 first.recordings_folder,
                 self._lines,
                 self._host,

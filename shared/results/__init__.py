@@ -17,6 +17,8 @@ from shared.results.results_database import (
     ResultsDatabase,
     StoreError,
     StoreTarget,
+    postgres_target,
+    station_store,
     store_target,
     without_password,
 )
@@ -37,6 +39,8 @@ __all__ = [
     "StoreTarget",
     "StoredResult",
     "migrate",
+    "postgres_target",
+    "station_store",
     "store_target",
     "stored_result",
     "version_of",

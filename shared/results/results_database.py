@@ -4,7 +4,7 @@ The store's SQL is written once, with ``?`` for parameters and types both
 databases take (``BIGINT``, ``DOUBLE PRECISION``, ``TEXT``,
 ``INSERT ... ON CONFLICT DO NOTHING``); :class:`ResultsDatabase` turns ``?``
 into psycopg's ``%s`` for PostgreSQL. Where the store is comes from one value
-(:func:`store_target`): none, the SQLite file ``results.sqlite`` in the
+(:func:`store_target`, :func:`station_store`): none, the SQLite file ``results.sqlite`` in the
 recordings folder (WAL, ``synchronous=FULL``: a result the recorder wrote
 survives a power cut); a ``postgresql://`` URL, a plant's server that every
 line's recorder writes into (libpq's own settings apply: ``PGPASSFILE`` for
@@ -25,11 +25,14 @@ import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import psycopg
 
 from shared.errors import StoreError
+
+if TYPE_CHECKING:
+    from shared.config import AnyStation
 
 #: the SQLite store's file in the recordings folder
 SQLITE_FILE = "results.sqlite"
@@ -65,9 +68,20 @@ def store_target(recordings_folder: Path, database: str | None) -> StoreTarget:
     when none, ``results.sqlite`` in its recordings folder."""
     if database is None:
         return StoreTarget(sqlite_path=recordings_folder / SQLITE_FILE)
-    if not database.startswith(POSTGRES_SCHEMES):
-        raise ValueError(f"not a postgresql:// URL: {without_password(database)!r}")
-    return StoreTarget(postgres_url=database)
+    return postgres_target(database)
+
+
+def station_store(station: AnyStation) -> StoreTarget:
+    """The results store a loaded station file names (its recordings folder resolved)."""
+    database = station.config.recorder.results_database
+    return store_target(station.recordings_folder.resolve(), database)
+
+
+def postgres_target(url: str) -> StoreTarget:
+    """A PostgreSQL store by its URL; ValueError when it is not a ``postgresql://`` one."""
+    if not url.startswith(POSTGRES_SCHEMES):
+        raise ValueError(f"not a postgresql:// URL: {without_password(url)!r}")
+    return StoreTarget(postgres_url=url)
 
 
 def without_password(url: str) -> str:

@@ -121,11 +121,11 @@ def _read(
     or (none there, or ``--from-recordings``) every recording in range."""
     from shared.errors import StoreError
     from shared.offline.report import read_results, read_stored
-    from shared.results import ResultsStore, store_target
+    from shared.results import ResultsStore, station_store
 
     why = ""
     if not from_recordings:
-        target = store_target(first.recordings_folder, first.config.recorder.results_database)
+        target = station_store(first)
         try:
             with ResultsStore(target, create=False) as store:
                 return read_stored(store, rule), f"from the results store {target}"

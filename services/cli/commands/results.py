@@ -177,21 +177,23 @@ def _sources(args: argparse.Namespace) -> list[Source]:
 
 def _target(args: argparse.Namespace, sources: Sequence[Source]) -> StoreTarget:
     """``--database``, else the one store the sources name."""
-    from shared.results import store_target
+    from shared.results import postgres_target, store_target
 
     if args.database is not None:
         try:
-            return store_target(Path("."), args.database)
+            return postgres_target(args.database)
         except ValueError as err:
             raise ConfigError(f"--database: {err}") from err
-    targets = {str(store_target(s.folder, s.database)): s for s in sources}
+    targets = {
+        str(target): target for target in (store_target(s.folder, s.database) for s in sources)
+    }
     if len(targets) > 1:
         raise ConfigError(
             f"the station files name {len(targets)} results stores "
             f"({', '.join(sorted(targets))}); give one with --database"
         )
-    (source,) = targets.values()
-    return store_target(source.folder, source.database)
+    (target,) = targets.values()
+    return target
 
 
 def _rebuild(target: StoreTarget, sources: Sequence[Source]) -> int:

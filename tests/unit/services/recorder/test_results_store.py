@@ -13,7 +13,7 @@ import zenoh
 from shared.config import LoadedStation, load_station
 from shared.contract import TighteningResult
 from shared.recordings.mcap import RecordingScan
-from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget, store_target
+from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget, station_store
 from shared.results.recordings_reading import fill_from_recordings
 from shared.runtime import zenoh_config
 from tests.support import factories
@@ -26,8 +26,6 @@ from tests.support.live_recorder import (
 )
 from tests.support.postgres_server import (
     PostgresServer,
-    PostgresUnavailableError,
-    start_postgres_server,
 )
 from tests.support.recorded_runs import T0_NS, run_messages
 
@@ -50,7 +48,7 @@ def _station(tmp_path: Path, database: str | None = None) -> LoadedStation:
 
 
 def _stored(station: LoadedStation) -> list[StoredResult]:
-    target = store_target(station.recordings_folder, station.config.recorder.results_database)
+    target = station_store(station)
     try:
         with ResultsStore(target, create=False) as store:
             return store.find(ResultsQuery(oldest_first=True))
@@ -101,55 +99,47 @@ def test_each_result_is_stored_with_the_recording_it_is_in(station: LoadedStatio
         assert (station.recordings_folder / "results.sqlite").is_file()
 
 
-@pytest.fixture
-def own_server(tmp_path: Path) -> PostgresServer:
-    try:
-        return start_postgres_server()
-    except PostgresUnavailableError as err:
-        pytest.skip(str(err))
-
-
 def test_a_store_down_keeps_results_waiting_and_the_next_start_finds_the_rest(
-    tmp_path: Path, own_server: PostgresServer
+    tmp_path: Path, own_postgres_server: PostgresServer
 ) -> None:
     """Down while runs 1-2 are recorded: they wait; it comes back: they go in. Down again
     for runs 3-4 and the recorder stops: they are not lost, the next start reads them from
     the recordings (the catch-up)."""
-    with own_server:
-        station = _station(tmp_path, own_server.url)
-        own_server.stop()
-        recorder = _record(station, [1, 2])
-        watch = recorder.service.results
-        assert watch is not None
+    server = own_postgres_server
+    station = _station(tmp_path, server.url)
+    server.stop()
+    recorder = _record(station, [1, 2])
+    watch = recorder.service.results
+    assert watch is not None
+    try:
+        wait_until(lambda: watch.waiting == 2, "2 results waiting")
+        (stats,) = recorder.service.stats(time.time_ns())
+        assert stats.waiting_results == 2 and stats.last_error is not None
+        assert stats.last_error.startswith(f"results store {server.url}")
+        server.start()
+        wait_until(lambda: len(_stored(station)) == 2, "the waiting results stored", WAIT_S)
+        assert watch.last_error is None
+        server.stop()
+        session = zenoh.open(zenoh_config("peer", connect=station.config.zenoh.listen))
         try:
-            wait_until(lambda: watch.waiting == 2, "2 results waiting")
-            (stats,) = recorder.service.stats(time.time_ns())
-            assert stats.waiting_results == 2 and stats.last_error is not None
-            assert stats.last_error.startswith(f"results store {own_server.url}")
-            own_server.start()
-            wait_until(lambda: len(_stored(station)) == 2, "the waiting results stored", WAIT_S)
-            assert watch.last_error is None
-            own_server.stop()
-            session = zenoh.open(zenoh_config("peer", connect=station.config.zenoh.listen))
-            try:
-                for run_id in (3, 4):
-                    publish(session, _run_with_result(run_id, f"VIN{run_id:04d}"))
-            finally:
-                session.close()
-            wait_until(lambda: watch.waiting == 2, "runs 3-4 waiting")
+            for run_id in (3, 4):
+                publish(session, _run_with_result(run_id, f"VIN{run_id:04d}"))
         finally:
-            recorder.finish()
-        own_server.start()
-        again = RunningRecorder(station)
-        try:
-            wait_until(lambda: len(_stored(station)) == 4, "runs 3-4 from the recordings", WAIT_S)
-        finally:
-            again.finish()
-        stored = _stored(station)
-        assert [s.result.part_id for s in stored] == [f"VIN{n:04d}" for n in (1, 2, 3, 4)]
-        for row in stored:
-            assert row.recording is not None
-            assert row.result in _results_in(Path(row.recording))
+            session.close()
+        wait_until(lambda: watch.waiting == 2, "runs 3-4 waiting")
+    finally:
+        recorder.finish()
+    server.start()
+    again = RunningRecorder(station)
+    try:
+        wait_until(lambda: len(_stored(station)) == 4, "runs 3-4 from the recordings", WAIT_S)
+    finally:
+        again.finish()
+    stored = _stored(station)
+    assert [s.result.part_id for s in stored] == [f"VIN{n:04d}" for n in (1, 2, 3, 4)]
+    for row in stored:
+        assert row.recording is not None
+        assert row.result in _results_in(Path(row.recording))
 
 
 def test_a_refused_results_payload_costs_no_result_of_its_file(tmp_path: Path) -> None:
