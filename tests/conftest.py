@@ -1,4 +1,4 @@
-"""Fixtures of every test folder: a PostgreSQL server, one per test run."""
+"""Fixtures of every test folder: a PostgreSQL server, one per test run or one of a test's own."""
 
 from __future__ import annotations
 
@@ -14,15 +14,25 @@ from tests.support.postgres_server import (
 )
 
 
-@pytest.fixture(scope="session")
-def postgres_server() -> Iterator[PostgresServer]:
-    """A real PostgreSQL server of the whole test run, started on first use; skipped with
-    the reason where none can start."""
+def _started_or_skipped() -> PostgresServer:
+    """A real PostgreSQL server started now; the test skipped with the reason where none can."""
     try:
-        server = start_postgres_server()
+        return start_postgres_server()
     except PostgresUnavailableError as err:
         pytest.skip(str(err))
-    with server:
+
+
+@pytest.fixture(scope="session")
+def postgres_server() -> Iterator[PostgresServer]:
+    """A real PostgreSQL server of the whole test run, started on first use."""
+    with _started_or_skipped() as server:
+        yield server
+
+
+@pytest.fixture
+def own_postgres_server() -> Iterator[PostgresServer]:
+    """A real PostgreSQL server of the test's own, which it may stop and start."""
+    with _started_or_skipped() as server:
         yield server
 
 

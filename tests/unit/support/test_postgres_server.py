@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import socket
-from collections.abc import Iterator
 from pathlib import Path
 
 import psycopg
@@ -14,17 +13,6 @@ from tests.support.postgres_server import (
     PostgresUnavailableError,
     start_postgres_server,
 )
-
-
-@pytest.fixture
-def own_server() -> Iterator[PostgresServer]:
-    """A server of the test's own, to stop."""
-    try:
-        server = start_postgres_server()
-    except PostgresUnavailableError as err:
-        pytest.skip(str(err))
-    with server:
-        yield server
 
 
 def accepts(port: int) -> bool:
@@ -64,33 +52,35 @@ def test_a_database_left_connected_is_a_failure(postgres_server: PostgresServer)
     postgres_server.drop_database("left_connected")
 
 
-def test_stop_ends_the_server_and_start_brings_back_its_rows(own_server: PostgresServer) -> None:
-    with psycopg.connect(own_server.url, autocommit=True) as connection:
+def test_stop_ends_the_server_and_start_brings_back_its_rows(
+    own_postgres_server: PostgresServer,
+) -> None:
+    with psycopg.connect(own_postgres_server.url, autocommit=True) as connection:
         connection.execute("CREATE TABLE kept AS SELECT 7 AS value")
-    assert accepts(own_server.port)
+    assert accepts(own_postgres_server.port)
 
-    own_server.stop()
-    assert not accepts(own_server.port)
-    assert not (own_server.data / "postmaster.pid").exists()
-    own_server.stop()  # safe twice
+    own_postgres_server.stop()
+    assert not accepts(own_postgres_server.port)
+    assert not (own_postgres_server.data / "postmaster.pid").exists()
+    own_postgres_server.stop()  # safe twice
 
-    own_server.start()
-    with psycopg.connect(own_server.url) as connection:
+    own_postgres_server.start()
+    with psycopg.connect(own_postgres_server.url) as connection:
         assert connection.execute("SELECT value FROM kept").fetchall() == [(7,)]
 
 
-def test_kill_cuts_off_its_clients(own_server: PostgresServer) -> None:
-    with psycopg.connect(own_server.url) as connection:
-        own_server.kill()
+def test_kill_cuts_off_its_clients(own_postgres_server: PostgresServer) -> None:
+    with psycopg.connect(own_postgres_server.url) as connection:
+        own_postgres_server.kill()
         with pytest.raises(psycopg.OperationalError):
             connection.execute("SELECT 1")
-    assert not accepts(own_server.port)
+    assert not accepts(own_postgres_server.port)
 
 
-def test_close_removes_the_folder(own_server: PostgresServer) -> None:
-    own_server.close()
-    assert not own_server.folder.exists()
-    own_server.close()  # safe twice
+def test_close_removes_the_folder(own_postgres_server: PostgresServer) -> None:
+    own_postgres_server.close()
+    assert not own_postgres_server.folder.exists()
+    own_postgres_server.close()  # safe twice
 
 
 def test_settings_given_replace_the_test_servers() -> None:

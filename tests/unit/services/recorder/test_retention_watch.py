@@ -25,7 +25,7 @@ from tests.support.live_recorder import (
     wait_until,
     write_station_file,
 )
-from tests.support.postgres_server import PostgresUnavailableError, start_postgres_server
+from tests.support.postgres_server import PostgresServer
 from tests.support.recorded_runs import recorded_files, run_messages
 from tests.support.retention_files import DAY_NS, run_result, store, write_run_file
 
@@ -135,36 +135,32 @@ def test_a_file_the_recorder_has_open_is_never_deleted(tmp_path: Path) -> None:
 
 
 def test_nothing_is_deleted_while_the_store_cannot_be_asked(
-    tmp_path: Path, caplog: pytest.LogCaptureFixture
+    tmp_path: Path, caplog: pytest.LogCaptureFixture, own_postgres_server: PostgresServer
 ) -> None:
     """A plant's PostgreSQL stopped: passes fail, delete nothing, say it once; back: the old
     stored file goes at the next pass."""
+    server = own_postgres_server
+    station = _station(tmp_path, database=server.url)
+    folder = station.recordings_folder
+    target = store_target(folder, server.url)
+    now_ns = time.time_ns()
+    old = write_run_file(folder, 1, now_ns - 40 * DAY_NS, [run_result(1)])
+    write_run_file(folder, 2, now_ns - 2 * DAY_NS, [run_result(2)])
+    store(target, [run_result(1), run_result(2)], old)
+    server.stop()
+    (scope,) = retention_scopes([station])
+    caplog.set_level(logging.INFO, logger="services.recorder.retention_watch")
+    watch = RetentionWatch(scope, interval_s=0.1)
     try:
-        server = start_postgres_server()
-    except PostgresUnavailableError as err:
-        pytest.skip(str(err))
-    with server:
-        station = _station(tmp_path, database=server.url)
-        folder = station.recordings_folder
-        target = store_target(folder, server.url)
-        now_ns = time.time_ns()
-        old = write_run_file(folder, 1, now_ns - 40 * DAY_NS, [run_result(1)])
-        write_run_file(folder, 2, now_ns - 2 * DAY_NS, [run_result(2)])
-        store(target, [run_result(1), run_result(2)], old)
-        server.stop()
-        (scope,) = retention_scopes([station])
-        caplog.set_level(logging.INFO, logger="services.recorder.retention_watch")
-        watch = RetentionWatch(scope, interval_s=0.1)
-        try:
-            watch.open_files([])
-            wait_until(lambda: watch.last_error is not None, "a failed pass")
-            time.sleep(0.5)  # a few more attempts
-            assert old.exists() and watch.passes == 0
-            server.start()
-            wait_until(lambda: watch.deleted["st1"] == 1, "the old file deleted")
-            assert not old.exists() and watch.last_error is None
-        finally:
-            watch.close()
+        watch.open_files([])
+        wait_until(lambda: watch.last_error is not None, "a failed pass")
+        time.sleep(0.5)  # a few more attempts
+        assert old.exists() and watch.passes == 0
+        server.start()
+        wait_until(lambda: watch.deleted["st1"] == 1, "the old file deleted")
+        assert not old.exists() and watch.last_error is None
+    finally:
+        watch.close()
     failing = [r for r in caplog.records if "nothing is deleted until" in r.getMessage()]
     assert [r.levelno for r in failing] == [logging.WARNING]
     assert any("answers again" in r.getMessage() for r in caplog.records)
