@@ -20,7 +20,7 @@ from pathlib import Path
 from shared.contract import RunSummary, TighteningResult, channels, decode
 from shared.errors import InputError
 from shared.recordings import recording_files, station_days
-from shared.recordings.mcap import RAW_ENCODING, RecordingScan
+from shared.recordings.mcap import RecordingScan
 from shared.results.results_store import ResultsStore
 from shared.results.stored_result import StoredResult, stored_result
 
@@ -58,9 +58,7 @@ def results_of(
     scan = RecordingScan(path)
     results: list[TighteningResult] = []
     summaries: dict[tuple[str, int], RunSummary] = {}
-    for _, channel, message in scan.messages():
-        if channel.message_encoding == RAW_ENCODING:
-            continue  # a payload the recorder refused, kept byte for byte: no result
+    for _, channel, message in scan.typed_messages():  # a refused payload is no result
         if channel.topic.endswith(_RESULTS):
             results.append(decode(TighteningResult, message.data))
         elif channel.topic.endswith(_RUNS):

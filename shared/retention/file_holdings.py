@@ -26,7 +26,7 @@ from pathlib import Path
 
 from shared.contract import TighteningResult, channels, decode
 from shared.errors import InputError
-from shared.recordings.mcap import RAW_ENCODING, RecordingScan
+from shared.recordings.mcap import RecordingScan
 from shared.results import ResultsStore
 from shared.retention.recording_files import RecordingFile
 
@@ -96,8 +96,8 @@ class FileResultsCache:
         if stat.st_size > 0:  # an empty file (a recorder that died at once) holds nothing
             held = tuple(
                 (result.station, result.run_id, result.result)
-                for _, channel, message in RecordingScan(path).messages(_RESULTS)
-                if channel.message_encoding != RAW_ENCODING  # refused: never in the store
+                # a refused payload is kept raw, never in the store
+                for _, _, message in RecordingScan(path).typed_messages(_RESULTS)
                 for result in [decode(TighteningResult, message.data)]
             )
         known = self._known[path] = _Known(version, held)

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from shared.contract import RunSummary, TighteningResult, channels, decode
 from shared.recordings import recording_files, station_days
-from shared.recordings.mcap import RAW_ENCODING, RecordingScan
+from shared.recordings.mcap import RecordingScan
 from shared.results import ResultsQuery, ResultsStore
 
 #: progress is told every this many files (when there are more)
@@ -87,12 +87,10 @@ def read_results(
     result_topic, runs_topic = channels.RESULTS.topic, channels.RUNS.topic
     for done, (station, path) in enumerate(files, start=1):
         scan = RecordingScan(path)
-        for _, channel, message in scan.messages():
+        for _, channel, message in scan.typed_messages():  # a refused payload is no result
             topic = channel.topic.rsplit("/", 1)[-1]
             if not channel.topic.startswith(f"boltwatch/{station}/"):
                 continue
-            if channel.message_encoding == RAW_ENCODING:
-                continue  # a payload the recorder refused, kept raw: no result
             if topic == result_topic:
                 result = decode(TighteningResult, message.data)
                 key = (result.station, result.run_id, result.tool_id, result.time_ns)

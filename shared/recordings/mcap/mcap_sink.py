@@ -38,14 +38,13 @@ from mcap.writer import CompressionType, Writer
 
 from shared.recordings.received import Received
 from shared.recordings.mcap.mcap_messages import MessageAppender, MessageRow
-from shared.recordings.mcap.recording_reader import RecordingScan
+from shared.recordings.mcap.recording_reader import RAW_ENCODING, RecordingScan
 from shared.contract import channels
 from shared.contract import json_schema
 from shared.errors import InputError
 
 LOG = logging.getLogger(__name__)
 
-RAW_ENCODING = "application/octet-stream"
 #: Channel metadata key saying why a raw channel exists.
 RAW_REASON = "boltwatch.raw"
 

@@ -26,6 +26,9 @@ from shared.errors import InputError
 
 LOG = logging.getLogger(__name__)
 
+#: Message encoding of a raw channel: a payload kept byte for byte (not a boltwatch message,
+#: or one the recorder refused), on a channel of the same topic as the typed one
+RAW_ENCODING = "application/octet-stream"
 #: What a damaged tail can raise while a record is parsed or a chunk decompressed.
 _DAMAGE = (McapError, ValueError, struct.error, zstandard.ZstdError, EOFError)
 
@@ -123,6 +126,15 @@ class RecordingScan:
             if topic_suffix is not None and not channel.topic.endswith(topic_suffix):
                 continue
             yield self.schemas.get(channel.schema_id), channel, record
+
+    def typed_messages(
+        self, topic_suffix: str | None = None
+    ) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        """:meth:`messages` without those of raw channels (:data:`RAW_ENCODING`): every
+        message a boltwatch decoder took when it was recorded."""
+        for schema, channel, message in self.messages(topic_suffix):
+            if channel.message_encoding != RAW_ENCODING:
+                yield schema, channel, message
 
     def describe(self) -> str:
         """One line on the file's state, e.g. for a warning."""
