@@ -33,6 +33,7 @@ import threading
 import time
 from collections import OrderedDict, deque
 from collections.abc import Callable, Mapping
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from shared.contract import RunSummary, TighteningResult
@@ -213,9 +214,12 @@ class ResultsWatch:
         this start."""
         last_ns = store.last_stored_ns(list(self._lines))
         since_ns = (last_ns if last_ns is not None else self._started_ns) - CATCH_UP_MARGIN_NS
+        # a file is in the day folder of its opening (UTC): the day before may hold one
+        # written since
+        first_day = datetime.fromtimestamp(since_ns / 1e9, UTC).date() - timedelta(days=1)
         files = [
             path
-            for path in station_recordings(self._folder, self._lines)
+            for path in station_recordings(self._folder, self._lines, first_day)
             if since_ns <= _modified_ns(path) <= self._started_ns
         ]
         if files:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from datetime import date
 from pathlib import Path
 
 from shared.contract import RunSummary, TighteningResult, channels, decode
@@ -40,12 +41,16 @@ class FillCounts:
     damaged: list[str] = field(default_factory=list)  # one line per damaged file
 
 
-def station_recordings(folder: Path, stations: Iterable[str]) -> list[Path]:
-    """Every MCAP file of ``stations`` under the recordings ``folder``, oldest day first."""
+def station_recordings(
+    folder: Path, stations: Iterable[str], first_day: date | None = None
+) -> list[Path]:
+    """Every MCAP file of ``stations`` under the recordings ``folder``, oldest day first
+    (``first_day``: only the day folders from it on)."""
     return [
         path
         for station in stations
-        for _, day in station_days(folder, station)
+        for day_date, day in station_days(folder, station)
+        if first_day is None or day_date >= first_day
         for path in recording_files(day)
     ]
 
