@@ -139,6 +139,13 @@ class Line:
             env={**os.environ, "PYTHONUNBUFFERED": "1"},
         )
 
+    def boltwatch(
+        self, namespace: str, args: Sequence[str], log_path: Path
+    ) -> subprocess.Popen[bytes]:
+        """``boltwatch ARGS`` of this checkout inside ``namespace``, its output appended to
+        ``log_path``."""
+        return self.popen(namespace, [*_CLI, *args], log_path.open("ab"), cwd=REPO)
+
     def run(
         self, namespace: str, command: Sequence[str], cwd: Path, timeout_s: float = 30.0
     ) -> subprocess.CompletedProcess[str]:

@@ -18,7 +18,6 @@ from __future__ import annotations
 import itertools
 import json
 import subprocess
-import sys
 import time
 from collections import defaultdict
 from dataclasses import dataclass, field
@@ -36,7 +35,6 @@ from tests.support.netns_line import (
     unavailable_reason,
     wait_until_up,
 )
-from tests.support.paths import REPO
 
 WHY_NOT = unavailable_reason()
 pytestmark = pytest.mark.skipif(WHY_NOT is not None, reason=WHY_NOT or "")
@@ -47,7 +45,6 @@ RUNS = 16  # about two seconds a run: well past the cut (3 s + 12 s)
 CUT_AFTER_S = 3.0
 CUT_FOR_S = 12.0
 ENDPOINT = LINE_ENDPOINT
-CLI = [sys.executable, "-m", "services.cli"]
 
 
 @dataclass
@@ -135,8 +132,7 @@ def test_three_hosts_one_cut_off_for_twelve_seconds(tmp_path: Path) -> None:
     processes: list[tuple[str, subprocess.Popen[bytes]]] = []
 
     def start(line: Line, namespace: str, name: str, args: list[str]) -> subprocess.Popen[bytes]:
-        log = (logs / f"{name}.log").open("ab")
-        process = line.popen(namespace, [*CLI, *args], log, cwd=REPO)
+        process = line.boltwatch(namespace, args, logs / f"{name}.log")
         processes.append((name, process))
         return process
 

@@ -27,7 +27,6 @@ import json
 import signal
 import sqlite3
 import subprocess
-import sys
 import time
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
@@ -47,7 +46,6 @@ from tests.support.netns_line import (
     unavailable_reason,
     wait_until_up,
 )
-from tests.support.paths import REPO
 
 WHY_NOT = unavailable_reason()
 pytestmark = pytest.mark.skipif(WHY_NOT is not None, reason=WHY_NOT or "")
@@ -58,7 +56,6 @@ CUT_S = 20.0
 #: and some time after
 RUNS = 40
 ENDPOINT = LINE_ENDPOINT
-CLI = [sys.executable, "-m", "services.cli"]
 
 
 @dataclass
@@ -121,8 +118,7 @@ def test_cables_cut_and_the_recorder_killed_lose_nothing(tmp_path: Path) -> None
     processes: dict[str, subprocess.Popen[bytes]] = {}
 
     def start(line: Line, namespace: str, name: str, args: list[str]) -> None:
-        log = (logs / f"{name}.log").open("ab")
-        processes[name] = line.popen(namespace, [*CLI, *args], log, cwd=REPO)
+        processes[name] = line.boltwatch(namespace, args, logs / f"{name}.log")
 
     def start_recorder(line: Line) -> None:
         config_all = [str(path) for path in files]
