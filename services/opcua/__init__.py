@@ -14,6 +14,9 @@ The address space is built from the OPC Foundation's NodeSet2 files (IJT Base
 - :mod:`.joining_systems` (one JoiningSystemType per station; a result into its
   ResultManagement and the result-ready event)
 - :mod:`.result_values` (a TighteningResult as IJT field values, pure),
+  :mod:`.result_trace` (its run's samples from the recording as an IJT trace),
   :mod:`.result_encoding` (those values as asyncua's classes)
+- :mod:`.result_requests` (ResultManagement's GetResultById: a result of the
+  results store, with its steps and trace)
 - :mod:`.result_inbox` (``boltwatch/<st>/results`` from zenoh, to the loop)
 """

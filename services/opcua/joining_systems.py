@@ -17,9 +17,11 @@ its ``Results`` folder). What :meth:`JoiningSystem.publish` does with a result:
   system's events). The model marks the type abstract; IJT's own servers send
   it as it is, and so does this one.
 
-The methods of ResultManagement and the other management objects are in the
-address space as the type has them, without an implementation (a call answers
-``BadNothingToDo``, asyncua's answer for a method without one).
+ResultManagement's ``GetResultById`` is linked by the service
+(:mod:`.result_requests`); the other methods of ResultManagement and of the
+other management objects are in the address space as the type has them,
+without an implementation (a call answers ``BadNothingToDo``, asyncua's answer
+for a method without one).
 """
 
 from __future__ import annotations
@@ -85,6 +87,11 @@ class JoiningSystem:
         names = (ours, ijt, result_ns)
         LOG.info("joining system %s at %s", station, node.nodeid.to_string())
         return cls(station, node, results, events, names)
+
+    async def result_management_method(self, name: str) -> Node:
+        """A method of the joining system's ResultManagement (e.g. ``GetResultById``)."""
+        _ours, _ijt, result_ns = self._names
+        return await self.node.get_child([f"{result_ns}:ResultManagement", f"{result_ns}:{name}"])
 
     async def publish(self, result_id: str, run_id: int, result: Any, message: str) -> None:
         """``result`` (a ``ua.ResultDataType``) into Results, then the result-ready event."""

@@ -1,9 +1,11 @@
 """The field values of :mod:`.result_values` as asyncua's classes of the IJT model.
 
 The classes (``ua.ResultDataType``, ``ua.JoiningResultMetaDataType``,
-``ua.JoiningResultDataType``, ``ua.ResultValueDataType``) exist once the models
+``ua.JoiningResultDataType``, ``ua.ResultValueDataType``...) exist once the models
 are loaded (:func:`~.nodeset_loading.load_models`); before that, this module
-cannot be used.
+cannot be used. A result's ``JoiningResultDataType`` carries its ``StepResults``
+(``StepResultDataType``) and, when asked by id, its ``Trace``
+(``JoiningTraceDataType`` of ``StepTraceDataType`` and ``TraceContentDataType``).
 """
 
 from __future__ import annotations
@@ -42,17 +44,51 @@ def result_data(values: dict[str, Any]) -> Any:
         if name in meta:
             meta[name] = ua.Byte(meta[name])
     content = [
-        ua.Variant(
-            model_class("JoiningResultDataType")(
-                OverallResultValues=[_value(item) for item in joining["OverallResultValues"]]
-            ),
-            ua.VariantType.ExtensionObject,
-        )
+        ua.Variant(_joining_result(joining), ua.VariantType.ExtensionObject)
         for joining in values["ResultContent"]
     ]
     return model_class("ResultDataType")(
         ResultMetaData=model_class("JoiningResultMetaDataType")(**meta), ResultContent=content
     )
+
+
+def _joining_result(joining: dict[str, Any]) -> Any:
+    fields: dict[str, Any] = {
+        "OverallResultValues": [_value(item) for item in joining["OverallResultValues"]]
+    }
+    if "StepResults" in joining:
+        fields["StepResults"] = [_step_result(step) for step in joining["StepResults"]]
+    if "Trace" in joining:
+        fields["Trace"] = _trace(joining["Trace"])
+    return model_class("JoiningResultDataType")(**fields)
+
+
+def _step_result(fields: dict[str, Any]) -> Any:
+    fields = dict(fields)
+    fields["ResultEvaluation"] = model_class("ResultEvaluationEnum")(fields["ResultEvaluation"])
+    if "StepResultValues" in fields:
+        fields["StepResultValues"] = [_value(item) for item in fields["StepResultValues"]]
+    return model_class("StepResultDataType")(**fields)
+
+
+def _trace(fields: dict[str, Any]) -> Any:
+    """A ``JoiningTraceDataType`` of :func:`.result_trace.trace_values`'s fields."""
+    steps = []
+    for given in fields["StepTraces"]:
+        step = dict(given)
+        step["NumberOfTracePoints"] = ua.UInt32(step["NumberOfTracePoints"])
+        step["StepTraceContent"] = [_trace_content(item) for item in step["StepTraceContent"]]
+        steps.append(model_class("StepTraceDataType")(**step))
+    return model_class("JoiningTraceDataType")(
+        TraceId=fields["TraceId"], ResultId=fields["ResultId"], StepTraces=steps
+    )
+
+
+def _trace_content(fields: dict[str, Any]) -> Any:
+    fields = dict(fields)
+    fields["PhysicalQuantity"] = ua.Byte(fields["PhysicalQuantity"])
+    fields["EngineeringUnits"] = eu_information(fields["EngineeringUnits"])
+    return model_class("TraceContentDataType")(**fields)
 
 
 def _value(fields: dict[str, Any]) -> Any:

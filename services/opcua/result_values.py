@@ -31,7 +31,15 @@ final torque, angle, preload    ``OverallResultValues``: ``MeasuredValue``, wind
 ``stop_reason``, ``source``,    ``ExtendedMetaData`` (key, text)
 ``station``, ``tool_id``,
 ``run_id``
-``steps``                       not mapped (``StepResults``: not in this version)
+``steps`` (a controller's)      ``StepResults``: per step its ``StepResultId``
+                                ``<ResultId>/step/<n>`` (n from 1), ``ProgramStep``
+                                n, ``Name``, ``ResultEvaluation``, and one
+                                ``StepResultValues`` (``Name`` the step's
+                                function, ``MeasuredValue`` its actual,
+                                ``TargetValue`` its nominal; no unit: the
+                                controller's own) when it has an actual value
+a trace (:mod:`.result_trace`)  ``Trace`` (a ``JoiningTraceDataType``): only in a
+                                result asked by id, never in the event
 ==============================  ==================================================
 
 ``Classification`` is 1 (a single result) and ``ResultState`` 1 (completed): a
@@ -44,7 +52,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
 
-from shared.contract import JudgedFigure, TighteningResult
+from shared.contract import JudgedFigure, ResultStep, TighteningResult
 
 #: JoiningResultMetaDataType.Classification of one tightening's result
 CLASSIFICATION_SINGLE = 1
@@ -56,6 +64,7 @@ EVALUATION_NOT_OK = 2
 EVALUATION_NOT_DECIDABLE = 3
 #: ResultValueDataType.PhysicalQuantity (IJT Base, the EnumStrings of PhysicalQuantity)
 QUANTITY_OTHER = 0
+QUANTITY_TIME = 1
 QUANTITY_TORQUE = 2
 QUANTITY_ANGLE = 3
 QUANTITY_FORCE = 8
@@ -87,11 +96,17 @@ class EngineeringUnit:
 NEWTON_METRE = EngineeringUnit("NU", "N·m", "newton metre")
 DEGREE = EngineeringUnit("DD", "°", "degree [unit of angle]")
 NEWTON = EngineeringUnit("NEW", "N", "newton")
+MILLISECOND = EngineeringUnit("C26", "ms", "millisecond")
 
 _EVALUATION_OF_STATUS = {
     "ok": EVALUATION_OK,
     "low": EVALUATION_NOT_OK,
     "high": EVALUATION_NOT_OK,
+    "not_judged": EVALUATION_NOT_DECIDABLE,
+}
+_EVALUATION_OF_STEP = {
+    "OK": EVALUATION_OK,
+    "NOK": EVALUATION_NOT_OK,
     "not_judged": EVALUATION_NOT_DECIDABLE,
 }
 
@@ -101,8 +116,9 @@ def result_id(station: str, run_id: int) -> str:
     return f"{station}/{run_id}"
 
 
-def result_values(result: TighteningResult) -> dict[str, Any]:
-    """``{"ResultMetaData": {...}, "ResultContent": [{"OverallResultValues": [...]}]}``."""
+def result_values(result: TighteningResult, trace: dict[str, Any] | None = None) -> dict[str, Any]:
+    """``{"ResultMetaData": {...}, "ResultContent": [{"OverallResultValues": [...], ...}]}``;
+    ``trace``: the fields of its ``JoiningTraceDataType`` (:func:`.result_trace.trace_values`)."""
     extended = {
         "Station": result.station,
         "ToolId": str(result.tool_id),
@@ -152,7 +168,30 @@ def result_values(result: TighteningResult) -> dict[str, Any]:
                 "PhysicalQuantity": QUANTITY_OTHER,
             }
         )
-    return {"ResultMetaData": meta, "ResultContent": [{"OverallResultValues": values}]}
+    joining: dict[str, Any] = {"OverallResultValues": values}
+    if result.steps:
+        joining["StepResults"] = [
+            _step(meta["ResultId"], number, step) for number, step in enumerate(result.steps, 1)
+        ]
+    if trace is not None:
+        joining["Trace"] = trace
+    return {"ResultMetaData": meta, "ResultContent": [joining]}
+
+
+def _step(identifier: str, number: int, step: ResultStep) -> dict[str, Any]:
+    """A controller's step as a StepResultDataType's fields."""
+    fields: dict[str, Any] = {
+        "StepResultId": f"{identifier}/step/{number}",
+        "ProgramStep": str(number),
+        "Name": step.name,
+        "ResultEvaluation": _EVALUATION_OF_STEP[step.status],
+    }
+    if step.actual is not None:
+        value: dict[str, Any] = {"Name": step.function or step.name, "MeasuredValue": step.actual}
+        if step.nominal is not None:
+            value["TargetValue"] = step.nominal
+        fields["StepResultValues"] = [value]
+    return fields
 
 
 def _figure(

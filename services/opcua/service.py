@@ -12,6 +12,8 @@ before the line's router is there); then results come from
 subscribed, the newest :data:`STARTUP_RESULTS` per station from the stations'
 results stores (:mod:`shared.results`), oldest first, so a client finds the last
 result at once. A result already served (the same ResultId) is not served twice.
+Each joining system's ``GetResultById`` answers from its station's results store,
+with the result's trace (:mod:`.result_requests`).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from services.opcua.nodeset_files import nodeset_folder
 from services.opcua.nodeset_loading import load_models
 from services.opcua.result_encoding import result_data
 from services.opcua.result_inbox import ResultInbox
+from services.opcua.result_requests import APPLICATION, get_result_by_id_method
 from services.opcua.result_values import result_id, result_values
 from services.opcua.server_security import SecuritySettings, apply
 from shared.config import AnyStation, load_any_line
@@ -46,7 +49,6 @@ POLL_S = 0.05
 SERVER_NAME = "boltwatch IJT server"
 #: its health token, boltwatch/<st>/health/opcua
 HEALTH = "opcua"
-APPLICATION = "boltwatch serve opcua"
 
 
 class OpcuaService:
@@ -81,6 +83,11 @@ class OpcuaService:
             station.station_id: await JoiningSystem.create(server, station.station_id)
             for station in self._stations
         }
+        for loaded in self._stations:
+            method = await systems[loaded.station_id].result_management_method("GetResultById")
+            server.link_method(
+                method, get_result_by_id_method(station_store(loaded), loaded.station_id)
+            )
         async with server:
             LOG.info("OPC UA server of %s at %s", ", ".join(systems), self._listen)
             # the line after the server: a client may connect and subscribe before the router

@@ -1,8 +1,9 @@
 """Which tightenings a question asks for: :class:`ResultsQuery` as SQL, newest first.
 
 Every criterion is optional and they all hold together: a part id, stations,
-a line, a program, a tool, a range of end times (``since`` included,
-``until`` not), NOK only. Each is a column with an index in front
+a run id (with one station: a tightening by the table's primary key), a line,
+a program, a tool, a range of end times (``since`` included, ``until`` not),
+NOK only. Each is a column with an index in front
 (:mod:`.results_schema`), so a part's tightenings are found by the index of
 ``part_id`` however large the store.
 """
@@ -21,6 +22,7 @@ DEFAULT_LIMIT = 100
 class ResultsQuery:
     part_id: str | None = None
     stations: Sequence[str] = ()  # any of them; empty: every station
+    run_id: int | None = None  # with one station: a tightening by the store's key
     line: str | None = None
     program_id: int | None = None
     tool_id: int | None = None
@@ -43,6 +45,8 @@ class ResultsQuery:
             term("part_id = ?", self.part_id)
         if self.stations:
             term(f"station IN ({', '.join('?' * len(self.stations))})", *self.stations)
+        if self.run_id is not None:
+            term("run_id = ?", self.run_id)
         if self.line is not None:
             term("line = ?", self.line)
         if self.program_id is not None:

@@ -4,7 +4,8 @@
 - :mod:`.mcap_messages`: a batch of messages packed into the writer's open chunk at once
 - :mod:`.recording_reader`: a recording read back, message by message
 - :mod:`.recovery`: a truncated MCAP made valid (``boltwatch recover``)
-- :mod:`.trace_export`: a recording as a CSV trace (``boltwatch export``)
+- :mod:`.trace_export`: a recording's samples of a run (its trace), and as a CSV trace
+  (``boltwatch export``)
 """
 
 
@@ -12,6 +13,6 @@ from shared.recordings.mcap.mcap_messages import MessageAppender, MessageRow
 from shared.recordings.mcap.mcap_sink import McapSink, RAW_ENCODING, RAW_REASON
 from shared.recordings.mcap.recording_reader import RecordingScan
 from shared.recordings.mcap.recovery import default_target, recover, remove_unfinished
-from shared.recordings.mcap.trace_export import SAMPLE_SCHEMA, export_trace
+from shared.recordings.mcap.trace_export import SAMPLE_SCHEMA, export_trace, read_samples, run_times_s
 
-__all__ = ["McapSink", "MessageAppender", "MessageRow", "RAW_ENCODING", "RAW_REASON", "RecordingScan", "SAMPLE_SCHEMA", "default_target", "export_trace", "recover", "remove_unfinished"]
+__all__ = ["McapSink", "MessageAppender", "MessageRow", "RAW_ENCODING", "RAW_REASON", "RecordingScan", "SAMPLE_SCHEMA", "default_target", "export_trace", "read_samples", "recover", "remove_unfinished", "run_times_s"]
