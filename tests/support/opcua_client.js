@@ -11,7 +11,10 @@
 // once every station is; one {"type": "result", "station", "eventType", "message",
 // "result"} per result-ready event (the Result field as JSON); at the end, per station,
 // {"type": "results_folder", "station", "names"} (the browse names in
-// ResultManagement/Results); then {"type": "done"}. Exit status 0, or 1 on an error
+// ResultManagement/Results); with "askById": true, the first result received asked by
+// its id (ResultManagement's GetResultById, again while the results store does not have
+// it yet: Error -1) as {"type": "by_id", "station", "resultId", "error", "result"}
+// (typed arrays as JSON arrays, NaN as null); then {"type": "done"}. Exit status 0, or 1 on an error
 // (its line: {"type": "error", "message"}).
 "use strict";
 const {
@@ -23,6 +26,8 @@ const {
     makeBrowsePath,
     constructEventFilter,
     UserTokenType,
+    DataType,
+    StatusCodes,
 } = require("node-opcua-client");
 
 const options = JSON.parse(process.argv[2]);
@@ -30,7 +35,11 @@ const say = (object) => process.stdout.write(JSON.stringify(object) + "\n");
 
 function plain(value) {
     return JSON.parse(
-        JSON.stringify(value, (_key, item) => (typeof item === "bigint" ? item.toString() : item)),
+        JSON.stringify(value, (_key, item) => {
+            if (typeof item === "bigint") return item.toString();
+            if (ArrayBuffer.isView(item)) return Array.from(item);
+            return item;
+        }),
     );
 }
 
@@ -73,6 +82,7 @@ async function main() {
     });
     const filter = constructEventFilter(["EventType", "SourceName", "Message", `${result}:Result`]);
     const systems = {};
+    const firstResultId = {};
     let received = 0;
     let finish;
     const finished = new Promise((resolve) => (finish = resolve));
@@ -91,6 +101,9 @@ async function main() {
         );
         item.on("changed", (fields) => {
             const [eventType, sourceName, message, value] = fields;
+            if (!(station in firstResultId) && value.value) {
+                firstResultId[station] = value.value.resultMetaData.resultId;
+            }
             say({
                 type: "result",
                 station,
@@ -118,10 +131,43 @@ async function main() {
             names: browsed.references.map((ref) => ref.browseName.name),
         });
     }
+    if (options.askById) {
+        for (const [station, nodeId] of Object.entries(systems)) {
+            await askById(session, nodeId, result, station, firstResultId[station]);
+        }
+    }
     await subscription.terminate();
     await session.close();
     await client.disconnect();
     say({ type: "done" });
+}
+
+async function askById(session, systemId, result, station, resultId) {
+    const child = async (path) => {
+        const found = await session.translateBrowsePath(makeBrowsePath(systemId, path));
+        return found.targets[0].targetId;
+    };
+    const request = {
+        objectId: await child(`/${result}:ResultManagement`),
+        methodId: await child(`/${result}:ResultManagement/${result}:GetResultById`),
+        inputArguments: [
+            { dataType: DataType.String, value: resultId },
+            { dataType: DataType.Int32, value: 0 },
+        ],
+    };
+    for (;;) {
+        const called = await session.call(request);
+        if (called.statusCode !== StatusCodes.Good) {
+            throw new Error(`GetResultById ${resultId}: ${called.statusCode.toString()}`);
+        }
+        const [, value, error] = called.outputArguments;
+        if (error.value === -1) {
+            await new Promise((resolve) => setTimeout(resolve, 200)); // not stored yet
+            continue;
+        }
+        say({ type: "by_id", station, resultId, error: error.value, result: plain(value.value) });
+        return;
+    }
 }
 
 main().then(

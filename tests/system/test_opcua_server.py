@@ -7,7 +7,9 @@ by the CA the server trusts (Basic256Sha256, sign and encrypt), browses to the
 station's joining system (Objects/Machines/st1), subscribes to its events before
 the first run, and receives one result-ready event per run whose Result equals
 the results store's tightening: its ResultId, part, program, verdict, creation
-time and final torque, angle and preload with their windows and units. A client
+time and final torque, angle and preload with their windows and units. It asks
+the first result by its id (ResultManagement's GetResultById) and finds in its
+trace every sample the recording holds of the run, value for value. A client
 without a certificate (security None) and a client whose certificate the CA did
 not sign are refused.
 """
@@ -25,8 +27,9 @@ import pytest
 
 from services.opcua.joining_systems import result_browse_name
 from services.opcua.nodeset_files import missing_files, nodeset_folder
+from services.opcua.result_trace import recorded_samples
 from services.opcua.result_values import DEGREE, NEWTON, NEWTON_METRE, result_id
-from shared.results import ResultsQuery, ResultsStore, store_target
+from shared.results import ResultsQuery, ResultsStore, StoredResult, store_target
 from tests.support.live_recorder import free_port
 from tests.support.opcua_certificates import (
     OpcuaCertificates,
@@ -99,7 +102,14 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
     )
     client = start_client(
         modules,
-        _options(endpoint, certificates, "client", results=RUNS, timeoutMs=CLIENT_TIMEOUT_S * 1000),
+        _options(
+            endpoint,
+            certificates,
+            "client",
+            results=RUNS,
+            askById=True,
+            timeoutMs=CLIENT_TIMEOUT_S * 1000,
+        ),
     )
     try:
         assert client.stdout is not None
@@ -136,7 +146,8 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
 
     target = store_target(station.parent / "recordings", None)
     with ResultsStore(target, create=False) as store:
-        stored = [s.result for s in store.find(ResultsQuery(stations=[STATION], oldest_first=True))]
+        found = store.find(ResultsQuery(stations=[STATION], oldest_first=True))
+    stored = [s.result for s in found]
     assert len(stored) == RUNS
     for event, expected in zip(events, stored, strict=True):
         result = event["result"]
@@ -167,9 +178,29 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
         assert _value(values, "StickSlipEvents")["measuredValue"] == expected.events
     [folder] = [line for line in lines if line["type"] == "results_folder"]
     assert folder["names"] == [result_browse_name(r.run_id) for r in stored]
+    _check_trace(lines, found[0])
 
     assert [line["type"] for line in refused] == ["refused"], refused
     assert [line["type"] for line in stranger] == ["refused"], stranger
+
+
+def _check_trace(lines: list[dict[str, Any]], first: StoredResult) -> None:
+    """The first result asked by id holds every sample of its recording."""
+    [asked] = [line for line in lines if line["type"] == "by_id"]
+    identifier = result_id(STATION, first.result.run_id)
+    assert (asked["resultId"], asked["error"]) == (identifier, 0)
+    assert asked["result"]["resultMetaData"]["resultId"] == identifier
+    assert first.recording is not None
+    samples = recorded_samples(Path(first.recording), STATION, first.result.run_id)
+    assert len(samples) > 100  # a whole run at 1 kHz
+    [content] = asked["result"]["resultContent"]
+    [step] = content["value"]["trace"]["stepTraces"]
+    assert step["numberOfTracePoints"] == len(samples)
+    assert step["samplingInterval"] == 1.0  # ms: the station's 1 kHz
+    channels = {item["name"]: item["values"] for item in step["stepTraceContent"]}
+    assert channels["Torque"] == [sample["torque_nm"] for sample in samples]
+    assert channels["Angle"] == [sample["angle_deg"] for sample in samples]
+    assert channels["Preload"] == [sample["force_n"] for sample in samples]  # None: NaN
 
 
 def test_serve_opcua_says_what_security_it_needs(tmp_path: Path) -> None:
