@@ -5,7 +5,9 @@ Machinery's ``Machines`` folder, its node id ``ns=<boltwatch>;s=<station>``
 and its browse name the station's id. asyncua instantiates the type's mandatory
 children (AssetManagement, Identification, JoiningProcessManagement,
 JointManagement, MachineryBuildingBlocks, ResultManagement with its methods and
-its ``Results`` folder). What :meth:`JoiningSystem.publish` does with a result:
+its ``Results`` folder), and instances of the type's placeholders too, which are
+deleted (:func:`drop_placeholders`; ``AssetManagement/Assets/Tools`` gets the
+station's tools from :mod:`.tool_assets`). What :meth:`JoiningSystem.publish` does with a result:
 
 - ``ResultManagement/Results``: a variable of ``JoiningSystemResultType``
   (data type ``ResultDataType``) named ``Result_<run id>`` (a browse name
@@ -31,6 +33,7 @@ from collections import deque
 from typing import Any
 
 from asyncua import Server, ua
+from asyncua.common.manage_nodes import delete_nodes
 from asyncua.common.node import Node
 
 from services.opcua.nodeset_loading import IJT_BASE, MACHINERY_RESULT, node_id
@@ -80,6 +83,7 @@ class JoiningSystem:
             ua.QualifiedName(station, ours),
             objecttype=node_id(JOINING_SYSTEM_TYPE, ijt),
         )
+        await drop_placeholders(node)
         results = await node.get_child([f"{result_ns}:ResultManagement", f"{result_ns}:Results"])
         events = await server.get_event_generator(
             node_id(RESULT_READY_EVENT_TYPE, ijt), emitting_node=node.nodeid
@@ -102,18 +106,42 @@ class JoiningSystem:
             ua.Variant(result, ua.VariantType.ExtensionObject),
             datatype=node_id(RESULT_DATA_TYPE, result_ns),
         )
-        await _set_type_definition(variable, node_id(JOINING_SYSTEM_RESULT_TYPE, ijt))
+        await set_type_definition(variable, node_id(JOINING_SYSTEM_RESULT_TYPE, ijt))
         self._kept.append(variable)
         while len(self._kept) > KEPT_RESULTS:
-            await self._kept.popleft().delete()
+            await remove_child(
+                self._results, self._kept.popleft(), node_id(ua.ObjectIds.HasComponent)
+            )
         self._events.event.Result = ua.Variant(result, ua.VariantType.ExtensionObject)
         self._events.event.Severity = 100
         await self._events.trigger(message=message)
 
 
-async def _set_type_definition(variable: Node, type_definition: ua.NodeId) -> None:
-    """add_variable gives BaseDataVariableType; the result variable is a
-    JoiningSystemResultType (its sub-variables are not instantiated)."""
+async def drop_placeholders(node: Node) -> None:
+    """Delete the instances asyncua made of a type's placeholders (``<Tool>``,
+    ``<LifetimeVariable>``...): a placeholder says what may be there, it is no node of an
+    instance (OPC 10000-3, 6.4.4.4.4)."""
+    for child in await node.get_children_descriptions(refs=ua.ObjectIds.HierarchicalReferences):
+        name = child.BrowseName.Name
+        if name.startswith("<") and name.endswith(">"):
+            await remove_child(node, Node(node.session, child.NodeId), child.ReferenceTypeId)
+        elif child.NodeClass == ua.NodeClass.Object:  # where the placeholders are
+            await drop_placeholders(Node(node.session, child.NodeId))
+
+
+async def remove_child(parent: Node, child: Node, reference_type: ua.NodeId) -> None:
+    """``child`` and the nodes below it deleted, and ``parent``'s reference to it.
+
+    Not ``Node.delete()``: asyncua's server then looks through every node of the address
+    space for references to each node deleted (about 0.1 s a node with the models loaded).
+    Only the parent refers to these nodes (and they to each other)."""
+    await parent.delete_reference(child.nodeid, reference_type, forward=True, bidirectional=False)
+    await delete_nodes(parent.session, [child], recursive=True, delete_target_references=False)
+
+
+async def set_type_definition(variable: Node, type_definition: ua.NodeId) -> None:
+    """add_variable gives BaseDataVariableType: ``type_definition`` instead (e.g. the result
+    variable's JoiningSystemResultType; its sub-variables are not instantiated)."""
     old = await variable.read_type_definition()
     if old is not None:
         await variable.delete_reference(old, ua.ObjectIds.HasTypeDefinition)
