@@ -18,5 +18,7 @@ The address space is built from the OPC Foundation's NodeSet2 files (IJT Base
   :mod:`.result_encoding` (those values as asyncua's classes)
 - :mod:`.result_requests` (ResultManagement's GetResultById: a result of the
   results store, with its steps and trace)
+- :mod:`.tool_values` (a tool of the wear ledger as an IJT tool's counters, pure),
+  :mod:`.tool_assets` (the station's tools in AssetManagement/Assets/Tools)
 - :mod:`.result_inbox` (``boltwatch/<st>/results`` from zenoh, to the loop)
 """

@@ -13,7 +13,9 @@ subscribed, the newest :data:`STARTUP_RESULTS` per station from the stations'
 results stores (:mod:`shared.results`), oldest first, so a client finds the last
 result at once. A result already served (the same ResultId) is not served twice.
 Each joining system's ``GetResultById`` answers from its station's results store,
-with the result's trace (:mod:`.result_requests`).
+with the result's trace (:mod:`.result_requests`). The station's tools and their
+counters come from its wear ledger (:mod:`.tool_assets`), read again every
+:data:`TOOLS_REFRESH_S`.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import argparse
 import asyncio
 import logging
 import threading
+import time
 from collections.abc import Sequence
 
 from asyncua import Server
@@ -34,11 +37,14 @@ from services.opcua.result_inbox import ResultInbox
 from services.opcua.result_requests import APPLICATION, get_result_by_id_method
 from services.opcua.result_values import result_id, result_values
 from services.opcua.server_security import SecuritySettings, apply
+from services.opcua.tool_assets import ToolAssets
+from services.opcua.tool_values import ToolCounters, tool_counters
 from shared.config import AnyStation, load_any_line
 from shared.contract import TighteningResult
-from shared.errors import StoreError
+from shared.errors import InputError, StoreError
 from shared.results import ResultsQuery, ResultsStore, station_store
 from shared.runtime import ServiceSkeleton
+from shared.wear import BrokenLedgerError, WearLedger, ledger_path
 
 LOG = logging.getLogger(__name__)
 
@@ -46,6 +52,8 @@ LOG = logging.getLogger(__name__)
 STARTUP_RESULTS = 5
 #: how often the loop looks at the inbox and the stop flag, seconds
 POLL_S = 0.05
+#: how often the tools' counters are read again from the wear ledgers, seconds
+TOOLS_REFRESH_S = 2.0
 SERVER_NAME = "boltwatch IJT server"
 #: its health token, boltwatch/<st>/health/opcua
 HEALTH = "opcua"
@@ -88,6 +96,10 @@ class OpcuaService:
             server.link_method(
                 method, get_result_by_id_method(station_store(loaded), loaded.station_id)
             )
+        assets = {
+            station: await ToolAssets.create(server, station, system.node)
+            for station, system in systems.items()
+        }
         async with server:
             LOG.info("OPC UA server of %s at %s", ", ".join(systems), self._listen)
             # the line after the server: a client may connect and subscribe before the router
@@ -98,7 +110,12 @@ class OpcuaService:
                 self._skeleton.health_token(station, HEALTH)
             for stored in await asyncio.to_thread(self._newest):  # after subscribing: no gap
                 await self._publish(systems, stored)
+            tools_due_s = 0.0
             while not stop.is_set():
+                if time.monotonic() >= tools_due_s:
+                    for station, counters in (await asyncio.to_thread(self._tools)).items():
+                        await assets[station].update(counters)
+                    tools_due_s = time.monotonic() + TOOLS_REFRESH_S
                 result = inbox.next()
                 if result is None:
                     await asyncio.sleep(POLL_S)
@@ -117,6 +134,21 @@ class OpcuaService:
         message = f"{identifier} {result.result}"
         await system.publish(identifier, result.run_id, result_data(result_values(result)), message)
         LOG.info("result %s served", message)
+
+    def _tools(self) -> dict[str, list[ToolCounters]]:
+        """Each station's tools in its wear ledger (none while it has no ledger)."""
+        found: dict[str, list[ToolCounters]] = {}
+        for station in self._stations:
+            path = ledger_path(station.recordings_folder)
+            threshold = station.config.recorder.wear_service_threshold
+            try:
+                with WearLedger(path, read_only=True) as ledger:
+                    tools = ledger.tools(station=station.station_id)
+            except (InputError, BrokenLedgerError) as err:
+                LOG.debug("no tools of %s from %s: %s", station.station_id, path, err)
+                continue
+            found[station.station_id] = [tool_counters(tool, threshold) for tool in tools]
+        return found
 
     def _newest(self) -> list[TighteningResult]:
         """The newest results of each station in its results store, oldest first."""

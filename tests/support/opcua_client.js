@@ -14,7 +14,10 @@
 // ResultManagement/Results); with "askById": true, the first result received asked by
 // its id (ResultManagement's GetResultById, again while the results store does not have
 // it yet: Error -1) as {"type": "by_id", "station", "resultId", "error", "result"}
-// (typed arrays as JSON arrays, NaN as null); then {"type": "done"}. Exit status 0, or 1 on an error
+// (typed arrays as JSON arrays, NaN as null); with "toolRuns": N, each tool of
+// AssetManagement/Assets/Tools once its OperationCycleCounter reached N (read again until
+// then) as {"type": "tool", "station", "name", "serialNumber", "tightenings",
+// "sinceService", "intensitySinceService", "limitValue", "unitId"}; then {"type": "done"}. Exit status 0, or 1 on an error
 // (its line: {"type": "error", "message"}).
 "use strict";
 const {
@@ -131,6 +134,11 @@ async function main() {
             names: browsed.references.map((ref) => ref.browseName.name),
         });
     }
+    if (options.toolRuns) {
+        for (const [station, nodeId] of Object.entries(systems)) {
+            await readTools(session, nodeId, namespaces, station, options.toolRuns);
+        }
+    }
     if (options.askById) {
         for (const [station, nodeId] of Object.entries(systems)) {
             await askById(session, nodeId, result, station, firstResultId[station]);
@@ -140,6 +148,58 @@ async function main() {
     await session.close();
     await client.disconnect();
     say({ type: "done" });
+}
+
+async function readTools(session, systemId, namespaces, station, runs) {
+    const [di, machinery, ijt, ours] = [
+        "http://opcfoundation.org/UA/DI/",
+        "http://opcfoundation.org/UA/Machinery/",
+        "http://opcfoundation.org/UA/IJT/Base/",
+        "urn:boltwatch:opcua",
+    ].map((uri) => namespaces.indexOf(uri));
+    const target = async (start, path) => {
+        const found = await session.translateBrowsePath(makeBrowsePath(start, path));
+        if (!found.targets || found.targets.length === 0) throw new Error(`no ${path}`);
+        return found.targets[0].targetId;
+    };
+    const folder = await target(systemId, `/${ijt}:AssetManagement/${ijt}:Assets/${ijt}:Tools`);
+    const browsed = await session.browse(folder);
+    const intensity = `/${machinery}:LifetimeCounters/${ours}:StickSlipIntensitySinceService`;
+    const paths = {
+        serialNumber: `/${di}:Identification/${di}:SerialNumber`,
+        tightenings: `/${di}:OperationCounters/${di}:OperationCycleCounter`,
+        sinceService: `/${di}:Maintenance/${ijt}:Service/${ijt}:ServiceCycleCount`,
+        intensitySinceService: intensity,
+        limitValue: `${intensity}/${di}:LimitValue`,
+        unit: `${intensity}/EngineeringUnits`,
+    };
+    for (const ref of browsed.references) {
+        if (!ref.browseName.name.startsWith("Tool_")) continue;
+        const ids = {};
+        for (const [key, path] of Object.entries(paths)) ids[key] = await target(ref.nodeId, path);
+        for (;;) {
+            const keys = Object.keys(ids);
+            const read = await session.read(keys.map((key) => ({ nodeId: ids[key], attributeId: AttributeIds.Value })));
+            const values = {};
+            keys.forEach((key, i) => (values[key] = read[i].value.value));
+            if (values.tightenings < runs) {
+                await new Promise((resolve) => setTimeout(resolve, 500)); // the ledger lags
+                continue;
+            }
+            say({
+                type: "tool",
+                station,
+                name: ref.browseName.name,
+                serialNumber: values.serialNumber,
+                tightenings: values.tightenings,
+                sinceService: values.sinceService,
+                intensitySinceService: values.intensitySinceService,
+                limitValue: values.limitValue,
+                unitId: values.unit ? values.unit.unitId : null,
+            });
+            break;
+        }
+    }
 }
 
 async function askById(session, systemId, result, station, resultId) {
@@ -170,10 +230,14 @@ async function askById(session, systemId, result, station, resultId) {
     }
 }
 
+// exit once stdout is written out: a pipe is written asynchronously, and process.exit
+// would cut a long line (a trace) short
+const exit = (code) => process.stdout.write("", () => process.exit(code));
+
 main().then(
-    () => process.exit(0),
+    () => exit(0),
     (err) => {
         say({ type: "error", message: String(err && err.stack ? err.stack : err) });
-        process.exit(1);
+        exit(1);
     },
 );

@@ -9,7 +9,9 @@ the first run, and receives one result-ready event per run whose Result equals
 the results store's tightening: its ResultId, part, program, verdict, creation
 time and final torque, angle and preload with their windows and units. It asks
 the first result by its id (ResultManagement's GetResultById) and finds in its
-trace every sample the recording holds of the run, value for value. A client
+trace every sample the recording holds of the run, value for value; it reads
+the station's tool with its counters from the wear ledger (tightenings, since
+service, stick-slip intensity since service against the threshold). A client
 without a certificate (security None) and a client whose certificate the CA did
 not sign are refused.
 """
@@ -29,7 +31,9 @@ from services.opcua.joining_systems import result_browse_name
 from services.opcua.nodeset_files import missing_files, nodeset_folder
 from services.opcua.result_trace import recorded_samples
 from services.opcua.result_values import DEGREE, NEWTON, NEWTON_METRE, result_id
+from services.opcua.tool_assets import ONE, tool_browse_name
 from shared.results import ResultsQuery, ResultsStore, StoredResult, store_target
+from shared.wear import WearLedger, ledger_path
 from tests.support.live_recorder import free_port
 from tests.support.opcua_certificates import (
     OpcuaCertificates,
@@ -45,6 +49,7 @@ pytestmark = pytest.mark.system
 STATION = "st1"
 RUNS = 5
 CLIENT_TIMEOUT_S = 120
+THRESHOLD = 500.0  # the station's recorder.wear_service_threshold
 
 
 def _needs() -> Path:
@@ -80,7 +85,11 @@ def _value(values: list[dict[str, Any]], name: str) -> dict[str, Any]:
 def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path) -> None:
     modules = _needs()
     zenoh_port, opcua_port = free_port(), free_port()
-    station = write_station(tmp_path, zenoh_port=zenoh_port)
+    station = write_station(
+        tmp_path,
+        zenoh_port=zenoh_port,
+        replacements={"[recorder]\n": f"[recorder]\nwear_service_threshold = {THRESHOLD}\n"},
+    )
     certificates = make_opcua_certificates(tmp_path / "pki", untrusted=("stranger",))
     endpoint = f"opc.tcp://127.0.0.1:{opcua_port}"
     log = tmp_path / "opcua.log"
@@ -108,6 +117,7 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
             "client",
             results=RUNS,
             askById=True,
+            toolRuns=RUNS,
             timeoutMs=CLIENT_TIMEOUT_S * 1000,
         ),
     )
@@ -179,6 +189,7 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
     [folder] = [line for line in lines if line["type"] == "results_folder"]
     assert folder["names"] == [result_browse_name(r.run_id) for r in stored]
     _check_trace(lines, found[0])
+    _check_tools(lines, station.parent / "recordings")
 
     assert [line["type"] for line in refused] == ["refused"], refused
     assert [line["type"] for line in stranger] == ["refused"], stranger
@@ -201,6 +212,22 @@ def _check_trace(lines: list[dict[str, Any]], first: StoredResult) -> None:
     assert channels["Torque"] == [sample["torque_nm"] for sample in samples]
     assert channels["Angle"] == [sample["angle_deg"] for sample in samples]
     assert channels["Preload"] == [sample["force_n"] for sample in samples]  # None: NaN
+
+
+def _check_tools(lines: list[dict[str, Any]], recordings: Path) -> None:
+    """The station's tool in AssetManagement/Assets/Tools with the wear ledger's counters."""
+    with WearLedger(ledger_path(recordings), read_only=True) as ledger:
+        [wear] = ledger.tools(station=STATION)
+    [tool] = [line for line in lines if line["type"] == "tool"]
+    assert tool["name"] == tool_browse_name(wear.tool_id)
+    assert (
+        (tool["tightenings"], tool["sinceService"])
+        == (RUNS, RUNS)
+        == (wear.runs, wear.runs_since_service)
+    )
+    assert tool["intensitySinceService"] == wear.intensity_since_service > 0
+    assert (tool["limitValue"], tool["unitId"]) == (THRESHOLD, ONE.unit_id)
+    assert tool["serialNumber"] == ""  # no controller named the simulated tool
 
 
 def test_serve_opcua_says_what_security_it_needs(tmp_path: Path) -> None:
