@@ -18,6 +18,9 @@ from services.opcua.nodeset_files import missing_files, nodeset_folder
 from services.opcua.nodeset_loading import load_models, node_id
 from services.opcua.result_encoding import model_class, result_data
 from services.opcua.result_values import result_values
+from services.opcua.tool_assets import ToolAssets
+from services.opcua.tool_values import tool_counters
+from shared.wear import ToolWear
 from tests.support import factories
 
 if missing_files(nodeset_folder()):
@@ -32,6 +35,31 @@ async def _loaded() -> Server:
     await server.init()
     await load_models(server, nodeset_folder())
     return server
+
+
+async def _tools_of(server: Server, system: JoiningSystem) -> dict[str, Any]:
+    """The Assets folders (no placeholders), the tools, and tool 7's values once written."""
+    assets = await ToolAssets.create(server, "st1", system.node)
+    wear = ToolWear(7, 5, 6.0, 1.2, None, None, 3, 2.5)
+    await assets.update([tool_counters(wear, 40.0)])
+    ijt = await server.get_namespace_index("http://opcfoundation.org/UA/IJT/Base/")
+    folder = await system.node.get_child([f"{ijt}:AssetManagement", f"{ijt}:Assets"])
+    names = sorted([(await node.read_browse_name()).Name for node in await folder.get_children()])
+    tools = await folder.get_child(f"{ijt}:Tools")
+    [tool] = await tools.get_children()
+    values = []
+    for path in (
+        "OperationCounters/OperationCycleCounter",
+        "LifetimeCounters/StickSlipIntensitySinceService",
+        "LifetimeCounters/StickSlipIntensitySinceService/LimitValue",
+        "Maintenance/Service/ServiceCycleCount",
+        "Maintenance/Calibration/LastCalibration",  # not known: no value
+    ):
+        node = server.get_node(node_id(f"st1/tools/7/{path}", tool.nodeid.NamespaceIndex))
+        written = (await node.read_data_value(raise_on_bad_status=False)).Value
+        values.append(None if written is None else written.Value)
+    tool_name = (await tool.read_browse_name()).Name
+    return {"assets": names, "tools": [tool_name], "values": values}
 
 
 def test_the_models_load_and_a_result_round_trips_with_its_joining_metadata() -> None:
@@ -49,9 +77,28 @@ def test_the_models_load_and_a_result_round_trips_with_its_joining_metadata() ->
         system = await JoiningSystem.create(server, "st1")
         await system.publish("st1/7", 7, data, "st1/7 OK")
         names = [(await node.read_browse_name()).Name for node in await system.node.get_children()]
+        tools.update(await _tools_of(server, system))
         return data, decoded, names, event_fields
 
+    tools: dict[str, Any] = {}
     data, decoded, names, event_fields = asyncio.run(scenario())
+    assert tools["assets"] == [
+        "Accessories",
+        "Batteries",
+        "Cables",
+        "Controllers",
+        "Feeders",
+        "MemoryDevices",
+        "PowerSupplies",
+        "Sensors",
+        "Servos",
+        "SoftwareComponents",
+        "SubComponents",
+        "Tools",
+        "VirtualStations",
+    ]
+    assert tools["tools"] == ["Tool_7"]  # no <Tool> placeholder either
+    assert tools["values"] == [5, 2.5, 40.0, 3, None]
     assert "Result" in event_fields  # lost without the dropped default values
     meta = decoded.ResultMetaData
     assert type(meta).__name__ == "JoiningResultMetaDataType"  # a subtype, as the model allows
