@@ -143,5 +143,7 @@ def test_an_unknown_id_is_an_error_and_a_result_without_its_recording_says_why(
 
 def test_a_trace_of_one_sample_has_no_interval_and_none_of_no_samples() -> None:
     assert trace_values("st1/1", []) is None
-    [step] = trace_values("st1/1", [asdict(factories.sample(1, 0))])["StepTraces"]
+    trace = trace_values("st1/1", [asdict(factories.sample(1, 0))])
+    assert trace is not None
+    [step] = trace["StepTraces"]
     assert step["NumberOfTracePoints"] == 1 and "SamplingInterval" not in step
