@@ -57,7 +57,8 @@ SERVICE_HELP = {
     "published as the station's runs",
     "dashboard": "the line's web page: services, results, stop reasons, tool wear, alerts, live",
     "opcua": "the line's results over OPC UA for industrial joining (IJT): one joining system "
-    "per station, results and result-ready events",
+    "per station, results and result-ready events, results by id with their traces, tools with "
+    "their counters",
 }
 
 
