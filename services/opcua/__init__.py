@@ -20,5 +20,7 @@ The address space is built from the OPC Foundation's NodeSet2 files (IJT Base
   results store, with its steps and trace)
 - :mod:`.tool_values` (a tool of the wear ledger as an IJT tool's counters, pure),
   :mod:`.tool_assets` (the station's tools in AssetManagement/Assets/Tools)
-- :mod:`.result_inbox` (``boltwatch/<st>/results`` from zenoh, to the loop)
+- :mod:`.alert_events` (alerts and a controller's alarms as IJT joining system
+  events, pure)
+- :mod:`.line_inbox` (results, alerts and alarms from zenoh, to the loop)
 """

@@ -19,6 +19,11 @@ station's tools from :mod:`.tool_assets`). What :meth:`JoiningSystem.publish` do
   system's events). The model marks the type abstract; IJT's own servers send
   it as it is, and so does this one.
 
+:meth:`JoiningSystem.report` emits a ``JoiningSystemEventType`` event (abstract
+too) of an alert or a controller's alarm (:mod:`.alert_events`), its
+``JoiningSystemEventContent`` with ``EventCode``, ``EventText`` and
+``JoiningTechnology``, its ``ConditionClassId``/``Name`` and ``Severity``.
+
 ResultManagement's ``GetResultById`` is linked by the service
 (:mod:`.result_requests`); the other methods of ResultManagement and of the
 other management objects are in the address space as the type has them,
@@ -30,13 +35,16 @@ from __future__ import annotations
 
 import logging
 from collections import deque
+from datetime import UTC, datetime
 from typing import Any
 
 from asyncua import Server, ua
 from asyncua.common.manage_nodes import delete_nodes
 from asyncua.common.node import Node
 
+from services.opcua.alert_events import AlertEvent
 from services.opcua.nodeset_loading import IJT_BASE, MACHINERY_RESULT, node_id
+from services.opcua.result_values import JOINING_TECHNOLOGY
 
 LOG = logging.getLogger(__name__)
 
@@ -48,6 +56,8 @@ KEPT_RESULTS = 20
 JOINING_SYSTEM_TYPE = 1005
 JOINING_SYSTEM_RESULT_TYPE = 2014
 RESULT_READY_EVENT_TYPE = 1007
+JOINING_SYSTEM_EVENT_TYPE = 1006
+EVENT_CONTENT = "JoiningSystemEventContent"
 MACHINES_FOLDER = 1001
 RESULT_DATA_TYPE = 3008
 MACHINERY = "http://opcfoundation.org/UA/Machinery/"
@@ -62,12 +72,17 @@ class JoiningSystem:
     """A station's joining system in the address space, with its event generator."""
 
     def __init__(
-        self, station: str, node: Node, results: Node, events: Any, names: tuple[int, int, int]
+        self,
+        station: str,
+        node: Node,
+        results: Node,
+        generators: tuple[Any, Any],
+        names: tuple[int, int, int],
     ) -> None:
         self.station = station
         self.node = node
         self._results = results
-        self._events = events
+        self._events, self._alerts = generators
         self._names = names
         self._kept: deque[Node] = deque()
 
@@ -88,9 +103,12 @@ class JoiningSystem:
         events = await server.get_event_generator(
             node_id(RESULT_READY_EVENT_TYPE, ijt), emitting_node=node.nodeid
         )
+        alerts = await server.get_event_generator(
+            node_id(JOINING_SYSTEM_EVENT_TYPE, ijt), emitting_node=node.nodeid
+        )
         names = (ours, ijt, result_ns)
         LOG.info("joining system %s at %s", station, node.nodeid.to_string())
-        return cls(station, node, results, events, names)
+        return cls(station, node, results, (events, alerts), names)
 
     async def result_management_method(self, name: str) -> Node:
         """A method of the joining system's ResultManagement (e.g. ``GetResultById``)."""
@@ -115,6 +133,28 @@ class JoiningSystem:
         self._events.event.Result = ua.Variant(result, ua.VariantType.ExtensionObject)
         self._events.event.Severity = 100
         await self._events.trigger(message=message)
+
+    async def report(self, alert: AlertEvent) -> None:
+        """A ``JoiningSystemEventType`` event of an alert or a controller's alarm."""
+        _ours, ijt, _result_ns = self._names
+        event = self._alerts.event
+        # the event type's JoiningSystemEventContent holds variables, which asyncua's event
+        # object leaves out (it takes properties): its fields by their browse paths
+        event.add_property(f"{EVENT_CONTENT}/EventCode", alert.code, ua.VariantType.Int64)
+        event.add_property(
+            f"{EVENT_CONTENT}/EventText", ua.LocalizedText(alert.text), ua.VariantType.LocalizedText
+        )
+        event.add_property(
+            f"{EVENT_CONTENT}/JoiningTechnology",
+            ua.LocalizedText(JOINING_TECHNOLOGY),
+            ua.VariantType.LocalizedText,
+        )
+        class_id, class_name = alert.condition_class
+        event.ConditionClassId = node_id(class_id, ijt)
+        event.ConditionClassName = ua.LocalizedText(class_name)
+        event.Severity = alert.severity
+        time = datetime.fromtimestamp(alert.time_ns / 1e9, tz=UTC)
+        await self._alerts.trigger(time_attr=time, message=alert.text)
 
 
 async def drop_placeholders(node: Node) -> None:

@@ -8,7 +8,8 @@ the asyncua server: the models (:mod:`.nodeset_loading`), a joining system per
 station (:mod:`.joining_systems`), then each result into it. Once the OPC UA
 server listens, the zenoh session is opened (clients may connect and subscribe
 before the line's router is there); then results come from
-``boltwatch/<st>/results`` (:class:`~.result_inbox.ResultInbox`) and, once
+``boltwatch/<st>/results`` (:class:`~.line_inbox.LineInbox`, with the alerts and
+alarms, which become joining system events: :mod:`.alert_events`) and, once
 subscribed, the newest :data:`STARTUP_RESULTS` per station from the stations'
 results stores (:mod:`shared.results`), oldest first, so a client finds the last
 result at once. A result already served (the same ResultId) is not served twice.
@@ -29,11 +30,12 @@ from collections.abc import Sequence
 
 from asyncua import Server
 
+from services.opcua.alert_events import alert_event
 from services.opcua.joining_systems import JoiningSystem
+from services.opcua.line_inbox import LineInbox
 from services.opcua.nodeset_files import nodeset_folder
 from services.opcua.nodeset_loading import load_models
 from services.opcua.result_encoding import result_data
-from services.opcua.result_inbox import ResultInbox
 from services.opcua.result_requests import APPLICATION, get_result_by_id_method
 from services.opcua.result_values import result_id, result_values
 from services.opcua.server_security import SecuritySettings, apply
@@ -105,7 +107,7 @@ class OpcuaService:
             # the line after the server: a client may connect and subscribe before the router
             # is there (the session waits for it, as [zenoh] connect_timeout_s says)
             await asyncio.to_thread(self._skeleton.open_session, self._stations[0].config.zenoh)
-            inbox = ResultInbox(self._skeleton, list(systems))
+            inbox = LineInbox(self._skeleton, list(systems))
             for station in systems:
                 self._skeleton.health_token(station, HEALTH)
             for stored in await asyncio.to_thread(self._newest):  # after subscribing: no gap
@@ -116,11 +118,15 @@ class OpcuaService:
                     for station, counters in (await asyncio.to_thread(self._tools)).items():
                         await assets[station].update(counters)
                     tools_due_s = time.monotonic() + TOOLS_REFRESH_S
-                result = inbox.next()
-                if result is None:
+                message = inbox.next()
+                if message is None:
                     await asyncio.sleep(POLL_S)
-                    continue
-                await self._publish(systems, result)
+                elif isinstance(message, TighteningResult):
+                    await self._publish(systems, message)
+                else:
+                    event = alert_event(message)
+                    await systems[event.station].report(event)
+                    LOG.info("%s event: %s", event.station, event.text)
 
     async def _publish(self, systems: dict[str, JoiningSystem], result: TighteningResult) -> None:
         system = systems.get(result.station)

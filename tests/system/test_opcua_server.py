@@ -118,6 +118,9 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
             results=RUNS,
             askById=True,
             toolRuns=RUNS,
+            # about 2 min of tries: the server listens once its models are loaded (10 s and
+            # more on a loaded machine; the client's default 40 tries, 20 s, ran out)
+            connectRetries=240,
             timeoutMs=CLIENT_TIMEOUT_S * 1000,
         ),
     )

@@ -13,6 +13,7 @@ import pytest
 from asyncua import Server, ua
 from asyncua.ua.ua_binary import struct_from_binary, struct_to_binary
 
+from services.opcua.alert_events import alert_event
 from services.opcua.joining_systems import JoiningSystem
 from services.opcua.nodeset_files import missing_files, nodeset_folder
 from services.opcua.nodeset_loading import load_models, node_id
@@ -20,6 +21,7 @@ from services.opcua.result_encoding import model_class, result_data
 from services.opcua.result_values import result_values
 from services.opcua.tool_assets import ToolAssets
 from services.opcua.tool_values import tool_counters
+from shared.contract import ControllerAlarm
 from shared.wear import ToolWear
 from tests.support import factories
 
@@ -62,6 +64,31 @@ async def _tools_of(server: Server, system: JoiningSystem) -> dict[str, Any]:
     return {"assets": names, "tools": [tool_name], "values": values}
 
 
+class _Events:
+    def __init__(self) -> None:
+        self.received: list[Any] = []
+
+    def event_notification(self, event: Any) -> None:
+        self.received.append(event)
+
+
+async def _alarm_events(server: Server, system: JoiningSystem) -> list[Any]:
+    """A controller's alarm reported by the joining system, as a subscriber of its
+    JoiningSystemEventType events gets it."""
+    ijt = await server.get_namespace_index("http://opcfoundation.org/UA/IJT/Base/")
+    events = _Events()
+    subscription = await server.create_subscription(10, events)
+    await subscription.subscribe_events(system.node, server.get_node(node_id(1006, ijt)))
+    alarm = ControllerAlarm(
+        "st1", factories.T0, factories.T0, "E404", "raised", True, None, None, "tool not connected"
+    )
+    await system.report(alert_event(alarm))
+    while not events.received:  # the subscription publishes every 10 ms
+        await asyncio.sleep(0.01)
+    await subscription.delete()
+    return events.received
+
+
 def test_the_models_load_and_a_result_round_trips_with_its_joining_metadata() -> None:
     async def scenario() -> tuple[Any, Any, list[Any], list[Any]]:
         server = await _loaded()
@@ -78,9 +105,11 @@ def test_the_models_load_and_a_result_round_trips_with_its_joining_metadata() ->
         await system.publish("st1/7", 7, data, "st1/7 OK")
         names = [(await node.read_browse_name()).Name for node in await system.node.get_children()]
         tools.update(await _tools_of(server, system))
+        alarms.extend(await _alarm_events(server, system))
         return data, decoded, names, event_fields
 
     tools: dict[str, Any] = {}
+    alarms: list[Any] = []
     data, decoded, names, event_fields = asyncio.run(scenario())
     assert tools["assets"] == [
         "Accessories",
@@ -99,6 +128,11 @@ def test_the_models_load_and_a_result_round_trips_with_its_joining_metadata() ->
     ]
     assert tools["tools"] == ["Tool_7"]  # no <Tool> placeholder either
     assert tools["values"] == [5, 2.5, 40.0, 3, None]
+    [alarm] = alarms  # through a subscription of the server's own session
+    assert alarm.Message.Text == "E404: tool not connected"
+    assert getattr(alarm, "JoiningSystemEventContent/EventCode") == 404
+    assert getattr(alarm, "JoiningSystemEventContent/EventText").Text == alarm.Message.Text
+    assert (alarm.Severity, alarm.ConditionClassName.Text) == (800, "ErrorConditionClassType")
     assert "Result" in event_fields  # lost without the dropped default values
     meta = decoded.ResultMetaData
     assert type(meta).__name__ == "JoiningResultMetaDataType"  # a subtype, as the model allows

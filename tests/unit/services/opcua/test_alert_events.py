@@ -1,0 +1,44 @@
+"""Alerts and a controller's alarms as IJT joining system events (pure)."""
+
+from __future__ import annotations
+
+from services.opcua.alert_events import (
+    ERROR_CONDITION,
+    THRESHOLD_VIOLATION,
+    THRESHOLD_VIOLATION_RESOLVED,
+    alert_event,
+)
+from shared.contract import ControllerAlarm, QualityAlert, WearAlert
+
+T0_NS = 1_700_000_000_000_000_000
+
+
+def test_a_wear_alert_is_a_threshold_violation_naming_its_tool() -> None:
+    event = alert_event(WearAlert("st1", 7, T0_NS, 512.3, 500.0, 88, None))
+    assert (event.code, event.severity, event.condition_class) == (1, 500, THRESHOLD_VIOLATION)
+    assert event.text == (
+        "tool 7: stick-slip intensity since service 512.3 reached its threshold 500 "
+        "(88 tightenings since service)"
+    )
+
+
+def test_a_quality_alert_and_its_clearing() -> None:
+    fields = ("st1", 1, T0_NS, "nok_run", None, 3.0, 3.0, 3)
+    raised = alert_event(QualityAlert(*fields, True, "3 NOK in a row"))
+    cleared = alert_event(QualityAlert(*fields, False, "back in control"))
+    assert (raised.code, raised.severity, raised.condition_class) == (12, 700, THRESHOLD_VIOLATION)
+    assert (cleared.severity, cleared.condition_class) == (100, THRESHOLD_VIOLATION_RESOLVED)
+    assert (raised.text, cleared.text) == ("3 NOK in a row", "back in control")
+
+
+def test_a_controller_alarm_keeps_its_code_and_says_when_it_went_off() -> None:
+    def alarm(code: str, active: bool, text: str) -> ControllerAlarm:
+        return ControllerAlarm("st1", T0_NS, T0_NS, code, "status", active, None, None, text)
+
+    on = alert_event(alarm("E404", True, "tool not connected"))
+    assert (on.code, on.text, on.severity, on.condition_class) == (
+        404, "E404: tool not connected", 800, ERROR_CONDITION
+    )  # fmt: skip
+    off = alert_event(alarm("E404", False, ""))
+    assert (off.text, off.severity) == ("E404 (off)", 100)
+    assert alert_event(alarm("EBATT", True, "")).code == 0  # no digits in the code
