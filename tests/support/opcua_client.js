@@ -9,8 +9,9 @@
 // per station {"type": "system", "station", "nodeId"} once it browsed to its joining
 // system (Objects/Machines/<station>) and subscribed to its events; {"type": "subscribed"}
 // once every station is; one {"type": "result", "station", "eventType", "message",
-// "result"} per result-ready event (the Result field as JSON); at the end, per station,
-// {"type": "results_folder", "station", "names"} (the browse names in
+// "result"} per result-ready event (the Result field as JSON), {"type": "event",
+// "station", "eventType", "message"} per other event of the joining system (an alert);
+// at the end, per station, {"type": "results_folder", "station", "names"} (the browse names in
 // ResultManagement/Results); with "askById": true, the first result received asked by
 // its id (ResultManagement's GetResultById, again while the results store does not have
 // it yet: Error -1) as {"type": "by_id", "station", "resultId", "error", "result"}
@@ -104,7 +105,17 @@ async function main() {
         );
         item.on("changed", (fields) => {
             const [eventType, sourceName, message, value] = fields;
-            if (!(station in firstResultId) && value.value) {
+            if (!value.value) {
+                // another event of the joining system (an alert, an alarm): no Result
+                say({
+                    type: "event",
+                    station,
+                    eventType: eventType.value ? eventType.value.toString() : null,
+                    message: message.value ? message.value.text : null,
+                });
+                return;
+            }
+            if (!(station in firstResultId)) {
                 firstResultId[station] = value.value.resultMetaData.resultId;
             }
             say({

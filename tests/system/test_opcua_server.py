@@ -11,7 +11,8 @@ time and final torque, angle and preload with their windows and units. It asks
 the first result by its id (ResultManagement's GetResultById) and finds in its
 trace every sample the recording holds of the run, value for value; it reads
 the station's tool with its counters from the wear ledger (tightenings, since
-service, stick-slip intensity since service against the threshold). A client
+service, stick-slip intensity since service against the threshold), and
+receives the recorder's wear alerts as the joining system's events. A client
 without a certificate (security None) and a client whose certificate the CA did
 not sign are refused.
 """
@@ -49,7 +50,7 @@ pytestmark = pytest.mark.system
 STATION = "st1"
 RUNS = 5
 CLIENT_TIMEOUT_S = 120
-THRESHOLD = 500.0  # the station's recorder.wear_service_threshold
+THRESHOLD = 500.0  # the station's recorder.wear_service_threshold: below one run's
 
 
 def _needs() -> Path:
@@ -231,6 +232,13 @@ def _check_tools(lines: list[dict[str, Any]], recordings: Path) -> None:
     assert tool["intensitySinceService"] == wear.intensity_since_service > 0
     assert (tool["limitValue"], tool["unitId"]) == (THRESHOLD, ONE.unit_id)
     assert tool["serialNumber"] == ""  # no controller named the simulated tool
+    # the recorder's wear alerts (the threshold is below one run's intensity) as the joining
+    # system's JoiningSystemEventType events
+    alerts = [line for line in lines if line["type"] == "event"]
+    assert alerts, lines
+    for alert in alerts:
+        assert alert["eventType"].endswith(";i=1006")
+        assert alert["message"].startswith(f"tool {wear.tool_id}: stick-slip intensity since")
 
 
 def test_serve_opcua_says_what_security_it_needs(tmp_path: Path) -> None:
