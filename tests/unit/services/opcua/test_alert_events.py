@@ -23,9 +23,11 @@ def test_a_wear_alert_is_a_threshold_violation_naming_its_tool() -> None:
 
 
 def test_a_quality_alert_and_its_clearing() -> None:
-    fields = ("st1", 1, T0_NS, "nok_run", None, 3.0, 3.0, 3)
-    raised = alert_event(QualityAlert(*fields, True, "3 NOK in a row"))
-    cleared = alert_event(QualityAlert(*fields, False, "back in control"))
+    def alert(active: bool, text: str) -> QualityAlert:
+        return QualityAlert("st1", 1, T0_NS, "nok_run", None, 3.0, 3.0, 3, active, text)
+
+    raised = alert_event(alert(True, "3 NOK in a row"))
+    cleared = alert_event(alert(False, "back in control"))
     assert (raised.code, raised.severity, raised.condition_class) == (12, 700, THRESHOLD_VIOLATION)
     assert (cleared.severity, cleared.condition_class) == (100, THRESHOLD_VIOLATION_RESOLVED)
     assert (raised.text, cleared.text) == ("3 NOK in a row", "back in control")
