@@ -7,7 +7,8 @@ children (AssetManagement, Identification, JoiningProcessManagement,
 JointManagement, MachineryBuildingBlocks, ResultManagement with its methods and
 its ``Results`` folder), and instances of the type's placeholders too, which are
 deleted (:func:`drop_placeholders`; ``AssetManagement/Assets/Tools`` gets the
-station's tools from :mod:`.tool_assets`). What :meth:`JoiningSystem.publish` does with a result:
+station's tools from :mod:`.tool_assets`). What :meth:`JoiningSystem.publish`
+does with a result:
 
 - ``ResultManagement/Results``: a variable of ``JoiningSystemResultType``
   (data type ``ResultDataType``) named ``Result_<run id>`` (a browse name
@@ -35,7 +36,6 @@ from __future__ import annotations
 
 import logging
 from collections import deque
-from datetime import UTC, datetime
 from typing import Any
 
 from asyncua import Server, ua
@@ -44,7 +44,7 @@ from asyncua.common.node import Node
 
 from services.opcua.alert_events import AlertEvent
 from services.opcua.nodeset_loading import IJT_BASE, MACHINERY_RESULT, node_id
-from services.opcua.result_values import JOINING_TECHNOLOGY
+from services.opcua.result_values import JOINING_TECHNOLOGY, utc_time
 
 LOG = logging.getLogger(__name__)
 
@@ -153,8 +153,7 @@ class JoiningSystem:
         event.ConditionClassId = node_id(class_id, ijt)
         event.ConditionClassName = ua.LocalizedText(class_name)
         event.Severity = alert.severity
-        time = datetime.fromtimestamp(alert.time_ns / 1e9, tz=UTC)
-        await self._alerts.trigger(time_attr=time, message=alert.text)
+        await self._alerts.trigger(time_attr=utc_time(alert.time_ns), message=alert.text)
 
 
 async def drop_placeholders(node: Node) -> None:

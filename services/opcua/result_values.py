@@ -111,6 +111,11 @@ _EVALUATION_OF_STEP = {
 }
 
 
+def utc_time(time_ns: int) -> datetime:
+    """An OPC UA UtcTime (a DateTime) of nanoseconds since the epoch."""
+    return datetime.fromtimestamp(time_ns / 1e9, tz=UTC)
+
+
 def result_id(station: str, run_id: int) -> str:
     """The ResultId of a station's run (unique in the results store)."""
     return f"{station}/{run_id}"
@@ -128,7 +133,7 @@ def result_values(result: TighteningResult, trace: dict[str, Any] | None = None)
     }
     meta: dict[str, Any] = {
         "ResultId": result_id(result.station, result.run_id),
-        "CreationTime": datetime.fromtimestamp(result.time_ns / 1e9, tz=UTC),
+        "CreationTime": utc_time(result.time_ns),
         "InternalRecipeId": str(result.program_id),
         "ResultState": RESULT_STATE_COMPLETED,
         "ResultEvaluation": EVALUATION_OK if result.result == "OK" else EVALUATION_NOT_OK,

@@ -31,7 +31,7 @@ seconds (the recorder adds a run to the ledger when its summary comes).
 
 from __future__ import annotations
 
-from datetime import UTC, datetime
+from datetime import datetime
 from typing import Any
 
 from asyncua import Server, ua
@@ -45,7 +45,7 @@ from services.opcua.joining_systems import (
 )
 from services.opcua.nodeset_loading import IJT_BASE, MODEL_URIS, node_id
 from services.opcua.result_encoding import eu_information
-from services.opcua.result_values import NEWTON_METRE, EngineeringUnit
+from services.opcua.result_values import NEWTON_METRE, EngineeringUnit, utc_time
 from services.opcua.tool_values import ToolCounters
 
 #: numeric ids in IJT Base, Machinery and DI
@@ -69,7 +69,7 @@ def tool_browse_name(tool_id: int) -> str:
 
 
 def _utc(time_ns: int | None) -> datetime | None:
-    return None if time_ns is None else datetime.fromtimestamp(time_ns / 1e9, tz=UTC)
+    return None if time_ns is None else utc_time(time_ns)
 
 
 def _data_value(value: Any, variant_type: ua.VariantType) -> ua.DataValue:
