@@ -24,29 +24,20 @@ from shared.quality.program_columns import (
     JUDGED_FIGURES,
     TOOL_STOPPED,
     ProgramColumns,
-    Window,
     reason_kinds,
 )
 from shared.results.results_query import ResultsQuery
 from shared.results.results_store import ResultsStore
 
-#: the columns of each run, in this order: what the figures' arrays are made of
-_FIGURE_COLUMNS = (
-    "program_id",
-    "torque_nm",
-    "angle_deg",
-    "force_n",
-    "process_intensity",
-    "events",
-    "CASE WHEN result = 'NOK' THEN 1 ELSE 0 END",
+#: what each run gives, in the order the runs ended: the figures' arrays, NOK reasons
+_RUN_COLUMNS = (
+    "program_id, torque_nm, angle_deg, force_n, process_intensity, events, "
+    "CASE WHEN result = 'NOK' THEN nok_reasons END"
 )
-#: each judged figure's window columns, in the order of JUDGED_FIGURES
-_WINDOW_COLUMNS = (
-    "torque_min_nm, torque_max_nm",
-    "angle_min_deg, angle_max_deg",
-    "force_min_n, force_max_n",
-)
-_WINDOWS = ", ".join(_WINDOW_COLUMNS)
+#: each judged figure's window, in the order of JUDGED_FIGURES
+_WINDOWS = "torque_min_nm, torque_max_nm, angle_min_deg, angle_max_deg, force_min_n, force_max_n"
+#: what is counted, grouped by the database
+_GROUPS = f"program_id, station, tool_id, stop_reason, {_WINDOWS}"
 
 
 def program_columns(store: ResultsStore, query: ResultsQuery) -> list[ProgramColumns]:
@@ -54,85 +45,66 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> list[ProgramCol
     order ignored: every one, in the order the runs ended), by program id."""
     everything = dataclasses.replace(query, limit=None, oldest_first=True)
     where, parameters = everything.where()
-
-    def rows(sql: str, where: str = where, parameters: list[Any] = parameters) -> list[Any]:
-        return store.database.rows(sql.format(where=where), parameters)
-
-    figures = _figure_array(rows(f"SELECT {', '.join(_FIGURE_COLUMNS)} FROM tightenings{{where}}"
-                                 f"{everything.order()}"))  # fmt: skip
-    if not len(figures):
+    rows = store.database.rows(
+        f"SELECT {_RUN_COLUMNS} FROM tightenings{where}{everything.order()}", parameters
+    )
+    if not rows:
         return []
-    windows: dict[int, list[set[Window]]] = defaultdict(lambda: [set() for _ in JUDGED_FIGURES])
-    for program_id, *bounds in rows(
-        f"SELECT program_id, {_WINDOWS} FROM tightenings{{where}} GROUP BY program_id, {_WINDOWS}"
+    figures = np.array([row[:6] for row in rows], dtype=np.float64)  # None: NaN
+    nok_reasons: dict[int, list[str]] = defaultdict(list)
+    for row in rows:
+        if row[6] is not None:
+            nok_reasons[row[0]].append(row[6])
+    del rows
+    grouped: dict[int, list[tuple[Any, ...]]] = defaultdict(list)
+    for program_id, *group in store.database.rows(
+        f"SELECT {_GROUPS}, COUNT(*) FROM tightenings{where} GROUP BY {_GROUPS}", parameters
     ):
-        for index, seen in enumerate(windows[program_id]):
-            seen.add((bounds[2 * index], bounds[2 * index + 1]))
-    newest = {
-        program_id: (name, bounds)
-        for program_id, name, *bounds in rows(
-            f"SELECT program_id, program_name, {_WINDOWS} FROM (SELECT program_id, program_name, "
-            f"{_WINDOWS}, ROW_NUMBER() OVER (PARTITION BY program_id ORDER BY ended_ns DESC, "
-            "station DESC, run_id DESC) AS newest FROM tightenings{where}) AS ranked "
-            "WHERE newest = 1"
-        )
-    }
-    nok_reasons: dict[int, Counter[str]] = defaultdict(Counter)
-    nok_where, nok_parameters = dataclasses.replace(everything, nok_only=True).where()
-    for program_id, reasons in rows(
-        "SELECT program_id, nok_reasons FROM tightenings{where}", nok_where, nok_parameters
-    ):
-        nok_reasons[program_id].update(reason_kinds(reasons))
-    stop_reasons: dict[int, Counter[str]] = defaultdict(Counter)
-    for program_id, reason, runs in rows(
-        "SELECT program_id, stop_reason, COUNT(*) FROM tightenings{where} "
-        "GROUP BY program_id, stop_reason"
-    ):
-        stop_reasons[program_id][reason or TOOL_STOPPED] += int(runs)
-    stations, tools = defaultdict(list), defaultdict(list)
-    for program_id, station in rows(
-        "SELECT DISTINCT program_id, station FROM tightenings{where} ORDER BY station"
-    ):
-        stations[program_id].append(station)
-    for program_id, tool_id in rows(
-        "SELECT DISTINCT program_id, tool_id FROM tightenings{where} ORDER BY tool_id"
-    ):
-        tools[program_id].append(int(tool_id))
+        grouped[program_id].append(tuple(group))
     columns = []
-    for program_id in sorted(newest):
+    for program_id in sorted(grouped):
+        latest = dataclasses.replace(everything, program_id=program_id, oldest_first=False, limit=1)
+        latest_where, latest_parameters = latest.where()  # by the index of program_id
+        ((name, *newest),) = store.database.rows(
+            f"SELECT program_name, {_WINDOWS} FROM tightenings{latest_where}{latest.order()}",
+            latest_parameters,
+        )
         of_program = figures[figures[:, 0] == program_id]
-        name, bounds = newest[program_id]
+        groups = grouped[program_id]
+        stop_reasons: Counter[str] = Counter()
+        for _station, _tool, reason, *_windows, runs in groups:
+            stop_reasons[reason or TOOL_STOPPED] += int(runs)
+        reasons: Counter[str] = Counter()
+        for text in nok_reasons[program_id]:
+            reasons.update(reason_kinds(text))
         columns.append(
             ProgramColumns(
                 program_id=program_id,
                 program_name=name,
                 runs=len(of_program),
-                noks=int(of_program[:, 6].sum()),
+                noks=len(nok_reasons[program_id]),
                 values={
                     key: _measured(of_program[:, 1 + index])
                     for index, key in enumerate((*JUDGED_FIGURES, "intensity"))
                 },
                 latest_windows={
-                    key: (bounds[2 * index], bounds[2 * index + 1])
+                    key: (newest[2 * index], newest[2 * index + 1])
                     for index, key in enumerate(JUDGED_FIGURES)
                 },
                 window_counts={
-                    key: len(windows[program_id][index]) for index, key in enumerate(JUDGED_FIGURES)
+                    key: len({group[3 + 2 * index : 5 + 2 * index] for group in groups})
+                    for index, key in enumerate(JUDGED_FIGURES)
                 },
-                nok_reasons=nok_reasons[program_id],
-                stop_reasons=stop_reasons[program_id],
+                nok_reasons=reasons,
+                stop_reasons=stop_reasons,
                 events_per_run=[int(events) for events in _measured(of_program[:, 5])],
-                stations=stations[program_id],
-                tools=tools[program_id],
+                stations=sorted({group[0] for group in groups}),
+                tools=sorted({int(group[1]) for group in groups}),
             )
         )
     return columns
 
 
-def _figure_array(rows: list[tuple[Any, ...]]) -> np.ndarray:
-    """The runs' figures as one float array, a row a run (NaN: not measured)."""
-    return np.array(rows, dtype=np.float64).reshape(len(rows), len(_FIGURE_COLUMNS))
-
-
 def _measured(column: np.ndarray) -> np.ndarray:
+    """The values of the runs that measured it (NaN: not measured)."""
     return column[~np.isnan(column)]
