@@ -34,7 +34,8 @@ from shared.contract import (
     channels,
     keys,
 )
-from shared.errors import TransportError
+from shared.errors import InputError, TransportError
+from shared.recordings import final_path_of, unfinished_files
 from shared.recordings.mcap import RecordingScan
 from shared.runtime import open_bus, open_from, zenoh_config
 from tests.support.listener import Listener
@@ -263,9 +264,19 @@ def live_station(
 
 def recorded_sequences(recordings: Path, run_id: int) -> list[int]:
     """Sequences of the run's samples in every file under ``recordings`` (damaged or open
-    files too: their complete records), in file order."""
+    files too, under their writing names: their complete records), in file order."""
+    for _ in range(4):
+        try:
+            return _sequences_in_files(recordings, run_id)
+        except InputError:  # a file renamed (closed) between the listing and its reading
+            continue
+    return _sequences_in_files(recordings, run_id)
+
+
+def _sequences_in_files(recordings: Path, run_id: int) -> list[int]:
+    files = [*recordings.rglob("*.mcap"), *unfinished_files(recordings)]
     sequences: list[int] = []
-    for path in sorted(recordings.rglob("*.mcap")):
+    for path in sorted(files, key=lambda path: final_path_of(path) or path):
         if path.name.endswith(".recovered.mcap"):
             continue
         for schema, _, message in RecordingScan(path).messages("/samples"):
