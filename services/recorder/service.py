@@ -15,9 +15,9 @@ served station gets its metadata from its own file, its own ``wear``
 queryable and its own health token; they share the recordings folder and
 the ``[recorder]`` settings (an error when the files disagree). One recorder
 holds a station: a second one is refused at start
-(:mod:`services.recorder.station_holder`); the one that starts first finishes
-the run files a crash left unfinished (:func:`~shared.recordings.mcap.finish_unfinished`). A station
-with no file is not its station: in a plant each line's recorder records its
+(:mod:`services.recorder.station_holder`); the one that holds it finishes
+the run files a crash left unfinished
+(:func:`~shared.recordings.mcap.finish_unfinished`). A station with no file is not its station: in a plant each line's recorder records its
 own line's stations, and the subscription never asks the router for the
 others (no other line's sample crosses to this line for it). No payload
 stops it: what it refuses (:mod:`shared.recordings.received`) is recorded

@@ -3,8 +3,8 @@
 A full disk cuts a file in the middle of a run; the guard keeps a reserve
 (``recorder.free_space_reserve_bytes``, by default the largest a run file
 may grow to) so that never happens to the files already open: below it, no
-new file is opened (:meth:`FreeSpace.check` raises :class:`LowFreeSpaceError`, an
-``OSError`` of ``ENOSPC``), while the files open now are finished whole. The
+new file is opened (:meth:`FreeSpace.check` raises :class:`LowFreeSpaceError`,
+an ``OSError`` of ``ENOSPC``), while the files open now are finished whole. The
 recorder treats it as the disk failing (:mod:`.recorder`): the run's messages
 are dropped and counted, one ERROR naming the free space and the key,
 ``recording: false`` and the reason in ``RecorderStats`` (``boltwatch status``,

@@ -193,8 +193,9 @@ class McapSink:
     def abandon(self) -> int:
         """Let go of the file without writing more (its disk failed); messages lost with it.
 
-        Never raises. What was flushed stays in the file (``boltwatch recover``
-        makes it valid); a file that holds no message is removed.
+        Never raises. What was flushed stays in the file (under its writing name
+        when renamed once complete: :mod:`.unfinished_files` makes it valid); a file
+        that holds no message is removed.
         """
         if self._abandoned:
             return 0
