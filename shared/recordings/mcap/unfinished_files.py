@@ -116,7 +116,7 @@ def finish_one(writing: Path) -> Unfinished:
             return Unfinished(writing, None, 0, False, None)
         LOG.error("%s could not be finished, left as it is: %s", writing, problem)
         return Unfinished(writing, None, 0, False, problem)
-    LOG.info("%s", report.describe().replace(str(staging), str(final)))
+    LOG.info("%s finished as %s", writing.name, final.name)  # recover() logged the counts
     return Unfinished(writing, final, report.messages, False, None)
 
 
