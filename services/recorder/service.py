@@ -10,25 +10,23 @@ interval, even when the line is quiet, and once a second publishes
 subscriber is undeclared, what it received is filed and every file
 finished, so it is readable without recovery.
 
-One process serves several stations (``--config A.toml B.toml``): each
-served station gets its metadata from its own file, its own ``wear``
-queryable and its own health token; they share the recordings folder and
-the ``[recorder]`` settings (an error when the files disagree). One recorder
-holds a station: a second one is refused at start
-(:mod:`services.recorder.station_holder`); the one that holds it finishes
-the run files a crash left unfinished
-(:func:`~shared.recordings.mcap.finish_unfinished`). A station with no file is not its station: in a plant each line's recorder records its
-own line's stations, and the subscription never asks the router for the
-others (no other line's sample crosses to this line for it). No payload
-stops it: what it refuses (:mod:`shared.recordings.received`) is recorded
-raw and counted in the station's ``RecorderStats.bad_payloads``. Every
-TighteningResult it files feeds the quality alert
+One process serves several stations (``--config A.toml B.toml``): each served station
+gets its metadata from its own file, its own ``wear`` queryable and its own health
+token; they share the recordings folder and the ``[recorder]`` settings (an error when
+the files disagree). One recorder holds a station: a second one is refused at start
+(:mod:`services.recorder.station_holder`); the one that holds it finishes the run files
+a crash left unfinished (:func:`~shared.recordings.mcap.finish_unfinished`). A station
+with no file is not its station: in a plant each line's recorder records its own line's
+stations, and the subscription never asks the router for the others (no other line's
+sample crosses to this line for it). No payload stops it: what it refuses
+(:mod:`shared.recordings.received`) is recorded raw and counted in the station's
+``RecorderStats.bad_payloads``. Every TighteningResult it files feeds the quality alert
 (:mod:`services.recorder.quality_watch`, on ``quality/alert``) and the results store
-(:mod:`services.recorder.results_watch`), every
-RunSummary the wear ledger (``wear/alert``); a view-only recorder keeps none of them.
-With a ``[retention]`` rule, a thread of its own deletes the recordings the policy lets
-go (:mod:`services.recorder.retention_watch`; the worker only tells it, at each tick,
-which files it has open).
+(:mod:`services.recorder.results_watch`), every RunSummary the wear ledger
+(``wear/alert``); a view-only recorder keeps none of them. With a ``[retention]`` rule,
+a thread of its own deletes the recordings the policy lets go
+(:mod:`services.recorder.retention_watch`; the worker only tells it, at each tick, which
+files it has open).
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
