@@ -13,7 +13,7 @@ cannot be read (not MCAP, or the disk fails again) is left as it is and named
 in the log.
 
 It runs only in the recorder that holds the recordings folder
-(:mod:`services.recorder.folder_lock`): a file being written by a live
+(:mod:`services.recorder.station_holder`): a file being written by a live
 recorder must never be taken for a crash's.
 """
 
