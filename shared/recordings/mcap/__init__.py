@@ -21,4 +21,4 @@ from shared.recordings.mcap.unfinished_files import (
     finish_unfinished,
 )
 
-__all__ = ["FinishedCount", "McapSink", "Unfinished", "finish_one", "finish_unfinished", "MessageAppender", "MessageRow", "RAW_ENCODING", "RAW_REASON", "RecordingScan", "SAMPLE_SCHEMA", "default_target", "export_trace", "recover", "remove_unfinished"]
+__all__ = ["default_target", "export_trace", "finish_one", "finish_unfinished", "FinishedCount", "McapSink", "MessageAppender", "MessageRow", "RAW_ENCODING", "RAW_REASON", "RecordingScan", "recover", "remove_unfinished", "SAMPLE_SCHEMA", "Unfinished"]
