@@ -4,6 +4,7 @@
 - :mod:`.mcap_messages`: a batch of messages packed into the writer's open chunk at once
 - :mod:`.recording_reader`: a recording read back, message by message
 - :mod:`.recovery`: a truncated MCAP made valid (``boltwatch recover``)
+- :mod:`.unfinished_files`: files a crash left under their writing name, made run files
 - :mod:`.trace_export`: a recording as a CSV trace (``boltwatch export``)
 """
 
@@ -13,5 +14,11 @@ from shared.recordings.mcap.mcap_sink import McapSink, RAW_ENCODING, RAW_REASON
 from shared.recordings.mcap.recording_reader import RecordingScan
 from shared.recordings.mcap.recovery import default_target, recover, remove_unfinished
 from shared.recordings.mcap.trace_export import SAMPLE_SCHEMA, export_trace
+from shared.recordings.mcap.unfinished_files import (
+    FinishedCount,
+    Unfinished,
+    finish_one,
+    finish_unfinished,
+)
 
-__all__ = ["McapSink", "MessageAppender", "MessageRow", "RAW_ENCODING", "RAW_REASON", "RecordingScan", "SAMPLE_SCHEMA", "default_target", "export_trace", "recover", "remove_unfinished"]
+__all__ = ["default_target", "export_trace", "finish_one", "finish_unfinished", "FinishedCount", "McapSink", "MessageAppender", "MessageRow", "RAW_ENCODING", "RAW_REASON", "RecordingScan", "recover", "remove_unfinished", "SAMPLE_SCHEMA", "Unfinished"]
