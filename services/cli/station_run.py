@@ -30,6 +30,7 @@ import zenoh
 from services.cli import run_table
 from services.cli.run_tally import RunTally
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
+from services.cli.unrecorded_runs import unrecorded_note, unrecorded_runs
 from shared.config import LoadedStation, Program
 from shared.contract import (
     BridgeStats,
@@ -88,6 +89,8 @@ class StationRun:
         self.started_s = time.time()
         self._session: zenoh.Session | None = None
         self._stopped = False
+        #: runs summarised with no run file (after the report): up's exit is then not 0
+        self.unrecorded: list[RunSummary] = []
 
     def process_name(self, service: str, station_id: str) -> str:
         """``rig`` for the one station of ``up``; ``rig-st2`` on a line."""
@@ -177,7 +180,7 @@ class StationRun:
             subscriber.undeclare()
         self.stop_everything()
         self.report()
-        return 0 if self._every_station_has_its_runs() else 1
+        return 0 if self._every_station_has_its_runs() and not self.unrecorded else 1
 
     def _every_station_has_its_runs(self) -> bool:
         return all(len(runs) >= self.runs for runs in self.summaries.values())
@@ -329,6 +332,13 @@ class StationRun:
             if bridge is not None:
                 print(run_table.bridge_line(bridge))
         self._report_recordings()
+        self.unrecorded = unrecorded_runs(
+            self.station.recordings_folder, every_summary, self.started_s
+        )
+        if self.unrecorded:
+            recorder_log = self.supervisor.log_dir / "recorder.log"
+            note = unrecorded_note(self.unrecorded, len(every_summary), recorder_log)
+            print(note, file=sys.stderr)
         print(f"logs: {self.supervisor.log_dir}")
         print(f"took {time.time() - self.started_s:.1f} s")
 

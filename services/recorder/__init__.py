@@ -5,6 +5,7 @@ store and the wear ledger.
   the flush ticks), :mod:`.wear_queryable` (``boltwatch/<st>/wear`` answered),
   :mod:`.arguments` (its options),
   :mod:`.served_stations` (the station files it serves, which must agree),
+  :mod:`.station_holder` (one recorder per station: the folder's lock, the station's token),
   :mod:`.live_views` (Rerun's viewer and the Foxglove WebSocket, started when asked for)
 - :mod:`.live` (what a line sends, filed per station and run: inbox, batches,
   run files, health, the order of stations' spooled messages and their

@@ -17,6 +17,7 @@ def limits_of(loaded: AnyStation) -> FileLimits:
         flush_interval_ns=round(section.flush_interval_s * 1e9),
         max_file_bytes=section.max_file_bytes,
         max_file_duration_ns=round(section.max_file_duration_s * 1e9),
+        free_space_reserve_bytes=section.free_space_reserve_bytes,
     )
 
 

@@ -10,22 +10,23 @@ interval, even when the line is quiet, and once a second publishes
 subscriber is undeclared, what it received is filed and every file
 finished, so it is readable without recovery.
 
-One process serves several stations (``--config A.toml B.toml``): each
-served station gets its metadata from its own file, its own ``wear``
-queryable and its own health token; they share the recordings folder and
-the ``[recorder]`` settings (an error when the files disagree). A station
-with no file is not its station: in a plant each line's recorder records its
-own line's stations, and the subscription never asks the router for the
-others (no other line's sample crosses to this line for it). No payload
-stops it: what it refuses (:mod:`shared.recordings.received`) is recorded
-raw and counted in the station's ``RecorderStats.bad_payloads``. Every
-TighteningResult it files feeds the quality alert
+One process serves several stations (``--config A.toml B.toml``): each served station
+gets its metadata from its own file, its own ``wear`` queryable and its own health
+token; they share the recordings folder and the ``[recorder]`` settings (an error when
+the files disagree). One recorder holds a station: a second one is refused at start
+(:mod:`services.recorder.station_holder`); the one that holds it finishes the run files
+a crash left unfinished (:func:`~shared.recordings.mcap.finish_unfinished`). A station
+with no file is not its station: in a plant each line's recorder records its own line's
+stations, and the subscription never asks the router for the others (no other line's
+sample crosses to this line for it). No payload stops it: what it refuses
+(:mod:`shared.recordings.received`) is recorded raw and counted in the station's
+``RecorderStats.bad_payloads``. Every TighteningResult it files feeds the quality alert
 (:mod:`services.recorder.quality_watch`, on ``quality/alert``) and the results store
-(:mod:`services.recorder.results_watch`), every
-RunSummary the wear ledger (``wear/alert``); a view-only recorder keeps none of them.
-With a ``[retention]`` rule, a thread of its own deletes the recordings the policy lets
-go (:mod:`services.recorder.retention_watch`; the worker only tells it, at each tick,
-which files it has open).
+(:mod:`services.recorder.results_watch`), every RunSummary the wear ledger
+(``wear/alert``); a view-only recorder keeps none of them. With a ``[retention]`` rule,
+a thread of its own deletes the recordings the policy lets go
+(:mod:`services.recorder.retention_watch`; the worker only tells it, at each tick, which
+files it has open).
 
 Beside each run's MCAP a Rerun ``.rrd`` is written (``--no-rerun``: not);
 ``--rerun-serve`` / ``--rerun-web`` also stream every run to a live viewer
@@ -41,6 +42,7 @@ the MCAP recording: it is logged and the recorder goes on without it.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import socket
 import threading
@@ -63,6 +65,10 @@ from services.recorder.quality_watch import QualityWatch
 from services.recorder.results_watch import ResultsWatch
 from services.recorder.retention_watch import RetentionWatch
 from services.recorder.served_stations import limits_of, served_stations
+from services.recorder.station_holder import (
+    recordings_folder_held,
+    refuse_stations_recorded_elsewhere,
+)
 from services.recorder.wear_queryable import wear_replier
 from services.recorder.wear_watch import WearWatch
 from shared.config import AnyStation, load_any_line
@@ -78,6 +84,7 @@ from shared.contract import (
     parse_seq_attachment,
 )
 from shared.recordings import OTHER_STATION, FileMetadata, Received, classify
+from shared.recordings.mcap import finish_unfinished
 from shared.results import station_store
 from shared.retention import retention_scopes
 from shared.runtime import ServiceSkeleton, Stop
@@ -420,14 +427,27 @@ def station_keys(station: str) -> str:
 def main(args: argparse.Namespace) -> int:
     loaded = load_any_line(args.config)  # serve recorder: one or more files, always a list
     served_stations(loaded)  # bad combinations fail before zenoh is opened
-    loaded[0].make_recordings_folder()  # and a folder that can never be made
+    folder = loaded[0].make_recordings_folder()  # and a folder that can never be made
     view_only = getattr(args, "view_only", False)
+    with contextlib.ExitStack() as held:
+        if not view_only:
+            held.enter_context(recordings_folder_held(folder))  # a second recorder: refused
+        return _serve(args, loaded, folder, view_only)
+
+
+def _serve(
+    args: argparse.Namespace, loaded: Sequence[AnyStation], folder: Path, view_only: bool
+) -> int:
+    """The recorder's process, the recordings folder held (a view: not)."""
     with ServiceSkeleton(VIEWER if view_only else "recorder") as skeleton:
         # listening before the router is reached: a Foxglove app may connect first
         foxglove = start_foxglove(args, [station.station_id for station in loaded])
         if foxglove is not None:
             skeleton.on_stop(Stop.DEVICE, foxglove.close)
-        skeleton.open_session(loaded[0].config.zenoh)
+        session = skeleton.open_session(loaded[0].config.zenoh)
+        if not view_only:
+            refuse_stations_recorded_elsewhere(session, [s.station_id for s in loaded])
+            finish_unfinished(folder)  # what a crash left, before the results' catch-up reads
         live = start_rerun_live(args)
         if live is not None:
             skeleton.on_stop(Stop.DEVICE, live.close)

@@ -128,6 +128,13 @@ class RecorderSection(StrictModel):
     flush_interval_s: float = Field(default=1.0, gt=0, le=60)
     max_file_bytes: int = Field(default=256 * 1024 * 1024, ge=1024 * 1024)
     max_file_duration_s: float = Field(default=600.0, gt=0)
+    free_space_reserve_bytes: int = Field(
+        default=256 * 1024 * 1024,
+        ge=0,
+        description="below this much free space on the recordings disk no new run file is "
+        "opened (an alert instead); 0: no reserve. The default is the largest a run file "
+        "grows to, so a file opened is never cut by a full disk",
+    )
     wear_service_threshold: float | None = Field(
         default=None,
         gt=0,

@@ -5,31 +5,37 @@
 - :mod:`.run_result` (a live run's TighteningResult from its summary and
   program), :mod:`.controller_result` (a controller's run's, from its own values)
 - :mod:`.capability` (mean, σ, Cp and Cpk of one figure against its window),
-  :mod:`.control_chart` (Shewhart X̄/R and X̄/s), :mod:`.program_statistics`
-  (a program's statistics over its results)
+  :mod:`.control_chart` (Shewhart X̄/R and X̄/s), :mod:`.program_columns`
+  (what a program's statistics are made from, as columns), :mod:`.program_statistics`
+  (a program's statistics over its columns)
 """
 
 from shared.quality.capability import capability, window_text
 from shared.quality.control_chart import c4, control_chart
 from shared.quality.controller_result import controller_result
+from shared.quality.program_columns import ProgramColumns, columns_of
 from shared.quality.program_statistics import (
     FigureStatistics,
     ProgramStatistics,
     program_statistics,
+    statistics_of,
 )
 from shared.quality.run_result import tightening_result
 from shared.quality.verdict import cut_text, judge
 
 __all__ = [
     "FigureStatistics",
+    "ProgramColumns",
     "ProgramStatistics",
     "c4",
     "capability",
+    "columns_of",
     "control_chart",
     "controller_result",
     "cut_text",
     "judge",
     "program_statistics",
+    "statistics_of",
     "tightening_result",
     "window_text",
 ]

@@ -37,7 +37,9 @@ class Capability:
     not_computed: str | None
 
 
-def capability(values: Sequence[float], lower: float | None, upper: float | None) -> Capability:
+def capability(
+    values: Sequence[float] | np.ndarray, lower: float | None, upper: float | None
+) -> Capability:
     """The capability of ``values`` (None values already left out) against a window."""
     data = np.asarray(values, dtype=float)
     n = int(data.size)

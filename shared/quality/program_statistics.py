@@ -12,6 +12,9 @@ events per run.
 The window of a figure is the one the runs were judged against (carried by
 each :class:`TighteningResult`); when it changed within the range, the
 latest one is used and :attr:`ProgramStatistics.window_changes` says so.
+Counts of equal size are listed by name. Made from a program's columns
+(:mod:`.program_columns`): the results store's, or those of results read
+from recordings (:func:`program_statistics`).
 """
 
 from __future__ import annotations
@@ -20,9 +23,12 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-from shared.contract import JudgedFigure, RunSummary, TighteningResult
+import numpy as np
+
+from shared.contract import RunSummary, TighteningResult
 from shared.quality.capability import Capability, capability
 from shared.quality.control_chart import ControlChart, control_chart
+from shared.quality.program_columns import ProgramColumns, columns_of
 
 #: (key, title, unit) of each figure, in the report's order
 FIGURES = (
@@ -31,8 +37,6 @@ FIGURES = (
     ("preload", "final preload", "N"),
     ("intensity", "process intensity", ""),
 )
-#: the stop reason shown for a run the tool stopped by itself (no StopCommand)
-TOOL_STOPPED = "tool"
 
 
 @dataclass(frozen=True, slots=True)
@@ -42,7 +46,7 @@ class FigureStatistics:
     key: str
     title: str
     unit: str
-    values: list[float]
+    values: np.ndarray  # the runs that measured it, in the order they ended
     capability: Capability
     chart: ControlChart | None  # None: fewer runs than one subgroup
 
@@ -68,57 +72,29 @@ class ProgramStatistics:
         return self.noks / self.runs if self.runs else 0.0
 
 
-def reason_kind(reason: str) -> str:
-    """What a NOK reason says without its figures: ``preload low: 52800 N, window 53000 to
-    59000 N`` -> ``preload low`` (the Pareto counts kinds, not values)."""
-    return reason.split(":", 1)[0].strip()
-
-
-def _judged(result: TighteningResult, key: str) -> JudgedFigure | None:
-    return {
-        "torque": result.final_torque_nm,
-        "angle": result.final_angle_deg,
-        "preload": result.final_force_n,
-    }.get(key)
-
-
-def _value(result: TighteningResult, key: str) -> float | None:
-    if key == "intensity":
-        return result.process_intensity
-    judged = _judged(result, key)
-    return judged.value if judged is not None else None
-
-
 def program_statistics(
     results: Sequence[TighteningResult],
     subgroup_size: int,
     summaries: Mapping[tuple[str, int, int], RunSummary] | None = None,
 ) -> list[ProgramStatistics]:
     """One :class:`ProgramStatistics` per program id of ``results`` (in time order)."""
-    by_program: dict[int, list[TighteningResult]] = {}
-    for result in results:
-        by_program.setdefault(result.program_id, []).append(result)
-    return [
-        _one_program(program_id, runs, subgroup_size, summaries or {})
-        for program_id, runs in sorted(by_program.items())
-    ]
+    return [statistics_of(columns, subgroup_size) for columns in columns_of(results, summaries)]
 
 
-def _one_program(
-    program_id: int,
-    runs: list[TighteningResult],
-    subgroup_size: int,
-    summaries: Mapping[tuple[str, int, int], RunSummary],
-) -> ProgramStatistics:
-    latest = runs[-1]
+def _most_common(counts: Counter[str]) -> list[tuple[str, int]]:
+    """Most frequent first; equal counts by name (the same order from any source)."""
+    return sorted(counts.items(), key=lambda item: (-item[1], item[0]))
+
+
+def statistics_of(columns: ProgramColumns, subgroup_size: int) -> ProgramStatistics:
+    """The statistics of one program's columns."""
     figures, changes = [], []
     for key, title, unit in FIGURES:
-        values = [value for value in (_value(run, key) for run in runs) if value is not None]
-        judged = _judged(latest, key)
-        lower, upper = (judged.min, judged.max) if judged is not None else (None, None)
-        windows = {(j.min, j.max) for j in (_judged(run, key) for run in runs) if j is not None}
-        if len(windows) > 1:
-            changes.append(f"{title}: {len(windows)} windows in the range, the latest used")
+        values = columns.values[key]
+        lower, upper = columns.latest_windows.get(key, (None, None))
+        windows = columns.window_counts.get(key, 0)
+        if windows > 1:
+            changes.append(f"{title}: {windows} windows in the range, the latest used")
         figures.append(
             FigureStatistics(
                 key,
@@ -129,28 +105,16 @@ def _one_program(
                 control_chart(values, subgroup_size),
             )
         )
-    reasons: Counter[str] = Counter()
-    for run in runs:
-        if run.result == "NOK":
-            reasons.update({reason_kind(reason) for reason in run.nok_reasons.split(";")} - {""})
-    stops = Counter(run.stop_reason or TOOL_STOPPED for run in runs)
-    events = []
-    for run in runs:
-        summary = summaries.get((run.station, run.run_id, run.tool_id))
-        if run.events is not None:
-            events.append(run.events)
-        elif summary is not None:
-            events.append(summary.events)
     return ProgramStatistics(
-        program_id=program_id,
-        program_name=latest.program_name,
-        runs=len(runs),
-        noks=sum(1 for run in runs if run.result == "NOK"),
+        program_id=columns.program_id,
+        program_name=columns.program_name,
+        runs=columns.runs,
+        noks=columns.noks,
         figures=figures,
-        nok_reasons=reasons.most_common(),
-        stop_reasons=stops.most_common(),
-        events_per_run=events,
+        nok_reasons=_most_common(columns.nok_reasons),
+        stop_reasons=_most_common(columns.stop_reasons),
+        events_per_run=columns.events_per_run,
         window_changes=changes,
-        stations=sorted({run.station for run in runs}),
-        tools=sorted({run.tool_id for run in runs}),
+        stations=columns.stations,
+        tools=columns.tools,
     )

@@ -1,6 +1,7 @@
 """Recordings, without zenoh: where a run's files go, what is recorded, and the file formats.
 
-- :mod:`.layout` (where a run's files go and how to find them: the one rule)
+- :mod:`.layout` (where a run's files go and how to find them: the one rule; the name a
+  file has while it is written)
 - :mod:`.received` (one received payload, classified, checked and decoded: what
   every sink writes), :mod:`.sink` (the shape every writer of a run shares)
 - :mod:`.file_metadata` (the metadata records of a recording)
@@ -13,12 +14,15 @@ from shared.recordings.layout import (
     FileName,
     file_name_of,
     file_path,
+    final_path_of,
     recording_files,
     rerun_path,
     run_file_prefix,
     run_files,
     station_days,
     station_folder_name,
+    unfinished_files,
+    writing_path,
 )
 from shared.recordings.received import MAX_AHEAD_S, OTHER_STATION, Received, classify
 from shared.recordings.sink import Sink
@@ -33,6 +37,7 @@ __all__ = [
     "classify",
     "file_name_of",
     "file_path",
+    "final_path_of",
     "flatten",
     "recording_files",
     "rerun_path",
@@ -40,4 +45,6 @@ __all__ = [
     "run_files",
     "station_days",
     "station_folder_name",
+    "unfinished_files",
+    "writing_path",
 ]

@@ -6,6 +6,11 @@ Layout (UTC)::
     <recordings>/<station>/<YYYY-MM-DD>/<station>_idle_<HHMMSS>.mcap   before a station's first run
     ... and beside a run's .mcap its Rerun recording, the same stem with .rrd
 
+While the recorder writes a run's file it is named ``.<name>.writing`` (hidden,
+and no ``.mcap``: no reader of the folder takes it for a run file) and renamed
+to ``<name>`` when it is complete (:func:`writing_path`, :func:`unfinished_files`:
+what a crash left, which the recorder finishes at its next start).
+
 ``<station>`` is the station id made safe for a file name (anything but
 letters, digits, ``_`` and ``-`` becomes ``_``): station ids are key-expression
 safe already, so this changes nothing of a valid id. ``part`` counts the
@@ -31,6 +36,8 @@ from typing import Final
 _UNSAFE: Final = re.compile(r"[^A-Za-z0-9_-]")
 MCAP_SUFFIX: Final = ".mcap"
 RERUN_SUFFIX: Final = ".rrd"
+#: the end of the name a recorder's run file has until it is complete
+WRITING_SUFFIX: Final = ".writing"
 
 
 def station_folder_name(station: str) -> str:
@@ -57,10 +64,30 @@ def file_path(
     day = folder / safe_station / f"{opened:%Y-%m-%d}"
     path = day / f"{stem}{MCAP_SUFFIX}"
     copy = 2
-    while unique and path.exists():
+    while unique and (path.exists() or writing_path(path).exists()):
         path = day / f"{stem}_{copy}{MCAP_SUFFIX}"
         copy += 1
     return path
+
+
+def writing_path(final: Path) -> Path:
+    """The name a file has while it is written (same folder): ``.<name>.writing``."""
+    return final.with_name(f".{final.name}{WRITING_SUFFIX}")
+
+
+def final_path_of(writing: Path) -> Path | None:
+    """The name a file written as ``writing`` takes when complete (None: not such a name)."""
+    name = writing.name
+    if not (name.startswith(".") and name.endswith(MCAP_SUFFIX + WRITING_SUFFIX)):
+        return None
+    return writing.with_name(name[1 : -len(WRITING_SUFFIX)])
+
+
+def unfinished_files(folder: Path) -> list[Path]:
+    """The files under ``folder`` (``<station>/<day>/``) still under their writing name,
+    regular files only, in name order: being written, or left so by a crash."""
+    pattern = f"*/*/.*{MCAP_SUFFIX}{WRITING_SUFFIX}"
+    return sorted(path for path in folder.glob(pattern) if path.is_file())
 
 
 def run_file_prefix(station: str, run_id: int) -> str:

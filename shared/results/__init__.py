@@ -7,11 +7,13 @@ line, program, tool, time), in SQLite beside the recordings or a plant's Postgre
 - :mod:`.stored_result` (a result as a row, and back)
 - :mod:`.results_store` (add idempotently, find, what was read of which recording)
 - :mod:`.results_query` (which tightenings a question asks for)
+- :mod:`.program_columns` (a report's columns per program, in a few statements)
 
 The recorder writes it (``services/recorder/results_watch.py``); ``boltwatch
 results`` reads it.
 """
 
+from shared.results.program_columns import program_columns
 from shared.results.results_database import (
     SQLITE_FILE,
     ResultsDatabase,
@@ -40,6 +42,7 @@ __all__ = [
     "StoredResult",
     "migrate",
     "postgres_target",
+    "program_columns",
     "station_store",
     "store_target",
     "stored_result",

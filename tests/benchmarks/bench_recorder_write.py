@@ -5,7 +5,9 @@ collected by pytest). Writes one minute of 1 kHz samples (a flush per simulated 
 with ``fsync`` on (each flush reaches the disk: what the recorder does) and off (a flush
 only reaches the OS), alternating, and prints the medians side by side: wall time per
 sample (fsync waits for the disk, not the CPU), recorder CPU per sample, and the cost of
-one flush. The budget is 1000 µs per sample.
+one flush. The budget is 1000 µs per sample. Last, the close of a run file (fsync on):
+finished where it was written, and finished then renamed from its writing name with the
+folder synced (what the recorder does, so a crash never leaves a broken run file).
 """
 
 from __future__ import annotations
@@ -81,6 +83,24 @@ def flush_times_ms(folder: Path, payloads: list[bytes], t0: int, fsync: bool) ->
     return times
 
 
+CLOSED_FILES = 100  # run files closed per trial, each of 50 samples
+
+
+def close_times_ms(folder: Path, payloads: list[bytes], t0: int, rename: bool) -> list[float]:
+    """Wall time of each run file's close (fsync on), renamed once complete or not."""
+    times: list[float] = []
+    for n in range(CLOSED_FILES):
+        path = folder / f"close-{rename}-{n}.mcap"
+        sink = McapSink(path, {}, n, t0, rename_when_complete=rename)
+        for k, payload in enumerate(payloads[:50]):
+            sink.write(classify("boltwatch/st1/samples", payload, t0 + k * 1_000_000))
+        sink.flush()
+        start = time.perf_counter()
+        sink.close()
+        times.append((time.perf_counter() - start) * 1e3)
+    return times
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--repeats", type=int, default=5, help="trials per setting (default 5)")
@@ -95,6 +115,7 @@ def main() -> None:
     ]
     trials: dict[bool, list[Trial]] = {True: [], False: []}
     flushes_ms: dict[bool, list[float]] = {True: [], False: []}
+    closes_ms: dict[bool, list[float]] = {True: [], False: []}
     with tempfile.TemporaryDirectory(dir=args.folder) as folder:
         for repeat in range(args.repeats):
             for fsync in (False, True):
@@ -102,6 +123,8 @@ def main() -> None:
                 trial_folder.mkdir()
                 trials[fsync].append(one_trial(trial_folder, payloads, t0, fsync))
                 flushes_ms[fsync] += flush_times_ms(trial_folder, payloads, t0, fsync)
+            for rename in (False, True):
+                closes_ms[rename] += close_times_ms(trial_folder, payloads, t0, rename)
     print(f"{SAMPLES} samples, {FLUSHES} flushes per trial, {args.repeats} trials each, medians:")
     medians = {}
     for fsync in (False, True):
@@ -121,6 +144,13 @@ def main() -> None:
             f"  one flush of 1 s of samples, fsync {'on ' if fsync else 'off'}: median "
             f"{statistics.median(times):.2f} ms, p90 {times[int(len(times) * 0.9)]:.2f} ms "
             f"({len(times)} flushes)"
+        )
+    for rename in (False, True):
+        times = sorted(closes_ms[rename])
+        label = "renamed from its writing name" if rename else "under its name"
+        print(
+            f"  close of a run file, {label}: median {statistics.median(times):.2f} ms, "
+            f"p90 {times[int(len(times) * 0.9)]:.2f} ms ({len(times)} files)"
         )
 
 

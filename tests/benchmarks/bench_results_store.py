@@ -55,7 +55,7 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
 from shared.offline.report import ResultFilter, read_results, read_stored
-from shared.quality import program_statistics
+from shared.quality import statistics_of
 from shared.results import ResultsQuery, ResultsStore, StoreError, StoreTarget
 from tests.benchmarks.results_ingest import add_rates, live_ingest
 from tests.benchmarks.run_recordings import record_runs
@@ -272,12 +272,13 @@ def queries(args: argparse.Namespace, target: StoreTarget) -> dict[str, Any]:
                 read = read_stored(store, rule)
             month_statements += seen or []
             read_s = time.perf_counter() - started
-            program_statistics(read.results, SUBGROUP_SIZE, read.summaries)
+            for columns in read.programs:
+                statistics_of(columns, SUBGROUP_SIZE)
             total_s = time.perf_counter() - started
             reads.append(read_s)
             stats.append(total_s - read_s)
             totals.append(total_s)
-            results = len(read.results)
+            results = read.results
             del read
         read_s, stats_s, total_s = (statistics.median(v) for v in (reads, stats, totals))
         figures["month"] = {
@@ -317,7 +318,7 @@ def file_scan(args: argparse.Namespace, folder: Path, stats_us: float | None) ->
         started = time.perf_counter()
         read = read_results(rule)
         took.append(time.perf_counter() - started)
-        assert len(read.results) == args.files, len(read.results)
+        assert read.results == args.files, read.results
     per_file_s = statistics.median(took) / len(files)
     month_s = per_file_s * MONTH_RUNS
     with_stats = month_s + (stats_us or 0.0) * 1e-6 * MONTH_RUNS

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import can
 import zenoh
+from mcap.records import Channel, Message, Schema
 
 from services.cli.station_supervisor import ManagedProcess, StationSupervisor
 from shared.config import LoadedStation, load_station
@@ -34,7 +35,8 @@ from shared.contract import (
     channels,
     keys,
 )
-from shared.errors import TransportError
+from shared.errors import InputError, TransportError
+from shared.recordings import final_path_of, unfinished_files
 from shared.recordings.mcap import RecordingScan
 from shared.runtime import open_bus, open_from, zenoh_config
 from tests.support.listener import Listener
@@ -263,15 +265,31 @@ def live_station(
 
 def recorded_sequences(recordings: Path, run_id: int) -> list[int]:
     """Sequences of the run's samples in every file under ``recordings`` (damaged or open
-    files too: their complete records), in file order."""
+    files too, under their writing names: their complete records), in file order."""
+    writing = unfinished_files(recordings)  # first: one renamed meanwhile is a run file next
+    files = sorted(recordings.rglob("*.mcap"))
+    files += [path for path in writing if final_path_of(path) not in files]
     sequences: list[int] = []
-    for path in sorted(recordings.rglob("*.mcap")):
+    for path in sorted(files, key=lambda path: final_path_of(path) or path):
         if path.name.endswith(".recovered.mcap"):
             continue
-        for schema, _, message in RecordingScan(path).messages("/samples"):
+        for schema, _, message in _samples(path):
             if schema is not None and json.loads(message.data)["run_id"] == run_id:
                 sequences.append(message.sequence)
     return sequences
+
+
+def _samples(path: Path) -> Iterator[tuple[Schema | None, Channel, Message]]:
+    """The sample messages of ``path``; when it was a writing name renamed (its file closed)
+    since it was listed, those of its run file (none: removed, it held no message)."""
+    final = final_path_of(path)
+    try:
+        yield from RecordingScan(path).messages("/samples")
+    except InputError:
+        if final is None or path.exists():
+            raise
+        if final.exists():
+            yield from RecordingScan(final).messages("/samples")
 
 
 def check_next_run_normal(station: LiveStation) -> int:

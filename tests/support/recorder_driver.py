@@ -15,7 +15,7 @@ from services.recorder.live.recorder import Recorder
 from services.recorder.live.run_files import FileLimits
 from shared.config import load_station
 from shared.contract import Sample, ToolState, encode
-from shared.recordings import FileMetadata, Received, classify
+from shared.recordings import FileMetadata, Received, classify, unfinished_files
 from shared.recordings.mcap import RecordingScan
 from tests.support.live_recorder import write_station_file
 
@@ -30,11 +30,16 @@ class RecorderDriver:
     (:meth:`Recorder.write_samples`, that many at once).
     """
 
-    def __init__(self, folder: Path, recordings: Path, batch_samples: int = 1) -> None:
+    def __init__(
+        self, folder: Path, recordings: Path, batch_samples: int = 1, reserve_bytes: int = 0
+    ) -> None:
+        """``reserve_bytes``: the free-space reserve (``recorder.free_space_reserve_bytes``)."""
         loaded = load_station(
             write_station_file(folder / "station.toml", recordings, listen=["tcp/127.0.0.1:1"])
         )
-        limits = FileLimits(1000 * MS, 1 << 40, 3600 * 1000 * MS)
+        limits = FileLimits(
+            1000 * MS, 1 << 40, 3600 * 1000 * MS, free_space_reserve_bytes=reserve_bytes
+        )
         self.recorder = Recorder(recordings, limits, FileMetadata(loaded))
         self.now_ns = T0_NS
         self.sequence = 0
@@ -68,8 +73,10 @@ class RecorderDriver:
 
 
 def recorded_messages(recordings: Path) -> int:
-    """Messages readable in every MCAP file under ``recordings`` (damaged ones too)."""
-    return sum(1 for path in recordings.rglob("*.mcap") for _ in RecordingScan(path).messages())
+    """Messages readable in every MCAP file under ``recordings``, and in the files left under
+    their writing name (a fault's that could not be finished: the next start does)."""
+    files = [*recordings.rglob("*.mcap"), *unfinished_files(recordings)]
+    return sum(1 for path in files for _ in RecordingScan(path).messages())
 
 
 def main(folder: Path) -> None:

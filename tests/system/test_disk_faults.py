@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 import resource
 import sqlite3
 import subprocess
@@ -22,6 +23,7 @@ import pytest
 
 from services.recorder.live.recorder import RETRY_INTERVAL_NS
 from shared.contract import RunSummary
+from shared.recordings import run_files, unfinished_files
 from shared.recordings.mcap import RecordingScan
 from shared.wear import CONTRACT_LIMITS, WearLedger
 from tests.support import factories
@@ -33,6 +35,7 @@ from tests.support.recorder_driver import RecorderDriver, recorded_messages
 pytestmark = pytest.mark.system
 
 RECORDER_LOG = "services.recorder.live.recorder"
+NO_RESERVE = {"flush_interval_s = 1.0": "flush_interval_s = 1.0\nfree_space_reserve_bytes = 0"}
 
 
 def errors_logged(caplog: pytest.LogCaptureFixture, level: int) -> list[str]:
@@ -76,6 +79,53 @@ def test_a_disk_that_fills_up_mid_run(
         assert recorder.abandoned_files  # the fault's file, readable up to its last flush
         abandoned = RecordingScan(recorder.abandoned_files[0])
         assert sum(1 for _ in abandoned.messages("/samples")) >= 2000  # flushed before the fault
+
+
+def leave_free(folder: Path, free_bytes: int) -> Path:
+    """Fill ``folder``'s file system until about ``free_bytes`` are left; the filler."""
+    found = os.statvfs(folder)
+    filler = folder / "filler.bin"
+    filler.write_bytes(b"\0" * max(0, found.f_bavail * found.f_frsize - free_bytes))
+    return filler
+
+
+def test_below_the_free_space_reserve_no_file_is_opened_and_none_is_cut(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A 4 MB tmpfs, a 1 MB reserve: the run open when the free space falls below it is
+    finished whole; the next run opens no file (dropped, counted, one ERROR, the reason in
+    the recorder's state); once there is room the next run is recorded again."""
+    caplog.set_level(logging.INFO, logger=RECORDER_LOG)
+    with tmpfs(tmp_path / "recordings", 4 << 20) as recordings:
+        driver = RecorderDriver(tmp_path, recordings, reserve_bytes=1 << 20)
+        recorder = driver.recorder
+        driver.start_run(1)
+        driver.samples(1, 1000)
+        filler = leave_free(recordings, 512 << 10)
+        driver.samples(1, 1000)  # the open file goes on: the reserve is there for it
+        driver.end_run(1)
+        driver.start_run(2)  # below the reserve: no file for run 2
+        driver.samples(2, 1000)
+        driver.end_run(2)
+        assert not recorder.recording_ok and recorder.last_write_error is not None
+        assert "below the reserve of 1.0 MB" in recorder.last_write_error
+        assert "free_space_reserve_bytes" in recorder.last_write_error
+        (started,) = errors_logged(caplog, logging.ERROR)
+        assert "recording failed" in started
+        (run1,) = run_files(recordings, "st1", 1)  # finished whole, under its name
+        scan = RecordingScan(run1)
+        assert sum(1 for _ in scan.messages("/samples")) == 2000 and scan.complete
+        assert run_files(recordings, "st1", 2) == [] and unfinished_files(recordings) == []
+        assert recorder.dropped_messages == 1002  # run 2, counted
+
+        filler.unlink()  # room again: the next run is recorded
+        driver.start_run(3)
+        driver.samples(3, 1000)
+        driver.end_run(3)
+        assert recorder.recording_ok
+        recorder.close()
+        assert len(run_files(recordings, "st1", 3)) == 1
+        assert recorded_messages(recordings) + recorder.dropped_messages == recorder.messages
 
 
 def test_a_read_only_folder_then_writable_again(
@@ -204,10 +254,11 @@ def test_a_full_disk_does_not_corrupt_the_wear_ledger(tmp_path: Path) -> None:
 
 def test_the_station_goes_on_while_the_recordings_disk_is_full(tmp_path: Path) -> None:
     """Real processes; the station's recordings folder is a 4 MB tmpfs filled mid-run
-    (the wear ledger, one level up, stays on the real disk)."""
+    (the wear ledger, one level up, stays on the real disk); no free-space reserve, so the
+    disk is met full."""
     with (
         tmpfs(tmp_path / "recordings" / "st1", 4 << 20) as station_folder,
-        live_station(tmp_path) as station,
+        live_station(tmp_path, replacements=NO_RESERVE) as station,
     ):
         station.wait_runs_summarised(1)
         filler = fill_up(station_folder)

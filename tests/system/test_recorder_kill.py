@@ -1,5 +1,7 @@
-"""The recorder as a real process: kill -9 loses at most about a flush interval; SIGTERM nothing;
-kill -9 while results arrive: after the restart the results store and the recordings agree.
+"""The recorder as a real process: kill -9 loses at most about a flush interval and leaves no
+broken file under a run file's name; SIGTERM nothing; kill -9 while results arrive: the
+restarted recorder finishes what the killed one left, and the results store and the
+recordings agree.
 
 ``boltwatch serve recorder`` runs as a subprocess (a zenoh peer listening on
 a free loopback port); this test publishes a run at ~1 kHz into it.
@@ -20,6 +22,7 @@ import zenoh
 from mcap.reader import make_reader
 
 from shared.contract import Sample, TighteningResult, ToolState, channels, decode, encode
+from shared.recordings import final_path_of, unfinished_files
 from shared.recordings.mcap import RecordingScan, recover
 from shared.results import ResultsQuery, ResultsStore, StoreTarget
 from shared.runtime import zenoh_config
@@ -59,6 +62,10 @@ class RecorderProcess:
 
     def files(self) -> list[Path]:
         return sorted(self.recordings.glob("st1/*/*.mcap"))
+
+    def unfinished(self) -> list[Path]:
+        """Files under their writing name: being written, or left by a kill."""
+        return unfinished_files(self.recordings)
 
     def stop(self) -> None:
         if self.process.poll() is None:
@@ -114,7 +121,8 @@ def test_kill_9_loses_at_most_about_one_flush_interval(
     recorder_process.process.send_signal(signal.SIGKILL)
     recorder_process.process.wait(10)
 
-    (killed,) = recorder_process.files()
+    assert recorder_process.files() == []  # no run file's name on a broken file
+    (killed,) = recorder_process.unfinished()
     report = recover(killed, tmp_path / "recovered.mcap")
     assert not report.was_complete
     with (tmp_path / "recovered.mcap").open("rb") as handle:
@@ -138,7 +146,7 @@ def test_sigterm_leaves_a_complete_file(
     sent = publish_run(session, run_id=2, duration_s=0.5)
 
     def everything_flushed() -> bool:
-        files = recorder_process.files()
+        files = recorder_process.unfinished()  # being written
         return len(files) == 1 and len(recorded_sequences(RecordingScan(files[0]))) == sent
 
     wait_until(everything_flushed, "the recorder to flush every sample")
@@ -146,6 +154,7 @@ def test_sigterm_leaves_a_complete_file(
     assert recorder_process.process.wait(10) == 0
 
     (path,) = recorder_process.files()
+    assert recorder_process.unfinished() == []
     with path.open("rb") as handle:
         reader = make_reader(handle)
         summary = reader.get_summary()
@@ -176,10 +185,10 @@ def publish_results(session: zenoh.Session, runs: range, stop: threading.Event) 
 
 
 def recorded_results(recordings: Path) -> dict[int, TighteningResult]:
-    """Every result in the recordings by run, damaged files read as far as they go."""
+    """Every result in the recordings by run, files left by a kill read as far as they go."""
     return {
         result.run_id: result
-        for path in sorted(recordings.glob("st1/*/*.mcap"))
+        for path in sorted([*recordings.glob("st1/*/*.mcap"), *unfinished_files(recordings)])
         for _, _, message in RecordingScan(path).messages("/results")
         for result in [decode(TighteningResult, message.data)]
     }
@@ -210,6 +219,9 @@ def test_kill_9_while_results_arrive_then_the_store_and_the_recordings_agree(
         publisher.join()
     killed_store = stored_results(recorder_process.recordings)
     recorded = recorded_results(recorder_process.recordings)
+    left = recorder_process.unfinished()  # the files open when it was killed (a run's, and
+    assert left  # the one before it within its late grace)
+    assert all(scan_complete(path) for path in recorder_process.files())  # only whole files
     assert killed_store.items() <= recorded.items()  # a result stored is in a file on disk
     print(f"kill -9: {len(recorded)} results recorded, {len(killed_store)} stored")
 
@@ -220,6 +232,18 @@ def test_kill_9_while_results_arrive_then_the_store_and_the_recordings_agree(
             "the restarted recorder to store what the killed one had not",
             30.0,
         )
+        # the restarted recorder finished what the killed one left, under its run file's name
+        wait_until(lambda: restarted.unfinished() == [], "the killed recorder's file finished")
+        assert {final_path_of(path) for path in left} <= set(restarted.files())
+        assert all(scan_complete(path) for path in restarted.files())
     finally:
         restarted.stop()
     assert recorded_results(restarted.recordings) == recorded
+    assert "finished under their names" in (tmp_path / "restarted.log").read_text()
+
+
+def scan_complete(path: Path) -> bool:
+    scan = RecordingScan(path)
+    for _ in scan.records():
+        pass
+    return scan.complete

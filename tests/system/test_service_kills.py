@@ -26,6 +26,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
+from shared.recordings.mcap import RecordingScan
 from tests.support.live_station import (
     LiveStation,
     check_next_run_normal,
@@ -95,8 +96,10 @@ def wait_recording_settled(station: LiveStation, run_id: int) -> None:
 
 
 def recover_killed_file(station: LiveStation, run_id: int, recovered: Path) -> list[int]:
-    """``boltwatch recover`` on the killed recorder's file; the recovered sample sequences."""
-    (killed_file,) = sorted(station.recordings.rglob(f"st1_run{run_id}_*.mcap"))
+    """``boltwatch recover`` on the killed recorder's file (under its writing name: no run
+    file's name is on a broken file); the recovered sample sequences."""
+    assert not list(station.recordings.rglob(f"st1_run{run_id}_*.mcap"))
+    (killed_file,) = sorted(station.recordings.rglob(f".st1_run{run_id}_*.mcap.writing"))
     result = boltwatch("recover", str(killed_file), "--out", str(recovered), timeout_s=None)
     assert result.returncode == 0, result.stderr
     with recovered.open("rb") as handle:  # the mcap library's own indexed reader: valid file
@@ -125,6 +128,13 @@ def test_a_service_killed_mid_run(station: LiveStation, service: str, tmp_path: 
 
     station.start(service)
     station.wait_alive((service,))
+    if service == "recorder":  # it finished the file it was killed in, under its name (or
+        # removed it: killed before its first flush, it held no message)
+        assert not list(station.recordings.rglob(f".st1_run{killed_run}_*.writing"))
+        assert recorded_sequences(station.recordings, killed_run) == got
+        for finished in station.recordings.rglob(f"st1_run{killed_run}_*.mcap"):
+            scan = RecordingScan(finished)
+            assert sum(1 for _ in scan.messages()) > 0 and scan.complete
     check_next_run_normal(station)
 
 

@@ -17,6 +17,9 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
+from shared.recordings import unfinished_files
+from tests.support.disk_faults import tmpfs
+from tests.support.paths import REPO
 from tests.support.station_files import (
     is_running,
     kill_all,
@@ -24,10 +27,12 @@ from tests.support.station_files import (
     write_station,
 )
 from tests.support.station_up import (
+    UP_TIMEOUT_S,
     read_recordings,
     run_up,
     services_of,
     start_up,
+    up_command,
     wait_for_first_run,
 )
 
@@ -181,3 +186,29 @@ def test_services_stop_cleanly_when_up_is_killed_outright(tmp_path: Path) -> Non
     for path in recordings:
         with path.open("rb") as handle:
             assert make_reader(handle).get_summary() is not None, path
+
+
+def test_runs_not_recorded_are_named_and_up_exits_non_zero(tmp_path: Path) -> None:
+    """The recordings folder is an 8 MB tmpfs, the recorder's free-space reserve 16 MB: no
+    run file is opened; the runs are still tightened and decided, and ``up`` ends with one
+    line naming the runs not recorded and exit status 1 (it used to say nothing, exit 0)."""
+    reserve = {
+        "flush_interval_s = 1.0": "flush_interval_s = 1.0\nfree_space_reserve_bytes = 16000000"
+    }
+    station = write_station(tmp_path, replacements=reserve)
+    with tmpfs(tmp_path / "recordings", 8 << 20) as recordings:
+        result = subprocess.run(
+            up_command(station, 1),
+            check=False,
+            capture_output=True,
+            text=True,
+            timeout=UP_TIMEOUT_S,
+            cwd=REPO,
+        )
+        assert result.returncode == 1, result.stdout + result.stderr
+        (note,) = [line for line in result.stderr.splitlines() if "NOT RECORDED" in line]
+        assert note.startswith("NOT RECORDED: 1 of 1 runs have no recording (st1 run ")
+        assert "recorder.log" in note
+        assert not list(recordings.rglob("*.mcap")) and unfinished_files(recordings) == []
+        recorder_log = next(recordings.rglob("recorder.log")).read_text()
+        assert "below the reserve of 16.0 MB" in recorder_log

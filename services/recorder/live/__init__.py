@@ -4,6 +4,7 @@
 - :mod:`.sample_batches`: a station's batch filed as the samples it holds
 - :mod:`.recorder`: payloads into each station's files, disk faults
 - :mod:`.run_files`: one file (and its parts) per run, rotation, the late grace
+- :mod:`.free_space`: no new file below a reserve of free space
 - :mod:`.recorder_health`: lag, counts and errors per station (``RecorderStats``)
 - :mod:`.spool_order`: where each numbered message of a station's spool goes (live,
   into a hole being filled again, skipped, deferred); pure

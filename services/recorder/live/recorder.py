@@ -10,13 +10,16 @@ files are flushed even when nothing arrives.
 Recording is not on the stop path: a disk that fails under it (full,
 read-only, an I/O error: any :class:`OSError` on open, write, flush or close)
 never stops the recorder. The station's open files are abandoned (what was
-flushed stays, ``boltwatch recover`` makes it valid), messages are dropped
+flushed stays under the file's writing name; :meth:`Recorder.close`, or the
+next start if it cannot, makes it the run file), messages are dropped
 and counted, and writing is tried again at the next run's start or every
 :data:`RETRY_INTERVAL_NS`. It logs one ERROR when the fault starts (file and
 errno text), a reminder with the count of dropped messages at most every
 :data:`REMINDER_INTERVAL_NS`, and one INFO when writing works again (a flush
 reached the disk). ``write_errors``, ``last_write_error`` and
 ``recording_ok`` say the same to whoever publishes the recorder's state.
+Free space below the reserve (:mod:`.free_space`) is such a fault, met
+before the disk is full: no new file is opened, none is cut.
 """
 
 from __future__ import annotations
@@ -29,7 +32,8 @@ from typing import TYPE_CHECKING
 
 from services.recorder.live.run_files import FileLimits, StationFiles
 from shared.files import describe_os_error
-from shared.recordings import FileMetadata, Received
+from shared.recordings import FileMetadata, Received, writing_path
+from shared.recordings.mcap import finish_one
 from shared.runtime import RateLimitedLog
 
 if TYPE_CHECKING:
@@ -181,6 +185,7 @@ class Recorder:
             except OSError as err:
                 self._fault(files, err, self._fault_started_ns, unwritten=0)
             closed.extend(files.closed_paths)
+        closed.extend(self._finish_abandoned())
         if self.refused:
             LOG.warning("refused payloads per station, recorded raw: %s", dict(self.refused))
         if self.dropped_messages:
@@ -192,6 +197,17 @@ class Recorder:
                 ", ".join(str(path) for path in self.abandoned_files) or "-",
             )
         return closed
+
+    def _finish_abandoned(self) -> list[Path]:
+        """The files a write fault abandoned, made run files (valid, under their names) if
+        the disk lets it now; else the next start does."""
+        finished = []
+        for path in self.abandoned_files:
+            if writing_path(path).is_file():
+                done = finish_one(writing_path(path))
+                if done.final is not None:
+                    finished.append(done.final)
+        return finished
 
     def open_paths(self) -> list[Path]:
         """The MCAP files open now (every station's current and previous, every hole's)."""
@@ -234,7 +250,8 @@ class Recorder:
             LOG.error(
                 "recording failed: %s; station %s: messages are dropped and counted, "
                 "writing is retried at the next run or every %.0f s "
-                "(the incomplete file: boltwatch recover FILE)",
+                "(what reached the incomplete file is kept: it is made valid when the "
+                "recorder stops or starts)",
                 self.last_write_error,
                 files.station,
                 RETRY_INTERVAL_NS / 1e9,

@@ -12,6 +12,14 @@ With ``rerun`` options each run file (not the idle ones) has a companion
 :class:`RerunSink` writing ``<same stem>.rrd``; it receives what its MCAP
 file receives, is flushed and closed with it, and never stops the MCAP file.
 
+Each file is written under its writing name and takes its run file's name
+when it is closed, complete (:class:`McapSink`'s ``rename_when_complete``): a
+reader of the folder never meets a run file being written or left broken.
+
+Below the free-space reserve (:mod:`.free_space`) no file is opened: the
+files open are finished and :class:`~.free_space.LowFreeSpaceError` (an
+``OSError``) is raised, which the owner takes as a failing disk.
+
 When the disk fails under a file (an :class:`OSError` out of any method),
 the owner (:class:`~services.recorder.live.recorder.Recorder`) calls
 :meth:`StationFiles.abandon`; the next write opens a new part of the same run.
@@ -26,6 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from services.recorder.live.free_space import FreeSpace
 from shared.contract import channels
 from shared.recordings import FileMetadata, Received, Sink, file_path
 from shared.recordings.mcap import McapSink
@@ -51,6 +60,8 @@ class FileLimits:
     max_file_duration_ns: int
     late_grace_ns: int = 2_000_000_000
     fsync: bool = True  # each flush reaches the disk: a power cut loses one interval at most
+    #: no new file below this much free space (:mod:`.free_space`); 0: no reserve
+    free_space_reserve_bytes: int = 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,6 +95,7 @@ class StationFiles:
         self._folder = folder
         self._limits = limits
         self._metadata = metadata
+        self._free_space = FreeSpace(folder, limits.free_space_reserve_bytes)
         self.current: McapSink | None = None
         self.previous: McapSink | None = None
         self._previous_until_ns = 0
@@ -286,7 +298,12 @@ class StationFiles:
         self._part = part
         self._run_ended = False
         self._resume = (run_id, part)  # until the file is open: a failed open is retried as is
-        self.current = None
+        self.current = None  # a run's start moved it to previous already
+        try:
+            self._free_space.check()
+        except OSError:
+            self.close()  # the files open now are finished whole: the reserve is for them
+            raise
         started_run, started_ns = self._run_started
         named_ns = now_ns
         # a run sent again after a cut opens late: named by its start, as it would have been
@@ -305,6 +322,7 @@ class StationFiles:
             now_ns,
             library=f"boltwatch {self._metadata.version}",
             fsync=self._limits.fsync,
+            rename_when_complete=True,
         )
         self._resume = None
         LOG.debug("opened %s", path)

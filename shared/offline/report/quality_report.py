@@ -15,7 +15,7 @@ from shared.errors import InputError
 from shared.offline.report.recorded_results import RecordedResults, ResultFilter
 from shared.offline.report.report_figure import build_figure, png_bytes
 from shared.offline.report.report_page import html_page
-from shared.quality import ProgramStatistics, program_statistics
+from shared.quality import ProgramStatistics, statistics_of
 
 HTML_NAME = "report.html"
 PNG_NAME = "report.png"
@@ -58,13 +58,13 @@ def write_report(
     if not read.results:
         searched = "; ".join(describe_scope(rule, subgroup_size)[:-1])
         raise InputError(f"no tightening results in range ({searched}; {source})")
-    programs = program_statistics(read.results, subgroup_size, read.summaries)
+    programs = [statistics_of(columns, subgroup_size) for columns in read.programs]
     title = f"boltwatch report: {', '.join(station for station, _ in rule.stations)}"
     figure = build_figure(programs, title)
     png = png_bytes(figure)
     out.mkdir(parents=True, exist_ok=True)
     png_path, html_path = out / PNG_NAME, out / HTML_NAME
     png_path.write_bytes(png)
-    scope = [*describe_scope(rule, subgroup_size), f"{len(read.results)} results ({source})"]
+    scope = [*describe_scope(rule, subgroup_size), f"{read.results} results ({source})"]
     html_path.write_text(html_page(programs, title, scope, png), encoding="utf-8")
-    return WrittenReport(html_path, png_path, programs, read.files, len(read.results), read.damaged)
+    return WrittenReport(html_path, png_path, programs, read.files, read.results, read.damaged)

@@ -7,9 +7,11 @@ range, every complete message of channels ``results`` and ``runs``, damaged
 files as far as they go (:class:`RecordingScan`, a warning each). A result
 is kept when it ended (``time_ns``) inside the range and matches the
 program / tool asked for. The same result seen twice (a file and its
-``.recovered`` copy) counts once. The store gives the same results, in the
-same order, each with the events of its run (what a summary adds to a
-result from the files), in one query instead of a read of every file.
+``.recovered`` copy) counts once. Either way what comes is each program's
+columns (what the report's statistics read): the store gives the same
+columns as the files, each result with the events of its run (what a
+summary adds to a result from the files), in a few statements instead of a
+read of every file.
 """
 
 from __future__ import annotations
@@ -20,9 +22,10 @@ from datetime import UTC, date, datetime, timedelta
 from pathlib import Path
 
 from shared.contract import RunSummary, TighteningResult, channels, decode
+from shared.quality import ProgramColumns, columns_of
 from shared.recordings import recording_files, station_days
 from shared.recordings.mcap import RecordingScan
-from shared.results import ResultsQuery, ResultsStore
+from shared.results import ResultsQuery, ResultsStore, program_columns
 
 #: progress is told every this many files (when there are more)
 PROGRESS_EVERY_FILES = 50
@@ -50,13 +53,16 @@ class ResultFilter:
 
 @dataclass
 class RecordedResults:
-    """What was read: the results kept, the summaries of their runs, the files."""
+    """What was read: each program's columns (:mod:`shared.quality.program_columns`), the
+    files and the damaged ones."""
 
-    results: list[TighteningResult] = field(default_factory=list)
-    #: (station, run id, tool id) -> its RunSummary (events per run when a result has none)
-    summaries: dict[tuple[str, int, int], RunSummary] = field(default_factory=dict)
+    programs: list[ProgramColumns] = field(default_factory=list)
     files: int = 0
     damaged: list[str] = field(default_factory=list)  # one line per damaged file
+
+    @property
+    def results(self) -> int:
+        return sum(program.runs for program in self.programs)
 
 
 def files_in_range(station: str, folder: Path, rule: ResultFilter) -> list[Path]:
@@ -82,7 +88,10 @@ def read_results(
         for station, folder in rule.stations
         for path in files_in_range(station, folder, rule)
     ]
-    read = RecordedResults(files=len(files))
+    results: list[TighteningResult] = []
+    #: (station, run id, tool id) -> its RunSummary (events per run when a result has none)
+    summaries: dict[tuple[str, int, int], RunSummary] = {}
+    damaged: list[str] = []
     seen: set[tuple[str, int, int, int]] = set()
     result_topic, runs_topic = channels.RESULTS.topic, channels.RUNS.topic
     for done, (station, path) in enumerate(files, start=1):
@@ -96,16 +105,16 @@ def read_results(
                 key = (result.station, result.run_id, result.tool_id, result.time_ns)
                 if key not in seen and rule.keeps(result):
                     seen.add(key)
-                    read.results.append(result)
+                    results.append(result)
             elif topic == runs_topic:
                 summary = decode(RunSummary, message.data)
-                read.summaries[(summary.station, summary.run_id, summary.tool_id)] = summary
+                summaries[(summary.station, summary.run_id, summary.tool_id)] = summary
         if not scan.complete:
-            read.damaged.append(scan.describe())
+            damaged.append(scan.describe())
         if progress is not None and (done % PROGRESS_EVERY_FILES == 0 or done == len(files)):
             progress(done, len(files))
-    read.results.sort(key=lambda result: (result.time_ns, result.station, result.run_id))
-    return read
+    results.sort(key=lambda result: (result.time_ns, result.station, result.run_id))
+    return RecordedResults(columns_of(results, summaries), len(files), damaged)
 
 
 def read_stored(store: ResultsStore, rule: ResultFilter) -> RecordedResults:
@@ -119,4 +128,4 @@ def read_stored(store: ResultsStore, rule: ResultFilter) -> RecordedResults:
         limit=None,
         oldest_first=True,
     )
-    return RecordedResults(results=[stored.result for stored in store.find(query)])
+    return RecordedResults(program_columns(store, query))

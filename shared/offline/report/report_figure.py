@@ -137,7 +137,7 @@ def _draw_histogram(axis: Axes, statistics: FigureStatistics) -> None:
         f"{statistics.title}: {window_text(cap.lower, cap.upper)}, {cpk_text(statistics)}",
         fontsize=9,
     )
-    if not statistics.values:
+    if not len(statistics.values):
         _empty(axis, "not measured")
         return
     axis.hist(statistics.values, bins="auto", color="C0", alpha=0.8)

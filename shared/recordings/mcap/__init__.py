@@ -4,6 +4,7 @@
 - :mod:`.mcap_messages`: a batch of messages packed into the writer's open chunk at once
 - :mod:`.recording_reader`: a recording read back, message by message
 - :mod:`.recovery`: a truncated MCAP made valid (``boltwatch recover``)
+- :mod:`.unfinished_files`: files a crash left under their writing name, made run files
 - :mod:`.trace_export`: a recording's samples of a run (its trace), and as a CSV trace
   (``boltwatch export``)
 """
@@ -13,6 +14,17 @@ from shared.recordings.mcap.mcap_messages import MessageAppender, MessageRow
 from shared.recordings.mcap.mcap_sink import McapSink, RAW_ENCODING, RAW_REASON
 from shared.recordings.mcap.recording_reader import RecordingScan
 from shared.recordings.mcap.recovery import default_target, recover, remove_unfinished
-from shared.recordings.mcap.trace_export import SAMPLE_SCHEMA, export_trace, read_samples, run_times_s
+from shared.recordings.mcap.trace_export import (
+    SAMPLE_SCHEMA,
+    export_trace,
+    read_samples,
+    run_times_s,
+)
+from shared.recordings.mcap.unfinished_files import (
+    FinishedCount,
+    Unfinished,
+    finish_one,
+    finish_unfinished,
+)
 
-__all__ = ["McapSink", "MessageAppender", "MessageRow", "RAW_ENCODING", "RAW_REASON", "RecordingScan", "SAMPLE_SCHEMA", "default_target", "export_trace", "read_samples", "recover", "remove_unfinished", "run_times_s"]
+__all__ = ["default_target", "export_trace", "finish_one", "finish_unfinished", "FinishedCount", "McapSink", "MessageAppender", "MessageRow", "RAW_ENCODING", "RAW_REASON", "read_samples", "RecordingScan", "recover", "remove_unfinished", "run_times_s", "SAMPLE_SCHEMA", "Unfinished"]

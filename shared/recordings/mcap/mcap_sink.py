@@ -21,6 +21,14 @@ A disk that fails (full, read-only, I/O error) raises :class:`OSError` from
 any method; the owner then calls :meth:`McapSink.abandon`, which lets go of
 the file without writing more (what was flushed stays readable with
 ``boltwatch recover``) and says how many messages were lost with it.
+
+``rename_when_complete=True`` (the recorder's run files): the file is written
+under its writing name (:func:`~shared.recordings.layout.writing_path`) and
+takes ``path`` only in :meth:`McapSink.close`, once finished and on the disk
+(fsync of the file, rename, fsync of the folder: the order rosbag2 and SQLite
+keep), so ``path`` never names a broken file whatever stops the process; an
+abandoned or killed one keeps its writing name
+(:mod:`~shared.recordings.mcap.unfinished_files` finishes it).
 """
 
 from __future__ import annotations
@@ -36,6 +44,7 @@ from typing import BinaryIO
 from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 
+from shared.recordings.layout import writing_path
 from shared.recordings.received import Received
 from shared.recordings.mcap.mcap_messages import MessageAppender, MessageRow
 from shared.recordings.mcap.recording_reader import RAW_ENCODING, RecordingScan
@@ -62,8 +71,11 @@ class McapSink:
         opened_ns: int,
         library: str = "boltwatch",
         fsync: bool = True,
+        rename_when_complete: bool = False,
     ) -> None:
-        self.path = path
+        self.path = path  # its name once complete
+        #: where the bytes go until :meth:`close` (``path`` itself unless renamed when complete)
+        self.writing_path = writing_path(path) if rename_when_complete else path
         self.run_id = run_id
         self.opened_ns = opened_ns
         self.messages = 0
@@ -80,7 +92,7 @@ class McapSink:
         self._abandoned = False
         self._name_synced = not fsync  # the folder's entry for the file, on the disk
         path.parent.mkdir(parents=True, exist_ok=True)
-        self._file: BinaryIO = path.open("xb")
+        self._file: BinaryIO = self.writing_path.open("xb")
         try:
             self._writer = Writer(
                 self._file, chunk_size=_CHUNK_BYTES, compression=CompressionType.ZSTD
@@ -156,7 +168,8 @@ class McapSink:
         self.flushed_messages = self.messages
 
     def close(self) -> None:
-        """Finish the file (summary, index, footer) and sync it; safe to call twice."""
+        """Finish the file (summary, index, footer), sync it and give it its name; safe to
+        call twice."""
         if self._closed:
             return
         self._closed = True
@@ -165,6 +178,10 @@ class McapSink:
             self._sync()
         finally:
             self._file.close()
+        if self.writing_path != self.path:
+            os.rename(self.writing_path, self.path)
+            if self._fsync:
+                sync_folder(self.path.parent)
         self.flushed_messages = self.messages
         LOG.info(
             "closed %s: %d messages, runs %s",
@@ -176,8 +193,9 @@ class McapSink:
     def abandon(self) -> int:
         """Let go of the file without writing more (its disk failed); messages lost with it.
 
-        Never raises. What was flushed stays in the file (``boltwatch recover``
-        makes it valid); a file that holds no message is removed.
+        Never raises. What was flushed stays in the file (under its writing name
+        when renamed once complete: :mod:`.unfinished_files` makes it valid); a file
+        that holds no message is removed.
         """
         if self._abandoned:
             return 0
@@ -187,7 +205,7 @@ class McapSink:
         self.flushed_messages = self._readable_messages()
         if self.flushed_messages == 0:
             with contextlib.suppress(OSError):
-                self.path.unlink()
+                self.writing_path.unlink()
         return self.messages - self.flushed_messages
 
     def _readable_messages(self) -> int:
@@ -196,7 +214,7 @@ class McapSink:
         if self.flushed_messages == 0 and self.messages == 0:
             return 0
         try:
-            return sum(1 for _ in RecordingScan(self.path).messages())
+            return sum(1 for _ in RecordingScan(self.writing_path).messages())
         except (InputError, OSError):
             return 0
 
@@ -204,7 +222,7 @@ class McapSink:
         if self._fsync:
             os.fsync(self._file.fileno())
             if not self._name_synced:  # the new file's name survives a power cut too
-                _sync_folder(self.path.parent)
+                sync_folder(self.path.parent)
                 self._name_synced = True
 
     def _channel_for(self, received: Received) -> int:
@@ -252,7 +270,7 @@ class McapSink:
         self.close()
 
 
-def _sync_folder(folder: Path) -> None:
+def sync_folder(folder: Path) -> None:
     """fsync a folder, so the names of the files just created in it are on the disk."""
     handle = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
     try:

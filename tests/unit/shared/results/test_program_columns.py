@@ -1,0 +1,93 @@
+"""A report's columns from the store are the columns of the results themselves: the same
+statistics from ``program_columns`` (a few statements) as from ``program_statistics`` over
+the results read one by one, on SQLite and PostgreSQL."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from shared.contract import JudgedFigure, TighteningResult
+from shared.quality import ProgramStatistics, program_statistics, statistics_of
+from shared.results import ResultsQuery, ResultsStore, StoreTarget, program_columns, stored_result
+from tests.support import factories
+
+SECOND_NS = 1_000_000_000
+RUNS = 120
+
+
+def _results() -> list[TighteningResult]:
+    """Two programs on three stations and four tools, in the order the runs ended: values
+    missing now and then, NOKs with several reasons, every stop reason and none, a torque
+    window and a program name changed halfway, runs ending at the same time."""
+    rng = np.random.default_rng(5)
+    results = []
+    for n in range(RUNS):
+        program = 1 + n % 2
+        changed = n >= RUNS // 2
+        torque = None if n % 17 == 0 else float(rng.normal(210.0, 12.0))
+        force = None if n % 11 == 0 else float(rng.normal(56000.0, 1500.0))
+        window = (185.0, 235.0) if changed and program == 1 else (180.0, 240.0)
+        reasons = []
+        if torque is not None and not window[0] <= torque <= window[1]:
+            reasons.append(f"torque {'low' if torque < window[0] else 'high'}: {torque:.1f} Nm")
+        if force is not None and force < 54000.0:
+            reasons.append(f"preload low: {force:.0f} N, window 54000 to 59000 N")
+        results.append(
+            factories.result(
+                n + 1,
+                station=f"st{1 + n % 3}",
+                tool_id=7 + n % 4,
+                program_id=program,
+                program_name=f"P{program}{' v2' if changed else ''}",
+                time_ns=factories.T0 + (n // 2) * SECOND_NS,  # two runs end at each time
+                final_torque_nm=JudgedFigure(torque, *window, "ok"),
+                final_angle_deg=JudgedFigure(float(rng.normal(47.0, 5.0)), 35.0, None, "ok"),
+                final_force_n=JudgedFigure(force, 54000.0, 59000.0, "ok"),
+                result="NOK" if reasons else "OK",
+                nok_reasons="; ".join(reasons),
+                stop_reason=(None, "plateau_closest", "target_reached")[n % 3],
+                events=None if n % 13 == 0 else int(rng.integers(30, 45)),
+                process_intensity=None if n % 7 == 0 else float(rng.normal(1e6, 4e4)),
+            )
+        )
+    results.sort(key=lambda result: (result.time_ns, result.station, result.run_id))
+    return results
+
+
+def _same(stored: ProgramStatistics, read: ProgramStatistics) -> None:
+    assert (stored.program_id, stored.program_name) == (read.program_id, read.program_name)
+    assert (stored.runs, stored.noks) == (read.runs, read.noks)
+    assert stored.nok_reasons == read.nok_reasons and stored.stop_reasons == read.stop_reasons
+    assert stored.events_per_run == read.events_per_run
+    assert stored.window_changes == read.window_changes
+    assert (stored.stations, stored.tools) == (read.stations, read.tools)
+    for mine, theirs in zip(stored.figures, read.figures, strict=True):
+        assert mine.key == theirs.key
+        np.testing.assert_array_equal(mine.values, theirs.values)
+        assert mine.capability == theirs.capability
+        assert (mine.chart is None) == (theirs.chart is None)
+        if mine.chart is not None and theirs.chart is not None:
+            np.testing.assert_array_equal(mine.chart.means, theirs.chart.means)
+
+
+def test_the_stores_columns_give_the_statistics_of_the_results(target: StoreTarget) -> None:
+    results = _results()
+    with ResultsStore(target) as store:
+        store.add([stored_result(result, "A", None, None, 1) for result in results])
+        stored = [statistics_of(c, 5) for c in program_columns(store, ResultsQuery(limit=3))]
+        query = ResultsQuery(stations=["st1", "st2"], since_ns=factories.T0 + 10 * SECOND_NS)
+        some = [statistics_of(c, 5) for c in program_columns(store, query)]
+        assert program_columns(store, ResultsQuery(part_id="none such")) == []
+    read = program_statistics(results, 5)
+    assert [program.runs for program in stored] == [RUNS // 2, RUNS // 2]
+    assert any(program.window_changes for program in stored), "the torque window changed"
+    assert all(program.nok_reasons for program in stored), "some runs must be NOK"
+    for mine, theirs in zip(stored, read, strict=True):
+        _same(mine, theirs)
+    kept = [
+        result
+        for result in results
+        if result.station in ("st1", "st2") and result.time_ns >= query.since_ns  # type: ignore[operator]
+    ]
+    for mine, theirs in zip(some, program_statistics(kept, 5), strict=True):
+        _same(mine, theirs)
