@@ -11,7 +11,8 @@ method that is not a coroutine in its thread pool):
 - ``ResultId`` ``<station>/<run id>`` of the joining system's station: the
   results store's tightening by its key, with its steps (``StepResults``),
   and the samples of its run from the recording the store names
-  (:mod:`.result_trace`) as ``Trace``;
+  (:mod:`.result_trace`; while the recorder still writes it, its flushed part
+  under the writing name) as ``Trace``;
 - the recording gone, or not on this machine (another host's path), or no
   samples of the run in it: the result without ``Trace``, and
   ``ExtendedMetaData`` ``TraceMissing`` says why;
@@ -34,6 +35,7 @@ from services.opcua.result_encoding import result_data
 from services.opcua.result_trace import recorded_samples, trace_values
 from services.opcua.result_values import result_id, result_values
 from shared.errors import InputError, StoreError
+from shared.recordings import writing_path
 from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget
 
 LOG = logging.getLogger(__name__)
@@ -66,8 +68,11 @@ def result_with_trace(stored: StoredResult) -> dict[str, Any]:
     if stored.recording is None:
         missing = "the results store names no recording of this run"
     else:
+        recording = Path(stored.recording)
+        if not recording.exists() and writing_path(recording).exists():
+            recording = writing_path(recording)  # still written: what was flushed is read
         try:
-            samples = recorded_samples(Path(stored.recording), result.station, result.run_id)
+            samples = recorded_samples(recording, result.station, result.run_id)
         except InputError as err:
             missing = f"recording on {stored.recording_host}: {err}"
         else:

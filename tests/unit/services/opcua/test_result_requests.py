@@ -147,3 +147,17 @@ def test_a_trace_of_one_sample_has_no_interval_and_none_of_no_samples() -> None:
     assert trace is not None
     [step] = trace["StepTraces"]
     assert step["NumberOfTracePoints"] == 1 and "SamplingInterval" not in step
+
+
+def test_a_recording_still_written_gives_what_was_flushed(tmp_path: Path, models: None) -> None:
+    final = tmp_path / "st1_run3_120000.mcap"
+    with McapSink(final, {}, RUN, factories.T0, rename_when_complete=True) as sink:
+        for n in range(SAMPLES):
+            sample = factories.sample(RUN, n)
+            sink.write(classify("boltwatch/st1/samples", encode(sample), sample.time_ns))
+        sink.flush()
+        assert not final.exists()  # under its writing name until complete
+        result, error = _asked(_store(tmp_path, final), f"st1/{RUN}")
+    assert error == 0
+    [step] = result.ResultContent[0].Value.Trace.StepTraces
+    assert step.NumberOfTracePoints == SAMPLES
