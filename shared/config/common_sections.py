@@ -71,8 +71,7 @@ class StationIdentity(StrictModel):
         default="",
         max_length=64,
         pattern=NO_CONTROL_CHARACTERS,
-        description="the plant the station's line is in, as results and reports name it; "
-        "'' none",
+        description="the plant the station's line is in, as results and reports name it; '' none",
     )
     line: str = Field(
         default="",

@@ -1,7 +1,7 @@
 """Which tightenings a question asks for: :class:`ResultsQuery` as SQL, newest first.
 
 Every criterion is optional and they all hold together: a part id, stations,
-a line, a program, a tool, a range of end times (``since`` included,
+a plant, a line, a program, a tool, a range of end times (``since`` included,
 ``until`` not), NOK only. Each is a column with an index in front
 (:mod:`.results_schema`), so a part's tightenings are found by the index of
 ``part_id`` however large the store.
@@ -21,6 +21,7 @@ DEFAULT_LIMIT = 100
 class ResultsQuery:
     part_id: str | None = None
     stations: Sequence[str] = ()  # any of them; empty: every station
+    plant: str | None = None
     line: str | None = None
     program_id: int | None = None
     tool_id: int | None = None
@@ -43,6 +44,8 @@ class ResultsQuery:
             term("part_id = ?", self.part_id)
         if self.stations:
             term(f"station IN ({', '.join('?' * len(self.stations))})", *self.stations)
+        if self.plant is not None:
+            term("plant = ?", self.plant)
         if self.line is not None:
             term("line = ?", self.line)
         if self.program_id is not None:

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 import zenoh
 
-from shared.config import LoadedStation, load_station
+from shared.config import LoadedStation, StationPlace, load_station
 from shared.contract import TighteningResult
 from shared.recordings.mcap import RecordingScan
 from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget, station_store
@@ -38,11 +38,19 @@ def _run_with_result(run_id: int, part_id: str) -> list[tuple[str, object]]:
     return [*run_messages(run_id, 50), ("results", result)]
 
 
+#: where the station of these tests is ([station] plant, line, name)
+PLACE = StationPlace("North", "B", "Wheel nuts")
+
+
 def _station(tmp_path: Path, database: str | None = None) -> LoadedStation:
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     recorder = {} if database is None else {"results_database": database}
     path = write_station_file(
-        tmp_path / "station.toml", tmp_path / "recordings", listen=[endpoint], recorder=recorder
+        tmp_path / "station.toml",
+        tmp_path / "recordings",
+        listen=[endpoint],
+        recorder=recorder,
+        station={"plant": PLACE.plant, "line": PLACE.line, "name": PLACE.name},
     )
     return load_station(path)
 
@@ -92,7 +100,8 @@ def test_each_result_is_stored_with_the_recording_it_is_in(station: LoadedStatio
     stored = _stored(station)
     assert [s.result.part_id for s in stored] == ["VIN0001", "VIN0002", "VIN0003"]
     for row in stored:
-        assert row.recording is not None and row.line == ""
+        assert row.recording is not None
+        assert StationPlace(row.plant, row.line, row.station_name) == PLACE
         assert row.result in _results_in(Path(row.recording)), row.recording
         assert f"_run{row.result.run_id}_" in Path(row.recording).name
     if station.config.recorder.results_database is None:
@@ -159,6 +168,8 @@ def test_a_refused_results_payload_costs_no_result_of_its_file(tmp_path: Path) -
     assert path is not None
     target = StoreTarget(sqlite_path=tmp_path / "again" / "results.sqlite")
     with ResultsStore(target) as store:
-        counts = fill_from_recordings(store, [Path(path)], {"st1": ""}, "box", time.time_ns)
+        counts = fill_from_recordings(store, [Path(path)], {"st1": PLACE}, "box", time.time_ns)
         assert (counts.read, counts.results, counts.new, counts.damaged) == (1, 1, 1, [])
+        (again,) = store.find(ResultsQuery(plant=PLACE.plant))
+        assert (again.line, again.station_name) == (PLACE.line, PLACE.name)
         assert store.recording_read("box", path) is not None
