@@ -1,6 +1,7 @@
 """The recorder puts every result it files into the results store, naming the file the run
 is in; while the store fails the results wait and go in when it works again; results a
-stopped recorder had not stored come from the recordings at its next start."""
+stopped recorder had not stored come from the recordings at its next start; a store of an
+older boltwatch is migrated at start."""
 
 from __future__ import annotations
 
@@ -13,7 +14,14 @@ import zenoh
 from shared.config import LoadedStation, StationPlace, load_station
 from shared.contract import TighteningResult
 from shared.recordings.mcap import RecordingScan
-from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget, station_store
+from shared.results import (
+    ResultsQuery,
+    ResultsStore,
+    StoredResult,
+    StoreTarget,
+    station_store,
+    stored_result,
+)
 from shared.results.recordings_reading import fill_from_recordings
 from shared.runtime import zenoh_config
 from tests.support import factories
@@ -24,6 +32,7 @@ from tests.support.live_recorder import (
     wait_until,
     write_station_file,
 )
+from tests.support.old_results_store import version_1_store
 from tests.support.postgres_server import (
     PostgresServer,
 )
@@ -106,6 +115,24 @@ def test_each_result_is_stored_with_the_recording_it_is_in(station: LoadedStatio
         assert f"_run{row.result.run_id}_" in Path(row.recording).name
     if station.config.recorder.results_database is None:
         assert (station.recordings_folder / "results.sqlite").is_file()
+
+
+def test_a_version_1_store_is_migrated_by_the_recorder_at_start_losing_no_row(
+    tmp_path: Path,
+) -> None:
+    """A line's store of the boltwatch before the plant model: the recorder migrates it at
+    start; the row it held is as it was (no plant, no name), the new run's has both."""
+    station = _station(tmp_path)
+    old = stored_result(factories.result(1, part_id="VIN0001"), "B", "/rec/old.mcap", "box", 1)
+    version_1_store(station_store(station), [old])
+    recorder = _record(station, [2])
+    try:
+        wait_until(lambda: len(_stored(station)) == 2, "the new result stored", WAIT_S)
+    finally:
+        recorder.finish()
+    kept, new = _stored(station)
+    assert kept == old and (kept.plant, kept.station_name) == ("", "")
+    assert StationPlace(new.plant, new.line, new.station_name) == PLACE
 
 
 def test_a_store_down_keeps_results_waiting_and_the_next_start_finds_the_rest(
