@@ -39,11 +39,7 @@ from pathlib import Path
 from shared.config import StationPlace
 from shared.contract import RunSummary, TighteningResult
 from shared.results import ResultsStore, StoredResult, StoreError, StoreTarget, stored_result
-from shared.results.recordings_reading import (
-    NOWHERE,
-    fill_from_recordings,
-    station_recordings,
-)
+from shared.results.recordings_reading import fill_from_recordings, station_recordings
 
 LOG = logging.getLogger(__name__)
 
@@ -114,7 +110,7 @@ class ResultsWatch:
     def on_result(self, result: TighteningResult, recording: Path | None, now_ns: int) -> None:
         """A filed result (``recording``: the file it went into), stored after
         :meth:`release`."""
-        place = self._places.get(result.station, NOWHERE)
+        place = self._places.get(result.station, StationPlace())
         self._unflushed.append(
             stored_result(
                 result,

@@ -28,8 +28,6 @@ from shared.results.stored_result import StoredResult, stored_result
 
 _RESULTS = "/" + channels.RESULTS.topic
 _RUNS = "/" + channels.RUNS.topic
-#: where a station of no station file is (``results rebuild --recordings``): nowhere named
-NOWHERE = StationPlace()
 
 
 @dataclass
@@ -86,7 +84,7 @@ def results_of(
             station_name=place.name,
         )
         for result in results
-        for place in [places.get(result.station, NOWHERE)]
+        for place in [places.get(result.station, StationPlace())]
     ]
     return stored, scan
 

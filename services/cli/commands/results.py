@@ -3,8 +3,8 @@
 ::
 
     boltwatch results [--part ID] [--station ST ...] [--plant P] [--line L] [--program P]
-                      [--tool T]
-                      [--since DATE] [--until DATE] [--nok] [--limit N] [--csv | --json]
+                      [--tool T] [--since DATE] [--until DATE] [--nok] [--limit N]
+                      [--csv | --json]
                       [--config FILE ... | --recordings DIR | --database URL]
     boltwatch results rebuild [--config FILE ... | --recordings DIR] [--database URL]
 
@@ -50,10 +50,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.description = (
         "Find tightening results in the results store the line's recorder keeps, newest "
         "first: every result of a part (--part), of stations, a plant, a line, a program or a "
-        "tool, in "
-        "a range of time, only the NOK ones. Each row names its recording (boltwatch inspect "
-        "FILE --run RUN draws it). 'boltwatch results rebuild' fills the store from existing "
-        "recordings, resumable and idempotent."
+        "tool, in a range of time, only the NOK ones. Each row names its recording (boltwatch "
+        "inspect FILE --run RUN draws it). 'boltwatch results rebuild' fills the store from "
+        "existing recordings, resumable and idempotent."
     )
     parser.add_argument(
         "action", nargs="?", choices=["rebuild"], help="rebuild: read recordings into the store"
