@@ -58,9 +58,8 @@ def _station_lines(status: StationStatus) -> list[str]:
     rate = f"{status.samples_per_s:.0f} received"
     if status.bus_samples_per_s is not None:
         rate += f" (bus {status.bus_samples_per_s:.0f})"
-    on_line = f" (line {status.recorder.line})" if status.recorder and status.recorder.line else ""
     out = [
-        f"station {status.station}{on_line}",
+        f"station {status.station}{_place_text(status.recorder)}",
         line("services", services),
         line("samples/s", rate),
         *_unless_bridge(status, status.bus, line("bus", _bus_text(status.bus))),
@@ -79,6 +78,17 @@ def _station_lines(status: StationStatus) -> list[str]:
     if status.unreadable_messages:
         out.append(line("unreadable", f"{status.unreadable_messages} messages"))
     return out
+
+
+def _place_text(recorder: RecorderHealth | None) -> str:
+    """Where the station is, as the recorder's station file says: ``"Wheel nuts" (plant
+    North, line B)``, each part only when named; "" when none is."""
+    if recorder is None:
+        return ""
+    named = [f"plant {recorder.plant}"] if recorder.plant else []
+    named += [f"line {recorder.line}"] if recorder.line else []
+    name = f' "{recorder.station_name}"' if recorder.station_name else ""
+    return name + (f" ({', '.join(named)})" if named else "")
 
 
 def _unless_bridge(status: StationStatus, figure: object, text: str) -> list[str]:

@@ -29,6 +29,7 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
+from shared.config import StationPlace
 from shared.contract import RunSummary, TighteningResult, channels, decode, keys
 from shared.errors import InputError
 from shared.line_status import KNOWN_SERVICES, StationStatus, StatusCollector, last_result
@@ -51,6 +52,7 @@ class StationSetting:
 
     station: str
     wear_threshold: float | None  # recorder.wear_service_threshold; None: none set
+    place: StationPlace = field(default_factory=StationPlace)  # [station] plant, line, name
 
 
 @dataclass(frozen=True, slots=True)
@@ -233,6 +235,9 @@ def _station_view(
         services = dict.fromkeys(KNOWN_SERVICES, False) if window_closed else {}
     return {
         "station": setting.station,
+        "name": setting.place.name,
+        "plant": setting.place.plant,
+        "line": setting.place.line,
         "services": services,
         "samples_per_s": window.samples_per_s if window is not None else None,
         "bus_samples_per_s": window.bus_samples_per_s if window is not None else None,

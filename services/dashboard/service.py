@@ -34,7 +34,11 @@ SHUTDOWN_TIMEOUT_S = 2.0
 def main(args: argparse.Namespace) -> int:
     stations = load_any_line(args.config)
     settings = [
-        StationSetting(station.station_id, station.config.recorder.wear_service_threshold)
+        StationSetting(
+            station.station_id,
+            station.config.recorder.wear_service_threshold,
+            station.config.station.place,
+        )
         for station in stations
     ]
     board = LineBoard(settings, time.time_ns())

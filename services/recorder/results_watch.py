@@ -36,6 +36,7 @@ from collections.abc import Callable, Mapping
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
+from shared.config import StationPlace
 from shared.contract import RunSummary, TighteningResult
 from shared.results import ResultsStore, StoredResult, StoreError, StoreTarget, stored_result
 from shared.results.recordings_reading import fill_from_recordings, station_recordings
@@ -62,14 +63,15 @@ class ResultsWatch:
         self,
         target: StoreTarget,
         recordings_folder: Path,
-        lines: Mapping[str, str],
+        places: Mapping[str, StationPlace],
         host: str,
         open_store: Callable[[StoreTarget], ResultsStore] = ResultsStore,
     ) -> None:
-        """``lines``: the line of each station served (its results and recordings)."""
+        """``places``: where each station served is (its results and recordings), as its
+        station file says (plant, line, name)."""
         self.target = target
         self._folder = recordings_folder
-        self._lines = dict(lines)
+        self._places = dict(places)
         self._host = host
         self._open_store = open_store
         self._store: ResultsStore | None = None
@@ -108,14 +110,17 @@ class ResultsWatch:
     def on_result(self, result: TighteningResult, recording: Path | None, now_ns: int) -> None:
         """A filed result (``recording``: the file it went into), stored after
         :meth:`release`."""
+        place = self._places.get(result.station, StationPlace())
         self._unflushed.append(
             stored_result(
                 result,
-                self._lines.get(result.station, ""),
+                place.line,
                 None if recording is None else str(recording.resolve()),
                 self._host,
                 now_ns,
                 self._summaries.get((result.station, result.run_id)),
+                plant=place.plant,
+                station_name=place.name,
             )
         )
 
@@ -212,18 +217,18 @@ class ResultsWatch:
         """Results of recordings made while none was stored (a stop, a kill, a failing
         store): the files modified from the newest stored result (less a margin) up to
         this start."""
-        last_ns = store.last_stored_ns(list(self._lines))
+        last_ns = store.last_stored_ns(list(self._places))
         since_ns = (last_ns if last_ns is not None else self._started_ns) - CATCH_UP_MARGIN_NS
         # a file is in the day folder of its opening (UTC): the day before may hold one
         # written since
         first_day = datetime.fromtimestamp(since_ns / 1e9, UTC).date() - timedelta(days=1)
         files = [
             path
-            for path in station_recordings(self._folder, self._lines, first_day)
+            for path in station_recordings(self._folder, self._places, first_day)
             if since_ns <= _modified_ns(path) <= self._started_ns
         ]
         if files:
-            counts = fill_from_recordings(store, files, self._lines, self._host, time.time_ns)
+            counts = fill_from_recordings(store, files, self._places, self._host, time.time_ns)
             LOG.info(
                 "results store %s: caught up from %d recordings: %d results, %d new",
                 self.target,

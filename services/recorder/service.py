@@ -138,9 +138,9 @@ class RecorderService:
         self.station_ids = metadata.station_ids
         self._sensor_ranges = {station.station_id: station.sensor_range for station in stations}
         self.recorder = Recorder(first.recordings_folder, limits_of(first), metadata, rerun)
-        #: the line of each served station (results, RecorderStats)
-        self._lines = {station.station_id: station.config.station.line for station in stations}
-        self.health = RecorderHealth(self.station_ids, self._lines)
+        #: where each served station is: plant, line, name (results, RecorderStats)
+        self._places = {station.station_id: station.config.station.place for station in stations}
+        self.health = RecorderHealth(self.station_ids, self._places)
         self._batches = BatchSamples()
         self._ledger_file = ledger_path(first.recordings_folder)
         #: with the ledger's path, which ledger a wear reply comes from (a plant has several)
@@ -171,7 +171,7 @@ class RecorderService:
             self.results = ResultsWatch(
                 station_store(first),
                 first.recordings_folder,
-                self._lines,
+                self._places,
                 self._host,
             )
             (scope,) = retention_scopes(stations)  # one folder, one policy: served_stations

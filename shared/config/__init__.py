@@ -17,7 +17,7 @@ names), :func:`load_any_station` (a CAN or a controller station) or
   :mod:`.toml_writer` (the files boltwatch derives from others)
 """
 
-from shared.config.common_sections import ENDPOINT_EXPECTED
+from shared.config.common_sections import ENDPOINT_EXPECTED, StationPlace
 from shared.config.controller_station import (
     ControllerProgram,
     ControllerStation,
@@ -66,6 +66,7 @@ __all__ = [
     "RigOpenProtocolSection",
     "RigSection",
     "StationConfig",
+    "StationPlace",
     "ZenohSection",
     "check_derivable",
     "derive_stations",

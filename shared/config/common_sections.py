@@ -4,7 +4,8 @@ A station file is one of two kinds (:mod:`shared.config.station_kinds`): a CAN
 station (:mod:`shared.config.station`: ``[can]``, a joint, programs with motor
 and hard limits) or a controller station (:mod:`shared.config.controller_station`:
 ``[openprotocol]``, no ``[can]``). Both have the sections here, read the same
-way: ``[station]`` ``id`` and ``tool_id``, ``[zenoh]`` (the line's router,
+way: ``[station]`` ``id`` and ``tool_id`` (and where it is: ``plant``, ``line``, its
+``name`` for people: :class:`StationPlace`), ``[zenoh]`` (the line's router,
 reconnection, TLS), ``[recorder]`` (where the recordings go) and ``[spool]``
 (store and forward on the edge box). Paths are relative to the station file.
 """
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Literal, Protocol, TypeVar
 
@@ -29,6 +31,8 @@ SPOOL_MAX_BYTES = 2 * 1024**3
 
 #: a zenoh endpoint: ``<protocol>/<address>[?<metadata>][#<config>]``
 ENDPOINT_FORM = re.compile(r"[A-Za-z0-9_-]+/[^?#\s]+(\?[^#\s]*)?(#\S*)?")
+#: a name people read (plant, line, station name): one line, no control characters
+NO_CONTROL_CHARACTERS = r"^[^\x00-\x1f\x7f]*$"
 ENDPOINT_EXPECTED = "expected <protocol>/<address>:<port>, e.g. tcp/127.0.0.1:7447"
 
 
@@ -41,8 +45,20 @@ def _endpoint(text: str) -> str:
 Endpoint = Annotated[str, AfterValidator(_endpoint)]
 
 
+@dataclass(frozen=True, slots=True)
+class StationPlace:
+    """Where a station is in the plant model (plant -> line -> station), as its station
+    file's ``[station]`` names it; ``""``: not named. ``name`` is the station's name for
+    people (its id is the key)."""
+
+    plant: str = ""
+    line: str = ""
+    name: str = ""
+
+
 class StationIdentity(StrictModel):
-    """``[station]`` keys of every station: its id on the line, its tool's id."""
+    """``[station]`` keys of every station: its id on the line, its tool's id, and where it
+    is (plant, line) with its name for people."""
 
     id: StationId = Field(pattern=r"^[A-Za-z0-9_-]{1,64}$", description="key-expression safe")
     tool_id: int = Field(
@@ -51,12 +67,30 @@ class StationIdentity(StrictModel):
         description="the tool's id: in ToolStatus on CAN; the id a controller station's "
         "runs and wear are counted under",
     )
+    plant: str = Field(
+        default="",
+        max_length=64,
+        pattern=NO_CONTROL_CHARACTERS,
+        description="the plant the station's line is in, as results and reports name it; '' none",
+    )
     line: str = Field(
         default="",
         max_length=64,
-        pattern=r"^[^\x00-\x1f]*$",
+        pattern=NO_CONTROL_CHARACTERS,
         description="the line the station is on, as results and reports name it; '' none",
     )
+    name: str = Field(
+        default="",
+        max_length=64,
+        pattern=NO_CONTROL_CHARACTERS,
+        description="the station's name for people (status, results, the line's page); "
+        "'' none: its id is shown",
+    )
+
+    @property
+    def place(self) -> StationPlace:
+        """Where the station is: its plant, line and name."""
+        return StationPlace(self.plant, self.line, self.name)
 
 
 class ZenohSection(StrictModel):

@@ -311,6 +311,12 @@ class RecorderStats:
     # run files of this station past their time that the last retention pass kept because
     # their results are not in the results store
     recordings_kept_unstored: Count = 0
+    # the plant of the station's line, as its station file names it (``[station] plant``;
+    # "": none)
+    plant: str = ""
+    # the station's name for people, as its station file names it (``[station] name``; "":
+    # none, its id is shown)
+    station_name: str = ""
 
 
 @dataclass(frozen=True, slots=True)

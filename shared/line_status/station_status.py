@@ -167,7 +167,9 @@ class RecorderHealth:
     refused_summaries: int = 0  # RunSummaries the wear ledger refused (beyond their bound)
     waiting_summaries: int = 0  # runs waiting in the recorder's memory for the wear ledger
     waiting_results: int = 0  # results waiting in the recorder's memory for the results store
+    plant: str = ""  # the plant of the station's line, as the recorder's station file names it
     line: str = ""  # the station's line, as the recorder's station file names it
+    station_name: str = ""  # the station's name for people, as that file names it
     bad_payloads: int = 0  # payloads it refused (recorded raw)
     recordings_deleted: int = 0  # run files the retention policy deleted since it started
     recordings_kept_unstored: int = 0  # past their time, kept: their results are not stored
@@ -339,7 +341,9 @@ def _recorder_health(
         refused_summaries=stats.refused_summaries,
         waiting_summaries=stats.waiting_summaries,
         waiting_results=stats.waiting_results,
+        plant=stats.plant,
         line=stats.line,
+        station_name=stats.station_name,
         bad_payloads=stats.bad_payloads,
         recordings_deleted=stats.recordings_deleted,
         recordings_kept_unstored=stats.recordings_kept_unstored,

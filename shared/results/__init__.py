@@ -1,5 +1,5 @@
 """The results store: every tightening result, findable in a second (by part, station,
-line, program, tool, time), in SQLite beside the recordings or a plant's PostgreSQL.
+plant, line, program, tool, time), in SQLite beside the recordings or a plant's PostgreSQL.
 
 - :mod:`.results_database` (one connection, SQLite or PostgreSQL, the same SQL;
   :func:`store_target`: where a station file's store is)

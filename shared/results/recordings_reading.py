@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from datetime import date
 from pathlib import Path
 
+from shared.config import StationPlace
 from shared.contract import RunSummary, TighteningResult, channels, decode
 from shared.errors import InputError
 from shared.recordings import recording_files, station_days
@@ -56,10 +57,11 @@ def station_recordings(
 
 
 def results_of(
-    path: Path, lines: Mapping[str, str], host: str, now_ns: int
+    path: Path, places: Mapping[str, StationPlace], host: str, now_ns: int
 ) -> tuple[list[StoredResult], RecordingScan]:
     """The results recorded in ``path`` (as far as it is readable), as the store keeps them:
-    the line of each station from ``lines``, the file as their recording."""
+    where each station is from ``places`` (one not in it: nowhere named), the file as their
+    recording."""
     scan = RecordingScan(path)
     results: list[TighteningResult] = []
     summaries: dict[tuple[str, int], RunSummary] = {}
@@ -73,13 +75,16 @@ def results_of(
     stored = [
         stored_result(
             result,
-            lines.get(result.station, ""),
+            place.line,
             recording,
             host,
             now_ns,
             summaries.get((result.station, result.run_id)),
+            plant=place.plant,
+            station_name=place.name,
         )
         for result in results
+        for place in [places.get(result.station, StationPlace())]
     ]
     return stored, scan
 
@@ -87,7 +92,7 @@ def results_of(
 def fill_from_recordings(
     store: ResultsStore,
     files: Sequence[Path],
-    lines: Mapping[str, str],
+    places: Mapping[str, StationPlace],
     host: str,
     clock_ns: Callable[[], int],
     progress: Callable[[FillCounts], None] | None = None,
@@ -104,7 +109,7 @@ def fill_from_recordings(
         recording = str(path.resolve())
         if store.recording_read(host, recording) != (stat.st_size, stat.st_mtime_ns):
             try:
-                stored, scan = results_of(path, lines, host, clock_ns())
+                stored, scan = results_of(path, places, host, clock_ns())
             except InputError as err:
                 counts.damaged.append(str(err))
             else:

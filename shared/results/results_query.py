@@ -1,9 +1,9 @@
 """Which tightenings a question asks for: :class:`ResultsQuery` as SQL, newest first.
 
 Every criterion is optional and they all hold together: a part id, stations,
-a run id (with one station: a tightening by the table's primary key), a line,
-a program, a tool, a range of end times (``since`` included, ``until`` not),
-NOK only. Each is a column with an index in front
+a run id (with one station: a tightening by the table's primary key), a plant,
+a line, a program, a tool, a range of end times (``since`` included, ``until``
+not), NOK only. Each is a column with an index in front
 (:mod:`.results_schema`), so a part's tightenings are found by the index of
 ``part_id`` however large the store.
 """
@@ -23,6 +23,7 @@ class ResultsQuery:
     part_id: str | None = None
     stations: Sequence[str] = ()  # any of them; empty: every station
     run_id: int | None = None  # with one station: a tightening by the store's key
+    plant: str | None = None
     line: str | None = None
     program_id: int | None = None
     tool_id: int | None = None
@@ -47,6 +48,8 @@ class ResultsQuery:
             term(f"station IN ({', '.join('?' * len(self.stations))})", *self.stations)
         if self.run_id is not None:
             term("run_id = ?", self.run_id)
+        if self.plant is not None:
+            term("plant = ?", self.plant)
         if self.line is not None:
             term("line = ?", self.line)
         if self.program_id is not None:

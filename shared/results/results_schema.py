@@ -3,10 +3,12 @@
 ``tightenings``: one row per tightening, keyed by (station, run_id), so a
 result heard twice (a spool's resend, a rebuild over files already read) is
 one row. It holds what a quality engineer asks about: the part, the program,
-the tool, the line, when it ended, OK/NOK and why, the final torque, angle
-and preload each with its window and status, what stopped the tool, the
-stick-slip events and intensity, who judged it (``source``), and where its
-recording is (``recording``: the MCAP file's path on ``recording_host``).
+the tool, where it was tightened (the plant, the line, the station's name for
+people: the station file's ``[station]`` when it was stored), when it ended,
+OK/NOK and why, the final torque, angle and preload each with its window and
+status, what stopped the tool, the stick-slip events and intensity, who judged
+it (``source``), and where its recording is (``recording``: the MCAP file's
+path on ``recording_host``).
 ``tightening_steps``: the steps of a controller's program, one row each.
 ``recordings_read``: which recordings ``results rebuild`` (and the
 recorder's catch-up at start) has read, so reading again skips them.
@@ -24,11 +26,11 @@ from __future__ import annotations
 from shared.results.results_database import ResultsDatabase, StoreError
 
 #: the version this boltwatch writes; MIGRATIONS[v - 1] makes version v
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 TIGHTENING_COLUMNS = (
-    "station", "run_id", "line", "tightening_id", "tool_id", "program_id", "program_name",
-    "part_id", "batch_counter", "ended_ns", "result", "nok_reasons",
+    "station", "run_id", "plant", "line", "station_name", "tightening_id", "tool_id",
+    "program_id", "program_name", "part_id", "batch_counter", "ended_ns", "result", "nok_reasons",
     "torque_nm", "torque_min_nm", "torque_max_nm", "torque_status",
     "angle_deg", "angle_min_deg", "angle_max_deg", "angle_status",
     "force_n", "force_min_n", "force_max_n", "force_status",
@@ -97,8 +99,18 @@ _VERSION_1 = (
     )""",
 )
 
+# the plant model: the station's plant, and its name for people, on each row (a row made
+# before has neither: ''). ADD COLUMN with a constant default rewrites no row in either
+# database (SQLite changes the table's schema; PostgreSQL 11+ keeps the default in the
+# catalogue); only the index reads the table.
+_VERSION_2 = (
+    "ALTER TABLE tightenings ADD COLUMN plant TEXT NOT NULL DEFAULT ''",
+    "ALTER TABLE tightenings ADD COLUMN station_name TEXT NOT NULL DEFAULT ''",
+    "CREATE INDEX tightenings_by_plant ON tightenings (plant, ended_ns)",
+)
+
 #: the statements that bring a store from version v - 1 to v, for v = 1, 2, ...
-MIGRATIONS: tuple[tuple[str, ...], ...] = (_VERSION_1,)
+MIGRATIONS: tuple[tuple[str, ...], ...] = (_VERSION_1, _VERSION_2)
 
 
 def migrate(database: ResultsDatabase, migrations: tuple[tuple[str, ...], ...] = MIGRATIONS) -> int:

@@ -1,6 +1,6 @@
-"""The results store: every tightening's result, findable by part, station, line, program,
-tool and time (:mod:`.results_schema` its tables, :mod:`.results_database` SQLite or
-PostgreSQL).
+"""The results store: every tightening's result, findable by part, station, plant, line,
+program, tool and time (:mod:`.results_schema` its tables, :mod:`.results_database` SQLite
+or PostgreSQL).
 
 The recorder adds each result as it files it (``services/recorder/results_watch.py``),
 ``boltwatch results rebuild`` those of existing recordings; both may write at once.

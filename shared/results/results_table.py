@@ -1,8 +1,9 @@
 """Stored tightenings for people and programs: a table, CSV, JSON (``boltwatch results``).
 
-The table has one line per tightening, newest first, its last column the
-recording (``boltwatch inspect <it> --run <run>`` draws the run); CSV has
-every column of the store, JSON every field with the steps.
+The table has one line per tightening, newest first (the station by its id,
+its name for people beside it), its last column the recording (``boltwatch
+inspect <it> --run <run>`` draws the run); CSV has every column of the store,
+JSON every field with the steps.
 """
 
 from __future__ import annotations
@@ -18,12 +19,12 @@ from shared.contract import JudgedFigure, to_dict
 from shared.results.stored_result import StoredResult
 
 HEADER = (
-    "ended (UTC)", "station", "line", "run", "part", "program", "tool", "result",
+    "ended (UTC)", "station", "plant", "line", "run", "part", "program", "tool", "result",
     "torque Nm", "angle deg", "preload kN", "stopped on", "events", "why NOK", "recording",
 )  # fmt: skip
 CSV_HEADER = (
-    "ended_utc", "station", "line", "run_id", "tightening_id", "part_id", "program_id",
-    "program_name", "tool_id", "batch_counter", "result", "nok_reasons",
+    "ended_utc", "station", "station_name", "plant", "line", "run_id", "tightening_id",
+    "part_id", "program_id", "program_name", "tool_id", "batch_counter", "result", "nok_reasons",
     "torque_nm", "torque_min_nm", "torque_max_nm", "torque_status",
     "angle_deg", "angle_min_deg", "angle_max_deg", "angle_status",
     "force_n", "force_min_n", "force_max_n", "force_status",
@@ -46,7 +47,8 @@ def row(stored: StoredResult) -> tuple[str, ...]:
     r = stored.result
     return (
         utc_text(r.time_ns),
-        r.station,
+        f"{r.station} ({stored.station_name})" if stored.station_name else r.station,
+        stored.plant or "-",
         stored.line or "-",
         str(r.run_id),
         r.part_id or "-",
@@ -78,8 +80,9 @@ def csv_row(stored: StoredResult) -> list[Any]:
     for figure in (r.final_torque_nm, r.final_angle_deg, r.final_force_n):
         figures += [figure.value, figure.min, figure.max, figure.status]
     return [
-        utc_text(r.time_ns), r.station, stored.line, r.run_id, r.tightening_id, r.part_id,
-        r.program_id, r.program_name, r.tool_id, r.batch_counter, r.result, r.nok_reasons,
+        utc_text(r.time_ns), r.station, stored.station_name, stored.plant, stored.line,
+        r.run_id, r.tightening_id, r.part_id, r.program_id, r.program_name, r.tool_id,
+        r.batch_counter, r.result, r.nok_reasons,
         *figures, r.stop_reason, r.events, r.process_intensity, r.source, stored.recording,
         stored.recording_host,
     ]  # fmt: skip
@@ -94,9 +97,12 @@ def format_csv(results: Sequence[StoredResult]) -> str:
 
 
 def as_dict(stored: StoredResult) -> dict[str, Any]:
-    """A tightening as JSON: the TighteningResult's fields, its line and recording."""
+    """A tightening as JSON: the TighteningResult's fields, where it was tightened (the
+    station's name, plant and line) and its recording."""
     document = to_dict(stored.result)
     document["ended_utc"] = utc_text(stored.result.time_ns)
+    document["station_name"] = stored.station_name
+    document["plant"] = stored.plant
     document["line"] = stored.line
     document["recording"] = stored.recording
     document["recording_host"] = stored.recording_host

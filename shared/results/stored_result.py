@@ -1,5 +1,5 @@
 """A tightening as the results store keeps it: a :class:`TighteningResult`, where it was
-tightened (line), where its recording is, and when it was stored.
+tightened (plant, line, the station's name), where its recording is, and when it was stored.
 
 :func:`stored_result` makes one from a result (and its run's summary: the
 events of a run whose result has none, as ``report`` counts them);
@@ -27,6 +27,9 @@ class StoredResult:
     recording: str | None = None  # the MCAP file's path on recording_host; None: unknown
     recording_host: str | None = None
     stored_ns: int = 0
+    plant: str = ""  # the plant of the station's line ("": none named)
+    # the station's name for people when the result was stored ("": none, its id is shown)
+    station_name: str = ""
 
 
 def stored_result(
@@ -36,19 +39,23 @@ def stored_result(
     recording_host: str | None,
     stored_ns: int,
     summary: RunSummary | None = None,
+    *,
+    plant: str = "",
+    station_name: str = "",
 ) -> StoredResult:
     """``result`` to store; ``summary``: its run's, whose events count when it has none."""
     if result.events is None and summary is not None and summary.run_id == result.run_id:
         result = replace(result, events=summary.events)
-    return StoredResult(result, line, recording, recording_host, stored_ns)
+    return StoredResult(result, line, recording, recording_host, stored_ns, plant, station_name)
 
 
 def to_row(stored: StoredResult) -> tuple[Any, ...]:
     r = stored.result
     torque, angle, force = r.final_torque_nm, r.final_angle_deg, r.final_force_n
     return (
-        r.station, r.run_id, stored.line, r.tightening_id, r.tool_id, r.program_id,
-        r.program_name, r.part_id, r.batch_counter, r.time_ns, r.result, r.nok_reasons,
+        r.station, r.run_id, stored.plant, stored.line, stored.station_name, r.tightening_id,
+        r.tool_id, r.program_id, r.program_name, r.part_id, r.batch_counter, r.time_ns,
+        r.result, r.nok_reasons,
         torque.value, torque.min, torque.max, torque.status,
         angle.value, angle.min, angle.max, angle.status,
         force.value, force.min, force.max, force.status,
@@ -68,8 +75,8 @@ def step_rows(stored: StoredResult) -> list[tuple[Any, ...]]:
 
 def from_row(row: Sequence[Any], steps: Sequence[ResultStep] = ()) -> StoredResult:
     (
-        station, run_id, line, tightening_id, tool_id, program_id, program_name, part_id,
-        batch_counter, ended_ns, verdict, nok_reasons,
+        station, run_id, plant, line, station_name, tightening_id, tool_id, program_id,
+        program_name, part_id, batch_counter, ended_ns, verdict, nok_reasons,
         torque, torque_min, torque_max, torque_status,
         angle, angle_min, angle_max, angle_status,
         force, force_min, force_max, force_status,
@@ -96,7 +103,9 @@ def from_row(row: Sequence[Any], steps: Sequence[ResultStep] = ()) -> StoredResu
         source=source,
         steps=list(steps),
     )
-    return StoredResult(result, line, recording, recording_host, int(stored_ns))
+    return StoredResult(
+        result, line, recording, recording_host, int(stored_ns), plant, station_name
+    )
 
 
 def step_of(row: Sequence[Any]) -> ResultStep:

@@ -1,18 +1,19 @@
 """A plant's year of tightening results, made up and written straight into a results store's
-own tables, for ``bench_results_store.py``.
+own tables, for ``bench_results_store.py`` and ``bench_results_migration.py``.
 
-The plant: 20 stations on 2 lines (``st01``-``st10`` on ``L1``, ``st11``-``st20``
-on ``L2``), 50 programs (each station 2 or 3 of its own), 200 tools (10 a
-station). A part gets 4 to 8 bolts at one station, all by one program and
-one tool; part ids count per line (``L1-P0000001``). Every fifth station is
-a tool controller's (Open Protocol: no preload measured, 3 steps per result,
-a batch counter, no predictor figures); the others are CAN stations judged
-by the predictor (torque, angle and preload windows, stick-slip events, a
-process intensity). A figure is drawn in its window (σ a quarter of the
-half-window) and about 1.5 % of the runs are pushed out of one window, so
-NOK; each figure's status comes from :func:`shared.quality.judge`. The runs
-are spread evenly over ``days`` (the stations in turn, a little jitter):
-10 million over a year is a run every 63 s at each station.
+The plant (``Plant 1``): 20 stations (``st01``, named ``Station 01``, ...) on 2
+lines (``st01``-``st10`` on ``L1``, ``st11``-``st20`` on ``L2``), 50 programs
+(each station 2 or 3 of its own), 200 tools (10 a station). A part gets 4 to 8
+bolts at one station, all by one program and one tool; part ids count per line
+(``L1-P0000001``). Every fifth station is a tool controller's (Open Protocol: no
+preload measured, 3 steps per result, a batch counter, no predictor figures);
+the others are CAN stations judged by the predictor (torque, angle and preload
+windows, stick-slip events, a process intensity). A figure is drawn in its
+window (σ a quarter of the half-window) and about 1.5 % of the runs are pushed
+out of one window, so NOK; each figure's status comes from
+:func:`shared.quality.judge`. The runs are spread evenly over ``days`` (the
+stations in turn, a little jitter): 10 million over a year is a run every 63 s
+at each station.
 
 The store is made by :class:`~shared.results.ResultsStore` first, so the
 tables and indexes are the product's; then the rows go in as a bulk loader
@@ -36,7 +37,14 @@ import psycopg
 
 from shared.contract import JudgedFigure
 from shared.quality import judge
-from shared.results import ResultsStore, StoreTarget
+from shared.results import (
+    MIGRATIONS,
+    SCHEMA_VERSION,
+    ResultsDatabase,
+    ResultsStore,
+    StoreTarget,
+    migrate,
+)
 from shared.results.results_schema import STEP_COLUMNS, TIGHTENING_COLUMNS
 
 STATIONS = 20
@@ -51,6 +59,7 @@ START_NS = 1_767_225_600 * 1_000_000_000
 DAY_NS = 86_400 * 1_000_000_000
 ROWS_PER_TRANSACTION = 200_000
 HOST = "line-server"
+PLANT = "Plant 1"
 
 
 @dataclass(frozen=True)
@@ -190,7 +199,7 @@ def _row(
     recording = f"/srv/boltwatch/recordings/{folder}/{day}/{folder}_run{run_id}_{clock}.mcap"
     controller = station.controller
     row = (
-        station.station, run_id, station.line,
+        station.station, run_id, PLANT, station.line, f"Station {station.station[2:]}",
         run_id + 500_000 if controller else run_id, station.tool_id, program.program_id,
         program.name, station.part_id, station.bolt if controller else None, ended_ns,
         "NOK" if reasons else "OK", "; ".join(reasons),
@@ -224,17 +233,20 @@ def _day_name(day: int) -> str:
     return datetime.fromtimestamp(day * 86_400, UTC).strftime("%Y-%m-%d")
 
 
-def fill_sqlite(path: Path, rows: int, days: float, seed: int) -> Rows:
-    """The store at ``path`` (made by ResultsStore) filled with :func:`synthetic_rows`."""
-    ResultsStore(StoreTarget(sqlite_path=path)).close()
+def fill_sqlite(
+    path: Path, rows: int, days: float, seed: int, version: int = SCHEMA_VERSION
+) -> Rows:
+    """The store at ``path`` (made by ResultsStore, or at an older ``version``) filled with
+    :func:`synthetic_rows` (the columns that version has)."""
+    columns = _make(StoreTarget(sqlite_path=path), version)
     made = Rows()
     connection = sqlite3.connect(path, isolation_level=None)
     connection.execute("PRAGMA synchronous=OFF")
     connection.execute("PRAGMA cache_size=-1048576")
-    insert = _insert("tightenings", TIGHTENING_COLUMNS)
+    insert = _insert("tightenings", columns)
     insert_step = _insert("tightening_steps", STEP_COLUMNS)
     try:
-        for chunk, steps in _chunks(synthetic_rows(rows, days, seed, made)):
+        for chunk, steps in _chunks(synthetic_rows(rows, days, seed, made), columns):
             connection.execute("BEGIN")
             connection.executemany(insert, chunk)
             connection.executemany(insert_step, steps)
@@ -245,15 +257,17 @@ def fill_sqlite(path: Path, rows: int, days: float, seed: int) -> Rows:
     return made
 
 
-def fill_postgres(url: str, rows: int, days: float, seed: int) -> Rows:
-    """The store at ``url`` (made by ResultsStore) filled with :func:`synthetic_rows` by
-    COPY, then VACUUM ANALYZE."""
-    ResultsStore(StoreTarget(postgres_url=url)).close()
+def fill_postgres(
+    url: str, rows: int, days: float, seed: int, version: int = SCHEMA_VERSION
+) -> Rows:
+    """The store at ``url`` (made by ResultsStore, or at an older ``version``) filled with
+    :func:`synthetic_rows` by COPY, then VACUUM ANALYZE."""
+    columns = _make(StoreTarget(postgres_url=url), version)
     made = Rows()
     with psycopg.connect(url) as connection:
-        for chunk, steps in _chunks(synthetic_rows(rows, days, seed, made)):
+        for chunk, steps in _chunks(synthetic_rows(rows, days, seed, made), columns):
             with connection.cursor() as cursor:
-                _copy(cursor, "tightenings", TIGHTENING_COLUMNS, chunk)
+                _copy(cursor, "tightenings", columns, chunk)
                 _copy(cursor, "tightening_steps", STEP_COLUMNS, steps)
             connection.commit()
         connection.autocommit = True
@@ -274,13 +288,29 @@ def _insert(table: str, columns: tuple[str, ...]) -> str:
     return f"INSERT INTO {table} ({', '.join(columns)}) VALUES ({', '.join('?' * len(columns))})"
 
 
+def _make(target: StoreTarget, version: int) -> tuple[str, ...]:
+    """The store at ``version`` (its tables and indexes the product's); its tightenings'
+    columns."""
+    if version == SCHEMA_VERSION:
+        ResultsStore(target).close()
+        return TIGHTENING_COLUMNS
+    with ResultsDatabase(target) as database:
+        migrate(database, MIGRATIONS[:version])
+    assert version == 1, "only version 1 is older"
+    return tuple(c for c in TIGHTENING_COLUMNS if c not in ("plant", "station_name"))
+
+
 def _chunks(
     rows: Iterator[tuple[tuple[Any, ...], list[tuple[Any, ...]]]],
+    columns: tuple[str, ...] = TIGHTENING_COLUMNS,
 ) -> Iterator[tuple[list[tuple[Any, ...]], list[tuple[Any, ...]]]]:
+    """Rows in transactions of :data:`ROWS_PER_TRANSACTION`, each of ``columns`` only."""
+    kept = [TIGHTENING_COLUMNS.index(column) for column in columns]
+    whole = columns == TIGHTENING_COLUMNS
     chunk: list[tuple[Any, ...]] = []
     steps: list[tuple[Any, ...]] = []
     for row, row_steps in rows:
-        chunk.append(row)
+        chunk.append(row if whole else tuple(row[i] for i in kept))
         steps.extend(row_steps)
         if len(chunk) == ROWS_PER_TRANSACTION:
             yield chunk, steps

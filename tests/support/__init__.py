@@ -30,7 +30,8 @@ with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
   :mod:`.can_injector` (frames on the CAN bus), :mod:`.disk_faults` (a full or
   read-only disk)
 - databases: :mod:`.postgres_server` (a throwaway PostgreSQL server; the fixtures
-  ``postgres_server`` and ``postgres_url`` in ``tests/conftest.py``)
+  ``postgres_server`` and ``postgres_url`` in ``tests/conftest.py``),
+  :mod:`.old_results_store` (a results store as an older boltwatch left it)
 - deployment: :mod:`.compose_layout`, :mod:`.access_rules`
 - :mod:`.fuzz` (hostile payloads for the live services), :mod:`.bad_arguments`
   (every bad argument of every command)

@@ -101,16 +101,19 @@ def write_station_file(
     recorder: Mapping[str, Any] | None = None,
     quality: Mapping[str, Any] | None = None,
     retention: Mapping[str, Any] | None = None,
+    station: Mapping[str, Any] | None = None,
 ) -> Path:
     """A copy of config/station.toml as a zenoh peer on the given endpoints.
 
     ``can.dbc`` and ``station.joint`` point at the repository's files;
-    ``recorder.folder`` is ``recordings``; ``recorder`` overrides recorder keys;
+    ``recorder.folder`` is ``recordings``; ``recorder`` overrides recorder keys,
+    ``station`` station keys;
     ``quality``: the ``[quality]`` section; ``retention``: the ``[retention]`` section.
     """
     with STATION_FILE.open("rb") as handle:
         data = tomllib.load(handle)
     base = STATION_FILE.parent
+    data["station"] = {**data["station"], **(station or {})}
     data["station"]["joint"] = str((base / data["station"]["joint"]).resolve())
     data["can"]["dbc"] = str((base / data["can"]["dbc"]).resolve())
     data["zenoh"] = {"mode": "peer", "connect": list(connect), "listen": list(listen)}

@@ -34,6 +34,8 @@ from tests.support.paths import REPO
 from tests.support.station_files import free_tcp_port, write_station
 
 LINES = (1, 2)
+#: the plant both lines are in ([station] plant)
+PLANT = "North"
 TOOL_ID = 31
 CLI = [sys.executable, "-m", "services.cli"]
 #: the plant's own subnet (test_netns_line.py uses 10.213.0.0/24)
@@ -112,7 +114,8 @@ class NamespacePlant:
 
 
 def line_station(folder: Path, hosts: Hosts, line: int, results_database: str | None) -> Path:
-    """Station ``st<line>`` of line ``line`` (``[station] line = "line<line>"``): its router,
+    """Station ``st<line>`` of line ``line`` (``[station] line = "line<line>"``, in plant
+    :data:`PLANT`, named ``Station <line>``): its router,
     its recordings folder, the plant's results store (none: its own, in its recordings)."""
     station = folder / f"line{line}"
     station.mkdir()
@@ -124,7 +127,8 @@ def line_station(folder: Path, hosts: Hosts, line: int, results_database: str | 
         zenoh_port=port,
         replacements={
             f"tcp/127.0.0.1:{port}": hosts.endpoint(line),
-            'id = "st1"': f'id = "st{line}"\nline = "line{line}"',
+            'id = "st1"': f'id = "st{line}"\nplant = "{PLANT}"\nline = "line{line}"\n'
+            f'name = "Station {line}"',
             "tool_id = 7": f"tool_id = {TOOL_ID}",
             "seed = 7": f"seed = {line}",
             flush: flush + database,

@@ -26,6 +26,7 @@ from tests.support.live_recorder import wait_until
 from tests.support.netns_line import unavailable_reason
 from tests.support.plant import (
     LINES,
+    PLANT,
     TOOL_ID,
     Hosts,
     LoopbackPlant,
@@ -55,16 +56,18 @@ def test_two_lines_on_loopback_into_one_postgresql(tmp_path: Path, postgres_url:
     run_plant(LoopbackPlant(), tmp_path, postgres_url)
     stations = [str(tmp_path / f"line{line}" / "station.toml") for line in LINES]
     for line in LINES:
-        found = _results("--database", postgres_url, "--line", f"line{line}")
-        assert [(row["station"], row["line"]) for row in found] == [
-            (f"st{line}", f"line{line}")
-        ] * RUNS
+        found = _results("--database", postgres_url, "--plant", PLANT, "--line", f"line{line}")
+        assert [
+            (row["station"], row["plant"], row["line"], row["station_name"]) for row in found
+        ] == [(f"st{line}", PLANT, f"line{line}", f"Station {line}")] * RUNS
     across = _results("--config", *stations)
     assert sorted(row["station"] for row in across) == ["st1"] * RUNS + ["st2"] * RUNS
     report = boltwatch("report", "--config", *stations, "--out", str(tmp_path / "report"))
     assert report.returncode == 0, report.stdout + report.stderr
     assert f"{2 * RUNS} results (from the results store postgresql://" in report.stdout
-    line_2 = boltwatch("report", "--config", *stations, "--line", "line2", "--out", str(tmp_path))
+    line_2 = boltwatch(
+        "report", "--config", *stations, "--plant", PLANT, "--line", "line2", "--out", str(tmp_path)
+    )
     assert f"{RUNS} results (from the results store postgresql://" in line_2.stdout, line_2
 
 
@@ -105,7 +108,9 @@ def run_plant(hosts: Hosts, folder: Path, results_database: str | None = None) -
         assert all(station["services"][s] for s in ("acquisition", "predictor", "recorder"))
         recorder = station["recorder"]
         assert recorder is not None, station
-        assert recorder["line"] == f"line{line}", recorder  # its station file's [station] line
+        # its station file's [station] plant, line and name
+        place = (recorder["plant"], recorder["line"], recorder["station_name"])
+        assert place == (PLANT, f"line{line}", f"Station {line}"), recorder
         assert recorder["recording"] and recorder["bad_payloads"] == 0, recorder
         assert recorder["missing_samples"] == 0, recorder
     # wear from either line: the tool's runs on both lines, from both ledgers

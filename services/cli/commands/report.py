@@ -2,7 +2,7 @@
 
 ::
 
-    boltwatch report [--config STATION ...] [--line L] [--since DATE] [--until DATE]
+    boltwatch report [--config STATION ...] [--plant P] [--line L] [--since DATE] [--until DATE]
                      [--program ID] [--tool ID] [--subgroup-size N] [--out FOLDER]
                      [--from-recordings]
 
@@ -61,6 +61,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="last day, included (YYYY-MM-DD), or moment, excluded; UTC (default: now)",
     )
     parser.add_argument(
+        "--plant", default=None, metavar="P", help="only the stations in plant P (station.plant)"
+    )
+    parser.add_argument(
         "--line", default=None, metavar="L", help="only the stations on line L (station.line)"
     )
     parser.add_argument("--program", type=int_in(0, 65535, "a program id"), default=None)
@@ -92,10 +95,17 @@ def run(args: argparse.Namespace) -> int:
     from shared.offline.report import ResultFilter, terminal_lines, write_report
 
     stations = [load_any_station(path) for path in args.config]
+    if args.plant is not None:
+        stations = [loaded for loaded in stations if loaded.config.station.plant == args.plant]
     if args.line is not None:
         stations = [loaded for loaded in stations if loaded.config.station.line == args.line]
-        if not stations:
-            raise ConfigError(f"--line {args.line}: no station of the station files is on it")
+    if not stations:
+        asked = " ".join(
+            f"{option} {value}"
+            for option, value in (("--plant", args.plant), ("--line", args.line))
+            if value is not None
+        )
+        raise ConfigError(f"{asked}: no station of the station files is there")
     rule = ResultFilter(
         stations=[(loaded.station_id, loaded.recordings_folder) for loaded in stations],
         since=args.since,

@@ -2,8 +2,9 @@
 
 ::
 
-    boltwatch results [--part ID] [--station ST ...] [--line L] [--program P] [--tool T]
-                      [--since DATE] [--until DATE] [--nok] [--limit N] [--csv | --json]
+    boltwatch results [--part ID] [--station ST ...] [--plant P] [--line L] [--program P]
+                      [--tool T] [--since DATE] [--until DATE] [--nok] [--limit N]
+                      [--csv | --json]
                       [--config FILE ... | --recordings DIR | --database URL]
     boltwatch results rebuild [--config FILE ... | --recordings DIR] [--database URL]
 
@@ -35,10 +36,11 @@ from shared.errors import ConfigError
 from shared.option_types import int_in
 
 if TYPE_CHECKING:
+    from shared.config import StationPlace
     from shared.results import StoreTarget
 
 NAME = "results"
-HELP = "find tightenings in the results store (by part, station, line, program, tool, time)"
+HELP = "find tightenings in the results store (by part, station, plant, line, program, tool, time)"
 
 #: progress is told at most this often (a rebuild of years of files)
 PROGRESS_INTERVAL_S = 1.0
@@ -47,10 +49,10 @@ PROGRESS_INTERVAL_S = 1.0
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.description = (
         "Find tightening results in the results store the line's recorder keeps, newest "
-        "first: every result of a part (--part), of stations, a line, a program or a tool, in "
-        "a range of time, only the NOK ones. Each row names its recording (boltwatch inspect "
-        "FILE --run RUN draws it). 'boltwatch results rebuild' fills the store from existing "
-        "recordings, resumable and idempotent."
+        "first: every result of a part (--part), of stations, a plant, a line, a program or a "
+        "tool, in a range of time, only the NOK ones. Each row names its recording (boltwatch "
+        "inspect FILE --run RUN draws it). 'boltwatch results rebuild' fills the store from "
+        "existing recordings, resumable and idempotent."
     )
     parser.add_argument(
         "action", nargs="?", choices=["rebuild"], help="rebuild: read recordings into the store"
@@ -76,6 +78,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     which.add_argument(
         "--station", action="append", default=[], metavar="ST", help="a station (repeatable)"
     )
+    which.add_argument("--plant", default=None, metavar="P", help="a plant (station.plant)")
     which.add_argument("--line", default=None, metavar="L", help="a line (station.line)")
     which.add_argument("--program", type=int_in(0, 2**63 - 1, "a program id"), default=None)
     which.add_argument("--tool", type=int_in(0, 2**63 - 1, "a tool id"), default=None)
@@ -116,6 +119,7 @@ def run(args: argparse.Namespace) -> int:
     query = ResultsQuery(
         part_id=args.part,
         stations=args.station,
+        plant=args.plant,
         line=args.line,
         program_id=args.program,
         tool_id=args.tool,
@@ -145,15 +149,17 @@ def run(args: argparse.Namespace) -> int:
 
 @dataclass(frozen=True)
 class Source:
-    """Recordings to read: a folder, its stations, their lines and the store they name."""
+    """Recordings to read: a folder, its stations, where each is and the store they name."""
 
     folder: Path
-    lines: dict[str, str]  # station -> its line
+    places: dict[str, StationPlace]  # station -> its plant, line and name
     database: str | None  # recorder.results_database
 
 
 def _sources(args: argparse.Namespace) -> list[Source]:
     """``--recordings DIR`` (every station folder in it), else the station files."""
+    from shared.config import StationPlace, load_any_station
+
     if args.recordings is not None:
         folder: Path = args.recordings
         if not folder.is_dir():
@@ -161,8 +167,7 @@ def _sources(args: argparse.Namespace) -> list[Source]:
         stations = sorted(
             path.name for path in folder.iterdir() if path.is_dir() and path.name[0] != "."
         )
-        return [Source(folder, dict.fromkeys(stations, ""), None)]
-    from shared.config import load_any_station
+        return [Source(folder, {station: StationPlace() for station in stations}, None)]
 
     sources: dict[Path, Source] = {}
     for path in args.config:
@@ -171,7 +176,7 @@ def _sources(args: argparse.Namespace) -> list[Source]:
         source = sources.setdefault(
             folder, Source(folder, {}, station.config.recorder.results_database)
         )
-        source.lines[station.station_id] = station.config.station.line
+        source.places[station.station_id] = station.config.station.place
     return list(sources.values())
 
 
@@ -204,8 +209,8 @@ def _rebuild(target: StoreTarget, sources: Sequence[Source]) -> int:
         station_recordings,
     )
 
-    lines = {station: line for source in sources for station, line in source.lines.items()}
-    files = [path for s in sources for path in station_recordings(s.folder, s.lines)]
+    places = {station: place for source in sources for station, place in source.places.items()}
+    files = [path for s in sources for path in station_recordings(s.folder, s.places)]
     told_s = [0.0]
 
     def progress(counts: FillCounts) -> None:
@@ -221,7 +226,7 @@ def _rebuild(target: StoreTarget, sources: Sequence[Source]) -> int:
     print(f"boltwatch results rebuild: {len(files)} recordings into {target}", file=sys.stderr)
     with ResultsStore(target, application="boltwatch results rebuild") as store:
         counts = fill_from_recordings(
-            store, files, lines, socket.gethostname(), time.time_ns, progress
+            store, files, places, socket.gethostname(), time.time_ns, progress
         )
     for line in counts.damaged:
         print(f"boltwatch results rebuild: warning: {line}; read what is readable", file=sys.stderr)

@@ -40,6 +40,14 @@ function services(station) {
                  "data-service": name }, `${name} ${station.services[name] ? "alive" : "down"}`)));
 }
 
+// Where the station is, as its station file says: "plant North, line B" (none named: nothing).
+function place(station) {
+  const named = [];
+  if (station.plant) named.push(`plant ${station.plant}`);
+  if (station.line) named.push(`line ${station.line}`);
+  return named.length ? el("span", { class: "place" }, ` (${named.join(", ")})`) : "";
+}
+
 function figures(station) {
   const parts = [`samples: ${fixed(station.samples_per_s, 0, " /s")}`];
   if (station.bus_samples_per_s !== null) parts.push(`bus: ${fixed(station.bus_samples_per_s, 0, " /s")}`);
@@ -114,7 +122,8 @@ function alerts(station) {
 function draw(board) {
   stations.replaceChildren(...board.stations.map((station) => el("section",
     { class: "station", id: `station-${station.station}` },
-    el("h2", {}, `Station ${station.station}`), services(station), figures(station),
+    el("h2", {}, `Station ${station.station}`, station.name ? ` — ${station.name}` : "",
+      place(station)), services(station), figures(station),
     el("h3", {}, "Last results"), results(station),
     el("h3", {}, "Last stop reasons"), stops(station),
     el("h3", {}, "Tool wear"), wear(station),

@@ -24,11 +24,12 @@ function recording(r) {
 }
 
 function tightenings(rows) {
-  return table(["ended (UTC)", "station", "line", "run", "program", "tool", "result", "torque",
+  return table(["ended (UTC)", "station", "plant", "line", "run", "program", "tool", "result", "torque",
     "angle", "preload", "stopped on", "events", "recording"],
   rows.map((r) => el("tr", { class: "found", "data-station": r.station, "data-run": r.run_id },
     el("td", {}, r.ended_utc),
-    el("td", {}, r.station),
+    el("td", {}, r.station, r.station_name ? el("div", { class: "name" }, r.station_name) : ""),
+    el("td", {}, r.plant || "-"),
     el("td", {}, r.line || "-"),
     el("td", { class: "num" }, r.run_id),
     el("td", { class: "program" }, `${r.program_id} ${r.program_name}`.trim()),

@@ -22,6 +22,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
+from shared.config import StationPlace
 from shared.contract import QualityAlert, RecorderStats
 
 _NS_PER_MS = 1_000_000
@@ -58,10 +59,12 @@ class _StationCounts:
 class RecorderHealth:
     """Per-station message counts and sample lags, turned into RecorderStats on demand."""
 
-    def __init__(self, stations: list[str], lines: Mapping[str, str] | None = None) -> None:
-        """``lines``: the line of each served station (its station file's)."""
+    def __init__(
+        self, stations: list[str], places: Mapping[str, StationPlace] | None = None
+    ) -> None:
+        """``places``: where each served station is (its station file's plant, line, name)."""
         self._stations: dict[str, _StationCounts] = {name: _StationCounts() for name in stations}
-        self._lines = dict(lines or {})
+        self._places = dict(places or {})
 
     @property
     def stations(self) -> list[str]:
@@ -144,6 +147,7 @@ class RecorderHealth:
         kept_unstored = recordings_kept_unstored or {}
         out: list[RecorderStats] = []
         for station, counts in self._stations.items():
+            place = self._places.get(station, StationPlace())
             p50_ms, max_ms = lag_figures_ms(counts.lags_ns)
             counts.lags_ns = []
             out.append(
@@ -160,7 +164,9 @@ class RecorderHealth:
                     refused_summaries=refused.get(station, 0),
                     waiting_summaries=waiting_summaries,
                     waiting_results=waiting_results,
-                    line=self._lines.get(station, ""),
+                    plant=place.plant,
+                    line=place.line,
+                    station_name=place.name,
                     bad_payloads=counts.bad_payloads,
                     quality_alerts=quality_alerts(station) if quality_alerts else [],
                     recordings_deleted=deleted.get(station, 0),

@@ -1,6 +1,7 @@
 """``boltwatch results`` over real controller runs: imported as recordings, read into the
 store by ``results rebuild`` (again: nothing twice, nothing read twice), then found by
-their part, as a table naming each run's recording, as CSV and as JSON."""
+their part (or plant: the station file's), as a table naming each run's recording, as CSV
+and as JSON."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ import pytest
 
 from services.cli.main import main
 from shared.recordings.mcap import RecordingScan
+from tests.support.config_files import write_station
 from tests.support.imported_runs import import_runs, recording_of
 from tests.support.paths import PROJECT_REAL_RUNS
 
@@ -71,6 +73,36 @@ def test_csv_and_json_have_every_column(
     (document,) = json.loads(out)
     assert document["part_id"] == "40000000016002" and document["steps"]
     assert Path(document["recording"]).is_file()
+
+
+def test_the_station_files_plant_line_and_name_go_with_each_result(
+    recordings: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``rebuild --config``: each result placed as its station file says; ``--plant``
+    finds them, the table names the station with its name, CSV and JSON have all three."""
+    station = write_station(recordings.parent, "")
+    text = station.read_text().replace('folder = "../recordings"', f'folder = "{recordings}"')
+    place = 'id = "cs351"\nplant = "North"\nline = "B"\nname = "Wheel nuts"'
+    station.write_text(text.replace('id = "st1"', place))
+    assert main(["results", "rebuild", "--config", str(station)]) == 0
+    capsys.readouterr()
+    status, out, _ = _results(capsys, "--config", str(station), "--plant", "South")
+    assert status == 1 and out == ""
+    status, out, _ = _results(capsys, "--config", str(station), "--plant", "North")
+    header, *rows = out.splitlines()
+    assert status == 0 and len(rows) == 4
+    assert header.split()[2:5] == ["station", "plant", "line"]
+    assert all(" cs351 (Wheel nuts)  North  B " in row for row in rows)
+    _, out, _ = _results(capsys, "--config", str(station), "--csv", "--limit", "1")
+    (row,) = csv.DictReader(io.StringIO(out))
+    assert (row["station_name"], row["plant"], row["line"]) == ("Wheel nuts", "North", "B")
+    _, out, _ = _results(capsys, "--config", str(station), "--json", "--limit", "1")
+    (document,) = json.loads(out)
+    assert (document["station_name"], document["plant"], document["line"]) == (
+        "Wheel nuts",
+        "North",
+        "B",
+    )
 
 
 def test_nothing_matching_is_one_line_and_status_1(

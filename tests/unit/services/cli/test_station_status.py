@@ -351,6 +351,18 @@ def test_the_stations_line_and_the_results_waiting_for_their_store_show() -> Non
     assert "station st1\n" in format_report(collector.report("e", 2.0, T0 + S))
 
 
+def test_the_stations_plant_and_name_show_beside_its_id() -> None:
+    collector = StatusCollector()
+    stats = recorder_stats(T0, plant="North", line="B", station_name="Wheel nuts, left")
+    feed(collector, channels.RECORDER.topic, stats)
+    report = collector.report("e", 2.0, T0)
+    assert 'station st1 "Wheel nuts, left" (plant North, line B)\n' in format_report(report)
+    recorder = to_json(report)["stations"]["st1"]["recorder"]
+    assert (recorder["plant"], recorder["station_name"]) == ("North", "Wheel nuts, left")
+    feed(collector, channels.RECORDER.topic, recorder_stats(T0 + S, plant="North"))
+    assert "station st1 (plant North)\n" in format_report(collector.report("e", 2.0, T0 + S))
+
+
 def test_what_each_service_refused_is_shown() -> None:
     """Bad decisions (BusStats), the predictor's bad payloads and samples (PredictorStats),
     the recorder's refused payloads (RecorderStats): counted where they were refused."""

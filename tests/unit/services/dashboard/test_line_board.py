@@ -9,6 +9,7 @@ import pytest
 
 from services.dashboard import line_board
 from services.dashboard.line_board import HISTORY, LineBoard, StationSetting
+from shared.config import StationPlace
 from shared.contract import QualityAlert, QualityFigure, WearAlert, channels, encode, keys
 from shared.errors import InputError
 from tests.support.factories import T0, S, summary
@@ -39,6 +40,15 @@ def wear_reply(intensity: float) -> bytes:
 
 def alert(tool_id: int, time_ns: int) -> WearAlert:
     return WearAlert("st1", tool_id, time_ns, 1.2e6, 1.0e6, 5, None)
+
+
+def test_each_station_shows_where_it_is_as_its_station_file_says() -> None:
+    placed = StationSetting("st1", None, StationPlace("North", "B", "Wheel nuts"))
+    line = LineBoard([placed, StationSetting("st2", None)], T0)
+    assert [(s["name"], s["plant"], s["line"]) for s in line.snapshot(T0)["stations"]] == [
+        ("Wheel nuts", "North", "B"),
+        ("", "", ""),
+    ]
 
 
 def test_services_alive_are_those_of_the_last_window_only() -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from services.recorder.live.recorder_health import RecorderHealth
+from shared.config import StationPlace
 
 T0 = 1_700_000_000_000_000_000
 
@@ -111,3 +112,17 @@ def test_stations_are_counted_apart() -> None:
     bus(health, 1000, "st2")
     assert missing(health, "st1") == 0
     assert missing(health, "st2") == 600
+
+
+def test_each_station_is_placed_as_its_station_file_says() -> None:
+    place = StationPlace("North", "B", "Wheel nuts")
+    health = RecorderHealth(["st1", "st2"], {"st1": place})
+    receive(health, 1, "st3")  # another line's station, heard: placed nowhere
+    stats = {s.station: s for s in health.report(T0, 0, None, True)}
+    assert StationPlace(stats["st1"].plant, stats["st1"].line, stats["st1"].station_name) == place
+    for station in ("st2", "st3"):
+        assert (stats[station].plant, stats[station].line, stats[station].station_name) == (
+            "",
+            "",
+            "",
+        )

@@ -1,6 +1,7 @@
 """The recorder puts every result it files into the results store, naming the file the run
 is in; while the store fails the results wait and go in when it works again; results a
-stopped recorder had not stored come from the recordings at its next start."""
+stopped recorder had not stored come from the recordings at its next start; a store of an
+older boltwatch is migrated at start."""
 
 from __future__ import annotations
 
@@ -10,10 +11,17 @@ from pathlib import Path
 import pytest
 import zenoh
 
-from shared.config import LoadedStation, load_station
+from shared.config import LoadedStation, StationPlace, load_station
 from shared.contract import TighteningResult
 from shared.recordings.mcap import RecordingScan
-from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget, station_store
+from shared.results import (
+    ResultsQuery,
+    ResultsStore,
+    StoredResult,
+    StoreTarget,
+    station_store,
+    stored_result,
+)
 from shared.results.recordings_reading import fill_from_recordings
 from shared.runtime import zenoh_config
 from tests.support import factories
@@ -24,6 +32,7 @@ from tests.support.live_recorder import (
     wait_until,
     write_station_file,
 )
+from tests.support.old_results_store import version_1_store
 from tests.support.postgres_server import (
     PostgresServer,
 )
@@ -38,11 +47,19 @@ def _run_with_result(run_id: int, part_id: str) -> list[tuple[str, object]]:
     return [*run_messages(run_id, 50), ("results", result)]
 
 
+#: where the station of these tests is ([station] plant, line, name)
+PLACE = StationPlace("North", "B", "Wheel nuts")
+
+
 def _station(tmp_path: Path, database: str | None = None) -> LoadedStation:
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     recorder = {} if database is None else {"results_database": database}
     path = write_station_file(
-        tmp_path / "station.toml", tmp_path / "recordings", listen=[endpoint], recorder=recorder
+        tmp_path / "station.toml",
+        tmp_path / "recordings",
+        listen=[endpoint],
+        recorder=recorder,
+        station={"plant": PLACE.plant, "line": PLACE.line, "name": PLACE.name},
     )
     return load_station(path)
 
@@ -92,11 +109,30 @@ def test_each_result_is_stored_with_the_recording_it_is_in(station: LoadedStatio
     stored = _stored(station)
     assert [s.result.part_id for s in stored] == ["VIN0001", "VIN0002", "VIN0003"]
     for row in stored:
-        assert row.recording is not None and row.line == ""
+        assert row.recording is not None
+        assert StationPlace(row.plant, row.line, row.station_name) == PLACE
         assert row.result in _results_in(Path(row.recording)), row.recording
         assert f"_run{row.result.run_id}_" in Path(row.recording).name
     if station.config.recorder.results_database is None:
         assert (station.recordings_folder / "results.sqlite").is_file()
+
+
+def test_a_version_1_store_is_migrated_by_the_recorder_at_start_losing_no_row(
+    tmp_path: Path,
+) -> None:
+    """A line's store of the boltwatch before the plant model: the recorder migrates it at
+    start; the row it held is as it was (no plant, no name), the new run's has both."""
+    station = _station(tmp_path)
+    old = stored_result(factories.result(1, part_id="VIN0001"), "B", "/rec/old.mcap", "box", 1)
+    version_1_store(station_store(station), [old])
+    recorder = _record(station, [2])
+    try:
+        wait_until(lambda: len(_stored(station)) == 2, "the new result stored", WAIT_S)
+    finally:
+        recorder.finish()
+    kept, new = _stored(station)
+    assert kept == old and (kept.plant, kept.station_name) == ("", "")
+    assert StationPlace(new.plant, new.line, new.station_name) == PLACE
 
 
 def test_a_store_down_keeps_results_waiting_and_the_next_start_finds_the_rest(
@@ -159,6 +195,8 @@ def test_a_refused_results_payload_costs_no_result_of_its_file(tmp_path: Path) -
     assert path is not None
     target = StoreTarget(sqlite_path=tmp_path / "again" / "results.sqlite")
     with ResultsStore(target) as store:
-        counts = fill_from_recordings(store, [Path(path)], {"st1": ""}, "box", time.time_ns)
+        counts = fill_from_recordings(store, [Path(path)], {"st1": PLACE}, "box", time.time_ns)
         assert (counts.read, counts.results, counts.new, counts.damaged) == (1, 1, 1, [])
+        (again,) = store.find(ResultsQuery(plant=PLACE.plant))
+        assert (again.line, again.station_name) == (PLACE.line, PLACE.name)
         assert store.recording_read("box", path) is not None

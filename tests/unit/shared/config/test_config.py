@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from shared.config import load_joint, load_station
+from shared.config import StationPlace, load_joint, load_station
 from shared.errors import ConfigError
 from tests.support.config_files import write_station
 from tests.support.paths import CONFIG, STATION_FILE
@@ -32,6 +32,9 @@ def test_shipped_files_load() -> None:
         ("tool_id = 7", 'tool_id = "seven"', "station.tool_id:"),
         ('id = "st1"', 'id = "st 1/x"', "station.id: String should match pattern"),
         ("[predictor]\nwindow_samples = 5", "[predictor]\nwindow_samples = 1", "window_samples"),
+        ("tool_id = 7", 'tool_id = 7\nplant = "North\\u0007"', "station.plant: String should"),
+        ("tool_id = 7", f'tool_id = 7\nname = "{"x" * 65}"', "station.name: String should"),
+        ("tool_id = 7", 'tool_id = 7\nplnat = "North"', "station.plnat: unknown key"),
     ],
 )
 def test_bad_value_names_file_and_key(tmp_path: Path, old: str, new: str, expected: str) -> None:
@@ -44,6 +47,17 @@ def test_bad_value_names_file_and_key(tmp_path: Path, old: str, new: str, expect
     message = str(caught.value)
     assert message.startswith(f"{path}: ")
     assert expected in message
+
+
+def test_the_station_says_where_it_is_in_the_plant(tmp_path: Path) -> None:
+    assert load_station(STATION_FILE).config.station.place == StationPlace("", "", "")
+    path = write_station(tmp_path, "")
+    path.write_text(
+        path.read_text().replace(
+            "tool_id = 7", 'tool_id = 7\nplant = "North"\nline = "B"\nname = "Wheel nuts, left"'
+        )
+    )
+    assert load_station(path).config.station.place == StationPlace("North", "B", "Wheel nuts, left")
 
 
 def test_program_without_target_and_duplicate_ids_are_errors(tmp_path: Path) -> None:

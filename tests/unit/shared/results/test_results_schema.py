@@ -1,6 +1,7 @@
 """The store's versions: a new store is made whole, an older one migrated with nothing
-lost, a newer one refused, a reader of a current one takes no lock, writers starting
-together migrate once, a damaged file is named and left as it is."""
+lost (a store of version 1, before the plant model, among them), a newer one refused, a
+reader of a current one takes no lock, writers starting together migrate once, a damaged
+file is named and left as it is."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from shared.contract import ResultStep
 from shared.errors import StoreError
 from shared.results import (
     MIGRATIONS,
@@ -22,6 +24,7 @@ from shared.results import (
     version_of,
 )
 from tests.support import factories
+from tests.support.old_results_store import version_1_store
 
 #: a later version, as the next boltwatch would bring one: a column added
 NEXT_VERSION = (*MIGRATIONS, ("ALTER TABLE tightenings ADD COLUMN operator TEXT",))
@@ -47,12 +50,49 @@ def test_an_older_store_is_migrated_and_keeps_its_results(target: StoreTarget) -
             ]
 
 
+def test_a_version_1_store_is_migrated_at_start_with_every_row_kept(target: StoreTarget) -> None:
+    """Version 2 (the plant model) adds ``plant`` and ``station_name`` to a store of
+    version 1 with rows: the first writer to open it (the recorder at start) migrates it;
+    each row and its steps are as stored, the new columns '' (none named); new rows carry
+    theirs and ``--plant`` finds them by its index."""
+    steps = [ResultStep("Rundown", "TF Angle", 720.0, 731.5, "OK")]
+    old = [
+        stored_result(
+            factories.result(run, part_id=f"VIN{run}", source="controller", steps=steps),
+            "A",
+            f"/rec/st1_run{run}.mcap",
+            "box",
+            run,
+        )
+        for run in (1, 2)
+    ]
+    version_1_store(target, old)
+    with ResultsStore(target) as store:
+        assert (store.migrated_from, store.version) == (1, 2)
+        assert store.find(ResultsQuery(oldest_first=True)) == old
+        assert {(s.plant, s.station_name) for s in old} == {("", "")}
+        new = stored_result(
+            factories.result(3), "A", None, None, 3, plant="North", station_name="Nuts"
+        )
+        store.add([new])
+        assert store.find(ResultsQuery(plant="North")) == [new]
+        assert store.count(ResultsQuery(plant="")) == 2
+    with ResultsDatabase(target) as database, database.transaction():
+        indexes = database.rows(
+            "SELECT name FROM sqlite_master WHERE type = 'index'"
+            if database.dialect == "sqlite"
+            else "SELECT indexname FROM pg_indexes WHERE tablename = 'tightenings'"
+        )
+    assert ("tightenings_by_plant",) in indexes
+
+
 def test_a_store_of_a_newer_boltwatch_is_not_written_into(target: StoreTarget) -> None:
     with ResultsStore(target) as store:
         store.add([stored_result(factories.result(1), "A", None, None, 1)])
     with ResultsDatabase(target) as database, database.transaction():
         database.execute("UPDATE store_version SET version = ?", (SCHEMA_VERSION + 5,))
-    with pytest.raises(StoreError, match=r"version 6 is newer than this boltwatch's 1"):
+    newer = rf"version {SCHEMA_VERSION + 5} is newer than this boltwatch's {SCHEMA_VERSION}"
+    with pytest.raises(StoreError, match=newer):
         ResultsStore(target)
     with ResultsDatabase(target) as database:
         assert version_of(database) == SCHEMA_VERSION + 5

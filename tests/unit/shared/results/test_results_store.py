@@ -20,9 +20,22 @@ def _result(run_id: int, **changes: object) -> TighteningResult:
     return factories.result(run_id, time_ns=T0_NS + run_id * MINUTE_NS, **changes)
 
 
-def _store(store: ResultsStore, *results: TighteningResult, line: str = "A") -> int:
+def _store(
+    store: ResultsStore, *results: TighteningResult, line: str = "A", plant: str = "North"
+) -> int:
     return store.add(
-        [stored_result(r, line, f"/rec/{r.station}_run{r.run_id}.mcap", "box", 1) for r in results]
+        [
+            stored_result(
+                r,
+                line,
+                f"/rec/{r.station}_run{r.run_id}.mcap",
+                "box",
+                1,
+                plant=plant,
+                station_name=f"{r.station} of line {line}",
+            )
+            for r in results
+        ]
     )
 
 
@@ -34,7 +47,7 @@ def test_a_result_stored_twice_is_one_row_and_the_first_stays(target: StoreTarge
         found = store.find(ResultsQuery(oldest_first=True))
     assert [stored.result for stored in found] == [first, _result(2), _result(3)]
     assert found[0].recording == "/rec/st1_run1.mcap" and found[0].recording_host == "box"
-    assert found[0].line == "A"
+    assert (found[0].plant, found[0].line, found[0].station_name) == ("North", "A", "st1 of line A")
 
 
 def test_a_controller_result_comes_back_whole_with_its_steps(target: StoreTarget) -> None:
@@ -88,18 +101,22 @@ def test_each_criterion_finds_its_tightenings_newest_first(target: StoreTarget) 
         _store(store, _result(1, part_id="P1"), _result(2, part_id="P1", program_id=3))
         _store(store, _result(3, part_id="P2", station="st2", tool_id=9), line="B")
         _store(store, _result(4, result="NOK", nok_reasons="preload low", station="st2"), line="B")
+        _store(store, _result(5, station="st9"), line="B", plant="South")
 
         def runs(**criteria: object) -> list[tuple[str, int]]:
             query = ResultsQuery(**criteria)  # type: ignore[arg-type]
             return [(s.result.station, s.result.run_id) for s in store.find(query)]
 
         assert runs(part_id="P1") == [("st1", 2), ("st1", 1)]
+        assert runs(plant="South") == [("st9", 5)]
+        assert runs(plant="North", line="B") == [("st2", 4), ("st2", 3)]
         assert runs(stations=["st2"]) == [("st2", 4), ("st2", 3)]
         assert runs(stations=["st1", "st2"], limit=3) == [("st2", 4), ("st2", 3), ("st1", 2)]
         assert runs(line="A") == [("st1", 2), ("st1", 1)]
         assert runs(program_id=3) == [("st1", 2)]
         assert runs(tool_id=9) == [("st2", 3)]
         assert runs(nok_only=True) == [("st2", 4)]
+        assert runs(plant="North", limit=1) == [("st2", 4)]
         assert runs(since_ns=T0_NS + 2 * MINUTE_NS, until_ns=T0_NS + 4 * MINUTE_NS) == [
             ("st2", 3),
             ("st1", 2),
@@ -107,6 +124,7 @@ def test_each_criterion_finds_its_tightenings_newest_first(target: StoreTarget) 
         assert runs(part_id="P1", program_id=3) == [("st1", 2)]
         assert runs(part_id="nowhere") == []
         assert store.count(ResultsQuery(stations=["st1", "st2"], limit=1)) == 4
+        assert store.count(ResultsQuery(plant="North")) == 4
 
 
 def test_the_newest_stored_result_of_stations(target: StoreTarget) -> None:
