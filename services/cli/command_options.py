@@ -47,6 +47,24 @@ def warn_damaged_recording(command: str, state: str, what_was_done: str) -> None
     print(f"boltwatch {command}: warning: {state}; {what_was_done}", file=sys.stderr)
 
 
+#: refused payloads and results named one by one on stderr; the rest are counted
+REFUSED_LINES = 20
+
+
+def warn_left_out(command: str, damaged: list[str], skipped: list[str], refused: list[str]) -> None:
+    """On stderr, what a reading of recordings left out: each damaged file and each file
+    skipped, the first :data:`REFUSED_LINES` payloads or results refused and how many more."""
+    warning = f"boltwatch {command}: warning:"
+    for line in damaged:
+        print(f"{warning} {line}; read what is readable", file=sys.stderr)
+    for line in skipped:
+        print(f"{warning} {line}; skipped", file=sys.stderr)
+    for line in refused[:REFUSED_LINES]:
+        print(f"{warning} refused {line}", file=sys.stderr)
+    if len(refused) > REFUSED_LINES:
+        print(f"{warning} {len(refused) - REFUSED_LINES} more refused", file=sys.stderr)
+
+
 def add_station_file_option(
     parser: argparse.ArgumentParser | argparse._ArgumentGroup,
     help_text: str = "station file",

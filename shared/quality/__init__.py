@@ -7,12 +7,14 @@
 - :mod:`.capability` (mean, σ, Cp and Cpk of one figure against its window),
   :mod:`.control_chart` (Shewhart X̄/R and X̄/s), :mod:`.program_columns`
   (what a program's statistics are made from, as columns), :mod:`.program_statistics`
-  (a program's statistics over its columns)
+  (a program's statistics over its columns), :mod:`.plausible_result` (whether a
+  result's figures can be a measurement at all: what statistics refuse)
 """
 
 from shared.quality.capability import capability, window_text
 from shared.quality.control_chart import c4, control_chart
 from shared.quality.controller_result import controller_result
+from shared.quality.plausible_result import figures_fault, implausible, refusal_line
 from shared.quality.program_columns import ProgramColumns, columns_of
 from shared.quality.program_statistics import (
     FigureStatistics,
@@ -33,8 +35,11 @@ __all__ = [
     "control_chart",
     "controller_result",
     "cut_text",
+    "figures_fault",
+    "implausible",
     "judge",
     "program_statistics",
+    "refusal_line",
     "statistics_of",
     "tightening_result",
     "window_text",

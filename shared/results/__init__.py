@@ -13,7 +13,7 @@ The recorder writes it (``services/recorder/results_watch.py``); ``boltwatch
 results`` reads it.
 """
 
-from shared.results.program_columns import program_columns
+from shared.results.program_columns import implausible_rows, program_columns
 from shared.results.results_database import (
     SQLITE_FILE,
     ResultsDatabase,
@@ -40,6 +40,7 @@ __all__ = [
     "StoreError",
     "StoreTarget",
     "StoredResult",
+    "implausible_rows",
     "migrate",
     "postgres_target",
     "program_columns",

@@ -9,7 +9,9 @@ so they come in a few statements: the figures of every run as one array
 (windows, the latest result's name and windows, NOK reasons of the NOK
 runs, stop reasons, stations, tools) grouped by the database. The same
 columns as :func:`shared.quality.program_columns.columns_of` makes from the
-results themselves: one report either way.
+results themselves: one report either way. A tightening whose figures cannot
+be a measurement (:mod:`shared.quality.plausible_result`: a torque of
+1e308 Nm) is left out of every statement; :func:`implausible_rows` names them.
 """
 
 from __future__ import annotations
@@ -20,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from shared.quality import figures_fault, refusal_line
+from shared.quality.plausible_result import EVENTS_LIMIT, FIGURE_LIMITS, INTENSITY_LIMIT
 from shared.quality.program_columns import (
     JUDGED_FIGURES,
     TOOL_STOPPED,
@@ -38,6 +42,49 @@ _RUN_COLUMNS = (
 _WINDOWS = "torque_min_nm, torque_max_nm, angle_min_deg, angle_max_deg, force_min_n, force_max_n"
 #: what is counted, grouped by the database
 _GROUPS = f"program_id, station, tool_id, stop_reason, {_WINDOWS}"
+#: each judged figure's value and window, in the order of JUDGED_FIGURES
+_JUDGED = (
+    ("torque_nm", "torque_min_nm", "torque_max_nm"),
+    ("angle_deg", "angle_min_deg", "angle_max_deg"),
+    ("force_n", "force_min_n", "force_max_n"),
+)
+#: a tightening whose figures cannot be a measurement (NULL: not measured, never beyond)
+_IMPLAUSIBLE = " OR ".join(
+    [
+        f"ABS(COALESCE({column}, 0)) > {limit!r}"
+        for (_, limit, _), columns in zip(FIGURE_LIMITS, _JUDGED, strict=True)
+        for column in columns
+    ]
+    + [
+        f"COALESCE(events, 0) > {EVENTS_LIMIT}",
+        "COALESCE(process_intensity, 0) < 0",
+        f"COALESCE(process_intensity, 0) > {INTENSITY_LIMIT!r}",
+    ]
+)
+
+
+def _and(where: str, condition: str) -> str:
+    """``where`` (`` WHERE ...`` or empty) and ``condition``."""
+    return f"{where} AND ({condition})" if where else f" WHERE ({condition})"
+
+
+def implausible_rows(store: ResultsStore, query: ResultsQuery) -> list[str]:
+    """A line for each tightening ``query`` asks for whose figures cannot be a measurement
+    (left out of :func:`program_columns`), in the order the runs ended."""
+    everything = dataclasses.replace(query, limit=None, oldest_first=True)
+    where, parameters = everything.where()
+    judged = ", ".join(column for columns in _JUDGED for column in columns)
+    rows = store.database.rows(
+        f"SELECT station, run_id, tool_id, {judged}, events, process_intensity FROM "
+        f"tightenings{_and(where, _IMPLAUSIBLE)}{everything.order()}",
+        parameters,
+    )
+    lines = []
+    for station, run_id, tool_id, *figures in rows:
+        judged_figures = [tuple(figures[index : index + 3]) for index in (0, 3, 6)]
+        why = figures_fault(judged_figures, figures[9], figures[10])
+        lines.append(refusal_line(station, run_id, tool_id, why or "beyond the bounds"))
+    return lines
 
 
 def program_columns(store: ResultsStore, query: ResultsQuery) -> list[ProgramColumns]:
@@ -45,6 +92,7 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> list[ProgramCol
     order ignored: every one, in the order the runs ended), by program id."""
     everything = dataclasses.replace(query, limit=None, oldest_first=True)
     where, parameters = everything.where()
+    where = _and(where, f"NOT ({_IMPLAUSIBLE})")
     rows = store.database.rows(
         f"SELECT {_RUN_COLUMNS} FROM tightenings{where}{everything.order()}", parameters
     )
@@ -65,6 +113,7 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> list[ProgramCol
     for program_id in sorted(grouped):
         latest = dataclasses.replace(everything, program_id=program_id, oldest_first=False, limit=1)
         latest_where, latest_parameters = latest.where()  # by the index of program_id
+        latest_where = _and(latest_where, f"NOT ({_IMPLAUSIBLE})")
         ((name, *newest),) = store.database.rows(
             f"SELECT program_name, {_WINDOWS} FROM tightenings{latest_where}{latest.order()}",
             latest_parameters,

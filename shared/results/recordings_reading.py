@@ -8,7 +8,11 @@ modification time in ``recordings_read``, so the next reading skips it
 unless it changed: a rebuild stopped halfway goes on where it stopped. A
 damaged file (a recorder killed mid-write, a cut cable) is read as far as it
 goes, warned of, and not marked: it is read again next time. A payload the
-recorder refused (kept raw on the topic's raw channel) is no result.
+recorder refused (kept raw on the topic's raw channel) is no result; one on a
+typed channel that does not decode (a file not written by our recorder: a
+Sample where a result belongs, ``{}``, binary) is refused and counted, the
+file's other results stored. A file that cannot be read at all (empty, not
+MCAP, not a regular file) is named, skipped and counted.
 """
 
 from __future__ import annotations
@@ -40,6 +44,8 @@ class FillCounts:
     results: int = 0  # results found in what it read
     new: int = 0  # of them, new to the store
     damaged: list[str] = field(default_factory=list)  # one line per damaged file
+    skipped: list[str] = field(default_factory=list)  # one line per file not read at all
+    refused: list[str] = field(default_factory=list)  # one line per payload refused
 
 
 def station_recordings(
@@ -57,20 +63,29 @@ def station_recordings(
 
 
 def results_of(
-    path: Path, places: Mapping[str, StationPlace], host: str, now_ns: int
+    path: Path,
+    places: Mapping[str, StationPlace],
+    host: str,
+    now_ns: int,
+    refused: list[str] | None = None,
 ) -> tuple[list[StoredResult], RecordingScan]:
     """The results recorded in ``path`` (as far as it is readable), as the store keeps them:
     where each station is from ``places`` (one not in it: nowhere named), the file as their
-    recording."""
+    recording; a payload that does not decode is left out (a line in ``refused`` each).
+    InputError: not readable."""
     scan = RecordingScan(path)
     results: list[TighteningResult] = []
     summaries: dict[tuple[str, int], RunSummary] = {}
     for _, channel, message in scan.typed_messages():  # a refused payload is no result
-        if channel.topic.endswith(_RESULTS):
-            results.append(decode(TighteningResult, message.data))
-        elif channel.topic.endswith(_RUNS):
-            summary = decode(RunSummary, message.data)
-            summaries[(summary.station, summary.run_id)] = summary
+        try:
+            if channel.topic.endswith(_RESULTS):
+                results.append(decode(TighteningResult, message.data))
+            elif channel.topic.endswith(_RUNS):
+                summary = decode(RunSummary, message.data)
+                summaries[(summary.station, summary.run_id)] = summary
+        except InputError as err:
+            if refused is not None:
+                refused.append(f"{path}: message {message.sequence} on {channel.topic}: {err}")
     recording = str(path.resolve())
     stored = [
         stored_result(
@@ -109,9 +124,9 @@ def fill_from_recordings(
         recording = str(path.resolve())
         if store.recording_read(host, recording) != (stat.st_size, stat.st_mtime_ns):
             try:
-                stored, scan = results_of(path, places, host, clock_ns())
+                stored, scan = results_of(path, places, host, clock_ns(), counts.refused)
             except InputError as err:
-                counts.damaged.append(str(err))
+                counts.skipped.append(str(err))
             else:
                 counts.read += 1
                 counts.results += len(stored)

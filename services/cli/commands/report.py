@@ -11,7 +11,10 @@ range from the results store (:mod:`shared.results`; none there, or
 ``--from-recordings``: from every recording in range,
 :mod:`shared.offline.report.recorded_results`), writes ``FOLDER/report.html``
 (one self-contained file) and ``FOLDER/report.png``, and prints a summary.
-No result in the range: one line, exit status 2.
+No result in the range: one line, exit status 2. A file that cannot be read
+is named on stderr and skipped; a payload or result refused is named too (the
+first 20, then how many more); both are counted in the
+report, which is written from the rest.
 """
 
 from __future__ import annotations
@@ -21,7 +24,12 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from services.cli.command_options import add_station_file_option, utc_end, utc_moment
+from services.cli.command_options import (
+    add_station_file_option,
+    utc_end,
+    utc_moment,
+    warn_left_out,
+)
 from shared.errors import ConfigError
 from shared.option_types import int_in
 
@@ -92,7 +100,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from shared.config import load_any_station
-    from shared.offline.report import ResultFilter, terminal_lines, write_report
+    from shared.offline.report import ResultFilter, read_counts, terminal_lines, write_report
 
     stations = [load_any_station(path) for path in args.config]
     if args.plant is not None:
@@ -115,9 +123,9 @@ def run(args: argparse.Namespace) -> int:
     )
     read, source = _read(rule, stations[0], args.from_recordings)
     report = write_report(rule, read, args.out, args.subgroup_size, source)
-    for line in report.damaged:
-        print(f"boltwatch report: warning: {line}; read what is readable", file=sys.stderr)
-    print(f"{report.results} results ({source})")
+    warn_left_out(NAME, report.damaged, report.skipped, report.refused)
+    left_out = read_counts(read)
+    print(f"{report.results} results ({source}{'; ' + left_out if left_out else ''})")
     for line in terminal_lines(report.programs):
         print(line)
     print(f"wrote {report.html_path} and {report.png_path}")

@@ -31,7 +31,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from services.cli.command_options import add_station_file_option, utc_end, utc_moment
+from services.cli.command_options import (
+    add_station_file_option,
+    utc_end,
+    utc_moment,
+    warn_left_out,
+)
 from shared.errors import ConfigError
 from shared.option_types import int_in
 
@@ -228,10 +233,16 @@ def _rebuild(target: StoreTarget, sources: Sequence[Source]) -> int:
         counts = fill_from_recordings(
             store, files, places, socket.gethostname(), time.time_ns, progress
         )
-    for line in counts.damaged:
-        print(f"boltwatch results rebuild: warning: {line}; read what is readable", file=sys.stderr)
+    warn_left_out("results rebuild", counts.damaged, counts.skipped, counts.refused)
+    before = counts.files - counts.read - len(counts.skipped)
+    left_out = [
+        f"{len(lines)} {what}"
+        for lines, what in ((counts.skipped, "not readable, skipped"), (counts.refused, "refused"))
+        if lines
+    ]
     print(
-        f"read {counts.read} of {counts.files} recordings ({counts.files - counts.read} read "
-        f"before, unchanged): {counts.results} results, {counts.new} new to {target}"
+        f"read {counts.read} of {counts.files} recordings ({before} read before, unchanged"
+        f"{''.join('; ' + text for text in left_out)}): {counts.results} results, "
+        f"{counts.new} new to {target}"
     )
     return 0

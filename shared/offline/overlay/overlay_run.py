@@ -4,8 +4,9 @@ A run is named on the command line by its id (looked up in a station's
 recordings folder, ``<folder>/<station>/<date>/<station>_run<id>_*.mcap``;
 a run the recorder split into parts is read from all of them) or by the path
 of an MCAP file (the run with the most samples in it). Damaged files are read
-as far as they go (:mod:`~shared.recordings.mcap.recording_reader`);
-``damage`` says what was lost.
+as far as they go (:mod:`~shared.recordings.mcap.recording_reader`); a file
+of several that cannot be read at all (empty, not MCAP, not a regular file)
+is skipped; ``damage`` says what was lost, naming each file.
 
 Run time is the sample's own clock (``Sample.time_s``, the tool's counter)
 when every sample has it, else the receive time (``time_ns``), counted from
@@ -75,29 +76,12 @@ def read_overlay_run(label: str, files: list[Path], run_id: int | None = None) -
     results: list[TighteningResult] = []
     damage: list[str] = []
     for path in files:
-        scan = RecordingScan(path)
-        for record in scan.records():
-            if not isinstance(record, Message):
-                continue
-            channel = scan.channels.get(record.channel_id)
-            schema = scan.schemas.get(channel.schema_id) if channel is not None else None
-            message_type = _SCHEMAS.get(schema.name) if schema is not None else None
-            if message_type is None:
-                continue
-            try:
-                message: Sample | StickSlipEvent | TighteningResult = decode(
-                    message_type, record.data
-                )
-            except InputError:
-                continue  # what cannot be decoded is not drawn
-            if isinstance(message, Sample):
-                samples.append(message)
-            elif isinstance(message, StickSlipEvent):
-                events.append(message)
-            else:
-                results.append(message)
-        if not scan.complete:
-            damage.append(scan.describe())
+        try:
+            _read_file(path, samples, events, results, damage)
+        except InputError as err:
+            if len(files) == 1:
+                raise
+            damage.append(f"{err}; skipped")
     run_id = _chosen_run(label, files, samples, run_id, damage)
     own = [sample for sample in samples if sample.run_id == run_id]
     own.sort(key=lambda sample: sample.sequence)
@@ -115,6 +99,37 @@ def read_overlay_run(label: str, files: list[Path], run_id: int | None = None) -
         result,
         "; ".join(damage),
     )
+
+
+def _read_file(
+    path: Path,
+    samples: list[Sample],
+    events: list[StickSlipEvent],
+    results: list[TighteningResult],
+    damage: list[str],
+) -> None:
+    """The samples, events and results of one file (as far as it reads); InputError: none."""
+    scan = RecordingScan(path)
+    for record in scan.records():
+        if not isinstance(record, Message):
+            continue
+        channel = scan.channels.get(record.channel_id)
+        schema = scan.schemas.get(channel.schema_id) if channel is not None else None
+        message_type = _SCHEMAS.get(schema.name) if schema is not None else None
+        if message_type is None:
+            continue
+        try:
+            message: Sample | StickSlipEvent | TighteningResult = decode(message_type, record.data)
+        except InputError:
+            continue  # what cannot be decoded is not drawn
+        if isinstance(message, Sample):
+            samples.append(message)
+        elif isinstance(message, StickSlipEvent):
+            events.append(message)
+        else:
+            results.append(message)
+    if not scan.complete:
+        damage.append(scan.describe())
 
 
 def _chosen_run(

@@ -7,7 +7,7 @@
   page and the lines printed)
 """
 
-from shared.offline.report.quality_report import write_report
+from shared.offline.report.quality_report import read_counts, write_report
 from shared.offline.report.recorded_results import (
     RecordedResults,
     ResultFilter,
@@ -19,6 +19,7 @@ from shared.offline.report.report_page import terminal_lines
 __all__ = [
     "RecordedResults",
     "ResultFilter",
+    "read_counts",
     "read_results",
     "read_stored",
     "terminal_lines",

@@ -3,7 +3,8 @@ written.
 
 Writes ``<out>/report.html`` (self-contained) and ``<out>/report.png`` (the
 same charts). No result in the range is an :class:`InputError` (one line,
-exit status 2), naming what was searched.
+exit status 2), naming what was searched. The files skipped and the payloads
+and results refused while reading are counted on the page (:func:`read_counts`).
 """
 
 from __future__ import annotations
@@ -31,6 +32,8 @@ class WrittenReport:
     files: int
     results: int
     damaged: list[str]
+    skipped: list[str]  # files not read at all, one line each
+    refused: list[str]  # payloads and results refused, one line each
 
 
 def describe_scope(rule: ResultFilter, subgroup_size: int) -> list[str]:
@@ -50,14 +53,28 @@ def describe_scope(rule: ResultFilter, subgroup_size: int) -> list[str]:
     return lines
 
 
+def read_counts(read: RecordedResults) -> str:
+    """What was left out while reading, in words ("" when nothing was)."""
+    parts = []
+    if read.damaged:
+        parts.append(f"damaged files read as far as they go: {len(read.damaged)}")
+    if read.skipped:
+        parts.append(f"files not readable, skipped: {len(read.skipped)}")
+    if read.refused:
+        parts.append(f"results and payloads refused: {len(read.refused)}")
+    return "; ".join(parts)
+
+
 def write_report(
     rule: ResultFilter, read: RecordedResults, out: Path, subgroup_size: int, source: str
 ) -> WrittenReport:
     """Compute, draw and write what was read (``source``: from where, in words); InputError
     when no result is in range."""
+    left_out = read_counts(read)
     if not read.results:
         searched = "; ".join(describe_scope(rule, subgroup_size)[:-1])
-        raise InputError(f"no tightening results in range ({searched}; {source})")
+        left = f"; {left_out}" if left_out else ""
+        raise InputError(f"no tightening results in range ({searched}; {source}{left})")
     programs = [statistics_of(columns, subgroup_size) for columns in read.programs]
     title = f"boltwatch report: {', '.join(station for station, _ in rule.stations)}"
     figure = build_figure(programs, title)
@@ -66,5 +83,16 @@ def write_report(
     png_path, html_path = out / PNG_NAME, out / HTML_NAME
     png_path.write_bytes(png)
     scope = [*describe_scope(rule, subgroup_size), f"{read.results} results ({source})"]
+    if left_out:
+        scope.append(f"left out: {left_out}")
     html_path.write_text(html_page(programs, title, scope, png), encoding="utf-8")
-    return WrittenReport(html_path, png_path, programs, read.files, read.results, read.damaged)
+    return WrittenReport(
+        html_path,
+        png_path,
+        programs,
+        read.files,
+        read.results,
+        read.damaged,
+        read.skipped,
+        read.refused,
+    )

@@ -4,10 +4,15 @@ store (:func:`read_stored`), or from the recordings themselves (:func:`read_resu
 Reads ``<recordings>/<station>/<YYYY-MM-DD>/*.mcap`` (the layout of
 :mod:`shared.recordings.layout`, dates in UTC) for the days of the
 range, every complete message of channels ``results`` and ``runs``, damaged
-files as far as they go (:class:`RecordingScan`, a warning each). A result
-is kept when it ended (``time_ns``) inside the range and matches the
-program / tool asked for. The same result seen twice (a file and its
-``.recovered`` copy) counts once. Either way what comes is each program's
+files as far as they go (:class:`RecordingScan`, a warning each). A file
+that cannot be read at all (empty, cut inside its header, not MCAP, not a
+regular file) is named, skipped and counted; a payload that does not decode
+(a Sample where a result belongs, ``{}``, binary) is refused and counted,
+the file's other messages still read. A result is kept when it ended
+(``time_ns``) inside the range, matches the program / tool asked for and
+can be a measurement (:func:`shared.quality.implausible`: refused and
+counted otherwise, from the store too). The same result seen twice (a file
+and its ``.recovered`` copy) counts once. Either way what comes is each program's
 columns (what the report's statistics read): the store gives the same
 columns as the files, each result with the events of its run (what a
 summary adds to a result from the files), in a few statements instead of a
@@ -22,10 +27,11 @@ from datetime import UTC, date, datetime, timedelta
 from pathlib import Path
 
 from shared.contract import RunSummary, TighteningResult, channels, decode
-from shared.quality import ProgramColumns, columns_of
+from shared.errors import InputError
+from shared.quality import ProgramColumns, columns_of, implausible, refusal_line
 from shared.recordings import recording_files, station_days
 from shared.recordings.mcap import RecordingScan
-from shared.results import ResultsQuery, ResultsStore, program_columns
+from shared.results import ResultsQuery, ResultsStore, implausible_rows, program_columns
 
 #: progress is told every this many files (when there are more)
 PROGRESS_EVERY_FILES = 50
@@ -59,6 +65,8 @@ class RecordedResults:
     programs: list[ProgramColumns] = field(default_factory=list)
     files: int = 0
     damaged: list[str] = field(default_factory=list)  # one line per damaged file
+    skipped: list[str] = field(default_factory=list)  # one line per file not read at all
+    refused: list[str] = field(default_factory=list)  # one line per payload or result refused
 
     @property
     def results(self) -> int:
@@ -91,30 +99,64 @@ def read_results(
     results: list[TighteningResult] = []
     #: (station, run id, tool id) -> its RunSummary (events per run when a result has none)
     summaries: dict[tuple[str, int, int], RunSummary] = {}
-    damaged: list[str] = []
+    read = RecordedResults(files=len(files))
     seen: set[tuple[str, int, int, int]] = set()
-    result_topic, runs_topic = channels.RESULTS.topic, channels.RUNS.topic
     for done, (station, path) in enumerate(files, start=1):
-        scan = RecordingScan(path)
-        for _, channel, message in scan.typed_messages():  # a refused payload is no result
-            topic = channel.topic.rsplit("/", 1)[-1]
-            if not channel.topic.startswith(f"boltwatch/{station}/"):
-                continue
-            if topic == result_topic:
-                result = decode(TighteningResult, message.data)
-                key = (result.station, result.run_id, result.tool_id, result.time_ns)
-                if key not in seen and rule.keeps(result):
-                    seen.add(key)
-                    results.append(result)
-            elif topic == runs_topic:
-                summary = decode(RunSummary, message.data)
-                summaries[(summary.station, summary.run_id, summary.tool_id)] = summary
-        if not scan.complete:
-            damaged.append(scan.describe())
+        try:
+            _read_file(path, station, rule, (results, summaries, seen), read)
+        except InputError as err:  # not a recording at all: named, skipped, counted
+            read.skipped.append(str(err))
         if progress is not None and (done % PROGRESS_EVERY_FILES == 0 or done == len(files)):
             progress(done, len(files))
     results.sort(key=lambda result: (result.time_ns, result.station, result.run_id))
-    return RecordedResults(columns_of(results, summaries), len(files), damaged)
+    read.programs = columns_of(results, summaries)
+    return read
+
+
+_Found = tuple[
+    list[TighteningResult],
+    dict[tuple[str, int, int], RunSummary],
+    set[tuple[str, int, int, int]],
+]
+
+
+def _read_file(
+    path: Path, station: str, rule: ResultFilter, found: _Found, read: RecordedResults
+) -> None:
+    """The results and summaries of one file into ``found`` (results, summaries, keys seen),
+    what was refused or damaged into ``read``; InputError: not readable at all."""
+    results, summaries, seen = found
+    result_topic, runs_topic = channels.RESULTS.topic, channels.RUNS.topic
+    scan = RecordingScan(path)
+    for _, channel, message in scan.typed_messages():  # a refused payload is no result
+        topic = channel.topic.rsplit("/", 1)[-1]
+        if not channel.topic.startswith(f"boltwatch/{station}/") or topic not in (
+            result_topic,
+            runs_topic,
+        ):
+            continue
+        try:
+            if topic == result_topic:
+                result = decode(TighteningResult, message.data)
+            else:
+                summary = decode(RunSummary, message.data)
+        except InputError as err:
+            read.refused.append(f"{path}: message {message.sequence} on {channel.topic}: {err}")
+            continue
+        if topic == runs_topic:
+            summaries[(summary.station, summary.run_id, summary.tool_id)] = summary
+            continue
+        key = (result.station, result.run_id, result.tool_id, result.time_ns)
+        if key in seen or not rule.keeps(result):
+            continue
+        seen.add(key)
+        why = implausible(result)
+        if why is None:
+            results.append(result)
+        else:
+            read.refused.append(refusal_line(result.station, result.run_id, result.tool_id, why))
+    if not scan.complete:
+        read.damaged.append(scan.describe())
 
 
 def read_stored(store: ResultsStore, rule: ResultFilter) -> RecordedResults:
@@ -128,4 +170,4 @@ def read_stored(store: ResultsStore, rule: ResultFilter) -> RecordedResults:
         limit=None,
         oldest_first=True,
     )
-    return RecordedResults(program_columns(store, query))
+    return RecordedResults(program_columns(store, query), refused=implausible_rows(store, query))

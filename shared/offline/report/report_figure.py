@@ -26,6 +26,8 @@ WIDTH_IN = 16.0
 DPI = 80
 ROWS_PER_PROGRAM = 5  # four figures and the row of reasons
 NOTE_STYLE: dict[str, Any] = {"ha": "center", "va": "center", "color": "0.4"}
+#: the events histogram draws one bar per count of events up to this many counts
+MAX_EVENT_BARS = 100
 
 
 def build_figure(programs: Sequence[ProgramStatistics], title: str) -> Figure:
@@ -182,6 +184,11 @@ def _draw_events(axis: Axes, events: Sequence[int]) -> None:
         _empty(axis, "no predictor saw these runs")
         return
     low, high = min(events), max(events)
-    axis.hist(events, bins=[value - 0.5 for value in range(low, high + 2)], color="C5")
+    # a bar per count of events while they are few; beyond, numpy's bins (a million bars
+    # would take minutes to draw)
+    bins = (
+        [value - 0.5 for value in range(low, high + 2)] if high - low <= MAX_EVENT_BARS else "auto"
+    )
+    axis.hist(events, bins=bins, color="C5")
     axis.set_xlabel("events", fontsize=8)
     axis.set_ylabel("runs", fontsize=8)

@@ -7,14 +7,22 @@ record from the start, which is what this module does: it yields every record
 up to the first one that is incomplete or fails its CRC, then stops and says
 where and why (:attr:`RecordingScan.damage`). Intact files read the same way,
 so one code path serves ``recover``, ``export`` and ``inspect``.
+
+Only a regular file is read: a FIFO, a device or a socket named like a
+recording (hostile, or a mistake) is refused at once with one line naming
+it, never waited on (it is opened without blocking, then checked). A read
+that fails (an I/O error) ends the scan like damage.
 """
 
 from __future__ import annotations
 
 import logging
+import os
+import stat
 import struct
 from collections.abc import Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 import zstandard
 from mcap.exceptions import EndOfFile, InvalidMagic, McapError
@@ -30,7 +38,15 @@ LOG = logging.getLogger(__name__)
 #: or one the recorder refused), on a channel of the same topic as the typed one
 RAW_ENCODING = "application/octet-stream"
 #: What a damaged tail can raise while a record is parsed or a chunk decompressed.
-_DAMAGE = (McapError, ValueError, struct.error, zstandard.ZstdError, EOFError)
+_DAMAGE = (McapError, ValueError, struct.error, zstandard.ZstdError, EOFError, OSError)
+#: what a file that is not a regular one is, in words
+_KINDS = (
+    (stat.S_ISFIFO, "a FIFO"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISDIR, "a folder"),
+)
 
 McapRecord = object
 
@@ -54,14 +70,9 @@ class RecordingScan:
 
     def records(self) -> Iterator[McapRecord]:
         """Every complete record (chunks opened up), in file order; stops at damage."""
-        try:
-            handle = self.path.open("rb")
-        except FileNotFoundError as err:
-            raise InputError(f"{self.path}: file not found") from err
-        except OSError as err:
-            raise InputError(f"{self.path}: cannot be read: {err.strerror}") from err
+        handle = self._open()
         with handle:
-            self.file_bytes = self.path.stat().st_size
+            self.file_bytes = os.fstat(handle.fileno()).st_size
             reader = StreamReader(handle, validate_crcs=True, record_size_limit=self.file_bytes)
             iterator = iter(reader.records)
             while True:
@@ -73,7 +84,7 @@ class RecordingScan:
                     return
                 except (InvalidMagic, *_DAMAGE) as err:
                     if self.good_bytes == 0:  # not even magic and header
-                        raise self._not_mcap(err) from err
+                        raise self._not_mcap(err, handle) from err
                     cut = isinstance(err, EndOfFile | struct.error | EOFError)
                     if cut and handle.tell() >= self.file_bytes:
                         self.damage = (
@@ -92,11 +103,31 @@ class RecordingScan:
                     self.channels[record.id] = record
                 yield record
 
-    def _not_mcap(self, err: Exception) -> InputError:
+    def _open(self) -> BinaryIO:
+        """The file, opened without waiting (a FIFO would wait for a writer), when it is a
+        regular file; InputError naming it otherwise."""
+        try:
+            descriptor = os.open(self.path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+        except FileNotFoundError as err:
+            raise InputError(f"{self.path}: file not found") from err
+        except OSError as err:
+            raise InputError(f"{self.path}: cannot be read: {err.strerror}") from err
+        mode = os.fstat(descriptor).st_mode
+        if not stat.S_ISREG(mode):
+            os.close(descriptor)
+            kind = next((name for test, name in _KINDS if test(mode)), "not a regular file")
+            raise InputError(f"{self.path}: {kind}, not a recording: not read")
+        os.set_blocking(descriptor, True)
+        return os.fdopen(descriptor, "rb")
+
+    def _not_mcap(self, err: Exception, handle: BinaryIO) -> InputError:
         if self.file_bytes == 0:
             return InputError(f"{self.path}: no MCAP data (empty file)")
-        with self.path.open("rb") as handle:
+        try:
+            handle.seek(0)
             start = handle.read(len(MCAP_MAGIC))
+        except OSError as read_err:
+            return InputError(f"{self.path}: cannot be read: {read_err.strerror}")
         if start != MCAP_MAGIC[: len(start)]:
             return InputError(
                 f"{self.path}: not an MCAP file (byte 0: {start!r}, expected the MCAP magic "

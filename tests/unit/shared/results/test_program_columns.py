@@ -1,14 +1,24 @@
 """A report's columns from the store are the columns of the results themselves: the same
 statistics from ``program_columns`` (a few statements) as from ``program_statistics`` over
-the results read one by one, on SQLite and PostgreSQL."""
+the results read one by one, on SQLite and PostgreSQL; a tightening whose figures cannot be
+a measurement is left out of them and named."""
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 
 from shared.contract import JudgedFigure, TighteningResult
 from shared.quality import ProgramStatistics, program_statistics, statistics_of
-from shared.results import ResultsQuery, ResultsStore, StoreTarget, program_columns, stored_result
+from shared.results import (
+    ResultsQuery,
+    ResultsStore,
+    StoreTarget,
+    implausible_rows,
+    program_columns,
+    stored_result,
+)
 from tests.support import factories
 
 SECOND_NS = 1_000_000_000
@@ -91,3 +101,30 @@ def test_the_stores_columns_give_the_statistics_of_the_results(target: StoreTarg
     ]
     for mine, theirs in zip(some, program_statistics(kept, 5), strict=True):
         _same(mine, theirs)
+
+
+def test_tightenings_that_cannot_be_a_measurement_are_left_out_and_named(
+    target: StoreTarget,
+) -> None:
+    absurd: dict[str, dict[str, Any]] = {
+        "final torque 1e+308 Nm": {"final_torque_nm": JudgedFigure(1e308, 180.0, 240.0, "high")},
+        "final torque -1e+308 Nm": {"final_torque_nm": JudgedFigure(-1e308, None, None, "low")},
+        "final preload window max 1e+300 N": {
+            "final_force_n": JudgedFigure(55e3, 53e3, 1e300, "ok")
+        },
+        "2000000 stick-slip events": {"events": 2_000_000},
+        "process intensity -1": {"process_intensity": -1.0},
+    }
+    good = [factories.result(n, time_ns=factories.T0 + n * SECOND_NS) for n in range(1, 7)]
+    bad = [
+        factories.result(10 + n, time_ns=factories.T0 + (10 + n) * SECOND_NS, **changes)
+        for n, changes in enumerate(absurd.values())
+    ]
+    with ResultsStore(target) as store:
+        store.add([stored_result(result, "A", None, None, 1) for result in good + bad])
+        (columns,) = program_columns(store, ResultsQuery())
+        lines = implausible_rows(store, ResultsQuery())
+    assert columns.runs == len(good) and float(columns.values["torque"].max()) < 1e6
+    assert len(lines) == len(absurd)
+    for line, (why, result) in zip(lines, zip(absurd, bad, strict=True), strict=True):
+        assert line.startswith(f"station st1 run {result.run_id} (tool 7): {why}"), line
