@@ -6,8 +6,12 @@ independence contract) and collects what ``boltwatch status`` collects
 
 - :mod:`.arguments` (its options, light), :mod:`.service` (``main``: files,
   session, server)
+- :mod:`.connection_guard` (the server's bounds: open files, connections,
+  idle time, request size, and one log line per kind of client fault)
 - :mod:`.line_board` (what the page shows, pure: status's collectors, the last
   results, stop reasons, alerts and wear per station)
+- :mod:`.line_link` (the zenoh session, opened in the background: the page
+  is served before the router answers)
 - :mod:`.board_feed` (zenoh: subscriptions, liveliness and wear queries per
   window, its health token)
 - :mod:`.web_app` (aiohttp: the page, ``/board.json``, server-sent ``/events``,

@@ -2,7 +2,8 @@
 
 - a subscriber on ``boltwatch/<st>/**`` per station served (every channel,
   alerts below ``wear/`` too; a station of no file is not asked for);
-- a window thread: every :data:`~.line_board.WINDOW_S` it asks which
+- a window thread: every :data:`~.line_board.WINDOW_S` it looks whether the
+  session reaches anyone (its router: the page says so), asks which
   liveliness tokens exist (``boltwatch/<st>/health/*``, as ``boltwatch
   status`` does) and each station's recorder for its wear (``boltwatch/<st>/wear``),
   then closes the board's window;
@@ -60,6 +61,8 @@ class BoardFeed:
     def _windows(self) -> None:
         while not self._stop.wait(WINDOW_S):
             try:
+                reachable = any(True for _ in self._session.info.transports())
+                self._board.router_link(reachable, time.time_ns())
                 self._close_window()
             except zenoh.ZError as err:  # the router is away: the next window tries again
                 LOG.warning("window not closed: %s", err)

@@ -81,8 +81,11 @@ class _History:
 class LineBoard:
     """Feed it from any thread; :meth:`snapshot` is what the page draws."""
 
-    def __init__(self, stations: list[StationSetting], started_ns: int) -> None:
+    def __init__(self, stations: list[StationSetting], started_ns: int, router: str = "") -> None:
         self._settings = {setting.station: setting for setting in stations}
+        self._router = router  # the endpoints the page's session reaches the line by
+        self._router_reachable: bool | None = None  # None: not known yet
+        self._router_since_ns = started_ns
         self._lock = threading.Lock()
         self._latest = StatusCollector()
         self._window = StatusCollector()
@@ -139,6 +142,12 @@ class LineBoard:
             history = self._history[station]
             history.wear_error, history.wear_ns = reason, now_ns
 
+    def router_link(self, reachable: bool, now_ns: int) -> None:
+        """Whether the page's zenoh session reaches the line (its router) now."""
+        with self._lock:
+            if reachable != self._router_reachable:
+                self._router_reachable, self._router_since_ns = reachable, now_ns
+
     def snapshot(self, now_ns: int) -> dict[str, Any]:
         """The page's data: every station served, in the order of its files."""
         with self._lock:
@@ -156,7 +165,12 @@ class LineBoard:
                 )
                 for name in self._settings
             ]
-        return {"now_ns": now_ns, "window_s": WINDOW_S, "stations": stations}
+            router = {
+                "endpoints": self._router,
+                "reachable": self._router_reachable,
+                "for_s": (now_ns - self._router_since_ns) / _NS,
+            }
+        return {"now_ns": now_ns, "window_s": WINDOW_S, "router": router, "stations": stations}
 
 
 def _remember(history: _History, topic: str, payload: bytes) -> bool:

@@ -21,19 +21,25 @@ from __future__ import annotations
 
 import asyncio
 import json
+import logging
 import time
 from pathlib import Path
 
 from aiohttp import web
+from aiohttp.typedefs import Middleware
 
 from services.dashboard.line_board import LineBoard
 from services.dashboard.part_search import PartSearch, SearchRequestError, limit_of, part_of
+from shared.runtime import RateLimitedLog
 
 PAGE = Path(__file__).with_name("page")
 #: the shortest pause between two updates of one stream (a burst of results is one update)
 MIN_INTERVAL_S = 0.2
 #: a comment line this often keeps proxies from closing a quiet stream
 KEEP_ALIVE_S = 15.0
+
+#: a client that went away mid-stream: one line, at most every 10 s
+_GONE = RateLimitedLog(logging.getLogger(__name__), logging.INFO)
 
 BOARD_KEY = web.AppKey("board", LineBoard)
 SEARCH_KEY = web.AppKey("search", PartSearch)
@@ -79,8 +85,13 @@ class Listeners:
 LISTENERS_KEY = web.AppKey("listeners", Listeners)
 
 
-def make_app(board: LineBoard, listeners: Listeners, search: PartSearch) -> web.Application:
-    app = web.Application()
+def make_app(
+    board: LineBoard,
+    listeners: Listeners,
+    search: PartSearch,
+    *middlewares: Middleware,
+) -> web.Application:
+    app = web.Application(middlewares=middlewares)
     app[BOARD_KEY] = board
     app[LISTENERS_KEY] = listeners
     app[SEARCH_KEY] = search
@@ -121,9 +132,9 @@ async def _events(request: web.Request) -> web.StreamResponse:
     response = web.StreamResponse(
         headers={"Content-Type": "text/event-stream", "Cache-Control": "no-cache"}
     )
-    await response.prepare(request)
     queue = listeners.add()
     try:
+        await response.prepare(request)
         more = True
         while more:
             snapshot = json.dumps(board.snapshot(time.time_ns()))
@@ -133,8 +144,8 @@ async def _events(request: web.Request) -> web.StreamResponse:
                 more = await asyncio.wait_for(queue.get(), KEEP_ALIVE_S)
             except TimeoutError:
                 await response.write(b": still here\n\n")
-    except ConnectionResetError:
-        pass  # the browser went away
+    except ConnectionResetError as err:  # the browser went away (aiohttp's is one too)
+        _GONE("an /events stream ended: the client went away (%s)", type(err).__name__)
     finally:
         listeners.remove(queue)
     return response

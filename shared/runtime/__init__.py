@@ -12,11 +12,14 @@
   scheduling of the stop path's threads)
 - :mod:`.logging_setup` (one line per event, JSON in containers), :mod:`.log_limit`
   (one log line for a flood of alike faults)
+- :mod:`.process_exit` (a process ended without the interpreter's finalisation, once
+  everything is closed)
 """
 
 from shared.runtime.can_bus import open_bus
 from shared.runtime.log_limit import RateLimitedLog
 from shared.runtime.logging_setup import setup_logging
+from shared.runtime.process_exit import exit_now
 from shared.runtime.queued_publisher import QueuedPublisher, station_spool
 from shared.runtime.realtime import RIG_PRIORITY, STOP_PATH_PRIORITY, use_realtime_priority
 from shared.runtime.receive_threads import keep_thread_state, use_one_receive_thread
@@ -34,6 +37,7 @@ from shared.runtime.zenoh_session import (
     declare_channel,
     open_from,
     open_session,
+    section_config,
     zenoh_config,
     zenoh_reason,
 )
@@ -53,11 +57,13 @@ __all__ = [
     "TlsFiles",
     "client_config",
     "declare_channel",
+    "exit_now",
     "follow_supervisor",
     "keep_thread_state",
     "open_bus",
     "open_from",
     "open_session",
+    "section_config",
     "setup_logging",
     "station_spool",
     "supervisor_environment",

@@ -32,9 +32,10 @@ def boltwatch(
 
 
 @contextlib.contextmanager
-def router_process(tmp_path: Path) -> Iterator[str]:
-    """A ``boltwatch serve router`` process; yields its endpoint once it accepts clients."""
-    endpoint = f"tcp/127.0.0.1:{free_tcp_port()}"
+def router_process(tmp_path: Path, endpoint: str | None = None) -> Iterator[str]:
+    """A ``boltwatch serve router`` process (on ``endpoint``; None: a free port); yields its
+    endpoint once it accepts clients."""
+    endpoint = endpoint or f"tcp/127.0.0.1:{free_tcp_port()}"
     log = (tmp_path / "router.log").open("w")
     process = subprocess.Popen(
         [sys.executable, "-m", "services.cli", "serve", "router", "--listen", endpoint],

@@ -3,6 +3,7 @@
 
 const stations = document.getElementById("stations");
 const link = document.getElementById("link");
+const router = document.getElementById("router");
 
 function el(tag, attrs = {}, ...children) {
   const node = document.createElement(tag);
@@ -119,7 +120,17 @@ function alerts(station) {
   return items.length ? el("ul", { class: "alerts" }, ...items) : none("no alert");
 }
 
+// what the page's server cannot reach: the line's router (then nothing below is live)
+function drawRouter(state) {
+  router.hidden = !state || state.reachable === true;
+  if (router.hidden) return;
+  router.textContent = state.reachable === null ? `reaching the line's router at ${state.endpoints}…`
+    : `the line's router at ${state.endpoints} is unreachable (${ago(state.for_s).replace(" ago", "")}): ` +
+      "what is shown is not live";
+}
+
 function draw(board) {
+  drawRouter(board.router);
   stations.replaceChildren(...board.stations.map((station) => el("section",
     { class: "station", id: `station-${station.station}` },
     el("h2", {}, `Station ${station.station}`, station.name ? ` — ${station.name}` : "",
