@@ -23,10 +23,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import logging
-import os
-import sys
 import threading
 import time
 from collections.abc import Sequence
@@ -48,7 +45,7 @@ from shared.config import AnyStation, load_any_line
 from shared.contract import TighteningResult
 from shared.errors import InputError, StoreError
 from shared.results import ResultsQuery, ResultsStore, station_store
-from shared.runtime import ServiceSkeleton
+from shared.runtime import ServiceSkeleton, exit_now
 from shared.wear import BrokenLedgerError, WearLedger, ledger_path
 
 LOG = logging.getLogger(__name__)
@@ -182,19 +179,4 @@ def main(args: argparse.Namespace) -> int:
     with ServiceSkeleton("opcua") as skeleton:
         service = OpcuaService(stations, skeleton, args.listen, security)
         status = skeleton.run(service.work)
-    _exit_now(status)
-    return status  # not reached
-
-
-def _exit_now(status: int) -> None:
-    """End the process with ``status`` once everything is stopped and closed, without the
-    interpreter's finalisation: there, a native thread that calls into Python late (a zenoh
-    callback in flight as the session closed) is ended by ``pthread_exit``, whose unwinding
-    through native frames aborted the process ("FATAL: exception not rethrown", SIGABRT;
-    seen once in about eight stops of a server with clients). Nothing is left to run at exit:
-    the logs and standard streams are flushed first."""
-    logging.shutdown()
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(OSError, ValueError, AttributeError):
-            stream.flush()
-    os._exit(status)
+    exit_now(status)  # the session is closed: no finalisation for a late zenoh thread to abort

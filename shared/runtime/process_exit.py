@@ -5,7 +5,8 @@ During finalisation a native thread that calls into Python late (a zenoh
 callback in flight as the session closed) is ended by ``pthread_exit``,
 whose unwinding through native frames aborts the process ("FATAL: exception
 not rethrown", SIGABRT): a clean stop would end with status -6 now and then
-(seen once in about ten stops of the line's page after hostile clients).
+(seen once in about ten stops of the line's page after hostile clients, and once
+in about eight of the OPC UA server with clients).
 Nothing is left to run at exit by then: the logs and standard streams are
 flushed first.
 """
