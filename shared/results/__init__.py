@@ -13,7 +13,7 @@ The recorder writes it (``services/recorder/results_watch.py``); ``boltwatch
 results`` reads it.
 """
 
-from shared.results.program_columns import implausible_rows, program_columns
+from shared.results.program_columns import StoredColumns, program_columns
 from shared.results.results_database import (
     SQLITE_FILE,
     ResultsDatabase,
@@ -39,8 +39,8 @@ __all__ = [
     "ResultsStore",
     "StoreError",
     "StoreTarget",
+    "StoredColumns",
     "StoredResult",
-    "implausible_rows",
     "migrate",
     "postgres_target",
     "program_columns",

@@ -11,13 +11,15 @@ runs, stop reasons, stations, tools) grouped by the database. The same
 columns as :func:`shared.quality.program_columns.columns_of` makes from the
 results themselves: one report either way. A tightening whose figures cannot
 be a measurement (:mod:`shared.quality.plausible_result`: a torque of
-1e308 Nm) is left out of every statement; :func:`implausible_rows` names them.
+1e308 Nm) is found in the first statement's scan, named
+(:attr:`StoredColumns.refused`) and left out of every statement.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from collections import Counter, defaultdict
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -68,48 +70,62 @@ def _and(where: str, condition: str) -> str:
     return f"{where} AND ({condition})" if where else f" WHERE ({condition})"
 
 
-def implausible_rows(store: ResultsStore, query: ResultsQuery) -> list[str]:
-    """A line for each tightening ``query`` asks for whose figures cannot be a measurement
-    (left out of :func:`program_columns`), in the order the runs ended."""
-    everything = dataclasses.replace(query, limit=None, oldest_first=True)
-    where, parameters = everything.where()
+def _refusal_lines(store: ResultsStore, keys: list[tuple[str, int]]) -> list[str]:
+    """A line for each tightening of ``keys`` (station, run id) saying why its figures
+    cannot be a measurement, each read by the table's key."""
     judged = ", ".join(column for columns in _JUDGED for column in columns)
-    rows = store.database.rows(
-        f"SELECT station, run_id, tool_id, {judged}, events, process_intensity FROM "
-        f"tightenings{_and(where, _IMPLAUSIBLE)}{everything.order()}",
-        parameters,
-    )
     lines = []
-    for station, run_id, tool_id, *figures in rows:
-        judged_figures = [tuple(figures[index : index + 3]) for index in (0, 3, 6)]
-        why = figures_fault(judged_figures, figures[9], figures[10])
-        lines.append(refusal_line(station, run_id, tool_id, why or "beyond the bounds"))
+    for key in keys:
+        for tool_id, *figures in store.database.rows(
+            f"SELECT tool_id, {judged}, events, process_intensity FROM tightenings "
+            "WHERE station = ? AND run_id = ?",
+            key,
+        ):
+            judged_figures = [tuple(figures[index : index + 3]) for index in (0, 3, 6)]
+            why = figures_fault(judged_figures, figures[9], figures[10])
+            lines.append(refusal_line(key[0], key[1], tool_id, why or "beyond the bounds"))
     return lines
 
 
-def program_columns(store: ResultsStore, query: ResultsQuery) -> list[ProgramColumns]:
+@dataclass
+class StoredColumns:
+    """What :func:`program_columns` read: each program's columns, and a line for each
+    tightening left out because its figures cannot be a measurement."""
+
+    programs: list[ProgramColumns] = field(default_factory=list)
+    refused: list[str] = field(default_factory=list)
+
+
+def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
     """The columns of each program of the tightenings ``query`` asks for (its limit and
-    order ignored: every one, in the order the runs ended), by program id."""
+    order ignored: every one, in the order the runs ended), by program id; those whose
+    figures cannot be a measurement are found in the same scan, left out and named."""
     everything = dataclasses.replace(query, limit=None, oldest_first=True)
     where, parameters = everything.where()
-    where = _and(where, f"NOT ({_IMPLAUSIBLE})")
     rows = store.database.rows(
-        f"SELECT {_RUN_COLUMNS} FROM tightenings{where}{everything.order()}", parameters
+        f"SELECT {_RUN_COLUMNS}, CASE WHEN ({_IMPLAUSIBLE}) THEN station END, "
+        f"CASE WHEN ({_IMPLAUSIBLE}) THEN run_id END FROM tightenings{where}"
+        f"{everything.order()}",
+        parameters,
     )
+    refused = [(row[7], row[8]) for row in rows if row[7] is not None]
+    if refused:
+        rows = [row for row in rows if row[7] is None]
+    read = StoredColumns(refused=_refusal_lines(store, refused))
     if not rows:
-        return []
+        return read
     figures = np.array([row[:6] for row in rows], dtype=np.float64)  # None: NaN
     nok_reasons: dict[int, list[str]] = defaultdict(list)
     for row in rows:
         if row[6] is not None:
             nok_reasons[row[0]].append(row[6])
     del rows
+    where = _and(where, f"NOT ({_IMPLAUSIBLE})")
     grouped: dict[int, list[tuple[Any, ...]]] = defaultdict(list)
     for program_id, *group in store.database.rows(
         f"SELECT {_GROUPS}, COUNT(*) FROM tightenings{where} GROUP BY {_GROUPS}", parameters
     ):
         grouped[program_id].append(tuple(group))
-    columns = []
     for program_id in sorted(grouped):
         latest = dataclasses.replace(everything, program_id=program_id, oldest_first=False, limit=1)
         latest_where, latest_parameters = latest.where()  # by the index of program_id
@@ -126,7 +142,7 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> list[ProgramCol
         reasons: Counter[str] = Counter()
         for text in nok_reasons[program_id]:
             reasons.update(reason_kinds(text))
-        columns.append(
+        read.programs.append(
             ProgramColumns(
                 program_id=program_id,
                 program_name=name,
@@ -151,7 +167,7 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> list[ProgramCol
                 tools=sorted({int(group[1]) for group in groups}),
             )
         )
-    return columns
+    return read
 
 
 def _measured(column: np.ndarray) -> np.ndarray:

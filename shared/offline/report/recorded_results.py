@@ -31,7 +31,7 @@ from shared.errors import InputError
 from shared.quality import ProgramColumns, columns_of, implausible, refusal_line
 from shared.recordings import recording_files, station_days
 from shared.recordings.mcap import RecordingScan
-from shared.results import ResultsQuery, ResultsStore, implausible_rows, program_columns
+from shared.results import ResultsQuery, ResultsStore, program_columns
 
 #: progress is told every this many files (when there are more)
 PROGRESS_EVERY_FILES = 50
@@ -170,4 +170,5 @@ def read_stored(store: ResultsStore, rule: ResultFilter) -> RecordedResults:
         limit=None,
         oldest_first=True,
     )
-    return RecordedResults(program_columns(store, query), refused=implausible_rows(store, query))
+    read = program_columns(store, query)
+    return RecordedResults(read.programs, refused=read.refused)

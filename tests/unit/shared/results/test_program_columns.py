@@ -15,7 +15,6 @@ from shared.results import (
     ResultsQuery,
     ResultsStore,
     StoreTarget,
-    implausible_rows,
     program_columns,
     stored_result,
 )
@@ -84,10 +83,12 @@ def test_the_stores_columns_give_the_statistics_of_the_results(target: StoreTarg
     results = _results()
     with ResultsStore(target) as store:
         store.add([stored_result(result, "A", None, None, 1) for result in results])
-        stored = [statistics_of(c, 5) for c in program_columns(store, ResultsQuery(limit=3))]
+        stored = [
+            statistics_of(c, 5) for c in program_columns(store, ResultsQuery(limit=3)).programs
+        ]
         query = ResultsQuery(stations=["st1", "st2"], since_ns=factories.T0 + 10 * SECOND_NS)
-        some = [statistics_of(c, 5) for c in program_columns(store, query)]
-        assert program_columns(store, ResultsQuery(part_id="none such")) == []
+        some = [statistics_of(c, 5) for c in program_columns(store, query).programs]
+        assert program_columns(store, ResultsQuery(part_id="none such")).programs == []
     read = program_statistics(results, 5)
     assert [program.runs for program in stored] == [RUNS // 2, RUNS // 2]
     assert any(program.window_changes for program in stored), "the torque window changed"
@@ -122,8 +123,8 @@ def test_tightenings_that_cannot_be_a_measurement_are_left_out_and_named(
     ]
     with ResultsStore(target) as store:
         store.add([stored_result(result, "A", None, None, 1) for result in good + bad])
-        (columns,) = program_columns(store, ResultsQuery())
-        lines = implausible_rows(store, ResultsQuery())
+        read = program_columns(store, ResultsQuery())
+    (columns,), lines = read.programs, read.refused
     assert columns.runs == len(good) and float(columns.values["torque"].max()) < 1e6
     assert len(lines) == len(absurd)
     for line, (why, result) in zip(lines, zip(absurd, bad, strict=True), strict=True):
