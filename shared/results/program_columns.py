@@ -11,8 +11,8 @@ runs, stop reasons, stations, tools) grouped by the database. The same
 columns as :func:`shared.quality.program_columns.columns_of` makes from the
 results themselves: one report either way. A tightening whose figures cannot
 be a measurement (:mod:`shared.quality.plausible_result`: a torque of
-1e308 Nm) is found in the first statement's scan, named
-(:attr:`StoredColumns.refused`) and left out of every statement.
+1e308 Nm) is flagged in the first statement's scan, read again by its key,
+named (:attr:`StoredColumns.refused`) and taken out of what is counted.
 """
 
 from __future__ import annotations
@@ -35,56 +35,33 @@ from shared.quality.program_columns import (
 from shared.results.results_query import ResultsQuery
 from shared.results.results_store import ResultsStore
 
-#: what each run gives, in the order the runs ended: the figures' arrays, NOK reasons
-_RUN_COLUMNS = (
-    "program_id, torque_nm, angle_deg, force_n, process_intensity, events, "
-    "CASE WHEN result = 'NOK' THEN nok_reasons END"
-)
-#: each judged figure's window, in the order of JUDGED_FIGURES
-_WINDOWS = "torque_min_nm, torque_max_nm, angle_min_deg, angle_max_deg, force_min_n, force_max_n"
-#: what is counted, grouped by the database
-_GROUPS = f"program_id, station, tool_id, stop_reason, {_WINDOWS}"
 #: each judged figure's value and window, in the order of JUDGED_FIGURES
 _JUDGED = (
     ("torque_nm", "torque_min_nm", "torque_max_nm"),
     ("angle_deg", "angle_min_deg", "angle_max_deg"),
     ("force_n", "force_min_n", "force_max_n"),
 )
-#: a tightening whose figures cannot be a measurement (NULL: not measured, never beyond)
+_WINDOWS = ", ".join(column for _value, *window in _JUDGED for column in window)
+#: what is counted, grouped by the database
+_GROUPS = f"program_id, station, tool_id, stop_reason, {_WINDOWS}"
+#: true for a tightening whose figures cannot be a measurement; NULL (not measured) is
+#: never beyond, so this is for CASE WHEN only (NOT of it is NULL, not true, for a NULL)
 _IMPLAUSIBLE = " OR ".join(
     [
-        f"ABS(COALESCE({column}, 0)) > {limit!r}"
+        f"{column} NOT BETWEEN {-limit!r} AND {limit!r}"
         for (_, limit, _), columns in zip(FIGURE_LIMITS, _JUDGED, strict=True)
         for column in columns
     ]
-    + [
-        f"COALESCE(events, 0) > {EVENTS_LIMIT}",
-        "COALESCE(process_intensity, 0) < 0",
-        f"COALESCE(process_intensity, 0) > {INTENSITY_LIMIT!r}",
-    ]
+    + [f"events > {EVENTS_LIMIT}", f"process_intensity NOT BETWEEN 0 AND {INTENSITY_LIMIT!r}"]
 )
-
-
-def _and(where: str, condition: str) -> str:
-    """``where`` (`` WHERE ...`` or empty) and ``condition``."""
-    return f"{where} AND ({condition})" if where else f" WHERE ({condition})"
-
-
-def _refusal_lines(store: ResultsStore, keys: list[tuple[str, int]]) -> list[str]:
-    """A line for each tightening of ``keys`` (station, run id) saying why its figures
-    cannot be a measurement, each read by the table's key."""
-    judged = ", ".join(column for columns in _JUDGED for column in columns)
-    lines = []
-    for key in keys:
-        for tool_id, *figures in store.database.rows(
-            f"SELECT tool_id, {judged}, events, process_intensity FROM tightenings "
-            "WHERE station = ? AND run_id = ?",
-            key,
-        ):
-            judged_figures = [tuple(figures[index : index + 3]) for index in (0, 3, 6)]
-            why = figures_fault(judged_figures, figures[9], figures[10])
-            lines.append(refusal_line(key[0], key[1], tool_id, why or "beyond the bounds"))
-    return lines
+#: what each run gives, in the order the runs ended: the figures' arrays, NOK reasons, and
+#: the run id of a tightening whose figures cannot be a measurement
+_RUN_COLUMNS = (
+    "program_id, torque_nm, angle_deg, force_n, process_intensity, events, "
+    f"CASE WHEN result = 'NOK' THEN nok_reasons END, CASE WHEN ({_IMPLAUSIBLE}) THEN run_id END"
+)
+#: run ids per statement when flagged tightenings are read again
+_RUNS_PER_QUERY = 500
 
 
 @dataclass
@@ -99,46 +76,40 @@ class StoredColumns:
 def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
     """The columns of each program of the tightenings ``query`` asks for (its limit and
     order ignored: every one, in the order the runs ended), by program id; those whose
-    figures cannot be a measurement are found in the same scan, left out and named."""
+    figures cannot be a measurement are flagged in the same scan, left out and named."""
     everything = dataclasses.replace(query, limit=None, oldest_first=True)
     where, parameters = everything.where()
     rows = store.database.rows(
-        f"SELECT {_RUN_COLUMNS}, CASE WHEN ({_IMPLAUSIBLE}) THEN station END, "
-        f"CASE WHEN ({_IMPLAUSIBLE}) THEN run_id END FROM tightenings{where}"
-        f"{everything.order()}",
-        parameters,
+        f"SELECT {_RUN_COLUMNS} FROM tightenings{where}{everything.order()}", parameters
     )
-    refused = [(row[7], row[8]) for row in rows if row[7] is not None]
-    if refused:
+    flagged = sorted({row[7] for row in rows if row[7] is not None})
+    refused = _refused(store, everything, flagged)
+    if flagged:
         rows = [row for row in rows if row[7] is None]
-    read = StoredColumns(refused=_refusal_lines(store, refused))
-    if not rows:
-        return read
-    figures = np.array([row[:6] for row in rows], dtype=np.float64)  # None: NaN
+    read = StoredColumns(refused=[line for line, _group in refused.values()])
+    figures = np.array([row[:6] for row in rows], dtype=np.float64).reshape(len(rows), 6)
     nok_reasons: dict[int, list[str]] = defaultdict(list)
     for row in rows:
         if row[6] is not None:
             nok_reasons[row[0]].append(row[6])
     del rows
-    where = _and(where, f"NOT ({_IMPLAUSIBLE})")
-    grouped: dict[int, list[tuple[Any, ...]]] = defaultdict(list)
-    for program_id, *group in store.database.rows(
+    counted: Counter[tuple[Any, ...]] = Counter()
+    for *group, runs in store.database.rows(
         f"SELECT {_GROUPS}, COUNT(*) FROM tightenings{where} GROUP BY {_GROUPS}", parameters
     ):
-        grouped[program_id].append(tuple(group))
+        counted[tuple(group)] += int(runs)
+    counted.subtract(group for _line, group in refused.values())
+    grouped: dict[int, list[tuple[Any, ...]]] = defaultdict(list)
+    for (program_id, *group), runs in counted.items():
+        if runs > 0:
+            grouped[program_id].append((*group, runs))
     for program_id in sorted(grouped):
-        latest = dataclasses.replace(everything, program_id=program_id, oldest_first=False, limit=1)
-        latest_where, latest_parameters = latest.where()  # by the index of program_id
-        latest_where = _and(latest_where, f"NOT ({_IMPLAUSIBLE})")
-        ((name, *newest),) = store.database.rows(
-            f"SELECT program_name, {_WINDOWS} FROM tightenings{latest_where}{latest.order()}",
-            latest_parameters,
-        )
+        name, newest = _latest(store, everything, program_id, set(refused))
         of_program = figures[figures[:, 0] == program_id]
         groups = grouped[program_id]
         stop_reasons: Counter[str] = Counter()
         for _station, _tool, reason, *_windows, runs in groups:
-            stop_reasons[reason or TOOL_STOPPED] += int(runs)
+            stop_reasons[reason or TOOL_STOPPED] += runs
         reasons: Counter[str] = Counter()
         for text in nok_reasons[program_id]:
             reasons.update(reason_kinds(text))
@@ -168,6 +139,53 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
             )
         )
     return read
+
+
+def _refused(
+    store: ResultsStore, query: ResultsQuery, run_ids: list[int]
+) -> dict[tuple[str, int], tuple[str, tuple[Any, ...]]]:
+    """(station, run id) -> why (a line) and its group, of each tightening ``query`` asks for
+    with one of ``run_ids`` whose figures cannot be a measurement, in the order they ended."""
+    where, parameters = query.where()
+    judged = ", ".join(column for columns in _JUDGED for column in columns)
+    found = []
+    for first in range(0, len(run_ids), _RUNS_PER_QUERY):
+        some = run_ids[first : first + _RUNS_PER_QUERY]
+        flagged = f"run_id IN ({', '.join('?' * len(some))}) AND ({_IMPLAUSIBLE})"
+        found += store.database.rows(
+            f"SELECT ended_ns, station, run_id, {_GROUPS}, {judged}, events, process_intensity "
+            f"FROM tightenings{_and(where, flagged)}",
+            [*parameters, *some],
+        )
+    refused = {}
+    for _ended_ns, station, run_id, *group_and_figures in sorted(found):
+        group, figures = tuple(group_and_figures[:10]), group_and_figures[10:]
+        judged_figures = [tuple(figures[index : index + 3]) for index in (0, 3, 6)]
+        why = figures_fault(judged_figures, figures[9], figures[10]) or "beyond the bounds"
+        refused[(station, run_id)] = (refusal_line(station, run_id, group[2], why), group)
+    return refused
+
+
+def _latest(
+    store: ResultsStore, query: ResultsQuery, program_id: int, refused: set[tuple[str, int]]
+) -> tuple[str, list[Any]]:
+    """The name and windows of ``program_id``'s newest tightening ``query`` asks for, not one
+    of ``refused`` (by the index of program_id)."""
+    latest = dataclasses.replace(query, program_id=program_id, oldest_first=False, limit=None)
+    where, parameters = latest.where()
+    for station, run_id, name, *windows in store.database.rows(
+        f"SELECT station, run_id, program_name, {_WINDOWS} FROM tightenings{where}"
+        f"{latest.order()} LIMIT {len(refused) + 1}",
+        parameters,
+    ):
+        if (station, run_id) not in refused:
+            return name, windows
+    raise AssertionError(f"program {program_id}: no tightening counted")
+
+
+def _and(where: str, condition: str) -> str:
+    """``where`` (`` WHERE ...`` or empty) and ``condition``."""
+    return f"{where} AND ({condition})" if where else f" WHERE ({condition})"
 
 
 def _measured(column: np.ndarray) -> np.ndarray:

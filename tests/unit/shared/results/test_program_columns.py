@@ -126,6 +126,9 @@ def test_tightenings_that_cannot_be_a_measurement_are_left_out_and_named(
         read = program_columns(store, ResultsQuery())
     (columns,), lines = read.programs, read.refused
     assert columns.runs == len(good) and float(columns.values["torque"].max()) < 1e6
+    # nothing of them counted: not their stop reasons, not the window of 1e300 N
+    assert sum(columns.stop_reasons.values()) == len(good)
+    assert columns.window_counts["preload"] == 1 and columns.latest_windows["preload"][1] == 59e3
     assert len(lines) == len(absurd)
     for line, (why, result) in zip(lines, zip(absurd, bad, strict=True), strict=True):
         assert line.startswith(f"station st1 run {result.run_id} (tool 7): {why}"), line
