@@ -41,13 +41,7 @@ from shared.stickslip.event_figures import (
 from shared.stickslip.event_history import HISTORY, EventHistory
 from shared.stickslip.extremum_tracker import NOISE_FACTOR, ExtremumTracker
 from shared.stickslip.force_history import ForceHistory
-from shared.stickslip.halt_planner import (
-    MIN_EVENTS,
-    HaltPlanner,
-    best_halt,
-    expected_error,
-    plan_halt_level,
-)
+from shared.stickslip.halt_planner import MIN_EVENTS, HaltPlanner, best_halt, expected_error
 from shared.stickslip.inclination_window import MAX_PASSED, MIN_PASSED, NO_FLIP, InclinationWindow
 from shared.stickslip.input_guard import InputReport
 from shared.stickslip.model_bands import MIN_STICK_SHARE, MODEL_SLACK, ModelBandCheck
@@ -104,7 +98,6 @@ __all__ = [
     "fit_parabola",
     "json_safe",
     "output_record",
-    "plan_halt_level",
     "predict_periods",
     "predict_plateaus",
     "replay",

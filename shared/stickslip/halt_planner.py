@@ -1,22 +1,13 @@
 """Torque target: where to halt in the stick phase now under way (torque-only stations).
 
 A halted tool keeps its torque if the joint still sticks, but a slip that
-starts before the motor has stopped drops the torque by the slip drop ΔT,
-while a slip before the decision costs nothing. So in each stick phase the
-halt torque H is the one of least expected error (:func:`expected_error`)
-given the predicted slip level P̂ of this phase and its scatter σ.
-
-Every input is what this joint has shown in this run, nothing assumes a
-range of joints: P̂ from the core (the screw-angle line of
-:mod:`.screw_plateaus` once it has enough events, else the line through the
-youngest peaks), σ the RMS of the errors of those predictions with the
-sampling step's r²/12, r the median stick ramp per sample, ΔT the median
-drop. H is searched around P̂ in units of σ and within T* ± ΔT (a halt
-further than one drop from the target is worse than any slip it avoids),
-for this phase and the ones after it as long as their predicted peak is
-within reach of the target (:func:`plan_halt_level`).
-Far from the target H is the target itself, and no plan is made before
-:data:`MIN_EVENTS` events or with an input that is not finite. The reasoning and how it was chosen:
+starts before the motor has stopped drops the torque by ΔT (5-12 % of the
+target), while a slip before the decision costs nothing. So in each stick
+phase the halt torque H is the one of least expected error
+(:func:`expected_error`) given the predicted slip level P̂ of this phase and
+its scatter σ, measured by the core; far from the target, H is the target
+itself, and no plan is made before :data:`MIN_EVENTS` events or with an input
+that is not finite. The reasoning and how it was chosen against other rules:
 ``docs/explanation/algorithm.md``, "Stopping on a torque target: the halt plan".
 """
 
@@ -29,12 +20,11 @@ from collections import deque
 MIN_EVENTS = 5
 RESIDUALS = 8
 RECENT = 5
-GRID_SIGMAS = 4.0  # H searched at P̂ + z·σ, |z| ≤ GRID_SIGMAS (and at T*), within T* ± ΔT
-GRID_STEPS = 33
-REACH_SIGMAS = 4.0  # a phase is within reach when |P̂ - T*| < REACH_SIGMAS · σ + ΔT
+MIN_SIGMA_FRACTION = 0.008
+SEARCH_BAND = 0.06  # H searched within target · (1 ± SEARCH_BAND)
+GRID_STEPS = 49
+REACH_SIGMAS = 4.0  # plan only when |P̂ - T*| < REACH_SIGMAS · σ + ΔT
 WAIT_PENALTY = 0.25  # share of the peak step added to e_next per phase waited
-MAX_HORIZONS = 6  # phases looked ahead at most
-STATIONARY_PASSES = 4  # passes over a last phase still within reach, as if it repeated
 
 
 def _phi(z: float) -> float:
@@ -75,24 +65,15 @@ def best_halt(
     target_nm: float,
     next_error_nm: float,
 ) -> tuple[float, float]:
-    """(H, E(H)) of least expected error; the target itself on a tie.
-
-    Searched at the target and at P̂ + z·σ for |z| ≤ GRID_SIGMAS (past that
-    the terms of E no longer change), within T* ± ΔT: a halt further from
-    the target than one drop is worse than any slip it could avoid.
-    """
-    low = target_nm - drop_nm
-    high = target_nm + drop_nm
+    """(H, E(H)) of least expected error on the search grid; the target itself on a tie."""
+    low = target_nm * (1.0 - SEARCH_BAND)
+    step = 2.0 * SEARCH_BAND * target_nm / (GRID_STEPS - 1)
     best_h = target_nm
     best_e = expected_error(
         target_nm, peak_nm, sigma_nm, rate_nm, drop_nm, target_nm, next_error_nm
     )
-    step = 2.0 * GRID_SIGMAS * sigma_nm / (GRID_STEPS - 1)
-    start = peak_nm - GRID_SIGMAS * sigma_nm
     for k in range(GRID_STEPS):
-        halt = start + k * step
-        if not low <= halt <= high:
-            continue
+        halt = low + k * step
         cost = expected_error(halt, peak_nm, sigma_nm, rate_nm, drop_nm, target_nm, next_error_nm)
         if cost < best_e:
             best_h, best_e = halt, cost
@@ -150,6 +131,7 @@ class HaltPlanner:
         rate = self.rate_nm_per_sample
         drop = self.drop_nm
         spread = math.sqrt(sum(e * e for e in self._residuals) / len(self._residuals))
+        spread = max(spread, MIN_SIGMA_FRACTION * target)
         sigma = math.sqrt(spread * spread + rate * rate / 12.0)
         values = (rate, drop, sigma, *predicted_peaks_nm)
         if not all(math.isfinite(v) for v in values) or rate <= 0.0 or drop <= 0.0:
@@ -157,38 +139,11 @@ class HaltPlanner:
         peaks = [p + 0.5 * rate for p in predicted_peaks_nm]
         if abs(peaks[0] - target) >= REACH_SIGMAS * sigma + drop:
             return None
+        error = 0.25 * rate  # a clean crossing, after the last horizon
+        halt = target
+        for k in range(len(peaks) - 1, -1, -1):
+            if k + 1 < len(peaks):
+                error += WAIT_PENALTY * max(0.0, peaks[k + 1] - peaks[k])
+            halt, error = best_halt(peaks[k], sigma, rate, drop, target, error)
         self.planned += 1
-        return plan_halt_level(peaks, sigma, rate, drop, target)
-
-
-def plan_halt_level(
-    peaks_nm: list[float], sigma_nm: float, rate_nm: float, drop_nm: float, target_nm: float
-) -> float:
-    """H for the phase under way, from the predicted peaks of it and the next phases.
-
-    The phases are extended at the last predicted peak step while their peak
-    stays within reach of the target (P̂ < T* + REACH_SIGMAS·σ + r), up to
-    MAX_HORIZONS. Past the last one the target is crossed cleanly (expected
-    error r/4, the sampling step), unless that phase is still within reach
-    (the peaks do not rise, or too slowly): then it is taken to repeat, its
-    value iterated STATIONARY_PASSES times from r/4. Then backwards, as in
-    the paper's eq. 64 but on expected errors: e_k = min_H E(H; P̂_k,
-    e_k+1 + WAIT_PENALTY · step), a later phase sitting on a higher preload.
-    """
-    peaks = list(peaks_nm)
-    step = max(0.0, peaks[-1] - peaks[-2]) if len(peaks) >= 2 else 0.0
-    reach = REACH_SIGMAS * sigma_nm + rate_nm
-    while len(peaks) < MAX_HORIZONS and peaks[-1] < target_nm + reach and step > 0.0:
-        peaks.append(peaks[-1] + step)
-    error = 0.25 * rate_nm
-    if peaks[-1] < target_nm + reach:
-        for _ in range(STATIONARY_PASSES):
-            _, error = best_halt(
-                peaks[-1], sigma_nm, rate_nm, drop_nm, target_nm, error + WAIT_PENALTY * step
-            )
-    halt = target_nm
-    for k in range(len(peaks) - 1, -1, -1):
-        if k + 1 < len(peaks):
-            error += WAIT_PENALTY * max(0.0, peaks[k + 1] - peaks[k])
-        halt, error = best_halt(peaks[k], sigma_nm, rate_nm, drop_nm, target_nm, error)
-    return halt
+        return halt

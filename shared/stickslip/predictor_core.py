@@ -221,13 +221,20 @@ class PredictorCore:
         )
         self.scores.remember(j, predictions)
         out: list[CoreOutput] = [event]
-        by_angle = None
-        if not settings.force_mode:
-            by_angle = self._screw.on_event(
-                peak.angle_deg, peak.torque_nm, trough.angle_deg, trough.torque_nm
-            )
         if self._halt_planner is not None and self.policy.decision is None:
-            self._plan_halt(self._halt_planner, slip, predictions, by_angle)
+            halt = self._halt_planner.on_event(
+                peak.index,
+                peak.torque_nm,
+                trough.index,
+                trough.torque_nm,
+                [p.peak_torque_nm for p in predictions],
+            )
+            planner = self._halt_planner
+            valid = 0
+            if predictions and self._guard.nominal_dt_s > 0.0:
+                period_s = predictions[0].time_s - peak.time_s
+                valid = int(PLAN_PERIODS * period_s / self._guard.nominal_dt_s) + 1
+            self.policy.plan_halt(halt, planner.rate_nm_per_sample, planner.drop_nm, valid)
         verdict = None
         if self.model_bands is not None:
             verdict = self.model_bands.on_event(
@@ -237,6 +244,11 @@ class PredictorCore:
                 event.force_step_n,
                 speed,
                 self._tracker.noise_d2_nm,
+            )
+        by_angle = None
+        if not settings.force_mode:
+            by_angle = self._screw.on_event(
+                peak.angle_deg, peak.torque_nm, trough.angle_deg, trough.torque_nm
             )
         decision = self._decide_on_event(
             now_s,
@@ -251,34 +263,6 @@ class PredictorCore:
         if decision is not None:
             out.append(decision)
         return out
-
-    def _plan_halt(
-        self,
-        planner: HaltPlanner,
-        slip: Slip,
-        predictions: list[Prediction],
-        by_angle: tuple[float, float] | None,
-    ) -> None:
-        """Torque target: the halt level of the stick phase that starts with this trough.
-
-        The next peaks come from the screw angle when :mod:`.screw_plateaus` has
-        them (the friction scatter averaged over the run), else from the line
-        through the youngest peaks. The plan holds for PLAN_PERIODS predicted
-        periods, and at least as long as the stick ramp needs to climb from the
-        trough to the halt level at half its measured rate (a plan above the
-        target that ran out first would leave the torque far over it).
-        """
-        peak, trough = slip.peak, slip.trough
-        peaks = list(by_angle) if by_angle is not None else [p.peak_torque_nm for p in predictions]
-        halt = planner.on_event(peak.index, peak.torque_nm, trough.index, trough.torque_nm, peaks)
-        rate = planner.rate_nm_per_sample
-        valid = 0
-        if predictions and self._guard.nominal_dt_s > 0.0:
-            period_s = predictions[0].time_s - peak.time_s
-            valid = int(PLAN_PERIODS * period_s / self._guard.nominal_dt_s) + 1
-        if halt is not None and rate > 0.0:
-            valid = max(valid, int(2.0 * (halt - trough.torque_nm) / rate) + 1)
-        self.policy.plan_halt(halt, rate, planner.drop_nm, valid)
 
     def _decide_on_event(
         self,
