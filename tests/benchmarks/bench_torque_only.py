@@ -195,6 +195,12 @@ def force_error(r: JointResult, end: End) -> float:
     return (end.force_n - r.joint.target_force_n) / r.joint.target_force_n
 
 
+def lost_drop(r: JointResult, end: End) -> bool:
+    """The stop ended a slip drop low: more than half a drop (and 1 %) under T*."""
+    drop = statistics.median(r.drops_pct) / 100.0 if r.drops_pct else r.joint.drop_share
+    return torque_error(r, end) < -max(WORSE_THAN_CONVENTIONAL, 0.5 * drop)
+
+
 def summary(errors: list[float]) -> str:
     """mean / p95 of |e| and the signed worst, in %."""
     magnitudes = sorted(abs(e) for e in errors)
@@ -239,6 +245,18 @@ def print_family(family: str, results: list[JointResult], worst: int) -> None:
         f"joints > 1 % of T* worse than conventional: {worse}; "
         f"preload > 1 % of F* worse: {worse_preload}"
     )
+    stick = [r for r in results if r.drops_pct]
+    smooth = [r for r in results if not r.drops_pct]
+    for name in ("conventional torque", "boltwatch torque-only"):
+        lost = sum(lost_drop(r, r.stops[name]) for r in results)
+        by_class = " / ".join(
+            f"{statistics.fmean(abs(torque_error(r, r.stops[name])) for r in rs) * 100:.2f}"
+            if rs
+            else "-"
+            for rs in (stick, smooth)
+        )
+        print(f"  {name}: mean % stick-slip / smooth near T* {by_class}; drops lost {lost}")
+    print(f"  ({len(stick)} joints stick and slip near T*, {len(smooth)} slide smoothly there)")
     ranked = sorted(results, key=lambda r: -abs(torque_error(r, r.stops["boltwatch torque-only"])))
     for r in ranked[:worst]:
         print_joint(r)
