@@ -24,7 +24,8 @@ def _started_or_skipped() -> PostgresServer:
 
 @pytest.fixture(scope="session")
 def postgres_server() -> Iterator[PostgresServer]:
-    """A real PostgreSQL server of the whole test run, started on first use."""
+    """A real PostgreSQL server of the whole test run (of each xdist worker under
+    ``make test``), started on first use."""
     with _started_or_skipped() as server:
         yield server
 
