@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import signal
 import subprocess
 import sys
 import time
@@ -63,13 +64,21 @@ def read_recordings(folder: Path) -> dict[str, list[dict[str, Any]]]:
 
 
 def start_up(station: Path, runs: int) -> subprocess.Popen[str]:
-    return subprocess.Popen(
-        up_command(station, runs),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        cwd=REPO,
-    )
+    """``up`` as from a terminal: SIGINT (Ctrl-C) at its default, even when the suite itself
+    was started in the background (a shell without job control starts what it puts behind
+    ``&`` with SIGINT ignored, and a child keeps an ignored signal ignored; a handled one is
+    at its default after exec, so one is handled here while ``up`` starts)."""
+    handled = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        return subprocess.Popen(
+            up_command(station, runs),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            cwd=REPO,
+        )
+    finally:
+        signal.signal(signal.SIGINT, handled)
 
 
 def wait_for_first_run(up: subprocess.Popen[str]) -> str:
