@@ -33,6 +33,7 @@ import pytest
 
 from shared.contract import TighteningResult, channels
 from shared.errors import StoreError
+from shared.recordings import writing_path
 from shared.results import ResultsQuery, ResultsStore, StoredResult, store_target
 from tests.support.listener import Listener
 from tests.support.live_recorder import free_port
@@ -105,7 +106,13 @@ def _search_a_part(
     expected = [[STATION, s.result.run_id, s.result.result, s.recording] for s in found]
     assert first.run_id in {s.result.run_id for s in found} and len(found) > 1
     assert all(verdicts.get(s.result.run_id, s.result.result) == s.result.result for s in found)
-    assert all(s.recording is not None and Path(s.recording).is_file() for s in found)
+    # each run's file, under its writing name while the recorder still writes it (the newest
+    # run's file takes its name when the next run starts)
+    assert all(
+        s.recording is not None
+        and (Path(s.recording).is_file() or writing_path(Path(s.recording)).is_file())
+        for s in found
+    )
     shown_run = page.locator("tr.result").first.get_attribute("data-run")
     page.fill("#part", f" {part} ")
     page.click("#part-search button")

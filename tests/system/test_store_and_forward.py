@@ -205,6 +205,7 @@ def check_station(station: str, runs: dict[int, RunRecord], counted: int, cut_of
         assert record.topics["events"] >= record.summary["events"], where
         assert record.topics["tool"] >= 2, f"{where}: tool states {record.topics}"
     assert counted == len(runs) - len(cut_short), f"{station}: the wear ledger's runs"
-    # at the kill, what the station's spool had not had acknowledged (its last second; 0.2 s
-    # while it drains) is filed again: a second straddles two runs at most
-    assert len(twice) <= 2, f"{station}: filed twice, more than a second: runs {twice}"
+    # at the kill, what the station's spool had not had acknowledged is filed again: its
+    # live messages of the last second (a second straddles two runs at most) and, while it
+    # drains, what it sent again in the last 0.2 s (two runs at most)
+    assert len(twice) <= 4, f"{station}: filed twice, more than a second's runs: {twice}"
