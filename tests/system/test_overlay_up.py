@@ -7,10 +7,15 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 
-from shared.offline.overlay import build_overlay, find_run_files, parse_alignment, read_overlay_run
+from shared.offline.overlay import (
+    align_index,
+    build_overlay,
+    find_run_files,
+    parse_alignment,
+    read_overlay_run,
+)
 from tests.support.paths import REPO
 from tests.support.station_files import write_station
 from tests.support.station_up import read_recordings, run_up
@@ -50,8 +55,9 @@ def test_overlay_of_real_runs_found_by_id(tmp_path: Path) -> None:
         assert series.verdict == verdicts[run.run_id] and series.aligned
         assert len(series.torque_nm) > 1000 and series.force_n is not None
         # each run's first stick-slip peak lands on the reference's, in angle and in time
-        peak = int(np.argmin(np.abs(run.time_ns - run.events[0].time_ns)))
-        ref_peak = int(np.argmin(np.abs(runs[0].time_ns - runs[0].events[0].time_ns)))
+        peak = align_index(run, parse_alignment("first-slip"))
+        ref_peak = align_index(runs[0], parse_alignment("first-slip"))
+        assert peak is not None and ref_peak is not None
         assert series.angle_deg[peak] == pytest.approx(reference.angle_deg[ref_peak])
         assert series.time_s[peak] == pytest.approx(reference.time_s[ref_peak])
         assert series.torque_nm[peak] == pytest.approx(run.events[0].peak_torque_nm)

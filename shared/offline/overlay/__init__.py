@@ -6,7 +6,7 @@
 - :mod:`.overlay_plot`: the figure drawn and saved (matplotlib, Agg)
 """
 
-from shared.offline.overlay.overlay_alignment import parse_alignment
+from shared.offline.overlay.overlay_alignment import align_index, parse_alignment
 from shared.offline.overlay.overlay_plot import build_figure, run_colours, save_figure
 from shared.offline.overlay.overlay_run import OverlayRun, find_run_files, read_overlay_run
 from shared.offline.overlay.overlay_series import Overlay, build_overlay
@@ -14,6 +14,7 @@ from shared.offline.overlay.overlay_series import Overlay, build_overlay
 __all__ = [
     "Overlay",
     "OverlayRun",
+    "align_index",
     "build_figure",
     "build_overlay",
     "find_run_files",

@@ -70,5 +70,9 @@ def align_index(run: OverlayRun, alignment: Alignment) -> int | None:
         return int(reached[0]) if len(reached) else None
     if not run.events:
         return None
-    # the event's peak sample: the one received at the event's time (else the nearest)
-    return int(np.argmin(np.abs(run.time_ns - run.events[0].time_ns)))
+    # the event's peak sample: the one received at the event's time (else the nearest); of
+    # samples received at one time (a burst of frames), the one with the peak's torque
+    event = run.events[0]
+    distance_ns = np.abs(run.time_ns - event.time_ns)
+    nearest = np.flatnonzero(distance_ns == distance_ns.min())
+    return int(nearest[np.argmin(np.abs(run.torque_nm[nearest] - event.peak_torque_nm))])
