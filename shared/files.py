@@ -1,5 +1,6 @@
 """Folders and files: making a folder, and saying plainly why one cannot be made; an
-``OSError`` in one line that names its file; a small JSON file replaced atomically."""
+``OSError`` in one line that names its file; a file or folder fsynced by its path; a small
+JSON file replaced atomically."""
 
 from __future__ import annotations
 
@@ -40,6 +41,16 @@ def describe_os_error(err: OSError, path: Path | None) -> str:
     return f"{where}: {err.strerror or err} ({code})"
 
 
+def fsync_path(path: Path) -> None:
+    """fsync the file or folder at ``path``: a file's bytes, or a folder's names (the files
+    just created or renamed in it), on the disk."""
+    handle = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(handle)
+    finally:
+        os.close(handle)
+
+
 def write_json_atomically(path: Path, document: Any) -> None:
     """Replace ``path`` by ``document`` as JSON, whole or not at all: a temporary file in the
     same folder, fsync, rename, fsync of the folder (after a crash: the old or the new)."""
@@ -56,8 +67,4 @@ def write_json_atomically(path: Path, document: Any) -> None:
         with contextlib.suppress(OSError):
             os.unlink(temporary)
         raise
-    directory = os.open(folder, os.O_RDONLY)
-    try:
-        os.fsync(directory)
-    finally:
-        os.close(directory)
+    fsync_path(folder)

@@ -40,6 +40,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from shared.errors import InputError
+from shared.files import fsync_path
 from shared.wear import wear_tool_data
 
 #: The first 16 bytes of every SQLite 3 database file.
@@ -160,7 +161,7 @@ def create_ledger(path: Path, schema: str) -> None:
             db.close()  # the WAL goes into the file: complete on its own
         with contextlib.suppress(FileExistsError):
             os.link(temporary, path)
-        _sync_folder(path.parent)
+        fsync_path(path.parent)
     finally:
         for name in (temporary, *(Path(f"{temporary}{end}") for end in COMPANIONS)):
             name.unlink(missing_ok=True)
@@ -207,13 +208,5 @@ def move_aside(path: Path, now: datetime | None = None) -> Path:
         with contextlib.suppress(FileNotFoundError):
             os.rename(f"{path}{end}", f"{target}{end}")
     os.rename(path, target)
-    _sync_folder(path.parent)
+    fsync_path(path.parent)
     return target
-
-
-def _sync_folder(folder: Path) -> None:
-    fd = os.open(folder, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)

@@ -28,6 +28,7 @@ from mcap.records import Message, Metadata
 
 from shared.contract import RunSummary, channels, decode
 from shared.errors import InputError
+from shared.files import fsync_path
 from shared.recordings.mcap import RecordingScan
 
 TEMPORARY_MARK = ".importing"
@@ -108,11 +109,7 @@ def put_in_place(moves: list[tuple[Path, Path]]) -> None:
         os.replace(temporary, final)
     folders = {final.parent for _, final in moves}
     for folder in folders:
-        handle = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
-        try:
-            os.fsync(handle)
-        finally:
-            os.close(handle)
+        fsync_path(folder)
 
 
 def _alive(pid: int) -> bool:

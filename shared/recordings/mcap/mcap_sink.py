@@ -44,6 +44,7 @@ from typing import BinaryIO
 from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 
+from shared.files import fsync_path
 from shared.recordings.layout import writing_path
 from shared.recordings.received import Received
 from shared.recordings.mcap.mcap_messages import MessageAppender, MessageRow
@@ -181,7 +182,7 @@ class McapSink:
         if self.writing_path != self.path:
             os.rename(self.writing_path, self.path)
             if self._fsync:
-                sync_folder(self.path.parent)
+                fsync_path(self.path.parent)
         self.flushed_messages = self.messages
         LOG.info(
             "closed %s: %d messages, runs %s",
@@ -222,7 +223,7 @@ class McapSink:
         if self._fsync:
             os.fsync(self._file.fileno())
             if not self._name_synced:  # the new file's name survives a power cut too
-                sync_folder(self.path.parent)
+                fsync_path(self.path.parent)
                 self._name_synced = True
 
     def _channel_for(self, received: Received) -> int:
@@ -268,12 +269,3 @@ class McapSink:
 
     def __exit__(self, *_exc: object) -> None:
         self.close()
-
-
-def sync_folder(folder: Path) -> None:
-    """fsync a folder, so the names of the files just created in it are on the disk."""
-    handle = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
-    try:
-        os.fsync(handle)
-    finally:
-        os.close(handle)

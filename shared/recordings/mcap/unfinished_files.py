@@ -25,9 +25,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from shared.errors import InputError
-from shared.files import describe_os_error
+from shared.files import describe_os_error, fsync_path
 from shared.recordings.layout import final_path_of, unfinished_files
-from shared.recordings.mcap.mcap_sink import sync_folder
 from shared.recordings.mcap.recording_reader import RecordingScan
 from shared.recordings.mcap.recovery import default_target, recover
 
@@ -104,7 +103,7 @@ def finish_one(writing: Path) -> Unfinished:
             writing.unlink()
             LOG.info("%s held no message: removed", writing)
             return Unfinished(writing, None, 0, False, None)
-        _sync_file(staging)
+        fsync_path(staging)
         _put_in_place(staging, final)
         writing.unlink()
     except (InputError, OSError) as err:
@@ -134,14 +133,6 @@ def _is_empty(path: Path) -> bool:
         return False
 
 
-def _sync_file(path: Path) -> None:
-    handle = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(handle)
-    finally:
-        os.close(handle)
-
-
 def _put_in_place(source: Path, final: Path) -> None:
     os.rename(source, final)
-    sync_folder(final.parent)
+    fsync_path(final.parent)
