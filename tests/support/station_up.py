@@ -35,8 +35,11 @@ def up_command(station: Path, runs: int) -> list[str]:
     ]
 
 
-def run_up(station: Path, runs: int, *options: str) -> subprocess.CompletedProcess[str]:
-    """``boltwatch up`` to its end; it must exit 0 (its output is the failure's message)."""
+def run_up(
+    station: Path, runs: int, *options: str, status: int = 0
+) -> subprocess.CompletedProcess[str]:
+    """``boltwatch up`` to its end; it must exit with ``status`` (its output is the failure's
+    message)."""
     result = subprocess.run(
         [*up_command(station, runs), *options],
         capture_output=True,
@@ -45,7 +48,7 @@ def run_up(station: Path, runs: int, *options: str) -> subprocess.CompletedProce
         cwd=REPO,
         check=False,
     )
-    assert result.returncode == 0, result.stdout + result.stderr
+    assert result.returncode == status, result.stdout + result.stderr
     return result
 
 

@@ -19,7 +19,6 @@ from mcap.reader import make_reader
 
 from shared.recordings import unfinished_files
 from tests.support.disk_faults import tmpfs
-from tests.support.paths import REPO
 from tests.support.station_files import (
     is_running,
     kill_all,
@@ -27,12 +26,10 @@ from tests.support.station_files import (
     write_station,
 )
 from tests.support.station_up import (
-    UP_TIMEOUT_S,
     read_recordings,
     run_up,
     services_of,
     start_up,
-    up_command,
     wait_for_first_run,
 )
 
@@ -197,15 +194,7 @@ def test_runs_not_recorded_are_named_and_up_exits_non_zero(tmp_path: Path) -> No
     }
     station = write_station(tmp_path, replacements=reserve)
     with tmpfs(tmp_path / "recordings", 8 << 20) as recordings:
-        result = subprocess.run(
-            up_command(station, 1),
-            check=False,
-            capture_output=True,
-            text=True,
-            timeout=UP_TIMEOUT_S,
-            cwd=REPO,
-        )
-        assert result.returncode == 1, result.stdout + result.stderr
+        result = run_up(station, 1, status=1)
         (note,) = [line for line in result.stderr.splitlines() if "NOT RECORDED" in line]
         assert note.startswith("NOT RECORDED: 1 of 1 runs have no recording (st1 run ")
         assert "recorder.log" in note
