@@ -6,8 +6,9 @@ plant, line, program, tool, time), in SQLite beside the recordings or a plant's 
 - :mod:`.results_schema` (the tables, their version, the migrations)
 - :mod:`.stored_result` (a result as a row, and back)
 - :mod:`.results_store` (add idempotently, find, what was read of which recording)
+- :mod:`.sqlite_statistics` (SQLite's planner statistics, written by the store's writer)
 - :mod:`.results_query` (which tightenings a question asks for)
-- :mod:`.program_columns` (a report's columns per program, in a few statements)
+- :mod:`.program_columns` (a report's columns per program, in one scan)
 
 The recorder writes it (``services/recorder/results_watch.py``); ``boltwatch
 results`` reads it.

@@ -27,6 +27,7 @@ from shared.results.results_schema import (
     migrate,
     version_of,
 )
+from shared.results.sqlite_statistics import FEWEST_ROWS, keep_statistics
 from shared.results.stored_result import StoredResult, from_row, step_of, step_rows, to_row
 
 #: run ids of one station per statement when rows are read by key (steps, verdicts)
@@ -48,6 +49,8 @@ _SELECT = f"SELECT {', '.join(TIGHTENING_COLUMNS)} FROM tightenings"
 class ResultsStore:
     """An open results store (a context manager)."""
 
+    _statistics_rows = 0  # a writer's: the rows its SQLite statistics stand for
+
     def __init__(self, target: StoreTarget, *, create: bool = True, application: str = "") -> None:
         """``create``: make the store when there is none (a writer); else StoreError.
         An older store is migrated either way; a reader (``create=False``) of a store at
@@ -63,6 +66,7 @@ class ResultsStore:
         try:
             if create:
                 self.migrated_from = migrate(self.database)
+                self._statistics_rows = keep_statistics(self.database)
             else:
                 found = version_of(self.database)
                 if found == 0:
@@ -72,6 +76,7 @@ class ResultsStore:
             self.database.close()
             raise
         self.version = SCHEMA_VERSION
+        self._added_since_statistics = 0
 
     def close(self) -> None:
         self.database.close()
@@ -90,6 +95,10 @@ class ResultsStore:
                 if self.database.execute(_INSERT_TIGHTENING, to_row(stored)) == 1:
                     new += 1
                     self.database.execute_many(_INSERT_STEP, step_rows(stored))
+        self._added_since_statistics += new
+        if self._added_since_statistics >= max(self._statistics_rows, FEWEST_ROWS):
+            self._statistics_rows = keep_statistics(self.database)
+            self._added_since_statistics = 0
         return new
 
     def find(self, query: ResultsQuery) -> list[StoredResult]:

@@ -232,6 +232,8 @@ def _cut(text: str, chars: int = 200) -> str:
 def queries(args: argparse.Namespace, target: StoreTarget) -> dict[str, Any]:
     """Step 3 on ``target``."""
     figures = filled(args, target)
+    with ResultsStore(target):  # opened by its writer, as a recorder starts: its statistics
+        pass
     with ResultsStore(target, create=False) as store:
         size = store_size_bytes(store)
         figures["bytes_per_million_rows"] = round(size / args.rows * 1e6)
