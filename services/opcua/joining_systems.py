@@ -118,13 +118,14 @@ class JoiningSystem:
     async def publish(self, result_id: str, run_id: int, result: Any, message: str) -> None:
         """``result`` (a ``ua.ResultDataType``) into Results, then the result-ready event."""
         ours, ijt, result_ns = self._names
-        variable = await self._results.add_variable(
+        variable = await add_typed_variable(
+            self._results,
             node_id(f"{self.station}/results/{result_id}", ours),
             ua.QualifiedName(result_browse_name(run_id), ours),
             ua.Variant(result, ua.VariantType.ExtensionObject),
-            datatype=node_id(RESULT_DATA_TYPE, result_ns),
+            node_id(RESULT_DATA_TYPE, result_ns),
+            node_id(JOINING_SYSTEM_RESULT_TYPE, ijt),
         )
-        await set_type_definition(variable, node_id(JOINING_SYSTEM_RESULT_TYPE, ijt))
         self._kept.append(variable)
         while len(self._kept) > KEPT_RESULTS:
             await remove_child(
@@ -178,10 +179,40 @@ async def remove_child(parent: Node, child: Node, reference_type: ua.NodeId) -> 
     await delete_nodes(parent.session, [child], recursive=True, delete_target_references=False)
 
 
-async def set_type_definition(variable: Node, type_definition: ua.NodeId) -> None:
-    """add_variable gives BaseDataVariableType: ``type_definition`` instead (e.g. the result
-    variable's JoiningSystemResultType; its sub-variables are not instantiated)."""
-    old = await variable.read_type_definition()
-    if old is not None:
-        await variable.delete_reference(old, ua.ObjectIds.HasTypeDefinition)
-    await variable.add_reference(type_definition, ua.ObjectIds.HasTypeDefinition)
+async def add_typed_variable(
+    parent: Node,
+    nodeid: ua.NodeId,
+    name: ua.QualifiedName,
+    value: ua.Variant,
+    datatype: ua.NodeId,
+    type_definition: ua.NodeId,
+) -> Node:
+    """A read-only scalar variable of ``type_definition`` (e.g. a result's
+    JoiningSystemResultType; its sub-variables are not instantiated), a component of
+    ``parent``. asyncua's ``add_variable`` makes a BaseDataVariableType, and a type definition
+    changed after stays BaseDataVariableType in the parent's reference: a browse (a
+    generic client's tree) showed that."""
+    attributes = ua.VariableAttributes(
+        DisplayName=ua.LocalizedText(name.Name),
+        Description=ua.LocalizedText(name.Name),
+        Value=value,
+        DataType=datatype,
+        ValueRank=ua.ValueRank.Scalar,
+        WriteMask=0,
+        UserWriteMask=0,
+        AccessLevel=ua.AccessLevel.CurrentRead.mask,
+        UserAccessLevel=ua.AccessLevel.CurrentRead.mask,
+        Historizing=False,
+    )
+    item = ua.AddNodesItem(
+        ParentNodeId=parent.nodeid,
+        ReferenceTypeId=node_id(ua.ObjectIds.HasComponent),
+        RequestedNewNodeId=nodeid,
+        BrowseName=name,
+        NodeClass=ua.NodeClass.Variable,
+        NodeAttributes=attributes,
+        TypeDefinition=type_definition,
+    )
+    [added] = await parent.session.add_nodes([item])
+    added.StatusCode.check()
+    return Node(parent.session, added.AddedNodeId)

@@ -40,8 +40,8 @@ from asyncua.common.node import Node
 from services.opcua.joining_systems import (
     BOLTWATCH_NAMESPACE,
     MACHINERY,
+    add_typed_variable,
     drop_placeholders,
-    set_type_definition,
 )
 from services.opcua.nodeset_loading import IJT_BASE, MODEL_URIS, node_id
 from services.opcua.result_encoding import eu_information
@@ -164,18 +164,24 @@ class ToolAssets:
             )
 
         async def variable(
-            path: str, parent: Node, name: tuple[int, str], value: Any, vtype: ua.VariantType
+            path: str,
+            parent: Node,
+            name: tuple[int, str],
+            value: Any,
+            vtype: ua.VariantType,
+            type_definition: ua.NodeId | None = None,  # None: BaseDataVariableType
         ) -> Node:
             try:  # instantiated with its group (a mandatory child of the group's type)
                 node = await parent.get_child(ua.QualifiedName(name[1], name[0]))
             except ua.UaError:
-                node = await parent.add_variable(
+                node = await add_typed_variable(
+                    parent,
                     node_id(f"{prefix}/{path}", ours),
                     ua.QualifiedName(name[1], name[0]),
                     # typed, as asyncua wants (the figures are written right after)
                     ua.Variant(ua.get_default_value(vtype) if value is None else value, vtype),
-                    varianttype=vtype,
-                    datatype=node_id(vtype.value),  # a built-in type's id is its variant type's
+                    node_id(vtype.value),  # a built-in type's id is its variant type's
+                    type_definition or node_id(ua.ObjectIds.BaseDataVariableType),
                 )
             nodes[path] = node
             return node
@@ -207,9 +213,13 @@ class ToolAssets:
 
         parameters = await group("Parameters", tool, (ijt, "Parameters"), None)
         tool_type = await variable(
-            "Parameters/Type", parameters, (ijt, "Type"), TOOL_TYPE_OTHER, V.Byte
+            "Parameters/Type",
+            parameters,
+            (ijt, "Type"),
+            TOOL_TYPE_OTHER,
+            V.Byte,
+            node_id(ua.ObjectIds.MultiStateDiscreteType),
         )
-        await set_type_definition(tool_type, node_id(ua.ObjectIds.MultiStateDiscreteType))
         declared = self._server.get_node(node_id(TOOL_TYPE_DECLARATION, ijt))
         strings = await (await declared.get_child("0:EnumStrings")).read_value()
         await tool_type.add_property(
@@ -235,8 +245,9 @@ class ToolAssets:
 
         for name in ("StickSlipIntensitySinceService", "StickSlipIntensity"):
             path = f"LifetimeCounters/{name}"
-            counter = await variable(path, lifetime, (ours, name), 0.0, V.Double)
-            await set_type_definition(counter, node_id(LIFETIME_VARIABLE_TYPE, di))
+            counter = await variable(
+                path, lifetime, (ours, name), 0.0, V.Double, node_id(LIFETIME_VARIABLE_TYPE, di)
+            )
             await counter.add_property(
                 node_id(f"{prefix}/{path}/EngineeringUnits", ours),
                 "EngineeringUnits",

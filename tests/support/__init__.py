@@ -33,6 +33,9 @@ with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
   ``postgres_server`` and ``postgres_url`` in ``tests/conftest.py``),
   :mod:`.old_results_store` (a results store as an older boltwatch left it)
 - deployment: :mod:`.compose_layout`, :mod:`.access_rules`
+- OPC UA: :mod:`.opcua_client` (node-opcua's client as a process), :mod:`.opcua_certificates`,
+  :mod:`.address_space_picture` (a browser's view of the address space, photographed)
+- pictures: :mod:`.chromium` (Debian's chromium for playwright)
 - :mod:`.fuzz` (hostile payloads for the live services), :mod:`.bad_arguments`
   (every bad argument of every command)
 - :mod:`.import_rules` (``make lint``: no test module imports another)

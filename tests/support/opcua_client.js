@@ -18,7 +18,10 @@
 // (typed arrays as JSON arrays, NaN as null); with "toolRuns": N, each tool of
 // AssetManagement/Assets/Tools once its OperationCycleCounter reached N (read again until
 // then) as {"type": "tool", "station", "name", "serialNumber", "tightenings",
-// "sinceService", "intensitySinceService", "limitValue", "unitId"}; then {"type": "done"}. Exit status 0, or 1 on an error
+// "sinceService", "intensitySinceService", "limitValue", "unitId"}; with "browseTree":
+// {"expand": [PATH, ...]}, per station {"type": "tree", "station", "nodes"}: the joining
+// system's address space as a generic browser shows it (opcua_browse_tree.js); then
+// {"type": "done"}. Exit status 0, or 1 on an error
 // (its line: {"type": "error", "message"}).
 "use strict";
 const {
@@ -33,6 +36,7 @@ const {
     DataType,
     StatusCodes,
 } = require("node-opcua-client");
+const { browseTree } = require("./opcua_browse_tree.js");
 
 const options = JSON.parse(process.argv[2]);
 const say = (object) => process.stdout.write(JSON.stringify(object) + "\n");
@@ -153,6 +157,12 @@ async function main() {
     if (options.askById) {
         for (const [station, nodeId] of Object.entries(systems)) {
             await askById(session, nodeId, result, station, firstResultId[station]);
+        }
+    }
+    if (options.browseTree) {
+        for (const [station, nodeId] of Object.entries(systems)) {
+            const nodes = await browseTree(session, nodeId, station, options.browseTree.expand);
+            say({ type: "tree", station, nodes });
         }
     }
     await subscription.terminate();

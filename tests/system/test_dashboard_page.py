@@ -35,6 +35,7 @@ from shared.contract import TighteningResult, channels
 from shared.errors import StoreError
 from shared.recordings import writing_path
 from shared.results import ResultsQuery, ResultsStore, StoredResult, store_target
+from tests.support.chromium import CHROMIUM, CHROMIUM_ARGS, MISSING
 from tests.support.listener import Listener
 from tests.support.live_recorder import free_port
 from tests.support.live_station import STATION, LiveStation, live_station
@@ -42,15 +43,6 @@ from tests.support.paths import REPO
 
 pytestmark = pytest.mark.system
 
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMIUM_ARGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
 DOCS_IMAGE = REPO / "docs" / "images" / "dashboard.png"
 PAGE_TIMEOUT_MS = 60_000
 #: a part id that is markup: shown as text, it never makes an element nor runs
@@ -145,7 +137,7 @@ def _search_a_part(
 
 def test_the_line_page_shows_results_live_in_a_real_browser(tmp_path: Path) -> None:
     if not CHROMIUM.exists():
-        pytest.skip(f"{CHROMIUM} is missing (.ci/run installs Debian's chromium as root)")
+        pytest.skip(MISSING)
     sync_api = pytest.importorskip("playwright.sync_api")
     threshold = {"[recorder]\n": "[recorder]\nwear_service_threshold = 4.0e6\n"}
     with live_station(tmp_path, placement="edge", replacements=threshold) as station:

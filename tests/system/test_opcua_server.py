@@ -20,6 +20,8 @@ not sign are refused.
 from __future__ import annotations
 
 import json
+import os
+import shutil
 import subprocess
 import sys
 from datetime import datetime
@@ -35,6 +37,8 @@ from services.opcua.result_values import DEGREE, NEWTON, NEWTON_METRE, result_id
 from services.opcua.tool_assets import ONE, tool_browse_name
 from shared.results import ResultsQuery, ResultsStore, StoredResult, store_target
 from shared.wear import WearLedger, ledger_path
+from tests.support.address_space_picture import screenshot, tree_page
+from tests.support.chromium import CHROMIUM
 from tests.support.live_recorder import free_port
 from tests.support.opcua_certificates import (
     OpcuaCertificates,
@@ -42,6 +46,7 @@ from tests.support.opcua_certificates import (
     make_opcua_certificates,
 )
 from tests.support.opcua_client import lines_of, node_opcua_client, run_client, start_client
+from tests.support.paths import REPO
 from tests.support.station_files import serve, write_station
 from tests.support.station_up import run_up
 
@@ -51,6 +56,18 @@ STATION = "st1"
 RUNS = 5
 CLIENT_TIMEOUT_S = 120
 THRESHOLD = 500.0  # the station's recorder.wear_service_threshold: below one run's
+#: what the browser's view of the joining system shows expanded
+EXPANDED = [
+    "AssetManagement",
+    "AssetManagement/Assets",
+    "AssetManagement/Assets/Tools",
+    "AssetManagement/Assets/Tools/*",
+    "AssetManagement/Assets/Tools/*/LifetimeCounters",
+    "AssetManagement/Assets/Tools/*/Maintenance",
+    "ResultManagement",
+    "ResultManagement/Results",
+]
+DOCS_IMAGE = REPO / "docs" / "images" / "opcua-address-space.png"
 
 
 def _needs() -> Path:
@@ -119,6 +136,7 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
             results=RUNS,
             askById=True,
             toolRuns=RUNS,
+            browseTree={"expand": EXPANDED},
             # about 2 min of tries: the server listens once its models are loaded (10 s and
             # more on a loaded machine; the client's default 40 tries, 20 s, ran out)
             connectRetries=240,
@@ -194,6 +212,7 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
     assert folder["names"] == [result_browse_name(r.run_id) for r in stored]
     _check_trace(lines, found[0])
     _check_tools(lines, station.parent / "recordings")
+    _check_tree(lines, stored, endpoint, tmp_path)
 
     assert [line["type"] for line in refused] == ["refused"], refused
     assert [line["type"] for line in stranger] == ["refused"], stranger
@@ -216,6 +235,32 @@ def _check_trace(lines: list[dict[str, Any]], first: StoredResult) -> None:
     assert channels["Torque"] == [sample["torque_nm"] for sample in samples]
     assert channels["Angle"] == [sample["angle_deg"] for sample in samples]
     assert channels["Preload"] == [sample["force_n"] for sample in samples]  # None: NaN
+
+
+def _check_tree(
+    lines: list[dict[str, Any]], stored: list[Any], endpoint: str, tmp_path: Path
+) -> None:
+    """The joining system as a generic browser shows it: its results, its tool with the
+    counters, its methods; photographed where chromium is (``BOLTWATCH_DOCS_IMAGES=1``: the
+    picture of docs/how-to/opcua.md)."""
+    [tree] = [line for line in lines if line["type"] == "tree"]
+    nodes = {node["path"]: node for node in tree["nodes"]}
+    assert nodes[""]["type"] == "JoiningSystemType"
+    results = [path for path in nodes if path.startswith("ResultManagement/Results/")]
+    assert results == [f"ResultManagement/Results/{result_browse_name(r.run_id)}" for r in stored]
+    assert {nodes[path]["type"] for path in results} == {"JoiningSystemResultType"}
+    assert nodes["ResultManagement/GetResultById"]["nodeClass"] == "Method"
+    tool = f"AssetManagement/Assets/Tools/{tool_browse_name(stored[0].tool_id)}"
+    counter = nodes[f"{tool}/LifetimeCounters/StickSlipIntensitySinceService"]
+    assert (counter["type"], counter["dataType"]) == ("LifetimeVariableType", "Double")
+    assert counter["value"] > 0
+    if not CHROMIUM.exists():
+        return  # the line page's test says why where chromium is missing
+    shot = tmp_path / "opcua-address-space.png"
+    screenshot(tree_page(tree["nodes"], f"{endpoint} — Objects/Machines/{STATION}"), shot)
+    assert shot.stat().st_size > 10_000
+    if os.environ.get("BOLTWATCH_DOCS_IMAGES") == "1":
+        shutil.copyfile(shot, DOCS_IMAGE)
 
 
 def _check_tools(lines: list[dict[str, Any]], recordings: Path) -> None:
