@@ -18,8 +18,11 @@ The address space is built from the OPC Foundation's NodeSet2 files (IJT Base
   :mod:`.result_encoding` (those values as asyncua's classes)
 - :mod:`.result_requests` (ResultManagement's GetResultById: a result of the
   results store, with its steps and trace)
+- :mod:`.asset_nodes` (an asset's nodes by the interface's names, its figures by path)
 - :mod:`.tool_values` (a tool of the wear ledger as an IJT tool's counters, pure),
   :mod:`.tool_assets` (the station's tools in AssetManagement/Assets/Tools)
+- :mod:`.controller_values` (the station's controller as an IJT controller's
+  identification, pure), :mod:`.controller_assets` (it in Assets/Controllers)
 - :mod:`.alert_events` (alerts and a controller's alarms as IJT joining system
   events, pure)
 - :mod:`.line_inbox` (results, alerts and alarms from zenoh, to the loop)

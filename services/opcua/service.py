@@ -16,7 +16,8 @@ result at once. A result already served (the same ResultId) is not served twice.
 Each joining system's ``GetResultById`` answers from its station's results store,
 with the result's trace (:mod:`.result_requests`). The station's tools and their
 counters come from its wear ledger (:mod:`.tool_assets`), read again every
-:data:`TOOLS_REFRESH_S`.
+:data:`TOOLS_REFRESH_S`, and so does its controller's identification
+(:mod:`.controller_assets`).
 """
 
 from __future__ import annotations
@@ -31,6 +32,8 @@ from collections.abc import Sequence
 from asyncua import Server
 
 from services.opcua.alert_events import alert_event
+from services.opcua.controller_assets import ControllerAsset
+from services.opcua.controller_values import ControllerIdentity, controller_identity
 from services.opcua.joining_systems import JoiningSystem
 from services.opcua.line_inbox import LineInbox
 from services.opcua.nodeset_files import nodeset_folder
@@ -41,9 +44,10 @@ from services.opcua.result_values import result_id, result_values
 from services.opcua.server_security import SecuritySettings, apply
 from services.opcua.tool_assets import ToolAssets
 from services.opcua.tool_values import ToolCounters, tool_counters
-from shared.config import AnyStation, load_any_line
+from shared.config import AnyStation, ControllerStation, load_any_line
 from shared.contract import TighteningResult
 from shared.errors import InputError, StoreError
+from shared.recordings import software_version
 from shared.results import ResultsQuery, ResultsStore, station_store
 from shared.runtime import ServiceSkeleton, exit_now
 from shared.wear import BrokenLedgerError, WearLedger, ledger_path
@@ -76,6 +80,7 @@ class OpcuaService:
         self._listen = listen
         self._security = security
         self._served: dict[str, set[str]] = {s.station_id: set() for s in self._stations}
+        self._version = software_version()
 
     def work(self, stop: threading.Event) -> None:
         if not LOG.isEnabledFor(logging.DEBUG):  # asyncua logs each node of its own at INFO
@@ -102,6 +107,10 @@ class OpcuaService:
             station: await ToolAssets.create(server, station, system.node)
             for station, system in systems.items()
         }
+        controllers = {
+            station: await ControllerAsset.create(server, station, system.node)
+            for station, system in systems.items()
+        }
         async with server:
             LOG.info("OPC UA server of %s at %s", ", ".join(systems), self._listen)
             # the line after the server: a client may connect and subscribe before the router
@@ -115,8 +124,11 @@ class OpcuaService:
             tools_due_s = 0.0
             while not stop.is_set():
                 if time.monotonic() >= tools_due_s:
-                    for station, counters in (await asyncio.to_thread(self._tools)).items():
+                    for station, (counters, controller) in (
+                        await asyncio.to_thread(self._assets)
+                    ).items():
                         await assets[station].update(counters)
+                        await controllers[station].update(controller)
                     tools_due_s = time.monotonic() + TOOLS_REFRESH_S
                 message = inbox.next()
                 if message is None:
@@ -141,9 +153,10 @@ class OpcuaService:
         await system.publish(identifier, result.run_id, result_data(result_values(result)), message)
         LOG.info("result %s served", message)
 
-    def _tools(self) -> dict[str, list[ToolCounters]]:
-        """Each station's tools in its wear ledger (none while it has no ledger)."""
-        found: dict[str, list[ToolCounters]] = {}
+    def _assets(self) -> dict[str, tuple[list[ToolCounters], ControllerIdentity]]:
+        """Each station's tools in its wear ledger (none while it has no ledger), and its
+        controller."""
+        found: dict[str, tuple[list[ToolCounters], ControllerIdentity]] = {}
         for station in self._stations:
             path = ledger_path(station.recordings_folder)
             threshold = station.config.recorder.wear_service_threshold
@@ -152,8 +165,11 @@ class OpcuaService:
                     tools = ledger.tools(station=station.station_id)
             except (InputError, BrokenLedgerError) as err:
                 LOG.debug("no tools of %s from %s: %s", station.station_id, path, err)
-                continue
-            found[station.station_id] = [tool_counters(tool, threshold) for tool in tools]
+                tools = []
+            found[station.station_id] = (
+                [tool_counters(tool, threshold) for tool in tools],
+                controller_identity(isinstance(station, ControllerStation), tools, self._version),
+            )
         return found
 
     def _newest(self) -> list[TighteningResult]:

@@ -9,7 +9,7 @@
   (Rerun ``.rrd``: written, recovered, made from MCAP)
 """
 
-from shared.recordings.file_metadata import FileMetadata, flatten
+from shared.recordings.file_metadata import FileMetadata, flatten, software_version
 from shared.recordings.layout import (
     FileName,
     file_name_of,
@@ -39,6 +39,7 @@ __all__ = [
     "file_path",
     "final_path_of",
     "flatten",
+    "software_version",
     "recording_files",
     "rerun_path",
     "run_file_prefix",

@@ -30,11 +30,13 @@ from typing import Any
 
 import pytest
 
+from services.opcua.controller_values import BOLTWATCH
 from services.opcua.joining_systems import result_browse_name
 from services.opcua.nodeset_files import missing_files, nodeset_folder
 from services.opcua.result_trace import recorded_samples
 from services.opcua.result_values import DEGREE, NEWTON, NEWTON_METRE, result_id
 from services.opcua.tool_assets import ONE, tool_browse_name
+from shared.recordings import software_version
 from shared.results import ResultsQuery, ResultsStore, StoredResult, store_target
 from shared.wear import WearLedger, ledger_path
 from tests.support.address_space_picture import screenshot, tree_page
@@ -60,6 +62,9 @@ THRESHOLD = 500.0  # the station's recorder.wear_service_threshold: below one ru
 EXPANDED = [
     "AssetManagement",
     "AssetManagement/Assets",
+    "AssetManagement/Assets/Controllers",
+    "AssetManagement/Assets/Controllers/*",
+    "AssetManagement/Assets/Controllers/*/Identification",
     "AssetManagement/Assets/Tools",
     "AssetManagement/Assets/Tools/*",
     "AssetManagement/Assets/Tools/*/LifetimeCounters",
@@ -254,6 +259,11 @@ def _check_tree(
     counter = nodes[f"{tool}/LifetimeCounters/StickSlipIntensitySinceService"]
     assert (counter["type"], counter["dataType"]) == ("LifetimeVariableType", "Double")
     assert counter["value"] > 0
+    # the station's controller: boltwatch's acquisition (a CAN station)
+    controller = "AssetManagement/Assets/Controllers/Controller"
+    assert nodes[f"{controller}/Identification/Manufacturer"]["value"] == BOLTWATCH
+    assert nodes[f"{controller}/Identification/SoftwareRevision"]["value"] == software_version()
+    assert nodes[f"{controller}/Parameters"]["children"] == 1
     if not CHROMIUM.exists():
         return  # the line page's test says why where chromium is missing
     shot = tmp_path / "opcua-address-space.png"
