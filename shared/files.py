@@ -1,6 +1,6 @@
 """Folders and files: making a folder, and saying plainly why one cannot be made; an
 ``OSError`` in one line that names its file; a file or folder fsynced by its path; a small
-JSON file replaced atomically."""
+text or JSON file replaced atomically."""
 
 from __future__ import annotations
 
@@ -52,14 +52,20 @@ def fsync_path(path: Path) -> None:
 
 
 def write_json_atomically(path: Path, document: Any) -> None:
-    """Replace ``path`` by ``document`` as JSON, whole or not at all: a temporary file in the
-    same folder, fsync, rename, fsync of the folder (after a crash: the old or the new)."""
+    """Replace ``path`` by ``document`` as JSON (:func:`write_text_atomically`)."""
+    write_text_atomically(path, json.dumps(document))
+
+
+def write_text_atomically(path: Path, text: str) -> None:
+    """Replace ``path`` by ``text`` (UTF-8), whole or not at all: a temporary file in the
+    same folder (mode 0600), fsync, rename, fsync of the folder (after a crash: the old or
+    the new)."""
     folder = path.parent
     folder.mkdir(parents=True, exist_ok=True)
     handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=folder)
     try:
         with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            json.dump(document, stream)
+            stream.write(text)
             stream.flush()
             os.fsync(stream.fileno())
         os.replace(temporary, path)

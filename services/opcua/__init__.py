@@ -10,7 +10,9 @@ The address space is built from the OPC Foundation's NodeSet2 files (IJT Base
 - :mod:`.nodeset_files` (the pinned npm package of the models, fetched and
   checked: ``make opcua-nodesets``), :mod:`.nodeset_loading` (the models into
   asyncua, and the four gaps of asyncua's reader handled)
-- :mod:`.server_security` (endpoints, certificates, trusted clients)
+- :mod:`.server_security` (endpoints, certificates, trusted clients, the session's
+  user), :mod:`.users_file` (the users file of ``--users``: names, password hashes,
+  roles), :mod:`.password_hashes` (salted scrypt hashes, checked in constant time, pure)
 - :mod:`.joining_systems` (one JoiningSystemType per station; a result into its
   ResultManagement and the result-ready event)
 - :mod:`.result_values` (a TighteningResult as IJT field values, pure),

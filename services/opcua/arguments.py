@@ -35,7 +35,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "recording's samples); the tools of the wear ledger with their counters in "
         "AssetManagement. "
         "Default security: Basic256Sha256 sign and encrypt with --certificate, "
-        "--private-key and --trusted-clients (docs/how-to/opcua.md). The OPC UA models "
+        "--private-key and --trusted-clients, and a user name and password of --users for "
+        "every session (docs/how-to/opcua.md). The OPC UA models "
         "come from `make opcua-nodesets` (npm)."
     )
     parser.add_argument(
@@ -64,6 +65,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="DIR",
         help="the client certificates (or their CAs) accepted, PEM or DER files",
+    )
+    security.add_argument(
+        "--users",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="the users (names, salted password hashes: `boltwatch opcua-user add`); every "
+        "session logs in with one (with --anonymous-read-only: anonymous sessions too)",
     )
     security.add_argument(
         "--anonymous-read-only",

@@ -1,34 +1,52 @@
 """Who may connect to the OPC UA server, from the command line's options, checked at start.
 
 By default (:class:`SecuritySettings` with ``anonymous_read_only`` False) the only
-endpoint is Basic256Sha256 Sign & Encrypt: the server shows its own certificate
-(``--certificate``, RSA, PEM or DER, its subjectAltName naming the server's
-application URI as ``URI:...``) and key (``--private-key``, PEM), and accepts a
-client only when the client's application instance certificate is in, or signed
-by a CA in, ``--trusted-clients DIR`` (PEM or DER files), is within its validity,
-names the client's application URI, and allows client authentication and the
-key usages OPC UA asks (digitalSignature, nonRepudiation, keyEncipherment,
-dataEncipherment). The session's user is anonymous over that channel (user
-names and passwords are not offered). A client without a certificate finds no
-endpoint it can use and is refused.
+endpoint is Basic256Sha256 Sign & Encrypt and every session needs a user:
+
+- the channel: the server shows its own certificate (``--certificate``, RSA, PEM
+  or DER, its subjectAltName naming the server's application URI as
+  ``URI:...``) and key (``--private-key``, PEM), and accepts a client only when
+  the client's application instance certificate is in, or signed by a CA in,
+  ``--trusted-clients DIR`` (PEM or DER files), is within its validity, names
+  the client's application URI, and allows client authentication and the key
+  usages OPC UA asks (digitalSignature, nonRepudiation, keyEncipherment,
+  dataEncipherment). A client without a certificate finds no endpoint it can use;
+- the session: a UserName token whose name is in ``--users FILE``
+  (:mod:`.users_file`) and whose password matches its hash
+  (:mod:`.password_hashes`, compared in constant time); an anonymous session,
+  an unknown name or a wrong password is refused (``BadUserAccessDenied``, or
+  ``BadIdentityTokenRejected`` for a token the endpoint does not offer).
 
 ``--anonymous-read-only`` adds an endpoint without security (None) and the
-anonymous user: anyone who reaches the port reads the address space. Nothing in
-it is writable by a client in either mode.
+anonymous user, on every endpoint (asyncua offers one set of user tokens for
+all; an anonymous session on the encrypted endpoint reads no more than one on
+None): anyone who reaches the port reads the address space. With ``--users``
+too, the users' names and passwords are checked as above. ``--users`` needs the
+server's certificate: a password never travels in clear. Nothing in the address
+space is writable by a client in any mode; every user is a reader.
 """
 
 from __future__ import annotations
 
+import logging
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from asyncua import Server, ua
+from asyncua.crypto.permission_rules import User, UserRole
 from asyncua.crypto.truststore import TrustStore
 from asyncua.crypto.validator import CertificateValidator, CertificateValidatorOptions
+from asyncua.server.user_managers import UserManager
 from cryptography import x509
 from cryptography.hazmat.primitives.asymmetric import rsa
 
+from services.opcua.password_hashes import verify, verify_unknown
+from services.opcua.users_file import OpcuaUser, others_may_read, read_users
 from shared.errors import ConfigError
+
+LOG = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,6 +56,7 @@ class SecuritySettings:
     certificate: Path | None
     private_key: Path | None
     trusted_clients: Path | None
+    users: Path | None
     anonymous_read_only: bool = False
 
     def check(self) -> None:
@@ -46,16 +65,22 @@ class SecuritySettings:
             "--certificate": self.certificate,
             "--private-key": self.private_key,
             "--trusted-clients": self.trusted_clients,
+            "--users": self.users,
         }
         if not self.anonymous_read_only:
             missing = [name for name, path in given.items() if path is None]
             if missing:
                 raise ConfigError(
-                    f"give {', '.join(missing)} (Basic256Sha256 sign and encrypt, the "
-                    "default), or --anonymous-read-only for a server anyone may read"
+                    f"give {', '.join(missing)} (Basic256Sha256 sign and encrypt with user "
+                    "names, the default), or --anonymous-read-only for a server anyone may read"
                 )
         if (self.certificate is None) != (self.private_key is None):
             raise ConfigError("give --certificate and --private-key together")
+        if self.users is not None and self.certificate is None:
+            raise ConfigError(
+                "--users needs --certificate and --private-key (Basic256Sha256 sign and "
+                "encrypt: a password never travels in clear)"
+            )
         for name, path in given.items():
             if path is None:
                 continue
@@ -63,6 +88,8 @@ class SecuritySettings:
             if not (path.is_dir() if wanted_dir else path.is_file()):
                 kind = "a folder" if wanted_dir else "a file"
                 raise ConfigError(f"{name} {path}: not {kind}")
+        if self.users is not None:
+            server_users(self.users)
 
     @property
     def secure(self) -> bool:
@@ -98,11 +125,64 @@ def application_uri_of(certificate: Path) -> str:
     return str(uris[0])
 
 
+def server_users(path: Path) -> dict[str, OpcuaUser]:
+    """The users of ``--users FILE``; ConfigError when it is bad or names nobody."""
+    users = read_users(path)
+    if not users:
+        raise ConfigError(
+            f"--users {path}: users: no user (add one: boltwatch opcua-user add NAME --users "
+            f"{path})"
+        )
+    return users
+
+
+class PasswordUsers(UserManager):
+    """asyncua's user manager: a session's user from its token (None: refused).
+
+    asyncua asks it at each ActivateSession, in the server's loop, with the name and
+    the password of a UserName token (decrypted), or no name for an anonymous one."""
+
+    def __init__(self, users: Mapping[str, OpcuaUser], anonymous: bool) -> None:
+        self._users = dict(users)
+        self._anonymous = anonymous
+
+    def get_user(
+        self,
+        iserver: Any,
+        username: str | None = None,
+        password: str | None = None,
+        certificate: Any = None,
+    ) -> User | None:
+        if username is None:
+            return User(role=UserRole.User) if self._anonymous else None
+        user = self._users.get(username)
+        # one scrypt either way: a refusal takes as long for a wrong name as a wrong password
+        if user is None:
+            matches = verify_unknown(password or "")
+        else:
+            matches = verify(password or "", user.password_hash)
+        if not matches:
+            LOG.warning("OPC UA user %r refused: unknown name or wrong password", username)
+            return None
+        return User(role=UserRole.User, name=username)
+
+
 async def apply(server: Server, settings: SecuritySettings) -> None:
-    """Endpoints, user tokens, certificate and client validation of ``server``."""
+    """Endpoints, user tokens and users, certificate and client validation of ``server``."""
     settings.check()
     policies: list[ua.SecurityPolicyType] = []
-    tokens: list[type] = [ua.AnonymousIdentityToken]
+    tokens: list[type] = []
+    if settings.anonymous_read_only:
+        tokens.append(ua.AnonymousIdentityToken)
+    if settings.users is not None:
+        tokens.append(ua.UserNameIdentityToken)
+        if others_may_read(settings.users):
+            LOG.warning(
+                "--users %s: anyone on this host may read it (its password hashes); chmod o-r it",
+                settings.users,
+            )
+        users = server_users(settings.users)
+        server.iserver.set_user_manager(PasswordUsers(users, settings.anonymous_read_only))
     if settings.secure:
         assert settings.certificate is not None and settings.private_key is not None
         await server.set_application_uri(application_uri_of(settings.certificate))

@@ -189,7 +189,11 @@ class OpcuaService:
 def main(args: argparse.Namespace) -> int:
     stations = load_any_line(args.config)
     security = SecuritySettings(
-        args.certificate, args.private_key, args.trusted_clients, args.anonymous_read_only
+        certificate=args.certificate,
+        private_key=args.private_key,
+        trusted_clients=args.trusted_clients,
+        users=args.users,
+        anonymous_read_only=args.anonymous_read_only,
     )
     security.check()
     with ServiceSkeleton("opcua") as skeleton:

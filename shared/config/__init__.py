@@ -32,7 +32,7 @@ from shared.config.line import (
     load_line,
     stations_by_id,
 )
-from shared.config.loading import resolve_relative
+from shared.config.loading import StrictModel, read_toml, resolve_relative, validate
 from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
 from shared.config.quality import QualitySection
 from shared.config.retention import RetentionSection
@@ -67,6 +67,7 @@ __all__ = [
     "RigSection",
     "StationConfig",
     "StationPlace",
+    "StrictModel",
     "ZenohSection",
     "check_derivable",
     "derive_stations",
@@ -77,6 +78,8 @@ __all__ = [
     "load_joint",
     "load_line",
     "load_station",
+    "read_toml",
     "resolve_relative",
     "stations_by_id",
+    "validate",
 ]

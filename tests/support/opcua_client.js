@@ -3,8 +3,9 @@
 //   node opcua_client.js '{"endpoint": "opc.tcp://127.0.0.1:4840", "certificate": "c.pem",
 //                          "privateKey": "c.key", "applicationUri": "urn:...",
 //                          "security": "SignAndEncrypt" | "None", "stations": ["st1"],
-//                          "results": 5, "timeoutMs": 60000}'
+//                          "results": 5, "timeoutMs": 60000, "userName": "u", "password": "p"}'
 //
+// The session's user: "userName" and "password" (a UserName token), anonymous without them.
 // Prints JSON lines on stdout: {"type": "connected"} or {"type": "refused", "reason"};
 // per station {"type": "system", "station", "nodeId"} once it browsed to its joining
 // system (Objects/Machines/<station>) and subscribed to its events; {"type": "subscribed"}
@@ -68,7 +69,11 @@ async function main() {
     let session;
     try {
         await client.connect(options.endpoint);
-        session = await client.createSession({ type: UserTokenType.Anonymous });
+        session = await client.createSession(
+            options.userName === undefined
+                ? { type: UserTokenType.Anonymous }
+                : { type: UserTokenType.UserName, userName: options.userName, password: options.password },
+        );
     } catch (err) {
         say({ type: "refused", reason: String(err && err.message ? err.message : err) });
         await client.disconnect().catch(() => {});

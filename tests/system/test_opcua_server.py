@@ -12,9 +12,10 @@ the first result by its id (ResultManagement's GetResultById) and finds in its
 trace every sample the recording holds of the run, value for value; it reads
 the station's tool with its counters from the wear ledger (tightenings, since
 service, stick-slip intensity since service against the threshold), and
-receives the recorder's wear alerts as the joining system's events. A client
-without a certificate (security None) and a client whose certificate the CA did
-not sign are refused.
+receives the recorder's wear alerts as the joining system's events. The client
+logs in with a user name and password of the server's users file. A client
+without a certificate (security None), a client whose certificate the CA did
+not sign and a client with a wrong password are refused.
 """
 
 from __future__ import annotations
@@ -33,9 +34,11 @@ import pytest
 from services.opcua.controller_values import BOLTWATCH
 from services.opcua.joining_systems import result_browse_name
 from services.opcua.nodeset_files import missing_files, nodeset_folder
+from services.opcua.password_hashes import hash_password
 from services.opcua.result_trace import recorded_samples
 from services.opcua.result_values import DEGREE, NEWTON, NEWTON_METRE, result_id
 from services.opcua.tool_assets import ONE, tool_browse_name
+from services.opcua.users_file import OpcuaUser, write_users
 from shared.recordings import software_version
 from shared.results import ResultsQuery, ResultsStore, StoredResult, store_target
 from shared.wear import WearLedger, ledger_path
@@ -73,6 +76,7 @@ EXPANDED = [
     "ResultManagement/Results",
 ]
 DOCS_IMAGE = REPO / "docs" / "images" / "opcua-address-space.png"
+USER, PASSWORD = "line-mes", "a password of the line's MES"
 
 
 def _needs() -> Path:
@@ -95,6 +99,8 @@ def _options(
         "applicationUri": client_uri(name),
         "security": "SignAndEncrypt",
         "stations": [STATION],
+        "userName": USER,
+        "password": PASSWORD,
         **more,
     }
 
@@ -115,6 +121,8 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
     )
     certificates = make_opcua_certificates(tmp_path / "pki", untrusted=("stranger",))
     endpoint = f"opc.tcp://127.0.0.1:{opcua_port}"
+    users = tmp_path / "opcua-users.toml"
+    write_users(users, {USER: OpcuaUser(USER, hash_password(PASSWORD))})
     log = tmp_path / "opcua.log"
     server = serve(
         [
@@ -129,6 +137,8 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
             str(certificates.server_key),
             "--trusted-clients",
             str(certificates.trusted_clients),
+            "--users",
+            str(users),
         ],
         log,
     )
@@ -168,6 +178,11 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
         stranger = run_client(
             modules,
             _options(endpoint, certificates, "stranger", connectRetries=1),
+            timeout_s=60,
+        )
+        wrong_password = run_client(
+            modules,
+            _options(endpoint, certificates, "client", password="wrong", connectRetries=1),
             timeout_s=60,
         )
     finally:
@@ -221,6 +236,8 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
 
     assert [line["type"] for line in refused] == ["refused"], refused
     assert [line["type"] for line in stranger] == ["refused"], stranger
+    assert [line["type"] for line in wrong_password] == ["refused"], wrong_password
+    assert "BadUserAccessDenied" in wrong_password[0]["reason"], wrong_password
 
 
 def _check_trace(lines: list[dict[str, Any]], first: StoredResult) -> None:
@@ -306,5 +323,5 @@ def test_serve_opcua_says_what_security_it_needs(tmp_path: Path) -> None:
         check=False,
     )
     assert done.returncode != 0
-    assert "--certificate, --private-key, --trusted-clients" in done.stderr, done.stderr
+    assert "--certificate, --private-key, --trusted-clients, --users" in done.stderr, done.stderr
     assert "--anonymous-read-only" in done.stderr

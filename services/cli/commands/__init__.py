@@ -20,4 +20,5 @@ inside ``run`` so that ``boltwatch --help`` stays fast.
     report       statistics per program over recorded results (X̄/R, Cp/Cpk, NOK Pareto)
     results      tightenings found in the results store; the store rebuilt from recordings
     recordings   the recordings' upkeep: ``prune`` applies the station file's ``[retention]``
+    opcua_user   ``boltwatch opcua-user``: the users file of ``serve opcua --users``
 """
