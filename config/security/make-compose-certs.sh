@@ -17,6 +17,14 @@
 #                                            station's predictor: placement "edge")
 # EXTRA_IDENTITIES="st1-predictor ..." makes more, e.g. for a line predictor
 # (placement "line": docker-compose.tls.yml says how to add one).
+# The OPC UA server (the opcua service, with or without TLS) gets RSA files of
+# config/security/make-opcua-certs.sh: OUT_DIR/opcua-server/ holds server.pem,
+# server.key and trusted/ca.pem (the CA of its clients), mounted read-only at
+# /etc/boltwatch-opcua; OUT_DIR/opcua-<client>/ holds a client's identity.pem,
+# identity.key and the server.pem it trusts, for each of OPCUA_CLIENTS (default
+# "mes"); OUT_DIR/opcua-ca/ keeps the clients' CA key (never mounted). OPCUA_SAN adds
+# the names the plant reaches the server by ("DNS:line1.plant.local") to "opcua". The
+# server's certificate is kept when the script runs again (its clients trust it).
 # OUT_DIR/line-ca/ is config/security/make-certs.sh's folder: the CA's key (ca.key) is
 # there and is never mounted; keep it offline. Running again reuses the CA and
 # re-issues every identity. Keys are 0600; the containers run as uid 10001
@@ -75,7 +83,31 @@ for name in "${names[@]}"; do
     identity "$name" "$name"
 done
 
-folders=(router "${names[@]}")
+# The OPC UA server's RSA files (Basic256Sha256 needs RSA; the identities above are EC).
+read -r -a opcua_clients <<<"${OPCUA_CLIENTS:-mes}"
+server="$out/opcua-server"
+if [[ -f "$server/server.pem" && -f "$server/server.key" ]]; then
+    mkdir -p "$out/opcua-ca"
+    cp -p "$server/server.pem" "$server/server.key" "$out/opcua-ca/"
+fi
+OPCUA_SAN="DNS:opcua${OPCUA_SAN:+,$OPCUA_SAN}" "$here/make-opcua-certs.sh" "$out/opcua-ca" \
+    "${opcua_clients[@]}" >/dev/null
+mkdir -p "$server/trusted"
+chmod 755 "$server" "$server/trusted"
+install -m 644 "$out/opcua-ca/ca.pem" "$server/trusted/ca.pem"
+install -m 644 "$out/opcua-ca/server.pem" "$server/server.pem"
+install -m 600 "$out/opcua-ca/server.key" "$server/server.key"
+rm -f "$out/opcua-ca/server.key"
+for name in "${opcua_clients[@]}"; do
+    client="$out/opcua-$name"
+    mkdir -p "$client"
+    install -m 644 "$server/server.pem" "$client/server.pem"
+    install -m 644 "$out/opcua-ca/$name.pem" "$client/identity.pem"
+    install -m 600 "$out/opcua-ca/$name.key" "$client/identity.key"
+    rm -f "$out/opcua-ca/$name.key"
+done
+
+folders=(router "${names[@]}" opcua-server)
 if [[ $(id -u) -eq 0 ]]; then
     for name in "${folders[@]}"; do
         chown -R "$owner_uid" "$out/$name"
@@ -85,4 +117,5 @@ else
     owned="keys 0600: the containers run as uid $owner_uid, so run
   sudo chown -R $owner_uid ${folders[*]/#/$out/}"
 fi
-echo "identities in $out: ${folders[*]} ($owned); the CA key stays in $out/line-ca"
+echo "identities in $out: ${folders[*]} ($owned); the CA keys stay in $out/line-ca and \
+$out/opcua-ca; OPC UA clients: ${opcua_clients[*]/#/$out/opcua-}"

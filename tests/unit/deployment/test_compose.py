@@ -1,11 +1,12 @@
 """docker-compose.yml and the Dockerfile, checked by parsing (no Docker engine here).
 
 The line layout: one router, one recorder for the line (every station file),
-an optional Rerun viewer (profile), and per station an acquisition (which
-holds the station's predictor: placement "edge") and a rig with that
-station's own file; the line's page searches the recorder's results store.
-Where each station's predictor runs:
-tests/unit/deployment/test_compose_placement.py.
+an optional Rerun viewer (profile), the line's page and its OPC UA server, and
+per station an acquisition (which holds the station's predictor: placement
+"edge") and a rig with that station's own file; the line's page and the OPC UA
+server read the recorder's results store. Where each station's predictor runs:
+tests/unit/deployment/test_compose_placement.py; the OPC UA server's certificates
+and the image's OPC UA models: tests/unit/deployment/test_compose_opcua.py.
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ VARIABLE = re.compile(r"\$\{([^}]*)\}")
 
 
 #: services of the whole line (every station file); the others serve one station
-LINE_WIDE = ("recorder", "viewer", "dashboard")
+LINE_WIDE = ("recorder", "viewer", "dashboard", "opcua")
 
 
 def served_role(name: str) -> str:
@@ -72,13 +73,16 @@ def station_files(name: str) -> list[Path]:
 
 
 def test_the_line_layout_is_there() -> None:
-    expected = {"router", "recorder", "viewer", "dashboard"} | {
+    expected = {"router", "recorder", "viewer", "dashboard", "opcua"} | {
         f"{role}-{station}" for role in PER_STATION for station in STATIONS
     }
     assert set(SERVICES) == expected
     assert SERVICES["viewer"]["profiles"] == ["viewer"]
     page = build_parser().parse_args(SERVICES["dashboard"]["command"])
     assert page.listen == ("0.0.0.0", 8080) and SERVICES["dashboard"]["ports"] == ["8080:8080"]
+    opcua = build_parser().parse_args(SERVICES["opcua"]["command"])
+    assert opcua.listen == "opc.tcp://0.0.0.0:4840" and SERVICES["opcua"]["ports"] == ["4840:4840"]
+    assert not opcua.anonymous_read_only, "the plant's network reads the line signed and encrypted"
     for station in STATIONS:  # the simulated bus is multicast inside the station's netns
         assert SERVICES[f"rig-{station}"]["network_mode"] == f"service:acquisition-{station}"
 
@@ -131,13 +135,16 @@ def test_health_checks_parse_and_dependencies_wait_for_health(name: str) -> None
         assert "healthcheck" in SERVICES[dependency], f"{dependency} has no health check"
 
 
-def test_the_page_searches_the_results_store_the_recorder_writes() -> None:
-    """The line's page finds a part's tightenings in the recorder's store: the same stores
-    of the same station files, on the same recordings volume, writable (a SQLite reader
-    in WAL mode writes the store's shared-memory file)."""
-    stores = {name: stores_of(load_line(station_files(name))) for name in ("recorder", "dashboard")}
-    assert stores["dashboard"] == stores["recorder"]
-    for target in stores["dashboard"]:
+@pytest.mark.parametrize("reader", ["dashboard", "opcua"])
+def test_the_readers_of_the_results_store_read_the_one_the_recorder_writes(reader: str) -> None:
+    """The line's page (a part's tightenings) and the OPC UA server (GetResultById, the
+    tools of the wear ledger beside it) read the recorder's store: the same stores of the
+    same station files, on the same recordings volume, writable (a SQLite reader in WAL
+    mode writes the store's shared-memory file)."""
+    names = ("recorder", reader)
+    stores = {name: stores_of(load_line(station_files(name))) for name in names}
+    assert stores[reader] == stores["recorder"]
+    for target in stores[reader]:
         assert target.sqlite_path is not None, "the compose line keeps its store in SQLite"
         mounts = {
             name: [
@@ -145,10 +152,10 @@ def test_the_page_searches_the_results_store_the_recorder_writes() -> None:
                 for volume in SERVICES[name]["volumes"]
                 if target.sqlite_path.is_relative_to(split_volume(volume)[1])
             ]
-            for name in ("recorder", "dashboard")
+            for name in names
         }
-        assert mounts["dashboard"] == mounts["recorder"] != []
-        assert not any(volume.endswith(":ro") for volume in mounts["dashboard"])
+        assert mounts[reader] == mounts["recorder"] != []
+        assert not any(volume.endswith(":ro") for volume in mounts[reader])
 
 
 def test_required_variables_fail_loudly() -> None:
@@ -202,7 +209,7 @@ def expected_identity(name: str) -> str:
         return {"router": "router", "recorder": "line-recorder"}[name]
     if name == "viewer":
         return "line-viewer"
-    if name == "dashboard":  # the line's page only listens: the operator's identity
+    if name in ("dashboard", "opcua"):  # they only listen: the operator's identity
         return "line-monitor"
     role, station = name.split("-", maxsplit=1)
     return f"{station}-{role}"
@@ -339,7 +346,8 @@ def station_settings(path: Path) -> dict[str, Any]:
 def test_identity_folders_hold_no_ca_key_and_keys_are_private(tls_line: TlsLine) -> None:
     names = {expected_identity(name) for name in SERVICES} | {"line-monitor"}
     made = {p.name for p in tls_line.certs.iterdir()}
-    assert made == names | {"line-ca"}, "only the identities the compose files use (+ operator)"
+    opcua = {"opcua-ca", "opcua-server", "opcua-mes"}  # test_compose_opcua.py checks them
+    assert made == names | {"line-ca"} | opcua, "only the identities the compose files use"
     for name in names:
         folder = tls_line.certs / name
         shown = {p.name for p in folder.iterdir()}

@@ -28,7 +28,11 @@ from tests.support.compose_layout import (
 from tests.support.paths import REPO
 
 LINE2_FILE = REPO / "docker-compose.line2.yml"
-ENV = {"BOLTWATCH_RECORDINGS": "/srv/line1", "BOLTWATCH_RECORDINGS_LINE2": "/srv/line2"}
+ENV = {
+    "BOLTWATCH_RECORDINGS": "/srv/line1",
+    "BOLTWATCH_RECORDINGS_LINE2": "/srv/line2",
+    "BOLTWATCH_CERTS": "/srv/certs",  # line 1's OPC UA server's files
+}
 MERGED: dict[str, Any] = load_merged([BASE_FILE, LINE2_FILE], ENV)["services"]
 LINE2 = ("router-line2", "recorder-line2", "acquisition-st3", "rig-st3")
 RECORDINGS = "/var/lib/boltwatch/recordings"
@@ -96,4 +100,4 @@ def test_no_two_stations_of_the_plant_share_a_tool_bus_or_seed() -> None:
 
 def test_line_twos_recordings_folder_is_required() -> None:
     with pytest.raises(MissingVariableError, match="BOLTWATCH_RECORDINGS_LINE2"):
-        load_merged([BASE_FILE, LINE2_FILE], {"BOLTWATCH_RECORDINGS": "/srv/line1"})
+        load_merged([BASE_FILE, LINE2_FILE], ENV | {"BOLTWATCH_RECORDINGS_LINE2": ""})

@@ -1,0 +1,124 @@
+"""The compose line's OPC UA server: its RSA files, made by the project's script.
+
+tests/unit/deployment/test_compose.py checks the ``opcua`` service as it checks
+every service (command, health check, mounts, dependencies, its TLS identity);
+here what is its own. config/security/make-compose-certs.sh makes, with
+config/security/make-opcua-certs.sh, the folder ``opcua-server`` that
+docker-compose.yml mounts at ``/etc/boltwatch-opcua``: the server starts with
+those files (its security options are checked as ``serve opcua`` checks them),
+its certificate is RSA and names the application URI and ``opcua``, it trusts
+exactly the clients the script's CA signed, and it stays when the script runs
+again. The models in the image:
+tests/unit/deployment/test_image_models.py.
+"""
+
+from __future__ import annotations
+
+import shutil
+import stat
+import subprocess
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from services.cli.main import build_parser
+from services.opcua.server_security import SecuritySettings, application_uri_of
+from tests.support.compose_layout import (
+    BASE_FILE,
+    TLS_FILE,
+    ContainerFiles,
+    certificate_field,
+    load_merged,
+    make_compose_certs,
+)
+
+OPCUA_FILES = "/etc/boltwatch-opcua"
+SERVER_URI = "urn:boltwatch:opcua"
+CLIENT = "mes"  # the client the script makes by default (OPCUA_CLIENTS)
+
+
+@pytest.fixture(scope="module")
+def certs(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    if shutil.which("openssl") is None:
+        pytest.skip("needs the openssl CLI (config/security/make-compose-certs.sh)")
+    folder = tmp_path_factory.mktemp("compose-opcua") / "certs"
+    make_compose_certs(folder)
+    return folder
+
+
+@pytest.mark.parametrize("files", [[BASE_FILE], [BASE_FILE, TLS_FILE]], ids=["plain", "tls"])
+def test_the_server_starts_with_the_files_compose_mounts(
+    certs: Path, files: list[Path], tmp_path: Path
+) -> None:
+    env = {"BOLTWATCH_CERTS": str(certs), "BOLTWATCH_RECORDINGS": str(tmp_path / "rec")}
+    service: dict[str, Any] = load_merged(files, env)["services"]["opcua"]
+    assert f"{certs}/opcua-server:{OPCUA_FILES}:ro" in service["volumes"]
+    container = ContainerFiles(tmp_path / "opcua", service["volumes"])
+    args = build_parser().parse_args(container.arguments(service["command"]))
+    settings = SecuritySettings(args.certificate, args.private_key, args.trusted_clients)
+    settings.check()  # what `serve opcua` checks before it starts: files there, of each kind
+    assert args.certificate == container.host(f"{OPCUA_FILES}/server.pem")
+    assert application_uri_of(args.certificate) == SERVER_URI  # RSA, URI in its SAN
+    names = certificate_field(args.certificate, "-ext subjectAltName")
+    assert "DNS:opcua" in names, "the line's containers reach it by its service name"
+    key = subprocess.run(
+        ["openssl", "pkey", "-in", str(args.private_key), "-pubout"],
+        capture_output=True,
+        check=True,
+    )
+    shown = subprocess.run(
+        ["openssl", "x509", "-in", str(args.certificate), "-noout", "-pubkey"],
+        capture_output=True,
+        check=True,
+    )
+    assert key.stdout == shown.stdout, "the key is the certificate's"
+
+
+def test_the_server_trusts_the_clients_of_its_ca_only(certs: Path) -> None:
+    server = certs / "opcua-server"
+    assert {p.relative_to(server).as_posix() for p in server.rglob("*")} == {
+        "server.pem",
+        "server.key",
+        "trusted",
+        "trusted/ca.pem",
+    }
+    assert stat.S_IMODE((server / "server.key").stat().st_mode) == 0o600
+    client = certs / f"opcua-{CLIENT}"
+    assert {p.name for p in client.iterdir()} == {"identity.pem", "identity.key", "server.pem"}
+    assert stat.S_IMODE((client / "identity.key").stat().st_mode) == 0o600
+    assert (client / "server.pem").read_bytes() == (server / "server.pem").read_bytes()
+    uri = certificate_field(client / "identity.pem", "-ext subjectAltName")
+    assert f"URI:urn:boltwatch:opcua-client:{CLIENT}" in uri
+    trusted = server / "trusted" / "ca.pem"
+    verified = subprocess.run(
+        [
+            "openssl",
+            "verify",
+            "-CAfile",
+            str(trusted),
+            "-purpose",
+            "sslclient",
+            str(client / "identity.pem"),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert verified.returncode == 0, verified.stdout + verified.stderr
+    # The CA key stays in opcua-ca, never mounted; no other key is left there.
+    assert [p.name for p in (certs / "opcua-ca").glob("*.key")] == ["ca.key"]
+
+
+def test_running_the_script_again_keeps_the_certificate_clients_trust(
+    certs: Path, tmp_path: Path
+) -> None:
+    """A station added (the script run again) must not change the server's certificate:
+    an MES trusts that one (it is self-signed)."""
+    again = tmp_path / "certs"
+    shutil.copytree(certs, again, symlinks=True)
+    make_compose_certs(again)
+    for name in ("server.pem", "server.key"):
+        kept = (again / "opcua-server" / name).read_bytes()
+        assert kept == (certs / "opcua-server" / name).read_bytes(), f"{name} was made again"
+    assert [p.name for p in (again / "opcua-ca").glob("*.key")] == ["ca.key"]
