@@ -32,7 +32,8 @@ with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
 - databases: :mod:`.postgres_server` (a throwaway PostgreSQL server; the fixtures
   ``postgres_server`` and ``postgres_url`` in ``tests/conftest.py``),
   :mod:`.old_results_store` (a results store as an older boltwatch left it)
-- deployment: :mod:`.compose_layout`, :mod:`.access_rules`
+- deployment: :mod:`.compose_layout`, :mod:`.compose_line` (the compose TLS line's
+  services run on loopback), :mod:`.access_rules`
 - OPC UA: :mod:`.opcua_client` (node-opcua's client as a process), :mod:`.opcua_certificates`,
   :mod:`.address_space_picture` (a browser's view of the address space, photographed)
 - pictures: :mod:`.chromium` (Debian's chromium for playwright)

@@ -1,14 +1,9 @@
 """docker-compose.tls.yml run on loopback: the commands compose would run, with the identities.
 
-Certificates come from config/security/make-compose-certs.sh; the compose files
-are merged as ``docker compose -f docker-compose.yml -f docker-compose.tls.yml``
-merges them (tests/support/compose_layout.py). Each service runs as
-``python -m services.cli`` with the exact arguments of its merged command, in a
-copy of what its container sees (config, its own identity, the recordings),
-with two things changed for loopback: the router is ``127.0.0.1`` on a free port
-instead of ``router:7447`` (the router's certificate names 127.0.0.1 too), and
-the station's CAN multicast port is a free one. Health checks run as the
-containers run them: ``boltwatch health ...`` with that container's identity.
+Each service runs with the exact arguments of its merged command, in a copy of
+what its container sees, the router and the CAN ports moved to free ones on
+loopback (tests/support/compose_line.py); health checks run as the containers
+run them, with that container's identity.
 
 The station's predictor is in its acquisition (placement "edge"): no predictor
 container runs, ``boltwatch health predictor`` is answered by acquisition-st1's
@@ -19,9 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import json
-import re
 import shutil
-import subprocess
 import threading
 import time
 from collections.abc import Iterator
@@ -32,22 +25,11 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
-from shared.config import load_station
 from shared.contract import RunSummary, StopDecision, channels, decode, keys
 from shared.errors import BoltwatchError
-from shared.runtime import open_session
-from tests.support.compose_layout import (
-    BASE_FILE,
-    IDENTITY,
-    TLS_FILE,
-    ContainerFiles,
-    load_merged,
-    make_compose_certs,
-    split_volume,
-)
+from tests.support.compose_line import TLS_STATIONS, ComposeLine
 from tests.support.live_recorder import has_subscribers
 from tests.support.router_process import boltwatch
-from tests.support.station_files import free_tcp_port, free_udp_port, serve
 
 pytestmark = [
     pytest.mark.system,
@@ -55,77 +37,12 @@ pytestmark = [
 ]
 
 RUNNING = ("router", "acquisition-st1", "rig-st1", "recorder", "dashboard")
-TLS_STATIONS = "/etc/boltwatch/compose/tls"
 HEALTHY_WITHIN_S = 60.0
 NOT_ALIVE = 1  # `boltwatch health`: 1 not alive (yet), 2 router unreachable or bad file
 HEARD_WITHIN_S = 60.0
 DECISION = channels.DECISION.key("st1")
 SAMPLES = channels.SAMPLE_BATCHES.key("st1")  # an edge station: its samples in batches
 RUNS = channels.RUNS.key("st1")
-
-
-class ComposeLine:
-    """The merged compose services, each with its container's files under ``folder``."""
-
-    def __init__(self, folder: Path) -> None:
-        self.folder = folder
-        self.certs = folder / "certs"
-        make_compose_certs(self.certs)
-        recordings = folder / "recordings"
-        recordings.mkdir()
-        env = {"BOLTWATCH_CERTS": str(self.certs), "BOLTWATCH_RECORDINGS": str(recordings)}
-        self.services: dict[str, Any] = load_merged([BASE_FILE, TLS_FILE], env)["services"]
-        self.port = free_tcp_port()
-        self.page_port = free_tcp_port()  # the dashboard's, instead of 0.0.0.0:8080
-        self.can_ports = {"43113": str(free_udp_port()), "43114": str(free_udp_port())}
-        self.processes: dict[str, subprocess.Popen[bytes]] = {}
-        self._containers: dict[tuple[str, str | None], ContainerFiles] = {}
-
-    def files(self, name: str, identity: str | None = None) -> ContainerFiles:
-        """Service ``name``'s container (with another identity mounted, if given)."""
-        if (name, identity) not in self._containers:
-            self._containers[name, identity] = self._lay_out(name, identity)
-        return self._containers[name, identity]
-
-    def _lay_out(self, name: str, identity: str | None) -> ContainerFiles:
-        volumes = list(self.services[name]["volumes"])
-        if identity is not None:
-            volumes = [v for v in volumes if split_volume(v)[1] != IDENTITY]
-            volumes.append(f"{self.certs / identity}:{IDENTITY}:ro")
-        root = self.folder / "containers" / (name if identity is None else f"{name}-as-{identity}")
-        files = ContainerFiles(root, volumes)
-        for station_file in files.host(TLS_STATIONS).glob("*.toml"):
-            text = station_file.read_text().replace("tls/router:7447", f"tls/127.0.0.1:{self.port}")
-            for compose_port, free_port in self.can_ports.items():
-                text = re.sub(rf"^port = {compose_port}$", f"port = {free_port}", text, flags=re.M)
-            station_file.write_text(text)
-        return files
-
-    def start(self, name: str) -> None:
-        command = self.files(name).arguments(self.services[name]["command"])
-        command = [a.replace("tls/0.0.0.0:7447", f"tls/127.0.0.1:{self.port}") for a in command]
-        command = [a.replace("0.0.0.0:8080", f"127.0.0.1:{self.page_port}") for a in command]
-        assert command[0] == "serve"
-        self.processes[name] = serve(command[1:], self.folder / f"{name}.log")
-
-    def health(self, name: str, service: str | None = None) -> subprocess.CompletedProcess[str]:
-        """The container's health check (``CMD boltwatch health ...``), once; with
-        ``service``, the same check in that container for another service."""
-        test = self.services[name]["healthcheck"]["test"]
-        assert test[:3] == ["CMD", "boltwatch", "health"]
-        arguments = self.files(name).arguments(test[2:])
-        if service is not None:
-            arguments[1] = service
-        return boltwatch(*arguments)
-
-    def session(self, name: str, identity: str | None = None) -> zenoh.Session:
-        """A session as service ``name``'s container opens it (its station file's [zenoh])."""
-        files = self.files(name, identity)
-        station_file = files.host(f"{TLS_STATIONS}/station1.toml")
-        return open_session(load_station(station_file).config.zenoh)
-
-    def log(self, name: str) -> str:
-        return (self.folder / f"{name}.log").read_text(errors="replace")[-3000:]
 
 
 @pytest.fixture

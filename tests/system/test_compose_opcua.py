@@ -1,0 +1,93 @@
+"""The compose line's OPC UA server run on loopback with the files compose mounts.
+
+The router and ``opcua`` of docker-compose.yml with docker-compose.tls.yml run
+their merged commands (tests/support/compose_line.py), with the identities and
+the OPC UA server's RSA files config/security/make-compose-certs.sh made:
+compose's health check passes (the server holds its token for both stations
+under line-monitor's certificate, which the router's access control lets
+listen), and an asyncua client with the script's client identity
+(``opcua-mes``) connects with Basic256Sha256 sign and encrypt, trusting the
+server's certificate from its folder, and finds both stations' joining systems.
+About 10 s (the seven models load in the server).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import shutil
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from asyncua import Client, ua
+from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
+from asyncua.crypto.uacrypto import CertProperties
+
+from services.cli.station_supervisor import stop_process
+from services.opcua.joining_systems import BOLTWATCH_NAMESPACE
+from services.opcua.nodeset_files import missing_files, nodeset_folder
+from tests.support.compose_line import ComposeLine
+
+pytestmark = [
+    pytest.mark.system,
+    pytest.mark.skipif(shutil.which("openssl") is None, reason="needs the openssl CLI"),
+]
+
+RUNNING = ("router", "opcua")
+STATIONS = ["st1", "st2"]
+CLIENT = "mes"  # make-compose-certs.sh's default OPC UA client
+HEALTHY_WITHIN_S = 90.0  # the models load before the server reaches the line
+NOT_ALIVE = 1
+CLIENT_TIMEOUT_S = 30.0
+
+
+@pytest.fixture
+def line(tmp_path: Path) -> Iterator[ComposeLine]:
+    if missing_files(nodeset_folder()):
+        pytest.skip("the OPC UA models are not fetched (`make opcua-nodesets` needs npm)")
+    started = ComposeLine(tmp_path)
+    try:
+        for name in RUNNING:
+            started.start(name)
+        yield started
+    finally:
+        for name in reversed(list(started.processes)):
+            stop_process(started.processes[name], grace_s=10.0)
+
+
+async def joining_systems(line: ComposeLine) -> list[str]:
+    """The stations' joining systems an MES with the script's client identity finds."""
+    identity = line.certs / f"opcua-{CLIENT}"
+    client = Client(f"opc.tcp://127.0.0.1:{line.opcua_port}", timeout=CLIENT_TIMEOUT_S)
+    client.application_uri = f"urn:boltwatch:opcua-client:{CLIENT}"
+    await client.set_security(
+        SecurityPolicyBasic256Sha256,
+        certificate=str(identity / "identity.pem"),
+        # asyncua takes a file's format from its name: ".key" is PEM here
+        private_key=CertProperties(identity / "identity.key", extension="pem"),
+        server_certificate=str(identity / "server.pem"),
+        mode=ua.MessageSecurityMode.SignAndEncrypt,
+    )
+    async with client:
+        ours = await client.get_namespace_index(BOLTWATCH_NAMESPACE)
+        names: list[str] = []
+        for station in STATIONS:
+            name = await client.get_node(f"ns={ours};s={station}").read_browse_name()
+            names.append(str(name.Name))
+        return names
+
+
+def test_the_opcua_service_serves_both_stations_with_the_scripts_files(
+    line: ComposeLine,
+) -> None:
+    deadline = time.monotonic() + HEALTHY_WITHIN_S
+    for name in RUNNING:  # as compose waits on health before it counts the service up
+        while (checked := line.health(name)).returncode != 0:
+            said = f"{checked.stdout}{checked.stderr}"
+            assert checked.returncode == NOT_ALIVE, f"{name}'s health check failed: {said}"
+            exited = line.processes[name].poll()
+            assert exited is None, f"{name} exited ({exited}):\n{line.log(name)}"
+            assert time.monotonic() < deadline, f"{name} never healthy: {said}\n{line.log(name)}"
+            time.sleep(0.5)
+    assert asyncio.run(joining_systems(line)) == STATIONS, line.log("opcua")
