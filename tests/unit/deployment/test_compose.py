@@ -5,8 +5,8 @@ an optional Rerun viewer (profile), the line's page and its OPC UA server, and
 per station an acquisition (which holds the station's predictor: placement
 "edge") and a rig with that station's own file; the line's page and the OPC UA
 server read the recorder's results store. Where each station's predictor runs:
-tests/unit/deployment/test_compose_placement.py; the OPC UA server's certificates
-and the image's OPC UA models: tests/unit/deployment/test_compose_opcua.py.
+tests/unit/deployment/test_compose_placement.py; the OPC UA server's certificates:
+test_compose_opcua.py; the image's OPC UA models: test_image_models.py.
 """
 
 from __future__ import annotations
