@@ -19,12 +19,14 @@
 # (placement "line": docker-compose.tls.yml says how to add one).
 # The OPC UA server (the opcua service, with or without TLS) gets RSA files of
 # config/security/make-opcua-certs.sh: OUT_DIR/opcua-server/ holds server.pem,
-# server.key and trusted/ca.pem (the CA of its clients), mounted read-only at
-# /etc/boltwatch-opcua; OUT_DIR/opcua-<client>/ holds a client's identity.pem,
-# identity.key and the server.pem it trusts, for each of OPCUA_CLIENTS (default
-# "mes"); OUT_DIR/opcua-ca/ keeps the clients' CA key (never mounted). OPCUA_SAN adds
-# the names the plant reaches the server by ("DNS:line1.plant.local") to "opcua". The
-# server's certificate is kept when the script runs again (its clients trust it).
+# server.key, trusted/ca.pem (the CA of its clients) and opcua-users.toml (its users,
+# `boltwatch opcua-user`), mounted read-only at /etc/boltwatch-opcua;
+# OUT_DIR/opcua-<client>/ holds a client's identity.pem, identity.key, the server.pem
+# it trusts and the password of its user <client> (made here, 0600), for each of
+# OPCUA_CLIENTS (default "mes"); OUT_DIR/opcua-ca/ keeps the clients' CA key (never
+# mounted). OPCUA_SAN adds the names the plant reaches the server by
+# ("DNS:line1.plant.local") to "opcua". When the script runs again the server's
+# certificate (its clients trust it) and each client's password are kept.
 # OUT_DIR/line-ca/ is config/security/make-certs.sh's folder: the CA's key (ca.key) is
 # there and is never mounted; keep it offline. Running again reuses the CA and
 # re-issues every identity. Keys are 0600; the containers run as uid 10001
@@ -105,6 +107,20 @@ for name in "${opcua_clients[@]}"; do
     install -m 644 "$out/opcua-ca/$name.pem" "$client/identity.pem"
     install -m 600 "$out/opcua-ca/$name.key" "$client/identity.key"
     rm -f "$out/opcua-ca/$name.key"
+done
+# Its users (--users): one per client, with a password made here, given once to the
+# user file's command (which keeps only a salted hash) and kept in the client's folder.
+users="$server/opcua-users.toml"
+for name in "${opcua_clients[@]}"; do
+    password_file="$out/opcua-$name/password"
+    if [[ -f $password_file && -f $users ]]; then
+        continue
+    fi
+    password=$(openssl rand -base64 24)
+    printf '%s\n' "$password" | PYTHONPATH="$repo${PYTHONPATH:+:$PYTHONPATH}" "$python" \
+        -m services.cli opcua-user add "$name" --users "$users" >/dev/null
+    printf '%s\n' "$password" >"$password_file"
+    chmod 600 "$password_file"
 done
 
 folders=(router "${names[@]}" opcua-server)

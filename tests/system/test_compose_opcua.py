@@ -7,7 +7,8 @@ compose's health check passes (the server holds its token for both stations
 under line-monitor's certificate, which the router's access control lets
 listen), and an asyncua client with the script's client identity
 (``opcua-mes``) connects with Basic256Sha256 sign and encrypt, trusting the
-server's certificate from its folder, and finds both stations' joining systems.
+server's certificate from its folder, logs in as the script's user ``mes``
+with the password left in that folder, and finds both stations' joining systems.
 About 10 s (the seven models load in the server).
 """
 
@@ -57,10 +58,13 @@ def line(tmp_path: Path) -> Iterator[ComposeLine]:
 
 
 async def joining_systems(line: ComposeLine) -> list[str]:
-    """The stations' joining systems an MES with the script's client identity finds."""
+    """The stations' joining systems an MES with the script's client identity and user
+    finds."""
     identity = line.certs / f"opcua-{CLIENT}"
     client = Client(f"opc.tcp://127.0.0.1:{line.opcua_port}", timeout=CLIENT_TIMEOUT_S)
     client.application_uri = f"urn:boltwatch:opcua-client:{CLIENT}"
+    client.set_user(CLIENT)
+    client.set_password((identity / "password").read_text().removesuffix("\n"))
     await client.set_security(
         SecurityPolicyBasic256Sha256,
         certificate=str(identity / "identity.pem"),

@@ -7,8 +7,9 @@ config/security/make-opcua-certs.sh, the folder ``opcua-server`` that
 docker-compose.yml mounts at ``/etc/boltwatch-opcua``: the server starts with
 those files (its security options are checked as ``serve opcua`` checks them),
 its certificate is RSA and names the application URI and ``opcua``, it trusts
-exactly the clients the script's CA signed, and it stays when the script runs
-again. The models in the image:
+exactly the clients the script's CA signed, its users file holds the script's
+client with the password left in the client's folder, and the certificate and
+the password stay when the script runs again. The models in the image:
 tests/unit/deployment/test_image_models.py.
 """
 
@@ -23,7 +24,9 @@ from typing import Any
 import pytest
 
 from services.cli.main import build_parser
+from services.opcua.password_hashes import verify
 from services.opcua.server_security import SecuritySettings, application_uri_of
+from services.opcua.users_file import read_users
 from tests.support.compose_layout import (
     BASE_FILE,
     TLS_FILE,
@@ -35,7 +38,8 @@ from tests.support.compose_layout import (
 
 OPCUA_FILES = "/etc/boltwatch-opcua"
 SERVER_URI = "urn:boltwatch:opcua"
-CLIENT = "mes"  # the client the script makes by default (OPCUA_CLIENTS)
+CLIENT = "mes"  # the client the script makes by default (OPCUA_CLIENTS), and its user
+USERS = "opcua-users.toml"
 
 
 @pytest.fixture(scope="module")
@@ -56,8 +60,10 @@ def test_the_server_starts_with_the_files_compose_mounts(
     assert f"{certs}/opcua-server:{OPCUA_FILES}:ro" in service["volumes"]
     container = ContainerFiles(tmp_path / "opcua", service["volumes"])
     args = build_parser().parse_args(container.arguments(service["command"]))
-    settings = SecuritySettings(args.certificate, args.private_key, args.trusted_clients)
-    settings.check()  # what `serve opcua` checks before it starts: files there, of each kind
+    settings = SecuritySettings(
+        args.certificate, args.private_key, args.trusted_clients, args.users
+    )
+    settings.check()  # what `serve opcua` checks before it starts: files, the users file
     assert args.certificate == container.host(f"{OPCUA_FILES}/server.pem")
     assert application_uri_of(args.certificate) == SERVER_URI  # RSA, URI in its SAN
     names = certificate_field(args.certificate, "-ext subjectAltName")
@@ -82,11 +88,14 @@ def test_the_server_trusts_the_clients_of_its_ca_only(certs: Path) -> None:
         "server.key",
         "trusted",
         "trusted/ca.pem",
+        "opcua-users.toml",
     }
-    assert stat.S_IMODE((server / "server.key").stat().st_mode) == 0o600
     client = certs / f"opcua-{CLIENT}"
-    assert {p.name for p in client.iterdir()} == {"identity.pem", "identity.key", "server.pem"}
-    assert stat.S_IMODE((client / "identity.key").stat().st_mode) == 0o600
+    shown = {p.name for p in client.iterdir()}
+    assert shown == {"identity.pem", "identity.key", "server.pem", "password"}
+    for secret in (server / "server.key", server / USERS, client / "identity.key"):
+        assert stat.S_IMODE(secret.stat().st_mode) == 0o600, secret
+    assert stat.S_IMODE((client / "password").stat().st_mode) == 0o600
     assert (client / "server.pem").read_bytes() == (server / "server.pem").read_bytes()
     uri = certificate_field(client / "identity.pem", "-ext subjectAltName")
     assert f"URI:urn:boltwatch:opcua-client:{CLIENT}" in uri
@@ -110,15 +119,26 @@ def test_the_server_trusts_the_clients_of_its_ca_only(certs: Path) -> None:
     assert [p.name for p in (certs / "opcua-ca").glob("*.key")] == ["ca.key"]
 
 
+def test_the_users_file_lets_the_scripts_client_in_with_its_password(certs: Path) -> None:
+    users = read_users(certs / "opcua-server" / USERS)
+    assert set(users) == {CLIENT}
+    password = (certs / f"opcua-{CLIENT}" / "password").read_text().removesuffix("\n")
+    assert len(password) >= 32, "made by openssl rand, not chosen"
+    assert verify(password, users[CLIENT].password_hash)
+    assert password not in (certs / "opcua-server" / USERS).read_text()
+
+
 def test_running_the_script_again_keeps_the_certificate_clients_trust(
     certs: Path, tmp_path: Path
 ) -> None:
-    """A station added (the script run again) must not change the server's certificate:
-    an MES trusts that one (it is self-signed)."""
+    """A station added (the script run again) must not change the server's certificate
+    (an MES trusts that one: it is self-signed) nor a client's password."""
     again = tmp_path / "certs"
     shutil.copytree(certs, again, symlinks=True)
     make_compose_certs(again)
-    for name in ("server.pem", "server.key"):
-        kept = (again / "opcua-server" / name).read_bytes()
-        assert kept == (certs / "opcua-server" / name).read_bytes(), f"{name} was made again"
+    for name in ("opcua-server/server.pem", "opcua-server/server.key", f"opcua-server/{USERS}"):
+        kept = (again / name).read_bytes()
+        assert kept == (certs / name).read_bytes(), f"{name} was made again"
+    password = f"opcua-{CLIENT}/password"
+    assert (again / password).read_bytes() == (certs / password).read_bytes()
     assert [p.name for p in (again / "opcua-ca").glob("*.key")] == ["ca.key"]
