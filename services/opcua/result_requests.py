@@ -146,17 +146,16 @@ def result_ids(
     """GetResultIdListFiltered's output arguments (ResultHandle, ResultIdList, Error) of
     ``query`` (None: nothing matches), at most ``max_results`` (0: no maximum) and ``most``."""
     wanted = most + 1 if max_results == 0 else min(max_results, most + 1)
-    found: list[StoredResult] = []
+    found: list[tuple[str, int]] = []
     if query is not None:
         try:
-            # the store gives whole results; the ids of a few thousand are read in a blink
-            found = _stored(target, replace(query, limit=wanted))
+            with ResultsStore(target, create=False, application=APPLICATION) as store:
+                found = store.keys(replace(query, limit=wanted))
         except StoreError as err:
             LOG.warning("GetResultIdListFiltered of %s: %s", station, err)
             return _id_outputs([], ERROR_STORE)
     error = ERROR_TOO_MANY if len(found) > most else 0
-    identifiers = [result_id(s.result.station, s.result.run_id) for s in found[:most]]
-    return _id_outputs(identifiers, error)
+    return _id_outputs([result_id(*key) for key in found[:most]], error)
 
 
 def _result_outputs(result: Any, error: int) -> list[ua.Variant]:
