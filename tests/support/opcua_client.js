@@ -15,11 +15,10 @@
 // at the end, per station, {"type": "results_folder", "station", "names"} (the browse names in
 // ResultManagement/Results); with "askById": true, the first result received asked by
 // its id (ResultManagement's GetResultById, again while the results store does not have
-// it yet: Error -1) as {"type": "by_id", "station", "resultId", "error", "result"};
-// with "askLatest": true, ResultManagement's GetLatestResult (again until the store has
-// the last result received) as {"type": "latest", "station", "resultId", "error",
-// "tracePoints"}
-// (typed arrays as JSON arrays, NaN as null); with "toolRuns": N, each tool of
+// it yet: Error -1) as {"type": "by_id", "station", "resultId", "error", "result"}
+// (typed arrays as JSON arrays, NaN as null); with "askLatest": true, ResultManagement's
+// GetLatestResult (again until the store has the last result received) as {"type":
+// "latest", "station", "resultId", "error", "tracePoints"}; with "toolRuns": N, each tool of
 // AssetManagement/Assets/Tools once its OperationCycleCounter reached N (read again until
 // then) as {"type": "tool", "station", "name", "serialNumber", "tightenings",
 // "sinceService", "intensitySinceService", "limitValue", "unitId"}; with "browseTree":
