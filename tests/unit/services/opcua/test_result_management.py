@@ -202,52 +202,51 @@ def test_an_empty_store_has_no_latest_result_and_a_missing_one_is_an_error(
     assert latest_result(missing, "st1")[2].Value == ERROR_STORE
 
 
-@pytest.mark.parametrize(
-    ("elements", "expected"),
-    [
-        ((), ["st1/3", "st1/2", "st1/1"]),
-        (((Op.Equals, ["ResultEvaluation", _literal(2, ua.VariantType.Int32)]),), ["st1/2"]),
+#: filters (their elements, a field by its name in ResultMetaData) and the ids they match
+FILTERS = {
+    "empty": ((), ["st1/3", "st1/2", "st1/1"]),
+    "NotOK": (((Op.Equals, ["ResultEvaluation", _literal(2, ua.VariantType.Int32)]),), ["st1/2"]),
+    "OK": (
+        ((Op.Equals, ["ResultEvaluation", _literal(1, ua.VariantType.Int32)]),),
+        ["st1/3", "st1/1"],
+    ),
+    "NotDecidable": (((Op.Equals, ["ResultEvaluation", _literal(3, ua.VariantType.Int32)]),), []),
+    "part-and-program": (
         (
-            ((Op.Equals, ["ResultEvaluation", _literal(1, ua.VariantType.Int32)]),),
-            ["st1/3", "st1/1"],
+            (Op.And, [ua.ElementOperand(1), ua.ElementOperand(2)]),
+            (Op.Equals, ["PartId", _literal("P1")]),
+            (Op.Equals, [_literal("2"), "InternalRecipeId"]),
         ),
-        (((Op.Equals, ["ResultEvaluation", _literal(3, ua.VariantType.Int32)]),), []),
+        ["st1/2"],
+    ),
+    "result-id": (((Op.Equals, ["ResultId", _literal("st1/2")]),), ["st1/2"]),
+    "another-station-s-id": (((Op.Equals, ["ResultId", _literal("st2/4")]),), []),
+    "since": (((Op.GreaterThanOrEqual, ["CreationTime", _created(2)]),), ["st1/3", "st1/2"]),
+    # run 1 ended 500 ns past its CreationTime's microsecond: it is that microsecond
+    "after": (((Op.GreaterThan, ["CreationTime", _created(1)]),), ["st1/3", "st1/2"]),
+    "until": (((Op.LessThanOrEqual, ["CreationTime", _created(1)]),), ["st1/1"]),
+    "at": (((Op.Equals, ["CreationTime", _created(1)]),), ["st1/1"]),
+    "literal-first": (((Op.LessThan, [_created(2), "CreationTime"]),), ["st1/3"]),
+    "between": (((Op.Between, ["CreationTime", _created(1), _created(2)]),), ["st1/2", "st1/1"]),
+    "an-empty-range": (
         (
-            (
-                (Op.And, [ua.ElementOperand(1), ua.ElementOperand(2)]),
-                (Op.Equals, ["PartId", _literal("P1")]),
-                (Op.Equals, [_literal("2"), "InternalRecipeId"]),
-            ),
-            ["st1/2"],
+            (Op.And, [ua.ElementOperand(1), ua.ElementOperand(2)]),
+            (Op.LessThan, ["CreationTime", _created(1)]),
+            (Op.GreaterThan, ["CreationTime", _created(3)]),
         ),
-        (((Op.Equals, ["ResultId", _literal("st1/2")]),), ["st1/2"]),
-        (((Op.Equals, ["ResultId", _literal("st2/4")]),), []),
-        (((Op.GreaterThanOrEqual, ["CreationTime", _created(2)]),), ["st1/3", "st1/2"]),
-        # run 1 ended 500 ns past its CreationTime's microsecond: it is that microsecond
-        (((Op.GreaterThan, ["CreationTime", _created(1)]),), ["st1/3", "st1/2"]),
-        (((Op.LessThanOrEqual, ["CreationTime", _created(1)]),), ["st1/1"]),
-        (((Op.Equals, ["CreationTime", _created(1)]),), ["st1/1"]),
-        (((Op.LessThan, [_created(2), "CreationTime"]),), ["st1/3"]),
-        (((Op.Between, ["CreationTime", _created(1), _created(2)]),), ["st1/2", "st1/1"]),
-        (
-            (
-                (Op.And, [ua.ElementOperand(1), ua.ElementOperand(2)]),
-                (Op.LessThan, ["CreationTime", _created(1)]),
-                (Op.GreaterThan, ["CreationTime", _created(3)]),
-            ),
-            [],
-        ),
-    ],
-)
-def test_the_ids_a_filter_matches_are_the_stations_newest_first(
-    served: Served, elements: tuple[tuple[Any, list[Any]], ...], expected: list[str]
-) -> None:
+        [],
+    ),
+}
+
+
+def test_the_ids_a_filter_matches_are_the_stations_newest_first(served: Served) -> None:
     """A field is named by its path in ResultType (``ResultMetaData/<field>``)."""
-    resolved = [
-        (op, [served.field("ResultMetaData", o) if isinstance(o, str) else o for o in operands])
-        for op, operands in elements
-    ]
-    assert served.ids(_filter(*resolved)) == expected
+    for name, (elements, expected) in FILTERS.items():
+        resolved = [
+            (op, [served.field("ResultMetaData", o) if isinstance(o, str) else o for o in operands])
+            for op, operands in elements
+        ]
+        assert served.ids(_filter(*resolved)) == expected, name
 
 
 def test_the_event_s_paths_order_and_max_results(served: Served) -> None:
