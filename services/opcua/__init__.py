@@ -18,8 +18,11 @@ The address space is built from the OPC Foundation's NodeSet2 files (IJT Base
 - :mod:`.result_values` (a TighteningResult as IJT field values, pure),
   :mod:`.result_trace` (its run's samples from the recording as an IJT trace),
   :mod:`.result_encoding` (those values as asyncua's classes)
-- :mod:`.result_requests` (ResultManagement's GetResultById: a result of the
-  results store, with its steps and trace)
+- :mod:`.result_requests` (ResultManagement's methods from the results store:
+  GetResultById and GetLatestResult, a result with its steps and trace;
+  GetResultIdListFiltered, the ResultIds a filter matches; ReleaseResultHandle),
+  :mod:`.result_filter` (GetResultIdListFiltered's ContentFilter as a results
+  query, pure)
 - :mod:`.asset_nodes` (an asset's nodes by the interface's names, its figures by path)
 - :mod:`.tool_values` (a tool of the wear ledger as an IJT tool's counters, pure),
   :mod:`.tool_assets` (the station's tools in AssetManagement/Assets/Tools)

@@ -25,11 +25,12 @@ too) of an alert or a controller's alarm (:mod:`.alert_events`), its
 ``JoiningSystemEventContent`` with ``EventCode``, ``EventText`` and
 ``JoiningTechnology``, its ``ConditionClassId``/``Name`` and ``Severity``.
 
-ResultManagement's ``GetResultById`` is linked by the service
-(:mod:`.result_requests`); the other methods of ResultManagement and of the
-other management objects are in the address space as the type has them,
-without an implementation (a call answers ``BadNothingToDo``, asyncua's answer
-for a method without one).
+ResultManagement's methods as the instance has them (``GetResultById``,
+``GetLatestResult``, ``GetResultIdListFiltered``, ``ReleaseResultHandle``) are
+linked by the service (:mod:`.result_requests`); the methods of the other
+management objects are in the address space as the type has them, without an
+implementation (a call answers ``BadNothingToDo``, asyncua's answer for a method
+without one).
 """
 
 from __future__ import annotations

@@ -49,7 +49,7 @@ run that the tool aborted is still a completed result, NOK.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 from typing import Any
 
 from shared.contract import JudgedFigure, ResultStep, TighteningResult
@@ -111,9 +111,14 @@ _EVALUATION_OF_STEP = {
 }
 
 
+EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
+
+
 def utc_time(time_ns: int) -> datetime:
-    """An OPC UA UtcTime (a DateTime) of nanoseconds since the epoch."""
-    return datetime.fromtimestamp(time_ns / 1e9, tz=UTC)
+    """An OPC UA UtcTime (a DateTime) of nanoseconds since the epoch: its whole microseconds,
+    exactly (a datetime holds no finer; through a float they would be off by one at times,
+    and a filter on CreationTime compares them with the results store's nanoseconds)."""
+    return EPOCH + timedelta(microseconds=time_ns // 1000)
 
 
 def result_id(station: str, run_id: int) -> str:

@@ -13,8 +13,9 @@ alarms, which become joining system events: :mod:`.alert_events`) and, once
 subscribed, the newest :data:`STARTUP_RESULTS` per station from the stations'
 results stores (:mod:`shared.results`), oldest first, so a client finds the last
 result at once. A result already served (the same ResultId) is not served twice.
-Each joining system's ``GetResultById`` answers from its station's results store,
-with the result's trace (:mod:`.result_requests`). The station's tools and their
+Each joining system's ResultManagement methods (GetResultById, GetLatestResult,
+GetResultIdListFiltered, ReleaseResultHandle) answer from its station's results
+store (:mod:`.result_requests`). The station's tools and their
 counters come from its wear ledger (:mod:`.tool_assets`), read again every
 :data:`TOOLS_REFRESH_S`, and so does its controller's identification
 (:mod:`.controller_assets`).
@@ -37,9 +38,9 @@ from services.opcua.controller_values import ControllerIdentity, controller_iden
 from services.opcua.joining_systems import JoiningSystem
 from services.opcua.line_inbox import LineInbox
 from services.opcua.nodeset_files import nodeset_folder
-from services.opcua.nodeset_loading import load_models
+from services.opcua.nodeset_loading import MACHINERY_RESULT, load_models
 from services.opcua.result_encoding import result_data
-from services.opcua.result_requests import APPLICATION, get_result_by_id_method
+from services.opcua.result_requests import APPLICATION, result_management_methods
 from services.opcua.result_values import result_id, result_values
 from services.opcua.server_security import SecuritySettings, apply
 from services.opcua.tool_assets import ToolAssets
@@ -98,11 +99,12 @@ class OpcuaService:
             station.station_id: await JoiningSystem.create(server, station.station_id)
             for station in self._stations
         }
+        result_ns = await server.get_namespace_index(MACHINERY_RESULT)
         for loaded in self._stations:
-            method = await systems[loaded.station_id].result_management_method("GetResultById")
-            server.link_method(
-                method, get_result_by_id_method(station_store(loaded), loaded.station_id)
-            )
+            system = systems[loaded.station_id]
+            methods = result_management_methods(station_store(loaded), system.station, result_ns)
+            for name, callback in methods.items():
+                server.link_method(await system.result_management_method(name), callback)
         assets = {
             station: await ToolAssets.create(server, station, system.node)
             for station, system in systems.items()

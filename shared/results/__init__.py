@@ -5,7 +5,8 @@ plant, line, program, tool, time), in SQLite beside the recordings or a plant's 
   :func:`store_target`: where a station file's store is)
 - :mod:`.results_schema` (the tables, their version, the migrations)
 - :mod:`.stored_result` (a result as a row, and back)
-- :mod:`.results_store` (add idempotently, find, what was read of which recording)
+- :mod:`.results_store` (add idempotently, find, a query's keys only, what was read
+  of which recording)
 - :mod:`.sqlite_statistics` (SQLite's planner statistics, written by the store's writer)
 - :mod:`.results_query` (which tightenings a question asks for)
 - :mod:`.program_columns` (a report's columns per program, in one scan)

@@ -3,7 +3,7 @@
 Every criterion is optional and they all hold together: a part id, stations,
 a run id (with one station: a tightening by the table's primary key), a plant,
 a line, a program, a tool, a range of end times (``since`` included, ``until``
-not), NOK only. Each is a column with an index in front
+not), a verdict (OK or NOK only). Each but the verdict is a column with an index in front
 (:mod:`.results_schema`), so a part's tightenings are found by the index of
 ``part_id`` however large the store.
 """
@@ -29,7 +29,7 @@ class ResultsQuery:
     tool_id: int | None = None
     since_ns: int | None = None  # the run ended at or after
     until_ns: int | None = None  # the run ended before
-    nok_only: bool = False
+    verdict: str | None = None  # "OK" or "NOK": those only
     limit: int | None = DEFAULT_LIMIT  # None: every row
     oldest_first: bool = False
 
@@ -60,8 +60,8 @@ class ResultsQuery:
             term("ended_ns >= ?", self.since_ns)
         if self.until_ns is not None:
             term("ended_ns < ?", self.until_ns)
-        if self.nok_only:
-            term("result = ?", "NOK")
+        if self.verdict is not None:
+            term("result = ?", self.verdict)
         return (" WHERE " + " AND ".join(terms) if terms else ""), parameters
 
     def order(self) -> str:

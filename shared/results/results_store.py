@@ -109,6 +109,17 @@ class ResultsStore:
             steps = self._steps_of([(row[0], row[1]) for row in rows])
         return [from_row(row, steps.get((row[0], int(row[1])), ())) for row in rows]
 
+    def keys(self, query: ResultsQuery) -> list[tuple[str, int]]:
+        """The (station, run id) of the tightenings ``query`` asks for, in its order: what
+        :meth:`find` gives without reading the rows and their steps (an OPC UA client's
+        list of ResultIds)."""
+        where, parameters = query.where()
+        with self.database.transaction():
+            rows = self.database.rows(
+                "SELECT station, run_id FROM tightenings" + where + query.order(), parameters
+            )
+        return [(str(row[0]), int(row[1])) for row in rows]
+
     def count(self, query: ResultsQuery) -> int:
         """How many tightenings ``query`` asks for (its limit aside)."""
         where, parameters = query.where()

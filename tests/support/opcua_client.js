@@ -16,7 +16,9 @@
 // ResultManagement/Results); with "askById": true, the first result received asked by
 // its id (ResultManagement's GetResultById, again while the results store does not have
 // it yet: Error -1) as {"type": "by_id", "station", "resultId", "error", "result"}
-// (typed arrays as JSON arrays, NaN as null); with "toolRuns": N, each tool of
+// (typed arrays as JSON arrays, NaN as null); with "askLatest": true, ResultManagement's
+// GetLatestResult (again until the store has the last result received) as {"type":
+// "latest", "station", "resultId", "error", "tracePoints"}; with "toolRuns": N, each tool of
 // AssetManagement/Assets/Tools once its OperationCycleCounter reached N (read again until
 // then) as {"type": "tool", "station", "name", "serialNumber", "tightenings",
 // "sinceService", "intensitySinceService", "limitValue", "unitId"}; with "browseTree":
@@ -96,6 +98,7 @@ async function main() {
     const filter = constructEventFilter(["EventType", "SourceName", "Message", `${result}:Result`]);
     const systems = {};
     const firstResultId = {};
+    const lastResultId = {};
     let received = 0;
     let finish;
     const finished = new Promise((resolve) => (finish = resolve));
@@ -127,6 +130,7 @@ async function main() {
             if (!(station in firstResultId)) {
                 firstResultId[station] = value.value.resultMetaData.resultId;
             }
+            lastResultId[station] = value.value.resultMetaData.resultId;
             say({
                 type: "result",
                 station,
@@ -168,6 +172,11 @@ async function main() {
         for (const [station, nodeId] of Object.entries(systems)) {
             const nodes = await browseTree(session, nodeId, station, options.browseTree.expand);
             say({ type: "tree", station, nodes });
+        }
+    }
+    if (options.askLatest) {
+        for (const [station, nodeId] of Object.entries(systems)) {
+            await askLatest(session, nodeId, result, station, lastResultId[station]);
         }
     }
     await subscription.terminate();
@@ -228,19 +237,24 @@ async function readTools(session, systemId, namespaces, station, runs) {
     }
 }
 
-async function askById(session, systemId, result, station, resultId) {
+// a call of the joining system's ResultManagement method `name`
+async function managementCall(session, systemId, result, name, inputArguments) {
     const child = async (path) => {
         const found = await session.translateBrowsePath(makeBrowsePath(systemId, path));
         return found.targets[0].targetId;
     };
-    const request = {
+    return {
         objectId: await child(`/${result}:ResultManagement`),
-        methodId: await child(`/${result}:ResultManagement/${result}:GetResultById`),
-        inputArguments: [
-            { dataType: DataType.String, value: resultId },
-            { dataType: DataType.Int32, value: 0 },
-        ],
+        methodId: await child(`/${result}:ResultManagement/${result}:${name}`),
+        inputArguments,
     };
+}
+
+async function askById(session, systemId, result, station, resultId) {
+    const request = await managementCall(session, systemId, result, "GetResultById", [
+        { dataType: DataType.String, value: resultId },
+        { dataType: DataType.Int32, value: 0 },
+    ]);
     for (;;) {
         const called = await session.call(request);
         if (called.statusCode !== StatusCodes.Good) {
@@ -252,6 +266,28 @@ async function askById(session, systemId, result, station, resultId) {
             continue;
         }
         say({ type: "by_id", station, resultId, error: error.value, result: plain(value.value) });
+        return;
+    }
+}
+
+async function askLatest(session, systemId, result, station, resultId) {
+    const request = await managementCall(session, systemId, result, "GetLatestResult", [
+        { dataType: DataType.Int32, value: 0 },
+    ]);
+    for (;;) {
+        const called = await session.call(request);
+        if (called.statusCode !== StatusCodes.Good) {
+            throw new Error(`GetLatestResult: ${called.statusCode.toString()}`);
+        }
+        const [, value, error] = called.outputArguments;
+        const latest = value.value ? value.value.resultMetaData.resultId : null;
+        if (error.value === -1 || latest !== resultId) {
+            await new Promise((resolve) => setTimeout(resolve, 200)); // not stored yet
+            continue;
+        }
+        const [content] = value.value.resultContent;
+        const [step] = content.value.trace.stepTraces;
+        say({ type: "latest", station, resultId: latest, error: error.value, tracePoints: step.numberOfTracePoints });
         return;
     }
 }

@@ -9,7 +9,8 @@ the first run, and receives one result-ready event per run whose Result equals
 the results store's tightening: its ResultId, part, program, verdict, creation
 time and final torque, angle and preload with their windows and units. It asks
 the first result by its id (ResultManagement's GetResultById) and finds in its
-trace every sample the recording holds of the run, value for value; it reads
+trace every sample the recording holds of the run, value for value, and asks
+the latest result (GetLatestResult: the last run's, with its trace); it reads
 the station's tool with its counters from the wear ledger (tightenings, since
 service, stick-slip intensity since service against the threshold), and
 receives the recorder's wear alerts as the joining system's events. The client
@@ -150,6 +151,7 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
             "client",
             results=RUNS,
             askById=True,
+            askLatest=True,
             toolRuns=RUNS,
             browseTree={"expand": EXPANDED},
             # about 2 min of tries: the server listens once its models are loaded (10 s and
@@ -231,6 +233,9 @@ def test_a_node_opcua_client_receives_the_results_of_a_real_line(tmp_path: Path)
     [folder] = [line for line in lines if line["type"] == "results_folder"]
     assert folder["names"] == [result_browse_name(r.run_id) for r in stored]
     _check_trace(lines, found[0])
+    [latest] = [line for line in lines if line["type"] == "latest"]
+    assert (latest["resultId"], latest["error"]) == (result_id(STATION, stored[-1].run_id), 0)
+    assert latest["tracePoints"] > 100  # the last run's samples at 1 kHz
     _check_tools(lines, station.parent / "recordings")
     _check_tree(lines, stored, endpoint, tmp_path)
 

@@ -130,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
         tool_id=args.tool,
         since_ns=None if args.since is None else round(args.since.timestamp() * 1e9),
         until_ns=None if args.until is None else round(args.until.timestamp() * 1e9),
-        nok_only=args.nok,
+        verdict="NOK" if args.nok else None,
         limit=args.limit,
     )
     with ResultsStore(target, create=False) as store:

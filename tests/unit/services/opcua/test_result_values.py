@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 
 from services.opcua.result_values import (
     DEGREE,
@@ -10,6 +10,7 @@ from services.opcua.result_values import (
     NEWTON_METRE,
     result_id,
     result_values,
+    utc_time,
 )
 from shared.contract import JudgedFigure
 from tests.support import factories
@@ -65,3 +66,9 @@ def test_unit_ids_are_the_unece_codes_of_opc_10000_8() -> None:
     assert NEWTON_METRE.unit_id == 20053  # "NU"
     assert DEGREE.unit_id == 17476  # "DD"
     assert NEWTON.unit_id == 5129559  # "NEW"
+
+
+def test_a_creation_time_is_the_end_s_whole_microseconds_exactly() -> None:
+    """1 999 ns past a whole second is 1 µs (a float of the seconds since 1970 made it 2)."""
+    second = datetime.fromtimestamp(factories.T0 // 1_000_000_000, tz=UTC)
+    assert utc_time(factories.T0 + 1_999) == second + timedelta(microseconds=1)

@@ -115,7 +115,9 @@ def test_each_criterion_finds_its_tightenings_newest_first(target: StoreTarget) 
         assert runs(line="A") == [("st1", 2), ("st1", 1)]
         assert runs(program_id=3) == [("st1", 2)]
         assert runs(tool_id=9) == [("st2", 3)]
-        assert runs(nok_only=True) == [("st2", 4)]
+        assert runs(verdict="NOK") == [("st2", 4)]
+        assert runs(verdict="OK", stations=["st2"]) == [("st2", 3)]
+        assert store.keys(ResultsQuery(verdict="OK", line="B")) == [("st9", 5), ("st2", 3)]
         assert runs(plant="North", limit=1) == [("st2", 4)]
         assert runs(since_ns=T0_NS + 2 * MINUTE_NS, until_ns=T0_NS + 4 * MINUTE_NS) == [
             ("st2", 3),
