@@ -14,7 +14,8 @@ The address space is built from the OPC Foundation's NodeSet2 files (IJT Base
   user), :mod:`.users_file` (the users file of ``--users``: names, password hashes,
   roles), :mod:`.password_hashes` (salted scrypt hashes, checked in constant time, pure)
 - :mod:`.joining_systems` (one JoiningSystemType per station; a result into its
-  ResultManagement and the result-ready event)
+  ResultManagement and the result-ready event), :mod:`.system_identification`
+  (the station as its joining system's Identification, pure)
 - :mod:`.result_values` (a TighteningResult as IJT field values, pure),
   :mod:`.result_trace` (its run's samples from the recording as an IJT trace),
   :mod:`.result_encoding` (those values as asyncua's classes)

@@ -46,6 +46,7 @@ from asyncua.common.node import Node
 from services.opcua.alert_events import AlertEvent
 from services.opcua.nodeset_loading import IJT_BASE, MACHINERY_RESULT, node_id
 from services.opcua.result_values import JOINING_TECHNOLOGY, utc_time
+from services.opcua.system_identification import SystemIdentification
 
 LOG = logging.getLogger(__name__)
 
@@ -136,6 +137,28 @@ class JoiningSystem:
         self._events.event.Severity = 100
         await self._events.trigger(message=message)
 
+    async def identify(self, identification: SystemIdentification) -> None:
+        """Write the joining system's ``Identification`` (its properties, instantiated with
+        the type, have no value until then)."""
+        group = (await _children_by_name(self.node))["Identification"]
+        texts = {
+            "Name": (identification.name, ua.VariantType.String),
+            "SystemId": (identification.system_id, ua.VariantType.String),
+            "Location": (identification.location, ua.VariantType.String),
+            "Description": (
+                ua.LocalizedText(identification.description),
+                ua.VariantType.LocalizedText,
+            ),
+            "JoiningTechnology": (
+                ua.LocalizedText(identification.joining_technology),
+                ua.VariantType.LocalizedText,
+            ),
+        }
+        by_name = await _children_by_name(group)
+        for name, (value, variant_type) in texts.items():
+            if value is not None:
+                await by_name[name].write_value(ua.Variant(value, variant_type))
+
     async def report(self, alert: AlertEvent) -> None:
         """A ``JoiningSystemEventType`` event of an alert or a controller's alarm."""
         _ours, ijt, _result_ns = self._names
@@ -156,6 +179,13 @@ class JoiningSystem:
         event.ConditionClassName = ua.LocalizedText(class_name)
         event.Severity = alert.severity
         await self._alerts.trigger(time_attr=utc_time(alert.time_ns), message=alert.text)
+
+
+async def _children_by_name(node: Node) -> dict[str, Node]:
+    """``node``'s children by their browse names (whatever their namespaces)."""
+    return {
+        str((await child.read_browse_name()).Name): child for child in await node.get_children()
+    }
 
 
 async def drop_placeholders(node: Node) -> None:

@@ -43,6 +43,7 @@ from services.opcua.result_encoding import result_data
 from services.opcua.result_requests import APPLICATION, result_management_methods
 from services.opcua.result_values import result_id, result_values
 from services.opcua.server_security import SecuritySettings, apply
+from services.opcua.system_identification import system_identification
 from services.opcua.tool_assets import ToolAssets
 from services.opcua.tool_values import ToolCounters, tool_counters
 from shared.config import AnyStation, ControllerStation, load_any_line
@@ -99,6 +100,8 @@ class OpcuaService:
             station.station_id: await JoiningSystem.create(server, station.station_id)
             for station in self._stations
         }
+        for loaded in self._stations:
+            await systems[loaded.station_id].identify(system_identification(loaded))
         result_ns = await server.get_namespace_index(MACHINERY_RESULT)
         for loaded in self._stations:
             system = systems[loaded.station_id]

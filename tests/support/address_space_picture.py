@@ -22,9 +22,12 @@ _CLASSES = {
     "ObjectType": ("OT", "#6a5acd"),
     "VariableType": ("VT", "#6a5acd"),
 }
+#: a value's characters shown (longer ones end in an ellipsis)
+_VALUE_CHARS = 48
 _STYLE = """
 body { font: 13px "DejaVu Sans", sans-serif; margin: 0; background: #f3f3f3; }
-header { background: #3b4b5c; color: #fff; padding: 6px 10px; font-weight: bold; }
+caption { background: #3b4b5c; color: #fff; padding: 6px 10px; font-weight: bold;
+          text-align: left; }
 table { border-collapse: collapse; width: 100%; background: #fff; }
 th { text-align: left; background: #e4e4e4; padding: 3px 8px; border-bottom: 1px solid #bbb; }
 td { padding: 1px 8px; white-space: nowrap; border-bottom: 1px solid #f0f0f0; }
@@ -43,6 +46,8 @@ def tree_page(nodes: Sequence[dict[str, Any]], title: str) -> str:
         expander = "▾" if expanded else ("▸" if node["children"] else "")
         mark, colour = _CLASSES.get(node["nodeClass"], ("?", "#888"))
         value = "" if node["value"] is None else str(node["value"])
+        if len(value) > _VALUE_CHARS:
+            value = value[: _VALUE_CHARS - 1] + "…"
         rows.append(
             "<tr><td>"
             f'<span style="padding-left: {18 * node["depth"]}px"></span>'
@@ -51,11 +56,11 @@ def tree_page(nodes: Sequence[dict[str, Any]], title: str) -> str:
             f"{html.escape(node['name'])}</td>"
             f'<td class="type">{html.escape(node["type"] or "")}</td>'
             f'<td class="type">{html.escape(node["dataType"] or "")}</td>'
-            f'<td class="value">{html.escape(value[:60])}</td></tr>'
+            f'<td class="value">{html.escape(value)}</td></tr>'
         )
     return (
         f"<!doctype html><html><head><meta charset='utf-8'><style>{_STYLE}</style></head>"
-        f"<body><header>{html.escape(title)}</header><table>"
+        f"<body><table><caption>{html.escape(title)}</caption>"
         "<tr><th>Address space</th><th>Type definition</th><th>Data type</th><th>Value</th></tr>"
         + "".join(rows)
         + "</table></body></html>"

@@ -64,6 +64,7 @@ CLIENT_TIMEOUT_S = 120
 THRESHOLD = 500.0  # the station's recorder.wear_service_threshold: below one run's
 #: what the browser's view of the joining system shows expanded
 EXPANDED = [
+    "Identification",
     "AssetManagement",
     "AssetManagement/Assets",
     "AssetManagement/Assets/Controllers",
@@ -273,6 +274,8 @@ def _check_tree(
     [tree] = [line for line in lines if line["type"] == "tree"]
     nodes = {node["path"]: node for node in tree["nodes"]}
     assert nodes[""]["type"] == "JoiningSystemType"
+    assert nodes["Identification/SystemId"]["value"] == STATION
+    assert nodes["Identification/JoiningTechnology"]["value"] == "Tightening"
     results = [path for path in nodes if path.startswith("ResultManagement/Results/")]
     assert results == [f"ResultManagement/Results/{result_browse_name(r.run_id)}" for r in stored]
     assert {nodes[path]["type"] for path in results} == {"JoiningSystemResultType"}
