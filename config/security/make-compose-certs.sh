@@ -110,15 +110,20 @@ for name in "${opcua_clients[@]}"; do
 done
 # Its users (--users): one per client, with a password made here, given once to the
 # user file's command (which keeps only a salted hash) and kept in the client's folder.
+# A client already in the users file with its password kept is left as it is; any other
+# gets a new password (a users file made again names every client again).
 users="$server/opcua-users.toml"
+opcua_user() {
+    PYTHONPATH="$repo${PYTHONPATH:+:$PYTHONPATH}" "$python" -m services.cli opcua-user "$@"
+}
 for name in "${opcua_clients[@]}"; do
     password_file="$out/opcua-$name/password"
-    if [[ -f $password_file && -f $users ]]; then
+    if [[ -f $password_file && -f $users ]] \
+        && opcua_user list --users "$users" | cut -f1 | grep -qxF -- "$name"; then
         continue
     fi
     password=$(openssl rand -base64 24)
-    printf '%s\n' "$password" | PYTHONPATH="$repo${PYTHONPATH:+:$PYTHONPATH}" "$python" \
-        -m services.cli opcua-user add "$name" --users "$users" >/dev/null
+    printf '%s\n' "$password" | opcua_user add "$name" --users "$users" >/dev/null
     printf '%s\n' "$password" >"$password_file"
     chmod 600 "$password_file"
 done

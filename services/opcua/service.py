@@ -160,17 +160,20 @@ class OpcuaService:
 
     def _assets(self) -> dict[str, tuple[list[ToolCounters], ControllerIdentity]]:
         """Each station's tools in its wear ledger (none while it has no ledger), and its
-        controller."""
+        controller; a station whose ledger cannot be read now is left out (its figures stay as
+        they were)."""
         found: dict[str, tuple[list[ToolCounters], ControllerIdentity]] = {}
         for station in self._stations:
             path = ledger_path(station.recordings_folder)
             threshold = station.config.recorder.wear_service_threshold
-            try:
-                with WearLedger(path, read_only=True) as ledger:
-                    tools = ledger.tools(station=station.station_id)
-            except (InputError, BrokenLedgerError) as err:
-                LOG.debug("no tools of %s from %s: %s", station.station_id, path, err)
-                tools = []
+            tools = []
+            if path.exists():
+                try:
+                    with WearLedger(path, read_only=True) as ledger:
+                        tools = ledger.tools(station=station.station_id)
+                except (InputError, BrokenLedgerError) as err:
+                    LOG.debug("no tools of %s from %s now: %s", station.station_id, path, err)
+                    continue
             found[station.station_id] = (
                 [tool_counters(tool, threshold) for tool in tools],
                 controller_identity(isinstance(station, ControllerStation), tools, self._version),

@@ -66,6 +66,9 @@ _RUN_COLUMNS = (
 )
 #: where the columns of _GROUPS start in a row of _RUN_COLUMNS
 _GROUP_AT = 8
+#: rows of the scan made into Python at once (a month of a line is a million and more: as
+#: one list of tuples, 464 bytes a row)
+_BATCH_ROWS = 50_000
 #: run ids per statement when flagged tightenings are read again
 _RUNS_PER_QUERY = 500
 
@@ -85,21 +88,25 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
     figures cannot be a measurement are flagged in the same scan, left out and named."""
     everything = dataclasses.replace(query, limit=None, oldest_first=True)
     where, parameters = everything.where()
-    rows = store.database.rows(
-        f"SELECT {_RUN_COLUMNS} FROM tightenings{where}{everything.order()}", parameters
-    )
-    flagged = sorted({row[7] for row in rows if row[7] is not None})
-    refused = _refused(store, everything, flagged)
-    if flagged:
-        rows = [row for row in rows if row[7] is None]
-    read = StoredColumns(refused=list(refused.values()))
-    figures = np.array([row[:6] for row in rows], dtype=np.float64).reshape(len(rows), 6)
+    flagged: set[int] = set()
+    arrays: list[np.ndarray] = []
     nok_reasons: dict[int, list[str]] = defaultdict(list)
-    for row in rows:
-        if row[6] is not None:
-            nok_reasons[row[0]].append(row[6])
-    counted = Counter(row[_GROUP_AT:] for row in rows)
-    del rows
+    counted: Counter[tuple[Any, ...]] = Counter()
+    for batch in store.database.row_batches(
+        f"SELECT {_RUN_COLUMNS} FROM tightenings{where}{everything.order()}",
+        parameters,
+        _BATCH_ROWS,
+    ):
+        rows = [row for row in batch if row[7] is None]
+        flagged.update(row[7] for row in batch if row[7] is not None)
+        arrays.append(np.array([row[:6] for row in rows], dtype=np.float64).reshape(-1, 6))
+        for row in rows:
+            if row[6] is not None:
+                nok_reasons[row[0]].append(row[6])
+        counted.update(row[_GROUP_AT:] for row in rows)
+    figures = np.concatenate(arrays) if arrays else np.empty((0, 6))
+    refused = _refused(store, everything, sorted(flagged))
+    read = StoredColumns(refused=list(refused.values()))
     grouped: dict[int, list[tuple[Any, ...]]] = defaultdict(list)
     for (program_id, *group), runs in counted.items():
         grouped[program_id].append((*group, runs))

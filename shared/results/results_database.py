@@ -167,6 +167,21 @@ class ResultsDatabase:
         came a fifth faster than as text)."""
         return list(self._run(sql, parameters, binary=True).fetchall())
 
+    def row_batches(
+        self, sql: str, parameters: Sequence[Any], batch_rows: int
+    ) -> Iterator[list[tuple[Any, ...]]]:
+        """The rows a query gives, ``batch_rows`` at a time (PostgreSQL's in its binary
+        format): a long scan made into Python a part at a time."""
+        cursor = self._run(sql, parameters, binary=True)
+        while True:
+            try:
+                batch = cursor.fetchmany(batch_rows)
+            except (sqlite3.Error, psycopg.Error) as err:
+                raise StoreError(f"results store {self.target}: {one_line(err)}") from err
+            if not batch:
+                return
+            yield list(batch)
+
     def _run(self, sql: str, parameters: Sequence[Any], binary: bool = False) -> Any:
         try:
             if self._sqlite is not None:

@@ -14,6 +14,7 @@ deletes no recording whose results are not). Readers (``boltwatch results``,
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Iterator, Sequence
 from typing import Any
 
@@ -29,6 +30,8 @@ from shared.results.results_schema import (
 )
 from shared.results.sqlite_statistics import FEWEST_ROWS, keep_statistics
 from shared.results.stored_result import StoredResult, from_row, step_of, step_rows, to_row
+
+LOG = logging.getLogger(__name__)
 
 #: run ids of one station per statement when rows are read by key (steps, verdicts)
 _RUNS_PER_QUERY = 500
@@ -66,7 +69,7 @@ class ResultsStore:
         try:
             if create:
                 self.migrated_from = migrate(self.database)
-                self._statistics_rows = keep_statistics(self.database)
+                self._keep_statistics()
             else:
                 found = version_of(self.database)
                 if found == 0:
@@ -97,9 +100,18 @@ class ResultsStore:
                     self.database.execute_many(_INSERT_STEP, step_rows(stored))
         self._added_since_statistics += new
         if self._added_since_statistics >= max(self._statistics_rows, FEWEST_ROWS):
-            self._statistics_rows = keep_statistics(self.database)
-            self._added_since_statistics = 0
+            self._keep_statistics()
         return new
+
+    def _keep_statistics(self) -> None:
+        """SQLite's planner statistics brought up to date (:mod:`.sqlite_statistics`), as best
+        effort: the results are stored whether they can be or not (a busy store, an index
+        they cannot describe); a failure is logged and tried again after as many adds."""
+        self._added_since_statistics = 0
+        try:
+            self._statistics_rows = keep_statistics(self.database)
+        except StoreError as err:
+            LOG.warning("results store %s: planner statistics not written: %s", self.target, err)
 
     def find(self, query: ResultsQuery) -> list[StoredResult]:
         """The tightenings ``query`` asks for, with their steps, in its order."""

@@ -23,8 +23,12 @@ documentation allows (https://sqlite.org/fileformat2.html#stat1tab), for the
 - the index's further columns (an end time, a run id) find one row.
 
 They are written at the writer's open and again whenever the rows have
-doubled since, in one short transaction; a store of fewer than
-:data:`FEWEST_ROWS` rows keeps SQLite's guesses (any plan is quick there).
+doubled since or an index has none (one made by a later migration), in one
+short transaction; a store of fewer than :data:`FEWEST_ROWS` rows keeps
+SQLite's guesses (any plan is quick there), and so does an index on an
+expression (none of the store's own). The writer takes them as best effort:
+a failure is logged and tried again later, its results stored all the same
+(:class:`~.results_store.ResultsStore`).
 Each connection opened after reads them; PostgreSQL keeps its own
 (autovacuum's ``ANALYZE``).
 """
@@ -52,13 +56,17 @@ def keep_statistics(database: ResultsDatabase) -> int:
         ((rows,),) = database.rows(f"SELECT COALESCE(MAX(rowid), 0) FROM {TABLE}")
         if rows < FEWEST_ROWS:
             return 0
-        written = _written_for(database)
-        if written and rows < 2 * written:
+        indexes = {
+            name: columns
+            for (name,) in database.rows(
+                "SELECT name FROM sqlite_master WHERE type = 'index' AND tbl_name = ?", (TABLE,)
+            )
+            if None not in (columns := _columns(database, name))  # not on an expression
+        }
+        written, described = _written_for(database)
+        if written and rows < 2 * written and described >= set(indexes):
             return written
-        indexes = database.rows(
-            "SELECT name FROM sqlite_master WHERE type = 'index' AND tbl_name = ?", (TABLE,)
-        )
-        lines = [(name, _index_stat(database, name, rows)) for (name,) in indexes]
+        lines = [(name, _index_stat(database, columns, rows)) for name, columns in indexes.items()]
         database.execute("ANALYZE sqlite_schema")  # makes sqlite_stat1 where there is none
         database.execute("DELETE FROM sqlite_stat1 WHERE tbl = ?", (TABLE,))
         database.execute_many(
@@ -72,23 +80,33 @@ def keep_statistics(database: ResultsDatabase) -> int:
 def statistics_rows(database: ResultsDatabase) -> int:
     """The rows the store's statistics were written for (0: none)."""
     with database.transaction():
-        return _written_for(database)
+        return _written_for(database)[0]
 
 
-def _written_for(database: ResultsDatabase) -> int:
+def _written_for(database: ResultsDatabase) -> tuple[int, set[str]]:
+    """The rows the statistics were written for (0: none), and the indexes they describe."""
     if not database.rows("SELECT name FROM sqlite_master WHERE name = 'sqlite_stat1'"):
-        return 0
+        return 0, set()
     found = database.rows(
-        "SELECT stat FROM sqlite_stat1 WHERE tbl = ? AND idx IS NOT NULL LIMIT 1", (TABLE,)
+        "SELECT idx, stat FROM sqlite_stat1 WHERE tbl = ? AND idx IS NOT NULL", (TABLE,)
     )
-    return int(found[0][0].split()[0]) if found else 0
+    return (int(found[0][1].split()[0]) if found else 0), {name for name, _stat in found}
 
 
-def _index_stat(database: ResultsDatabase, index: str, rows: int) -> str:
-    """``sqlite_stat1``'s line of ``index``: its rows, the rows per value of its first
-    column, and 1 for each further column."""
-    columns = [row[2] for row in database.rows(f"PRAGMA index_info({index})")]
-    first = columns[0]
+def _quoted(name: str) -> str:
+    """An SQL identifier, quoted."""
+    return '"' + name.replace('"', '""') + '"'
+
+
+def _columns(database: ResultsDatabase, index: str) -> list[str | None]:
+    """The columns of ``index`` in order (None: an expression)."""
+    return [row[2] for row in database.rows(f"PRAGMA index_info({_quoted(index)})")]
+
+
+def _index_stat(database: ResultsDatabase, columns: list[str | None], rows: int) -> str:
+    """``sqlite_stat1``'s line of an index on ``columns``: its rows, the rows per value of
+    its first column, and 1 for each further column."""
+    first = _quoted(str(columns[0]))
     values, value = 0, None
     while values < SEEKS:
         after = "" if value is None else f" WHERE {first} > ?"

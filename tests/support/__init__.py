@@ -34,8 +34,9 @@ with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
   :mod:`.old_results_store` (a results store as an older boltwatch left it)
 - deployment: :mod:`.compose_layout`, :mod:`.compose_line` (the compose TLS line's
   services run on loopback), :mod:`.access_rules`
-- OPC UA: :mod:`.opcua_client` (node-opcua's client as a process), :mod:`.opcua_certificates`,
-  :mod:`.address_space_picture` (a browser's view of the address space, photographed)
+- OPC UA: :mod:`.opcua_client` (node-opcua's client as a process: ``opcua_client.js``,
+  with ``opcua_browse_tree.js``, a browser's tree of the address space),
+  :mod:`.opcua_certificates`, :mod:`.address_space_picture` (that tree, photographed)
 - pictures: :mod:`.chromium` (Debian's chromium for playwright)
 - :mod:`.fuzz` (hostile payloads for the live services), :mod:`.bad_arguments`
   (every bad argument of every command)

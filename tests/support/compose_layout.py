@@ -73,10 +73,15 @@ def load_merged(files: list[Path], env: Mapping[str, str]) -> dict[str, Any]:
     return merged
 
 
-def make_compose_certs(out: Path, extra_identities: tuple[str, ...] = ()) -> None:
+def make_compose_certs(
+    out: Path, extra_identities: tuple[str, ...] = (), opcua_clients: tuple[str, ...] = ()
+) -> None:
     """The identities of docker-compose.tls.yml, by config/security/make-compose-certs.sh
-    (and ``extra_identities``, its ``EXTRA_IDENTITIES``)."""
+    (and ``extra_identities``, its ``EXTRA_IDENTITIES``; ``opcua_clients``, its
+    ``OPCUA_CLIENTS``: none, its default)."""
     env = os.environ | {"EXTRA_IDENTITIES": " ".join(extra_identities)}
+    if opcua_clients:
+        env["OPCUA_CLIENTS"] = " ".join(opcua_clients)
     script = [str(CERTS_SCRIPT), str(out)]
     subprocess.run(script, check=True, capture_output=True, cwd=out.parent, env=env)
 

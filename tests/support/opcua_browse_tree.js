@@ -4,10 +4,10 @@
 // From the joining system down, each node's hierarchical children (HasChild, Organizes...)
 // in the server's order; a node is expanded when its path (browse names without their
 // namespaces, from the joining system: "ResultManagement/Results"; "*" stands for any one
-// name) is one of "expand", and shown collapsed otherwise. Each node: {depth, path, name, nodeClass ("Object",
-// "Variable", "Method"...), type (its type definition's browse name), dataType, value (a
-// scalar as it is, a structure by its type's name, an array by its length), children (how
-// many)}.
+// name) is one of "expand", and shown collapsed otherwise. Each node: {depth, path, name,
+// nodeClass ("Object", "Variable", "Method"...), type (its type definition's browse name),
+// dataType, value (a scalar as it is, a structure by its type's name, an array by its
+// length), children (how many)}.
 "use strict";
 const { AttributeIds, BrowseDirection, NodeClass } = require("node-opcua-client");
 
@@ -86,7 +86,8 @@ async function browseTree(session, rootId, rootName, expand) {
         referenceTypeId: "HasTypeDefinition",
         browseDirection: BrowseDirection.Forward,
     });
-    const rootType = typed.references && typed.references.length ? typed.references[0].nodeId : null;
+    const found = typed.references || [];
+    const rootType = found.length ? found[0].nodeId : null;
     await visit(rootId, rootName, NodeClass.Object, rootType, 0, "");
     return nodes;
 }

@@ -142,3 +142,19 @@ def test_running_the_script_again_keeps_the_certificate_clients_trust(
     password = f"opcua-{CLIENT}/password"
     assert (again / password).read_bytes() == (certs / password).read_bytes()
     assert [p.name for p in (again / "opcua-ca").glob("*.key")] == ["ca.key"]
+
+
+def test_a_users_file_made_again_names_every_client_again(certs: Path, tmp_path: Path) -> None:
+    """The users file lost, the script run again for two clients: both are in the new file,
+    each with the password left in its folder (the kept password of the first one is not
+    taken for a user the new file does not have)."""
+    again = tmp_path / "certs"
+    shutil.copytree(certs, again, symlinks=True)
+    make_compose_certs(again, opcua_clients=(CLIENT, "plc"))  # plc: a second client
+    (again / "opcua-server" / USERS).unlink()
+    make_compose_certs(again, opcua_clients=(CLIENT, "plc"))
+    users = read_users(again / "opcua-server" / USERS)
+    assert set(users) == {CLIENT, "plc"}
+    for name in (CLIENT, "plc"):
+        password = (again / f"opcua-{name}" / "password").read_text().removesuffix("\n")
+        assert verify(password, users[name].password_hash), name

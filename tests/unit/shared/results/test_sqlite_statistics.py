@@ -5,7 +5,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from shared.results import ResultsQuery, ResultsStore, StoreTarget, stored_result
+import pytest
+
+from shared.errors import StoreError
+from shared.results import ResultsQuery, ResultsStore, StoreTarget, results_store, stored_result
 from shared.results.sqlite_statistics import FEWEST_ROWS, keep_statistics, statistics_rows
 from tests.support import factories
 
@@ -100,3 +103,32 @@ def test_postgresql_keeps_its_own(postgres_url: str) -> None:
     with ResultsStore(StoreTarget(postgres_url=postgres_url)) as store:
         _add(store, 0, 400)
         assert keep_statistics(store.database) == 0
+
+
+def test_an_index_on_an_expression_is_left_to_sqlite_and_a_new_index_is_described(
+    tmp_path: Path,
+) -> None:
+    target = StoreTarget(sqlite_path=tmp_path / "results.sqlite")
+    with ResultsStore(target) as store:
+        _add(store, 0, 500)
+        with store.database.transaction():
+            store.database.execute("CREATE INDEX by_lower_part ON tightenings (lower(part_id))")
+            store.database.execute('CREATE INDEX "by ""tool"" id" ON tightenings (tool_id)')
+        assert keep_statistics(store.database) == 1500  # not doubled, but an index is new
+        stat = _stat1(store)
+    assert stat['by "tool" id'] == "1500 1500"  # one tool; the index's one column
+    assert "by_lower_part" not in stat
+
+
+def test_statistics_that_cannot_be_written_do_not_keep_a_result_from_the_store(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    def refused(database: object) -> int:
+        raise StoreError("results store: database is locked")
+
+    monkeypatch.setattr(results_store, "keep_statistics", refused)
+    target = StoreTarget(sqlite_path=tmp_path / "results.sqlite")
+    with ResultsStore(target) as store:  # the writer's open tries them too
+        _add(store, 0, FEWEST_ROWS // 3 + 1)
+        assert store.count(ResultsQuery()) == 3 * (FEWEST_ROWS // 3 + 1)
+    assert "planner statistics not written: results store: database is locked" in caplog.text
