@@ -24,11 +24,14 @@ field of ResultMetaData  comparisons                         ResultsQuery
   ``And``\\ s, each by an ``ElementOperand`` to a later element). An empty or null
   filter asks for every result of the station.
 - A comparison holds a field and a ``LiteralOperand``, in either order. A
-  value no result can have (ResultEvaluation 3, a program id that is no number,
-  another station's ResultId, two different PartIds) matches nothing: no query.
+  value no result can have (ResultEvaluation 3, a ResultId or program id not as
+  the server writes one (:func:`~.result_values.parse_result_id`), another
+  station's ResultId, two different PartIds) matches nothing: no query.
 - ``CreationTime`` is the end of the run to the microsecond (what the server
   sends: :func:`~.result_values.utc_time`), compared with a literal's whole
-  microseconds, so a bound is exact against the store's nanoseconds.
+  microseconds, so a bound is exact against the store's nanoseconds; a bound
+  beyond an int64's nanoseconds (before 1677, after 2262) is no bound, or
+  matches nothing (``> 9999-12-31``).
 - Names in a path are compared in the Machinery/Result namespace or without one
   (a structure's field names have none); the ``TypeDefinitionId`` is not looked at;
   ``AttributeId`` is Value, ``IndexRange`` empty.
@@ -38,7 +41,9 @@ field of ResultMetaData  comparisons                         ResultsQuery
   ``SequenceNumber``, or a comparison it does not have (``Bad_NotSupported``);
   an operand of another kind, a literal of the wrong type, a wrong count of
   operands (``Bad_FilterOperandInvalid``, ``Bad_FilterOperandCountMismatch``); an
-  ``ElementOperand`` to no later element (``Bad_FilterElementInvalid``).
+  ``ElementOperand`` to no later element, or to one another operand refers to
+  (``Bad_FilterElementInvalid``: each element is read once); more than
+  :data:`MAX_FILTER_ELEMENTS` elements (``Bad_ContentFilterInvalid``).
 - ``OrderedBy`` empty or null: newest first (the spec leaves the order to the
   server); ``[CreationTime]``: oldest first (a criterion has no direction: it
   ascends); anything else ``Bad_NotSupported``.
@@ -52,17 +57,27 @@ from typing import Any
 
 from asyncua import ua
 
-from services.opcua.result_values import EPOCH, EVALUATION_NOT_OK, EVALUATION_OK
+from services.opcua.result_values import (
+    EPOCH,
+    EVALUATION_NOT_OK,
+    EVALUATION_OK,
+    parse_id,
+    parse_result_id,
+)
+from shared.contract import INT64_MAX
 from shared.results import ResultsQuery
 
 #: the input arguments of GetResultIdListFiltered, by their index
 FILTER_ARGUMENT = 0
 ORDERED_BY_ARGUMENT = 1
+#: the elements of a filter at most (five fields, a few comparisons each, and their Ands)
+MAX_FILTER_ELEMENTS = 64
 #: the path of a field of the result's metadata: ResultType's, or the event's Result
 METADATA_PATHS = (("ResultMetaData",), ("Result", "ResultMetaData"))
 #: the fields of ResultMetaData the results store filters on
 FIELDS = ("CreationTime", "ResultEvaluation", "PartId", "InternalRecipeId", "ResultId")
 _MICROSECOND = timedelta(microseconds=1)
+_INT64_MIN = -INT64_MAX - 1
 _VERDICT_OF_EVALUATION = {EVALUATION_OK: "OK", EVALUATION_NOT_OK: "NOK"}
 _Op = ua.FilterOperator
 _MIRRORED = {  # literal first: the comparison seen from the field
@@ -99,28 +114,48 @@ def filtered_query(
     if not elements:
         return query
     try:
-        return _element(elements, 0, query, station, result_ns)
+        return _walked(elements, query, station, result_ns)
     except _NoMatchError:
         return None
 
 
-def _element(
-    elements: list[Any], index: int, query: ResultsQuery, station: str, result_ns: int
-) -> ResultsQuery:
-    element = elements[index]
-    operator, operands = element.FilterOperator, list(element.FilterOperands or [])
-    if operator == _Op.And:
+def _walked(elements: list[Any], query: ResultsQuery, station: str, result_ns: int) -> ResultsQuery:
+    """``query`` with the criteria of the element 0 and every element its ``And``\\ s join,
+    walked with a list of the elements still to read (no recursion); an element that two
+    operands refer to is refused (walking it once per reference was exponential)."""
+    if len(elements) > MAX_FILTER_ELEMENTS:
+        raise _refused(
+            ua.StatusCodes.BadContentFilterInvalid,
+            f"{len(elements)} elements: at most {MAX_FILTER_ELEMENTS}",
+        )
+    referred = {0}
+    waiting = [0]
+    while waiting:
+        index = waiting.pop()
+        element = elements[index]
+        operator, operands = element.FilterOperator, list(element.FilterOperands or [])
+        if operator != _Op.And:
+            query = _criterion(operator, operands, query, station, result_ns)
+            continue
         _count(operands, 2)
         for operand in operands:
             if not isinstance(operand, ua.ElementOperand):
                 raise _refused(ua.StatusCodes.BadFilterOperandInvalid, "And joins elements")
-            if not index < operand.Index < len(elements):
+            if not index < operand.Index < len(elements) or operand.Index in referred:
                 raise _refused(
                     ua.StatusCodes.BadFilterElementInvalid,
-                    f"element {index} refers to element {operand.Index}: not a later one",
+                    f"element {index} refers to element {operand.Index}: not a later one, or "
+                    "one another operand refers to",
                 )
-            query = _element(elements, operand.Index, query, station, result_ns)
-        return query
+            referred.add(operand.Index)
+        waiting.extend(operand.Index for operand in reversed(operands))  # the first first
+    return query
+
+
+def _criterion(
+    operator: Any, operands: list[Any], query: ResultsQuery, station: str, result_ns: int
+) -> ResultsQuery:
+    """``query`` with the criterion of a comparison or a Between."""
     if operator == _Op.Between:
         _count(operands, 3)
         field, low, high = operands
@@ -155,11 +190,10 @@ def _compare(
     text = _literal(literal, str)
     if name == "PartId":
         return _same(query, "part_id", text)
-    prefix, run = ("", text) if name == "InternalRecipeId" else text.rpartition("/")[::2]
-    number = int(run) if run.lstrip("-").isdigit() and str(int(run)) == run else None
     if name == "InternalRecipeId":
-        return _same(query, "program_id", number)
-    return _same(query, "run_id", number if prefix == station else None)
+        return _same(query, "program_id", parse_id(text))
+    parsed = parse_result_id(text)
+    return _same(query, "run_id", parsed[1] if parsed and parsed[0] == station else None)
 
 
 def _same(query: ResultsQuery, criterion: str, value: Any) -> ResultsQuery:
@@ -172,19 +206,25 @@ def _same(query: ResultsQuery, criterion: str, value: Any) -> ResultsQuery:
 def _time(query: ResultsQuery, operator: Any, when: datetime) -> ResultsQuery:
     """``query`` within a bound on CreationTime: a result's is its end's whole microseconds,
     ``ended_ns // 1000``; against a literal's ``t`` µs, ``>= t`` is ``ended_ns >= t * 1000``
-    and ``> t`` is ``>= (t + 1) * 1000`` (``<`` and ``<=`` likewise, on ``until_ns``)."""
+    and ``> t`` is ``>= (t + 1) * 1000`` (``<`` and ``<=`` likewise, on ``until_ns``).
+
+    A bound beyond the nanoseconds an int64 holds (before 1677-09-21, after 2262-04-11; the
+    store's ``ended_ns`` is one) is no bound on the side every end is within, and matches
+    nothing on the other (e.g. ``< 9999-12-31`` every result, ``> 9999-12-31`` none)."""
     if when.tzinfo is None:
         when = when.replace(tzinfo=UTC)
     micros = (when - EPOCH) // _MICROSECOND
     since = {_Op.GreaterThanOrEqual: micros, _Op.GreaterThan: micros + 1, _Op.Equals: micros}
     until = {_Op.LessThan: micros, _Op.LessThanOrEqual: micros + 1, _Op.Equals: micros + 1}
-    if operator in since:
-        bound = since[operator] * 1000
+    if operator in since and (bound := since[operator] * 1000) > _INT64_MIN:
+        if bound > INT64_MAX:
+            raise _NoMatchError
         query = replace(
             query, since_ns=bound if query.since_ns is None else max(bound, query.since_ns)
         )
-    if operator in until:
-        bound = until[operator] * 1000
+    if operator in until and (bound := until[operator] * 1000) <= INT64_MAX:
+        if bound <= _INT64_MIN:
+            raise _NoMatchError
         query = replace(
             query, until_ns=bound if query.until_ns is None else min(bound, query.until_ns)
         )

@@ -49,7 +49,7 @@ from asyncua.ua.ua_binary import struct_from_binary
 from services.opcua.result_encoding import result_data
 from services.opcua.result_filter import UnsupportedFilterError, filtered_query
 from services.opcua.result_trace import recorded_samples, trace_values
-from services.opcua.result_values import result_id, result_values
+from services.opcua.result_values import parse_result_id, result_id, result_values
 from shared.errors import InputError, StoreError
 from shared.recordings import writing_path
 from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget
@@ -81,10 +81,10 @@ def _stored(target: StoreTarget, query: ResultsQuery) -> list[StoredResult]:
 
 def stored_by_id(target: StoreTarget, station: str, identifier: str) -> StoredResult | None:
     """The stored tightening whose ResultId is ``identifier``, if it is ``station``'s."""
-    prefix, _, run = identifier.rpartition("/")
-    if prefix != station or not run.isdigit():
+    parsed = parse_result_id(identifier)
+    if parsed is None or parsed[0] != station:
         return None
-    found = _stored(target, ResultsQuery(stations=[station], run_id=int(run), limit=1))
+    found = _stored(target, ResultsQuery(stations=[station], run_id=parsed[1], limit=1))
     return found[0] if found else None
 
 

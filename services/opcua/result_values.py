@@ -48,11 +48,12 @@ run that the tool aborted is still a completed result, NOK.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 from typing import Any
 
-from shared.contract import JudgedFigure, ResultStep, TighteningResult
+from shared.contract import INT64_MAX, JudgedFigure, ResultStep, TighteningResult
 
 #: JoiningResultMetaDataType.Classification of one tightening's result
 CLASSIFICATION_SINGLE = 1
@@ -112,6 +113,7 @@ _EVALUATION_OF_STEP = {
 
 
 EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
+_ID = re.compile(r"0|[1-9][0-9]*")
 
 
 def utc_time(time_ns: int) -> datetime:
@@ -124,6 +126,23 @@ def utc_time(time_ns: int) -> datetime:
 def result_id(station: str, run_id: int) -> str:
     """The ResultId of a station's run (unique in the results store)."""
     return f"{station}/{run_id}"
+
+
+def parse_id(text: str) -> int | None:
+    """The run or program id ``text`` is as the server writes one (``str(id)``: ASCII digits,
+    no sign, no leading zero, at most :data:`~shared.contract.INT64_MAX`); None for any other
+    text, which no result has."""
+    if _ID.fullmatch(text) is None or int(text) > INT64_MAX:
+        return None
+    return int(text)
+
+
+def parse_result_id(text: str) -> tuple[str, int] | None:
+    """The station and run id of the ResultId ``text`` (what :func:`result_id` gives); None
+    for a text it never gives."""
+    station, _, run = text.rpartition("/")
+    run_id = parse_id(run)
+    return None if not station or run_id is None else (station, run_id)
 
 
 def result_values(result: TighteningResult, trace: dict[str, Any] | None = None) -> dict[str, Any]:

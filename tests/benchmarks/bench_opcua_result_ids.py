@@ -31,7 +31,7 @@ from services.opcua.result_requests import result_ids
 from shared.results import ResultsQuery, ResultsStore, StoreTarget, store_target, stored_result
 from tests.support import factories
 
-S = 1_000_000_000
+SECOND_NS = 1_000_000_000
 
 
 def fill(folder: Path, count: int) -> StoreTarget:
@@ -43,7 +43,7 @@ def fill(folder: Path, count: int) -> StoreTarget:
                 for station in ("st1", "st2"):
                     verdict = "NOK" if run % 10 == 0 else "OK"
                     result = factories.result(
-                        run, station=station, time_ns=factories.T0 + run * S, result=verdict
+                        run, station=station, time_ns=factories.T0 + run * SECOND_NS, result=verdict
                     )
                     batch.append(stored_result(result, "", None, "h", 1))
             store.add(batch)
@@ -56,11 +56,11 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
     every = ResultsQuery(stations=["st1"], limit=None)
-    last_s = factories.T0 + args.results * S
+    last_ns = factories.T0 + args.results * SECOND_NS
     filters = {
         "every result (MaxResults 0)": (every, 0),
         "NOK (ResultEvaluation 2)": (replace(every, verdict="NOK"), 0),
-        "the last hour (CreationTime >=)": (replace(every, since_ns=last_s - 3600 * S), 0),
+        "the last hour (CreationTime >=)": (replace(every, since_ns=last_ns - 3600 * SECOND_NS), 0),
         "the newest 100 (MaxResults 100)": (every, 100),
     }
     with tempfile.TemporaryDirectory() as scratch:

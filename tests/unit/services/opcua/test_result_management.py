@@ -13,6 +13,7 @@ import asyncio
 import threading
 from collections.abc import Iterator
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
@@ -46,11 +47,17 @@ if missing_files(nodeset_folder()):
         allow_module_level=True,
     )
 
-S = 1_000_000_000
+SECOND_NS = 1_000_000_000
 #: the ends of st1's runs 1 to 3 (run 1's half a microsecond past a whole one) and st2's 4
-ENDED_NS = {1: factories.T0 + S + 500, 2: factories.T0 + 2 * S, 3: factories.T0 + 3 * S}
-ST2_ENDED_NS = factories.T0 + 4 * S
+ENDED_NS = {
+    1: factories.T0 + SECOND_NS + 500,
+    2: factories.T0 + 2 * SECOND_NS,
+    3: factories.T0 + 3 * SECOND_NS,
+}
+ST2_ENDED_NS = factories.T0 + 4 * SECOND_NS
 SAMPLES = 12  # of run 3 in its recording
+#: times beyond the nanoseconds since 1970 an int64 holds (1677 to 2262)
+YEAR_9999, YEAR_1601 = datetime(9999, 12, 31), datetime(1601, 1, 2)
 Op = ua.FilterOperator
 
 
@@ -176,7 +183,11 @@ def _literal(value: Any, kind: ua.VariantType = ua.VariantType.String) -> ua.Lit
 
 def _created(run: int) -> ua.LiteralOperand:
     """Run ``run``'s CreationTime as the server sends it (whole microseconds)."""
-    return _literal(utc_time(ENDED_NS[run]), ua.VariantType.DateTime)
+    return _at(utc_time(ENDED_NS[run]))
+
+
+def _at(when: datetime) -> ua.LiteralOperand:
+    return _literal(when, ua.VariantType.DateTime)
 
 
 def test_the_latest_result_is_the_stations_newest_with_its_trace(served: Served) -> None:
@@ -228,6 +239,20 @@ FILTERS = {
     "at": (((Op.Equals, ["CreationTime", _created(1)]),), ["st1/1"]),
     "literal-first": (((Op.LessThan, [_created(2), "CreationTime"]),), ["st1/3"]),
     "between": (((Op.Between, ["CreationTime", _created(1), _created(2)]),), ["st1/2", "st1/1"]),
+    # beyond an int64's nanoseconds: no bound, or no result
+    "until-9999": (
+        ((Op.LessThan, ["CreationTime", _at(YEAR_9999)]),),
+        ["st1/3", "st1/2", "st1/1"],
+    ),
+    "after-9999": (
+        ((Op.GreaterThan, ["CreationTime", _at(YEAR_9999)]),),
+        [],
+    ),
+    "since-1601": (
+        ((Op.GreaterThanOrEqual, ["CreationTime", _at(YEAR_1601)]),),
+        ["st1/3", "st1/2", "st1/1"],
+    ),
+    "at-1601": (((Op.Equals, ["CreationTime", _at(YEAR_1601)]),), []),
     "an-empty-range": (
         (
             (Op.And, [ua.ElementOperand(1), ua.ElementOperand(2)]),
@@ -336,3 +361,14 @@ def test_handle_0_is_released_and_arguments_are_checked(served: Served) -> None:
     ]
     by_id = served.call("GetResultById", ua.Variant("st1/2", ua.VariantType.String), zero)
     assert by_id.OutputArguments[1].Value.ResultMetaData.ResultId == "st1/2"
+
+
+def test_an_id_the_server_never_gives_is_unknown_to_both_methods(served: Served) -> None:
+    """Not digits, a sign, a leading zero, beyond an int64: no result of either method."""
+    result_id = served.field("ResultMetaData", "ResultId")
+    zero = ua.Variant(0, ua.VariantType.Int32)
+    for text in ("st1/--5", "st1/²", "st1/-5", "st1/02", "st1/9223372036854775808"):
+        by_id = served.call("GetResultById", ua.Variant(text, ua.VariantType.String), zero)
+        assert by_id.StatusCode.is_good(), (text, by_id.StatusCode)
+        assert by_id.OutputArguments[2].Value == ERROR_UNKNOWN_RESULT, text
+        assert served.ids(_filter((Op.Equals, [result_id, _literal(text)]))) == [], text

@@ -8,11 +8,12 @@ from services.opcua.result_values import (
     DEGREE,
     NEWTON,
     NEWTON_METRE,
+    parse_result_id,
     result_id,
     result_values,
     utc_time,
 )
-from shared.contract import JudgedFigure
+from shared.contract import INT64_MAX, JudgedFigure
 from tests.support import factories
 
 
@@ -72,3 +73,11 @@ def test_a_creation_time_is_the_end_s_whole_microseconds_exactly() -> None:
     """1 999 ns past a whole second is 1 µs (a float of the seconds since 1970 made it 2)."""
     second = datetime.fromtimestamp(factories.T0 // 1_000_000_000, tz=UTC)
     assert utc_time(factories.T0 + 1_999) == second + timedelta(microseconds=1)
+
+
+def test_a_result_id_reads_back_and_no_other_text_is_one() -> None:
+    assert parse_result_id(result_id("line 2/st1", 0)) == ("line 2/st1", 0)
+    assert parse_result_id(result_id("st1", INT64_MAX)) == ("st1", INT64_MAX)
+    for text in ("st1/--5", "st1/²", "st1/٣", "st1/-5", "st1/+5", "st1/05", "st1/", "/5", "5"):
+        assert parse_result_id(text) is None, text
+    assert parse_result_id(f"st1/{INT64_MAX + 1}") is None
