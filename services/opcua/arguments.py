@@ -31,9 +31,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "Tightening): one joining system per station, each tightening result of "
         "boltwatch/<station>/results as a JoiningResultDataType in its ResultManagement "
         "and a result-ready event; the newest results of the results store at start; "
-        "ResultManagement's GetResultById gives any stored result with its trace (the "
-        "recording's samples); the tools of the wear ledger with their counters in "
-        "AssetManagement. "
+        "ResultManagement's methods give any stored result with its trace (the "
+        "recording's samples) and the ids a filter matches; the tools of the wear "
+        "ledger with their counters in AssetManagement. "
         "Default security: Basic256Sha256 sign and encrypt with --certificate, "
         "--private-key and --trusted-clients, and a user name and password of --users for "
         "every session (docs/how-to/opcua.md). The OPC UA models "
@@ -72,11 +72,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="FILE",
         help="the users (names, salted password hashes: `boltwatch opcua-user add`); every "
-        "session logs in with one (with --anonymous-read-only: anonymous sessions too)",
+        "session logs in with one (not with --anonymous-read-only)",
     )
     security.add_argument(
         "--anonymous-read-only",
         action="store_true",
         help="also serve without security to anonymous clients (read only): only on a "
-        "network where anyone may read the line's results",
+        "network where anyone may read the line's results; not with --users (a password "
+        "could travel in clear)",
     )

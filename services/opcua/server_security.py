@@ -20,10 +20,11 @@ endpoint is Basic256Sha256 Sign & Encrypt and every session needs a user:
 ``--anonymous-read-only`` adds an endpoint without security (None) and the
 anonymous user, on every endpoint (asyncua offers one set of user tokens for
 all; an anonymous session on the encrypted endpoint reads no more than one on
-None): anyone who reaches the port reads the address space. With ``--users``
-too, the users' names and passwords are checked as above. ``--users`` needs the
-server's certificate: a password never travels in clear. Nothing in the address
-space is writable by a client in any mode; every user is a reader.
+None): anyone who reaches the port reads the address space. It is refused with
+``--users``: asyncua would offer the UserName token on the None endpoint too and
+take its password in clear (a UserName token without an EncryptionAlgorithm),
+so a password could cross the network unencrypted. Nothing in the address space
+is writable by a client in any mode; every user is a reader.
 """
 
 from __future__ import annotations
@@ -67,6 +68,11 @@ class SecuritySettings:
             "--trusted-clients": self.trusted_clients,
             "--users": self.users,
         }
+        if self.anonymous_read_only and self.users is not None:
+            raise ConfigError(
+                "give --users or --anonymous-read-only, not both: asyncua would offer user "
+                "names on the endpoint without security too and take a password there in clear"
+            )
         if not self.anonymous_read_only:
             missing = [name for name, path in given.items() if path is None]
             if missing:
@@ -76,11 +82,6 @@ class SecuritySettings:
                 )
         if (self.certificate is None) != (self.private_key is None):
             raise ConfigError("give --certificate and --private-key together")
-        if self.users is not None and self.certificate is None:
-            raise ConfigError(
-                "--users needs --certificate and --private-key (Basic256Sha256 sign and "
-                "encrypt: a password never travels in clear)"
-            )
         for name, path in given.items():
             if path is None:
                 continue
@@ -140,11 +141,11 @@ class PasswordUsers(UserManager):
     """asyncua's user manager: a session's user from its token (None: refused).
 
     asyncua asks it at each ActivateSession, in the server's loop, with the name and
-    the password of a UserName token (decrypted), or no name for an anonymous one."""
+    the password of a UserName token (decrypted), or no name for an anonymous one (refused:
+    the users file and anonymous sessions do not go together)."""
 
-    def __init__(self, users: Mapping[str, OpcuaUser], anonymous: bool) -> None:
+    def __init__(self, users: Mapping[str, OpcuaUser]) -> None:
         self._users = dict(users)
-        self._anonymous = anonymous
 
     def get_user(
         self,
@@ -154,7 +155,7 @@ class PasswordUsers(UserManager):
         certificate: Any = None,
     ) -> User | None:
         if username is None:
-            return User(role=UserRole.User) if self._anonymous else None
+            return None
         user = self._users.get(username)
         # one scrypt either way: a refusal takes as long for a wrong name as a wrong password
         if user is None:
@@ -182,7 +183,7 @@ async def apply(server: Server, settings: SecuritySettings) -> None:
                 settings.users,
             )
         users = server_users(settings.users)
-        server.iserver.set_user_manager(PasswordUsers(users, settings.anonymous_read_only))
+        server.iserver.set_user_manager(PasswordUsers(users))
     if settings.secure:
         assert settings.certificate is not None and settings.private_key is not None
         await server.set_application_uri(application_uri_of(settings.certificate))

@@ -23,6 +23,7 @@ from asyncua.crypto.uacrypto import CertProperties
 from services.opcua.password_hashes import hash_password
 from services.opcua.server_security import SecuritySettings, apply
 from services.opcua.users_file import OpcuaUser, write_users
+from shared.errors import ConfigError
 from tests.support.live_recorder import free_port
 from tests.support.opcua_certificates import (
     OpcuaCertificates,
@@ -158,7 +159,23 @@ def test_a_session_without_a_user_is_refused_and_only_user_names_are_offered(
     assert [t.TokenType for t in offered[0].UserIdentityTokens] == [ua.UserTokenType.UserName]
 
 
-def test_anonymous_read_only_with_users_lets_anonymous_read_and_still_checks_passwords(
+def test_anonymous_read_only_with_users_is_refused_at_start(
+    certificates: OpcuaCertificates, users_file: Path
+) -> None:
+    """asyncua would offer the UserName token on the None endpoint too and take its
+    password in clear."""
+    settings = SecuritySettings(
+        certificate=certificates.server_certificate,
+        private_key=certificates.server_key,
+        trusted_clients=certificates.trusted_clients,
+        users=users_file,
+        anonymous_read_only=True,
+    )
+    with pytest.raises(ConfigError, match="give --users or --anonymous-read-only, not both"):
+        asyncio.run(apply(Server(), settings))  # refused before the server is touched
+
+
+def test_a_users_file_anyone_on_the_host_may_read_is_warned_of(
     certificates: OpcuaCertificates,
     users_file: Path,
     tmp_path: Path,
@@ -172,11 +189,13 @@ def test_anonymous_read_only_with_users_lets_anonymous_read_and_still_checks_pas
         private_key=certificates.server_key,
         trusted_clients=certificates.trusted_clients,
         users=readable,
-        anonymous_read_only=True,
     )
-    with caplog.at_level(logging.WARNING, "services.opcua"), serving(settings) as endpoint:
-        assert _session_state(endpoint, certificates, None, None) == ua.ServerState.Running
-        assert _session_state(endpoint, certificates, USER, PASSWORD) == ua.ServerState.Running
-        with pytest.raises(ua.uaerrors.BadUserAccessDenied):
-            _session_state(endpoint, certificates, USER, "wrong")
+
+    async def secure() -> None:
+        server = Server()
+        await server.init()
+        await apply(server, settings)
+
+    with caplog.at_level(logging.WARNING, "services.opcua"):
+        asyncio.run(secure())
     assert f"--users {readable}: anyone on this host may read it" in caplog.text

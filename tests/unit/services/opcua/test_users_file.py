@@ -95,19 +95,20 @@ def test_a_bad_users_file_names_the_file_and_the_key(
     assert expected in str(raised.value), raised.value
 
 
-def test_the_server_refuses_a_users_file_without_users_or_without_its_certificate(
+def test_the_server_refuses_a_users_file_without_users_or_with_anonymous_sessions(
     tmp_path: Path,
 ) -> None:
     path = tmp_path / "users.toml"
     write_users(path, {})
     certificate = tmp_path / "server.pem"
     certificate.write_text("not read by check")
-    settings = SecuritySettings(certificate, certificate, None, path, anonymous_read_only=True)
+    settings = SecuritySettings(certificate, certificate, tmp_path, path)
     with pytest.raises(ConfigError, match=r"--users .*users.toml: users: no user \(add one"):
         settings.check()
-    plain = SecuritySettings(None, None, None, path, anonymous_read_only=True)
-    with pytest.raises(ConfigError, match="--users needs --certificate and --private-key"):
-        plain.check()
+    for certificates in (certificate, None):
+        both = SecuritySettings(certificates, certificates, None, path, anonymous_read_only=True)
+        with pytest.raises(ConfigError, match="give --users or --anonymous-read-only, not both"):
+            both.check()
     default = SecuritySettings(certificate, certificate, tmp_path, None)
     with pytest.raises(ConfigError, match=r"give --users \(Basic256Sha256 sign and encrypt"):
         default.check()
