@@ -7,13 +7,22 @@ A hash is one PHC string (the format passlib and others write for scrypt)::
 ``ln`` is log2 of scrypt's cost N, ``r`` its block size and ``p`` its
 parallelism; salt (16 random bytes) and key (32 bytes of ``hashlib.scrypt``)
 are base64 without padding. :data:`COST_LN` 14, ``r`` 8, ``p`` 1 is RFC 7914's
-figure for interactive logins (16 MiB and about 50 ms a check on one core). A
-hash with a lower cost than :data:`MIN_COST_LN` is refused when read: a weak
-hash in the file is an error, not a quiet login.
+figure for interactive logins (16 MiB and about 50 ms a check on one core).
+
+A hash is read only with ``r`` 8, ``p`` 1 and ``ln`` from :data:`MIN_COST_LN` to
+:data:`MAX_COST_LN`; any other is refused when the file is read, with what was
+expected. Cheaper is a weak hash (an error, not a quiet login); dearer is work
+the server would do in its event loop at every login attempt, a user's or an
+attacker's (scrypt needs 128 * r * N bytes and time in proportion, p times over).
+``r`` and ``p`` are fixed rather than capped: N alone sets the cost, what this
+module and the usual tools write (passlib, hashlib's examples) is r 8, p 1, and
+the dearest check is then 2^16: 64 MiB and four times the default's time.
 
 :func:`verify` compares in constant time (``hmac.compare_digest``);
-:func:`verify_unknown` spends the same work on a user who does not exist, so a
-refusal takes as long whether the name or the password was wrong.
+:func:`verify_unknown` spends the work of a check on a user who does not exist,
+with the cost of :func:`unknown_user_hash` (the dearest hash of the file), so a
+refusal of an unknown name takes as long as one of the dearest user's wrong
+password.
 """
 
 from __future__ import annotations
@@ -24,12 +33,15 @@ import hashlib
 import hmac
 import os
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 #: log2 of scrypt's N for new hashes
 COST_LN = 14
-#: the lowest and highest log2 N a hash may have (2^20: 1 GiB a check)
-MIN_COST_LN, MAX_COST_LN = 14, 20
+#: the lowest and highest log2 N a hash may have (128 * r * N bytes a check: 2^14 16 MiB,
+#: 2^16 64 MiB)
+MIN_COST_LN, MAX_COST_LN = 14, 16
+#: scrypt's r and p, the only ones a hash may have
 BLOCK_SIZE = 8
 PARALLELISM = 1
 SALT_BYTES = 16
@@ -37,7 +49,7 @@ KEY_BYTES = 32
 EXPECTED = "$scrypt$ln=N,r=R,p=P$SALT$KEY (write one with `boltwatch opcua-user add`)"
 
 _PHC = re.compile(
-    r"\$scrypt\$ln=(?P<ln>\d+),r=(?P<r>\d+),p=(?P<p>\d+)\$(?P<salt>[A-Za-z0-9+/]+)\$"
+    r"\$scrypt\$ln=(?P<ln>[0-9]+),r=(?P<r>[0-9]+),p=(?P<p>[0-9]+)\$(?P<salt>[A-Za-z0-9+/]+)\$"
     r"(?P<key>[A-Za-z0-9+/]+)"
 )
 
@@ -78,10 +90,14 @@ def parse_hash(text: str) -> PasswordHash:
     if not MIN_COST_LN <= cost_ln <= MAX_COST_LN:
         raise HashFormatError(
             f"ln={cost_ln}: expected {MIN_COST_LN} to {MAX_COST_LN} (scrypt's N = 2^ln; "
-            "lower is too cheap to guess against)"
+            "lower is too cheap to guess against, higher too dear for the server to check "
+            "at every login)"
         )
-    if not 1 <= block_size <= 32 or not 1 <= parallelism <= 16:
-        raise HashFormatError(f"r={block_size}, p={parallelism}: expected r 1 to 32, p 1 to 16")
+    if (block_size, parallelism) != (BLOCK_SIZE, PARALLELISM):
+        raise HashFormatError(
+            f"r={block_size}, p={parallelism}: expected r={BLOCK_SIZE}, p={PARALLELISM} "
+            "(the cost is set by ln alone)"
+        )
     try:
         salt, key = _unb64(found["salt"]), _unb64(found["key"])
     except binascii.Error as err:
@@ -107,12 +123,17 @@ def verify(password: str, stored: PasswordHash) -> bool:
     return hmac.compare_digest(key, stored.key)
 
 
-_UNKNOWN = PasswordHash(COST_LN, BLOCK_SIZE, PARALLELISM, b"\0" * SALT_BYTES, b"\0" * KEY_BYTES)
+def unknown_user_hash(hashes: Iterable[PasswordHash]) -> PasswordHash:
+    """A hash no password matches with the highest cost of ``hashes`` (:data:`COST_LN` when
+    there are none), for :func:`verify_unknown`."""
+    dearest = max((stored.cost_ln for stored in hashes), default=COST_LN)
+    return PasswordHash(dearest, BLOCK_SIZE, PARALLELISM, b"\0" * SALT_BYTES, b"\0" * KEY_BYTES)
 
 
-def verify_unknown(password: str) -> bool:
-    """False, after the work of a check (a user that does not exist)."""
-    verify(password, _UNKNOWN)
+def verify_unknown(password: str, unknown: PasswordHash) -> bool:
+    """False, after the work of checking ``password`` against ``unknown`` (a user that does
+    not exist; ``unknown`` from :func:`unknown_user_hash` of the known users' hashes)."""
+    verify(password, unknown)
     return False
 
 

@@ -43,7 +43,7 @@ from asyncua.server.user_managers import UserManager
 from cryptography import x509
 from cryptography.hazmat.primitives.asymmetric import rsa
 
-from services.opcua.password_hashes import verify, verify_unknown
+from services.opcua.password_hashes import unknown_user_hash, verify, verify_unknown
 from services.opcua.users_file import OpcuaUser, others_may_read, read_users
 from shared.errors import ConfigError
 
@@ -146,6 +146,8 @@ class PasswordUsers(UserManager):
 
     def __init__(self, users: Mapping[str, OpcuaUser]) -> None:
         self._users = dict(users)
+        #: what an unknown name is checked against: the file's dearest hash's cost
+        self.unknown_hash = unknown_user_hash(user.password_hash for user in users.values())
 
     def get_user(
         self,
@@ -157,9 +159,9 @@ class PasswordUsers(UserManager):
         if username is None:
             return None
         user = self._users.get(username)
-        # one scrypt either way: a refusal takes as long for a wrong name as a wrong password
+        # one scrypt either way: a wrong name takes as long as the dearest user's wrong password
         if user is None:
-            matches = verify_unknown(password or "")
+            matches = verify_unknown(password or "", self.unknown_hash)
         else:
             matches = verify(password or "", user.password_hash)
         if not matches:

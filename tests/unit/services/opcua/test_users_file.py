@@ -5,19 +5,23 @@ one line naming the file, the key and what was expected."""
 from __future__ import annotations
 
 import stat
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
 from services.opcua.password_hashes import (
+    COST_LN,
+    MAX_COST_LN,
     HashFormatError,
     PasswordHash,
     hash_password,
     parse_hash,
+    unknown_user_hash,
     verify,
     verify_unknown,
 )
-from services.opcua.server_security import SecuritySettings
+from services.opcua.server_security import PasswordUsers, SecuritySettings
 from services.opcua.users_file import OpcuaUser, others_may_read, read_users, write_users
 from shared.errors import ConfigError
 
@@ -32,7 +36,7 @@ def test_a_hash_of_rfc_7914_verifies_its_password_only() -> None:
     stored = PasswordHash(14, 8, 1, b"SodiumChloride", RFC_KEY)
     assert verify("pleaseletmein", stored)
     assert not verify("pleaseletmein ", stored)
-    assert not verify_unknown("pleaseletmein")
+    assert not verify_unknown("pleaseletmein", unknown_user_hash([stored]))
 
 
 def test_a_new_hash_is_salted_and_reads_back() -> None:
@@ -58,9 +62,13 @@ def test_the_file_written_reads_back_and_only_its_owner_reads_it(tmp_path: Path)
     ("text", "expected"),
     [
         ("plain", "expected $scrypt$ln=N,r=R,p=P$SALT$KEY"),
-        ("$scrypt$ln=10,r=8,p=1$c2FsdHNhbHRzYWx0c2FsdA$a2V5", "ln=10: expected 14 to 20"),
+        ("$scrypt$ln=10,r=8,p=1$c2FsdHNhbHRzYWx0c2FsdA$a2V5", "ln=10: expected 14 to 16"),
+        # 4 GiB and minutes of the server's loop a login, with r 32 and p 16
+        ("$scrypt$ln=20,r=8,p=1$c2FsdA$a2V5", "ln=20: expected 14 to 16"),
         ("$scrypt$ln=14,r=8,p=1$c2FsdA$a2V5", "a salt of 4 bytes and a key of 3"),
-        ("$scrypt$ln=14,r=99,p=1$c2FsdA$a2V5", "r=99, p=1: expected r 1 to 32"),
+        ("$scrypt$ln=14,r=32,p=1$c2FsdA$a2V5", "r=32, p=1: expected r=8, p=1"),
+        ("$scrypt$ln=14,r=8,p=16$c2FsdA$a2V5", "r=8, p=16: expected r=8, p=1"),
+        ("$scrypt$ln=１４,r=8,p=1$c2FsdA$a2V5", "expected $scrypt$ln=N"),  # fullwidth digits
     ],
 )
 def test_a_hash_that_is_not_one_says_what_was_expected(text: str, expected: str) -> None:
@@ -69,6 +77,17 @@ def test_a_hash_that_is_not_one_says_what_was_expected(text: str, expected: str)
 
 
 GOOD = hash_password("x").text()
+DEAR = GOOD.replace(",p=1$", ",p=2$")
+
+
+def test_an_unknown_name_costs_the_dearest_hash_of_the_file() -> None:
+    """A name not in the file is checked against a hash of the file's highest cost, so
+    the refusal does not come sooner than the dearest user's."""
+    cheap, dear = parse_hash(GOOD), replace(parse_hash(GOOD), cost_ln=MAX_COST_LN)
+    users = {"a": OpcuaUser("a", cheap), "b": OpcuaUser("b", dear), "c": OpcuaUser("c", cheap)}
+    assert PasswordUsers(users).unknown_hash.cost_ln == MAX_COST_LN
+    assert PasswordUsers({"a": OpcuaUser("a", cheap)}).unknown_hash.cost_ln == cheap.cost_ln
+    assert unknown_user_hash([]).cost_ln == COST_LN
 
 
 @pytest.mark.parametrize(
@@ -80,9 +99,19 @@ GOOD = hash_password("x").text()
         (f"[users.a]\npassword_hash = '{GOOD}'\nrole = 'admin'\n", "users.a.role: Input should"),
         (f"[users.\"a\\u0007\"]\npassword_hash = '{GOOD}'\n", "users.a\x07.[key]: String should"),
         ("[users.a]\npassword_hash = 'plain'\n", "users.a.password_hash: expected $scrypt$"),
+        (f"[users.a]\npassword_hash = '{DEAR}'\n", "users.a.password_hash: r=8, p=2: expected"),
         ("[user.a]\n", "user: unknown key; expected one of: users"),
     ],
-    ids=["not TOML", "no hash", "a password", "a role", "a name", "a plain hash", "a table"],
+    ids=[
+        "not TOML",
+        "no hash",
+        "a password",
+        "a role",
+        "a name",
+        "a plain hash",
+        "a dear hash",
+        "a table",
+    ],
 )
 def test_a_bad_users_file_names_the_file_and_the_key(
     tmp_path: Path, text: str, expected: str
