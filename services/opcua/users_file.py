@@ -11,8 +11,8 @@ One table per user under ``users``; the key is the user name an OPC UA client
 gives (1 to 64 characters, no control characters). ``password_hash`` is a
 salted scrypt hash (:mod:`.password_hashes`), never the password. ``role`` is
 ``reader``, the only one: nothing in the server's address space is writable,
-so every user reads (and calls GetResultById); the key is there so that a role
-that may write can come without changing the file's shape.
+so every user reads (and calls ResultManagement's four methods); the key is there
+so that a role that may write can come without changing the file's shape.
 
 :func:`read_users` fails with one line naming the file, the key and what was
 expected; :func:`write_users` replaces the file whole (a temporary file made

@@ -237,8 +237,8 @@ async function readTools(session, systemId, namespaces, station, runs) {
     }
 }
 
-// a call of the joining system's ResultManagement method `name`
-async function managementCall(session, systemId, result, name, inputArguments) {
+// the request of a call of the joining system's ResultManagement method `name` (not made here)
+async function managementRequest(session, systemId, result, name, inputArguments) {
     const child = async (path) => {
         const found = await session.translateBrowsePath(makeBrowsePath(systemId, path));
         return found.targets[0].targetId;
@@ -251,7 +251,7 @@ async function managementCall(session, systemId, result, name, inputArguments) {
 }
 
 async function askById(session, systemId, result, station, resultId) {
-    const request = await managementCall(session, systemId, result, "GetResultById", [
+    const request = await managementRequest(session, systemId, result, "GetResultById", [
         { dataType: DataType.String, value: resultId },
         { dataType: DataType.Int32, value: 0 },
     ]);
@@ -271,7 +271,7 @@ async function askById(session, systemId, result, station, resultId) {
 }
 
 async function askLatest(session, systemId, result, station, resultId) {
-    const request = await managementCall(session, systemId, result, "GetLatestResult", [
+    const request = await managementRequest(session, systemId, result, "GetLatestResult", [
         { dataType: DataType.Int32, value: 0 },
     ]);
     for (;;) {
