@@ -9,8 +9,8 @@ the joining system emits it (:meth:`~.joining_systems.JoiningSystem.report`).
 - ``QualityAlert``: code 11 (Cpk low), 12 (NOKs in a row), 13 (NOK rate),
   ThresholdViolationConditionClassType and severity 700; cleared (``active``
   False): ThresholdViolationResolvedConditionClassType, severity 100;
-- ``ControllerAlarm``: code the digits of the controller's code (E404: 404; 0
-  when it has none), ErrorConditionClassType, severity 800, 100 when it went off.
+- ``ControllerAlarm``: code the ASCII digits of the controller's code (E404: 404;
+  0 when it has none), ErrorConditionClassType, severity 800, 100 when it went off.
 
 ``EventText`` (and the event's ``Message``) is the alert's own text, with the
 controller's code for an alarm; ``JoiningTechnology`` "Tightening".
@@ -18,6 +18,7 @@ controller's code for an alarm; ``JoiningTechnology`` "Tightening".
 
 from __future__ import annotations
 
+import string
 from dataclasses import dataclass
 
 from shared.contract import ControllerAlarm, QualityAlert, WearAlert
@@ -64,7 +65,7 @@ def alert_event(alert: Alert) -> AlertEvent:
             severity,
             condition,
         )
-    digits = "".join(character for character in alert.error_code if character.isdigit())
+    digits = "".join(character for character in alert.error_code if character in string.digits)
     state = "" if alert.active else " (off)"
     text = f"{alert.error_code}{state}: {alert.text}" if alert.text else alert.error_code + state
     return AlertEvent(

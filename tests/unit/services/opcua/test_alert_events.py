@@ -44,3 +44,5 @@ def test_a_controller_alarm_keeps_its_code_and_says_when_it_went_off() -> None:
     off = alert_event(alarm("E404", False, ""))
     assert (off.text, off.severity) == ("E404 (off)", 100)
     assert alert_event(alarm("EBATT", True, "")).code == 0  # no digits in the code
+    # only ASCII digits: "²" and "٣" are digits to str.isdigit, and int() refuses "²"
+    assert alert_event(alarm("E²٣4", True, "")).code == 4
