@@ -114,6 +114,7 @@ _EVALUATION_OF_STEP = {
 
 EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
 _ID = re.compile(r"0|[1-9][0-9]*")
+_ID_DIGITS = len(str(INT64_MAX))
 
 
 def utc_time(time_ns: int) -> datetime:
@@ -132,8 +133,8 @@ def parse_id(text: str) -> int | None:
     """The run or program id ``text`` is as the server writes one (``str(id)``: ASCII digits,
     no sign, no leading zero, at most :data:`~shared.contract.INT64_MAX`); None for any other
     text, which no result has."""
-    if _ID.fullmatch(text) is None or int(text) > INT64_MAX:
-        return None
+    if len(text) > _ID_DIGITS or _ID.fullmatch(text) is None or int(text) > INT64_MAX:
+        return None  # the length first: int() refuses more than 4300 digits
     return int(text)
 
 

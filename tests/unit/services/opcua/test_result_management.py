@@ -364,10 +364,12 @@ def test_handle_0_is_released_and_arguments_are_checked(served: Served) -> None:
 
 
 def test_an_id_the_server_never_gives_is_unknown_to_both_methods(served: Served) -> None:
-    """Not digits, a sign, a leading zero, beyond an int64: no result of either method."""
+    """Not digits, a sign, a leading zero, beyond an int64 (more digits than int() reads):
+    no result of either method."""
     result_id = served.field("ResultMetaData", "ResultId")
     zero = ua.Variant(0, ua.VariantType.Int32)
-    for text in ("st1/--5", "st1/²", "st1/-5", "st1/02", "st1/9223372036854775808"):
+    odd = ("--5", "²", "-5", "02", "9223372036854775808", "1" * 5000)
+    for text in (f"st1/{run}" for run in odd):
         by_id = served.call("GetResultById", ua.Variant(text, ua.VariantType.String), zero)
         assert by_id.StatusCode.is_good(), (text, by_id.StatusCode)
         assert by_id.OutputArguments[2].Value == ERROR_UNKNOWN_RESULT, text

@@ -81,3 +81,4 @@ def test_a_result_id_reads_back_and_no_other_text_is_one() -> None:
     for text in ("st1/--5", "st1/²", "st1/٣", "st1/-5", "st1/+5", "st1/05", "st1/", "/5", "5"):
         assert parse_result_id(text) is None, text
     assert parse_result_id(f"st1/{INT64_MAX + 1}") is None
+    assert parse_result_id("st1/" + "1" * 5000) is None  # more digits than int() reads
