@@ -41,6 +41,7 @@ import argparse
 import contextlib
 import json
 import random
+import resource
 import statistics
 import sys
 import tempfile
@@ -268,6 +269,7 @@ def queries(args: argparse.Namespace, target: StoreTarget) -> dict[str, Any]:
         )
         reads, stats, totals, results = [], [], [], 0
         month_statements: list[tuple[str, list[Any]]] = []
+        rss_before_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
         for repeat in range(args.repeats):
             started = time.perf_counter()
             with recorded(store) if repeat == 0 else contextlib.nullcontext() as seen:
@@ -282,6 +284,7 @@ def queries(args: argparse.Namespace, target: StoreTarget) -> dict[str, Any]:
             totals.append(total_s)
             results = read.results
             del read
+        grown_mb = (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - rss_before_kb) / 1024
         read_s, stats_s, total_s = (statistics.median(v) for v in (reads, stats, totals))
         figures["month"] = {
             "results": results,
@@ -290,12 +293,14 @@ def queries(args: argparse.Namespace, target: StoreTarget) -> dict[str, Any]:
             "total_s": round(total_s, 2),
             "per_result_us": round(total_s / results * 1e6, 2),
             "statistics_per_result_us": round(stats_s / results * 1e6, 2),
+            "peak_rss_grown_mb": round(grown_mb),
         }
         print(
             f"3. {target.dialect}, a month of {STATIONS} stations ({results} results): "
             f"read_stored {read_s:.2f} s + program_statistics {stats_s:.2f} s = "
             f"{total_s:.2f} s (median of {args.repeats}; goal ≤ 5 s); at a run every 30 s "
-            f"({MONTH_RUNS} results) scaled per result: {total_s / results * MONTH_RUNS:.1f} s",
+            f"({MONTH_RUNS} results) scaled per result: {total_s / results * MONTH_RUNS:.1f} s; "
+            f"the process's peak memory grew by {grown_mb:.0f} MB",
             flush=True,
         )
         if args.explain:
