@@ -1,0 +1,454 @@
+"""The OPC UA server under load: results a second it publishes to 5 subscribed clients that
+ask each result's trace, and the line recorder's figures with the server beside it and
+without it (not a test).
+
+Run on demand::
+
+    .venv/bin/python tests/benchmarks/bench_opcua_publish.py [--stations 10]
+        [--rates 10 50 200] [--seconds 10] [--clients 5] [--rounds 2] [--round-seconds 20]
+        [--samples 1700] [--folder FOLDER]
+
+Real processes on loopback: a router, ``serve recorder`` (MCAP only, the line
+server's configuration; its results store SQLite beside the recordings) and
+``serve opcua`` (Basic256Sha256 sign and encrypt, client certificates signed by a
+CA it trusts) serving ``--stations`` stations, and ``--clients`` node-opcua
+clients (``opcua_publish_client.js``, a process each: subscribed to every
+station's result-ready events, each result's trace asked by ``GetResultById``
+one call at a time, oldest first).
+
+Before: each station's runs (``--samples`` samples at 1 kHz) recorded by the real
+recorder (``run_recordings``); the recorder's catch-up at start puts them into
+its results store, so each result served has its real trace.
+
+1. **Publishing**: per rate of ``--rates`` (results a second, all stations
+   together, round robin), ``--seconds`` of those results put on
+   ``boltwatch/<st>/results`` (as the recorder stores them). Per step: the
+   results whose event every client received and the rate sustained (first put
+   to the last receipt), the event latency p50/p99 (put -> a client's receipt,
+   every client's, CLOCK_MONOTONIC on both sides), the traces answered (all
+   clients) and a call's latency p50/p99, the server's CPU (share of one core,
+   first put to the step's end). A step waits up to ``--drain-s`` for the last
+   events; the traces not asked by then are dropped (the clients' queues).
+2. **The recorder with and without the server**: ``--rounds`` pairs A/B, A
+   without the server, B with it and its clients: the line load of
+   ``bench_line.py``'s generator (a ``SampleBatch`` of 50 samples every 50 ms
+   per station, 1 s runs 0.2 s apart) for ``--round-seconds``, and results
+   at ``--line-rate`` a second (all stations: a run each every 1.2 s). Per
+   round: the recorder's CPU µs a sample and its lag p50/p99
+   (``RecorderStats``), samples missing, the server's CPU and the clients'
+   figures (B).
+
+The load average at each step is printed: the machine is shared.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import math
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO) not in sys.path:  # run as a script from anywhere
+    sys.path.insert(0, str(REPO))
+
+import zenoh
+
+from services.cli.station_supervisor import stop_process
+from services.opcua.result_values import result_id
+from shared.config import derive_stations, load_station
+from shared.contract import TighteningResult, channels, encode
+from shared.results import ResultsQuery, ResultsStore, StoreError, station_store
+from shared.runtime import zenoh_config
+from tests.benchmarks.bench_line import RecorderHeard, cpu_s, wait_alive
+from tests.benchmarks.opcua_publish_clients import (
+    LoadClient,
+    figures_json,
+    percentile,
+    step_figures,
+    wait_answered,
+    wait_delivered,
+)
+from tests.benchmarks.run_recordings import record_runs
+from tests.support.opcua_certificates import make_opcua_certificates
+from tests.support.opcua_client import node_opcua_client
+from tests.support.station_files import free_tcp_port, serve, write_station
+
+RUN_SPACING_NS = 30 * 1_000_000_000  # record_runs: a run every 30 s or so
+STORE_TIMEOUT_S = 300.0  # the recorder's catch-up of the recordings at start
+LINE_RUN_S = 1.2  # bench_line's generator: a 1 s run, 0.2 s apart
+WARM_UP_S = 60.0
+WARM_MS = 500.0
+WARM_IN_A_ROW = 3
+
+
+def load() -> str:
+    return "load " + " ".join(f"{figure:.1f}" for figure in os.getloadavg())
+
+
+class Line:
+    """The router, the recorder and (when started) the OPC UA server with its clients."""
+
+    def __init__(
+        self, args: argparse.Namespace, folder: Path, files: list[Path], endpoint: str
+    ) -> None:
+        self.args = args
+        self.folder = folder
+        self.files = [str(path) for path in files]
+        self.stations = [path.stem for path in files]
+        self.endpoint = endpoint
+        self.certificates = make_opcua_certificates(
+            folder / "pki", clients=tuple(f"client{n}" for n in range(1, args.clients + 1))
+        )
+        self.processes: list[subprocess.Popen[bytes]] = []
+        self.server: subprocess.Popen[bytes] | None = None
+        self.clients: list[LoadClient] = []
+        self.opcua_endpoint = ""
+
+    def start(self) -> None:
+        self.processes.append(
+            serve(["router", "--listen", self.endpoint], self.folder / "router.log")
+        )
+        self.recorder = serve(
+            ["recorder", "--config", *self.files, "--no-rerun"], self.folder / "recorder.log"
+        )
+        self.processes.append(self.recorder)
+
+    def start_server(self, session: zenoh.Session, results: Results) -> None:
+        modules, reason = node_opcua_client()
+        if modules is None:
+            raise SystemExit(reason)
+        self.opcua_endpoint = f"opc.tcp://127.0.0.1:{free_tcp_port()}"
+        certificates = self.certificates
+        self.server = serve(
+            [
+                *("opcua", "--config", *self.files, "--listen", self.opcua_endpoint),
+                *("--certificate", str(certificates.server_certificate)),
+                *("--private-key", str(certificates.server_key)),
+                *("--trusted-clients", str(certificates.trusted_clients)),
+            ],
+            self.folder / "opcua.log",
+        )
+        wait_alive(session, {(s, "opcua") for s in self.stations}, [self.server], self.folder)
+        self.clients = [
+            LoadClient(
+                modules,
+                name,
+                self.opcua_endpoint,
+                certificates,
+                self.stations,
+                "SignAndEncrypt",
+                self.args.publishing_interval_ms,
+                self.folder / f"{name}.log",
+            )
+            for name in certificates.clients
+        ]
+        for client in self.clients:
+            client.wait_subscribed()
+        self.warm_up(results)
+
+    def warm_up(self, results: Results) -> None:
+        """Results put one at a time until :data:`WARM_IN_A_ROW` in a row reach every client
+        within :data:`WARM_MS` (the first after subscribing take seconds: the server and the
+        clients' publish requests settle), at most :data:`WARM_UP_S`."""
+        deadline = time.monotonic() + WARM_UP_S
+        in_a_row = warm = 0
+        while in_a_row < WARM_IN_A_ROW and time.monotonic() < deadline:
+            put_ns = results.put(1.0, 1.0)
+            wait_delivered(self.clients, list(put_ns), self.args.drain_s)
+            figures = step_figures(self.clients, put_ns)
+            in_a_row = in_a_row + 1 if figures.event_ms[1] <= WARM_MS else 0
+            warm += 1
+            for client in self.clients:
+                client.skip()
+            time.sleep(0.5)
+        print(f"warmed up with {warm} results ({in_a_row} in a row within {WARM_MS} ms)")
+
+    def stop_server(self) -> None:
+        for client in self.clients:
+            client.stop()
+        self.clients = []
+        if self.server is not None:
+            stop_process(self.server, grace_s=15.0)
+            self.server = None
+
+    def close(self) -> None:
+        self.stop_server()
+        for process in reversed(self.processes):
+            stop_process(process, grace_s=15.0)
+
+
+def recorded(args: argparse.Namespace, folder: Path, files: list[Path], runs: int) -> None:
+    """Each station's ``runs`` runs in the recordings folder (kept from an earlier session
+    with ``--folder`` when it holds what is asked)."""
+    marker = folder / "recorded.json"
+    wanted = {"stations": len(files), "runs": runs, "samples": args.samples}
+    if marker.is_file() and json.loads(marker.read_text()) == wanted:
+        print(f"reusing the recordings of {folder}", flush=True)
+        return
+    started = time.monotonic()
+    start_ns = time.time_ns() - (runs + 10) * RUN_SPACING_NS  # recent: kept by retention
+    for path in files:
+        record_runs(folder, runs, args.samples, station_file=path, start_ns=start_ns)
+    marker.write_text(json.dumps(wanted))
+    print(
+        f"recorded {runs} runs of {len(files)} stations ({args.samples} samples a run) in "
+        f"{time.monotonic() - started:.0f} s",
+        flush=True,
+    )
+
+
+def stored_results(files: list[Path], expected: int) -> dict[str, list[TighteningResult]]:
+    """Each station's results in the store, oldest first, once the recorder's catch-up has
+    put all ``expected`` there."""
+    target = station_store(load_station(files[0]))
+    deadline = time.monotonic() + STORE_TIMEOUT_S
+    while True:
+        with contextlib.suppress(StoreError), ResultsStore(target, create=False) as store:
+            if store.count(ResultsQuery()) >= expected:
+                return {
+                    path.stem: [
+                        found.result
+                        for found in store.find(
+                            ResultsQuery(stations=[path.stem], oldest_first=True)
+                        )
+                    ]
+                    for path in files
+                }
+        if time.monotonic() > deadline:
+            raise SystemExit(f"the recorder's store lacks results after {STORE_TIMEOUT_S} s")
+        time.sleep(0.5)
+
+
+class Results:
+    """The stations' recorded results, put on zenoh in turn (each once), and when."""
+
+    def __init__(self, session: zenoh.Session, results: dict[str, list[TighteningResult]]):
+        self._publishers = {
+            station: session.declare_publisher(
+                channels.RESULTS.key(station), congestion_control=zenoh.CongestionControl.BLOCK
+            )
+            for station in results
+        }
+        self._left = {station: list(found) for station, found in results.items()}
+        self._turn = 0
+
+    def put(self, rate: float, seconds: float) -> dict[str, int]:
+        """``rate`` results a second for ``seconds``; ResultId -> when put (monotonic ns)."""
+        put_ns: dict[str, int] = {}
+        stations = list(self._left)
+        started = time.monotonic()
+        for n in range(max(1, round(rate * seconds))):
+            if (wait := started + n / rate - time.monotonic()) > 0:
+                time.sleep(wait)
+            station = stations[self._turn % len(stations)]
+            self._turn += 1
+            result = self._left[station].pop(0)
+            put_ns[result_id(station, result.run_id)] = time.monotonic_ns()
+            self._publishers[station].put(encode(result))
+        return put_ns
+
+    def close(self) -> None:
+        for publisher in self._publishers.values():
+            publisher.undeclare()
+
+
+def publishing(args: argparse.Namespace, line: Line, results: Results) -> list[dict[str, Any]]:
+    """Part 1: the steps of ``--rates`` with the server and its clients."""
+    assert line.server is not None
+    intervals = {client.publishing_interval_ms for client in line.clients}
+    print(f"1. {len(line.clients)} clients subscribed (publishing interval {intervals} ms)")
+    steps = []
+    for rate in args.rates:
+        cpu0, started = cpu_s(line.server), time.monotonic()
+        put_ns = results.put(rate, args.seconds)
+        ids = list(put_ns)
+        delivered = wait_delivered(line.clients, ids, args.drain_s)
+        wait_answered(line.clients, ids, started + 2 * args.seconds)
+        took_s = time.monotonic() - started
+        server_cpu = (cpu_s(line.server) - cpu0) / took_s
+        for client in line.clients:
+            client.skip()
+        figures = step_figures(line.clients, put_ns)
+        print(
+            f"1. {rate:g}/s for {args.seconds:g} s, {len(line.stations)} stations: "
+            f"{figures.line(took_s)}; server CPU {server_cpu:.0%} of a core over {took_s:.1f} s"
+            f"{'' if delivered else ' (events still missing at the drain limit)'}; {load()}",
+            flush=True,
+        )
+        steps.append(
+            {
+                "offered_per_s": rate,
+                **figures_json(figures),
+                "server_cpu_core_share": round(server_cpu, 2),
+                "step_s": round(took_s, 1),
+                "load": os.getloadavg()[0],
+            }
+        )
+    return steps
+
+
+def generator_samples(log: Path) -> int:
+    found = re.findall(r"generator: (\d+) samples", log.read_text())
+    return int(found[-1]) if found else 0
+
+
+def line_round(
+    args: argparse.Namespace, line: Line, results: Results, heard: RecorderHeard, name: str
+) -> dict[str, Any]:
+    """One round of part 2: the generator's line load and results at ``--line-rate``."""
+    log = line.folder / f"generator-{name}.log"
+    with heard.lock:
+        missing_before = sum(heard.missing.values())
+        heard.lag_p50_ms.clear()
+        heard.lag_max_ms.clear()
+    recorder0 = cpu_s(line.recorder)
+    server0 = cpu_s(line.server) if line.server else 0.0
+    with log.open("wb") as out:
+        generator = subprocess.Popen(
+            [
+                *(sys.executable, str(REPO / "tests/benchmarks/bench_line.py"), "--generate"),
+                *(line.endpoint, "--seconds", str(args.round_seconds), *line.files),
+            ],
+            cwd=REPO,
+            stdout=out,
+            stderr=subprocess.STDOUT,
+        )
+    started = time.monotonic()
+    time.sleep(1.0)  # its own wait for the router to learn the subscribers
+    with heard.lock:
+        heard.listening = True
+    put_ns = results.put(args.line_rate, args.round_seconds - 1.0)
+    generator.wait(timeout=args.round_seconds + 60)
+    time.sleep(3.0)  # the last batches filed, the last BusStats counted and reported
+    with heard.lock:
+        heard.listening = False
+        lag_p50 = statistics.median(heard.lag_p50_ms) if heard.lag_p50_ms else math.nan
+        lag_p99 = percentile(heard.lag_max_ms, 0.99)
+        missing = sum(heard.missing.values()) - missing_before
+    took_s = time.monotonic() - started
+    samples = generator_samples(log)
+    figures: dict[str, Any] = {
+        "round": name,
+        "recorder_cpu_us_per_sample": round((cpu_s(line.recorder) - recorder0) / samples * 1e6, 2)
+        if samples
+        else None,
+        "recorder_lag_p50_ms": round(lag_p50, 1),
+        "recorder_lag_p99_ms": round(lag_p99, 1),
+        "samples": samples,
+        "samples_missing": missing,
+        "load": os.getloadavg()[0],
+    }
+    if line.server is not None:
+        figures["server_cpu_core_share"] = round((cpu_s(line.server) - server0) / took_s, 2)
+        wait_delivered(line.clients, list(put_ns), args.drain_s)
+        figures.update(figures_json(step_figures(line.clients, put_ns)))
+        for client in line.clients:
+            client.skip()
+    print(f"2. {name}: {json.dumps(figures)}; {load()}", flush=True)
+    return figures
+
+
+def beside(
+    args: argparse.Namespace, line: Line, session: zenoh.Session, results: Results
+) -> list[dict[str, Any]]:
+    """Part 2: A (no server) and B (the server and its clients), ``--rounds`` times."""
+    heard = RecorderHeard()
+    subscriber = session.declare_subscriber(channels.RECORDER.key("*"), heard.on_stats)
+    rounds = []
+    try:
+        for n in range(1, args.rounds + 1):
+            line.stop_server()
+            rounds.append(line_round(args, line, results, heard, f"A{n} without the server"))
+            line.start_server(session, results)
+            rounds.append(line_round(args, line, results, heard, f"B{n} with the server"))
+    finally:
+        subscriber.undeclare()
+    for kind in ("A", "B"):
+        mine = [r for r in rounds if r["round"].startswith(kind)]
+        us = [r["recorder_cpu_us_per_sample"] for r in mine if r["recorder_cpu_us_per_sample"]]
+        print(
+            f"2. {kind}: recorder CPU a sample, median {statistics.median(us):.2f} µs "
+            f"({', '.join(f'{u:.2f}' for u in us)}); lag p99 "
+            f"{', '.join(str(r['recorder_lag_p99_ms']) for r in mine)} ms",
+            flush=True,
+        )
+    return rounds
+
+
+def runs_needed(args: argparse.Namespace) -> int:
+    """Runs a station for every result put (and the server's newest at start, kept back)."""
+    total = sum(max(1, round(rate * args.seconds)) for rate in args.rates)
+    total += 2 * args.rounds * max(1, round(args.line_rate * args.round_seconds))
+    total += (args.rounds + 1) * WARM_UP_S  # at most, one a second
+    return math.ceil(total / args.stations) + 10
+
+
+@contextlib.contextmanager
+def folder_of(args: argparse.Namespace) -> Iterator[Path]:
+    if args.folder is not None:
+        args.folder.mkdir(parents=True, exist_ok=True)
+        yield args.folder
+        return
+    with tempfile.TemporaryDirectory(prefix="bench-opcua-") as scratch:
+        yield Path(scratch)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--stations", type=int, default=10)
+    parser.add_argument(
+        "--rates", type=float, nargs="*", default=[10, 50, 200],
+        help="results a second of part 1, all stations together (10 50 200; none: no part 1)",
+    )  # fmt: skip
+    parser.add_argument("--seconds", type=float, default=10.0, help="of each rate (10)")
+    parser.add_argument("--drain-s", type=float, default=30.0, help="a step's last events (30)")
+    parser.add_argument("--clients", type=int, default=5)
+    parser.add_argument("--publishing-interval-ms", type=float, default=100.0, help="(100)")
+    parser.add_argument("--rounds", type=int, default=2, help="A/B pairs of part 2 (0: none)")
+    parser.add_argument("--round-seconds", type=float, default=20.0, help="a round's load (20)")
+    parser.add_argument("--line-rate", type=float, default=None, help="part 2's results a second")
+    parser.add_argument("--samples", type=int, default=1700, help="a run's (1.7 s at 1 kHz)")
+    parser.add_argument("--folder", type=Path, default=None, help="keep and reuse files here")
+    args = parser.parse_args(argv)
+    if args.line_rate is None:
+        args.line_rate = args.stations / LINE_RUN_S
+    figures: dict[str, Any] = {"load_at_start": os.getloadavg()}
+    with folder_of(args) as folder:
+        port = free_tcp_port()
+        base = write_station(folder, zenoh_port=port)
+        files = derive_stations(base, args.stations, folder / "stations")
+        runs = runs_needed(args)
+        recorded(args, folder, files, runs)
+        line = Line(args, folder, files, f"tcp/127.0.0.1:{port}")
+        try:
+            line.start()
+            stored = stored_results(files, runs * args.stations)
+            with zenoh.open(zenoh_config("client", [line.endpoint])) as session:
+                results = Results(session, stored)
+                wait_alive(session, {(s, "recorder") for s in line.stations}, [], folder)
+                if args.rates:
+                    line.start_server(session, results)
+                    figures["publishing"] = publishing(args, line, results)
+                if args.rounds:
+                    figures["beside"] = beside(args, line, session, results)
+                results.close()
+        finally:
+            line.close()
+    figures["load_at_end"] = os.getloadavg()
+    print(json.dumps(figures))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
