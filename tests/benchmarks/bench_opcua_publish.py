@@ -17,8 +17,8 @@ station's result-ready events, each result's trace asked by ``GetResultById``
 one call at a time, oldest first).
 
 Before: each station's runs (``--samples`` samples at 1 kHz) recorded by the real
-recorder (``run_recordings``); the recorder's catch-up at start puts them into
-its results store, so each result served has its real trace.
+recorder (``run_recordings``) and put into the results store by ``boltwatch
+results rebuild``, so each result served has its real trace.
 
 1. **Publishing**: per rate of ``--rates`` (results a second, all stations
    together, round robin), ``--seconds`` of those results put on
@@ -38,7 +38,10 @@ its results store, so each result served has its real trace.
    (``RecorderStats``), samples missing, the server's CPU and the clients'
    figures (B).
 
-The load average at each step is printed: the machine is shared.
+The load average at each step is printed: the machine is shared. ``--profile
+FILE``: part 1's server runs under cProfile (``opcua_profiled_server.py``: its
+asyncio loop and its GetResultById calls), and the heaviest functions are
+printed after part 1.
 """
 
 from __future__ import annotations
@@ -48,6 +51,7 @@ import contextlib
 import json
 import math
 import os
+import pstats
 import re
 import statistics
 import subprocess
@@ -85,8 +89,10 @@ from tests.support.opcua_client import node_opcua_client
 from tests.support.station_files import free_tcp_port, serve, write_station
 
 RUN_SPACING_NS = 30 * 1_000_000_000  # record_runs: a run every 30 s or so
-STORE_TIMEOUT_S = 300.0  # the recorder's catch-up of the recordings at start
+STORE_TIMEOUT_S = 60.0  # the results store there once the recorder started
 LINE_RUN_S = 1.2  # bench_line's generator: a 1 s run, 0.2 s apart
+PROFILED_SERVER = Path(__file__).with_name("opcua_profiled_server.py")
+PROFILE_LINES = 30
 WARM_UP_S = 60.0
 WARM_MS = 500.0
 WARM_IN_A_ROW = 3
@@ -124,21 +130,31 @@ class Line:
         )
         self.processes.append(self.recorder)
 
-    def start_server(self, session: zenoh.Session, results: Results) -> None:
+    def start_server(
+        self, session: zenoh.Session, results: Results, profile: Path | None = None
+    ) -> None:
         modules, reason = node_opcua_client()
         if modules is None:
             raise SystemExit(reason)
         self.opcua_endpoint = f"opc.tcp://127.0.0.1:{free_tcp_port()}"
         certificates = self.certificates
-        self.server = serve(
-            [
-                *("opcua", "--config", *self.files, "--listen", self.opcua_endpoint),
-                *("--certificate", str(certificates.server_certificate)),
-                *("--private-key", str(certificates.server_key)),
-                *("--trusted-clients", str(certificates.trusted_clients)),
-            ],
-            self.folder / "opcua.log",
-        )
+        arguments = [
+            *("opcua", "--config", *self.files, "--listen", self.opcua_endpoint),
+            *("--certificate", str(certificates.server_certificate)),
+            *("--private-key", str(certificates.server_key)),
+            *("--trusted-clients", str(certificates.trusted_clients)),
+        ]
+        log = self.folder / "opcua.log"
+        if profile is None:
+            self.server = serve(arguments, log)
+        else:
+            with log.open("ab") as out:
+                self.server = subprocess.Popen(
+                    [sys.executable, str(PROFILED_SERVER), str(profile), *arguments],
+                    cwd=REPO,
+                    stdout=out,
+                    stderr=subprocess.STDOUT,
+                )
         wait_alive(session, {(s, "opcua") for s in self.stations}, [self.server], self.folder)
         self.clients = [
             LoadClient(
@@ -200,17 +216,20 @@ def recorded(args: argparse.Namespace, folder: Path, files: list[Path], runs: in
     start_ns = time.time_ns() - (runs + 10) * RUN_SPACING_NS  # recent: kept by retention
     for path in files:
         record_runs(folder, runs, args.samples, station_file=path, start_ns=start_ns)
+    # into the store as ``results rebuild`` reads them (the recorder's catch-up at start
+    # reads only the files of the last minutes)
+    rebuild = [sys.executable, "-m", "services.cli", "results", "rebuild", "--config"]
+    subprocess.run([*rebuild, *map(str, files)], cwd=REPO, check=True, capture_output=True)
     marker.write_text(json.dumps(wanted))
     print(
-        f"recorded {runs} runs of {len(files)} stations ({args.samples} samples a run) in "
-        f"{time.monotonic() - started:.0f} s",
+        f"recorded {runs} runs of {len(files)} stations ({args.samples} samples a run) and "
+        f"stored their results in {time.monotonic() - started:.0f} s",
         flush=True,
     )
 
 
 def stored_results(files: list[Path], expected: int) -> dict[str, list[TighteningResult]]:
-    """Each station's results in the store, oldest first, once the recorder's catch-up has
-    put all ``expected`` there."""
+    """Each station's results in the store, oldest first (all ``expected`` of them)."""
     target = station_store(load_station(files[0]))
     deadline = time.monotonic() + STORE_TIMEOUT_S
     while True:
@@ -220,7 +239,7 @@ def stored_results(files: list[Path], expected: int) -> dict[str, list[Tightenin
                     path.stem: [
                         found.result
                         for found in store.find(
-                            ResultsQuery(stations=[path.stem], oldest_first=True)
+                            ResultsQuery(stations=[path.stem], oldest_first=True, limit=None)
                         )
                     ]
                     for path in files
@@ -420,6 +439,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--line-rate", type=float, default=None, help="part 2's results a second")
     parser.add_argument("--samples", type=int, default=1700, help="a run's (1.7 s at 1 kHz)")
     parser.add_argument("--folder", type=Path, default=None, help="keep and reuse files here")
+    parser.add_argument(
+        "--profile", type=Path, default=None, metavar="FILE",
+        help="part 1's server under cProfile (opcua_profiled_server.py), its pstats into FILE",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     if args.line_rate is None:
         args.line_rate = args.stations / LINE_RUN_S
@@ -438,8 +461,13 @@ def main(argv: Sequence[str] | None = None) -> int:
                 results = Results(session, stored)
                 wait_alive(session, {(s, "recorder") for s in line.stations}, [], folder)
                 if args.rates:
-                    line.start_server(session, results)
+                    line.start_server(session, results, args.profile)
                     figures["publishing"] = publishing(args, line, results)
+                    if args.profile is not None:
+                        line.stop_server()
+                        stats = pstats.Stats(str(args.profile))
+                        stats.sort_stats("tottime").print_stats(PROFILE_LINES)
+                        stats.sort_stats("cumulative").print_stats(PROFILE_LINES)
                 if args.rounds:
                     figures["beside"] = beside(args, line, session, results)
                 results.close()
