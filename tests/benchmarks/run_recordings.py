@@ -1,6 +1,6 @@
 """Recordings of whole runs as the recorder writes them, for ``bench_results_store.py``'s file
-scan: the real :class:`Recorder` (MCAP, zstd, no Rerun), fed classified messages on a
-simulated 1 kHz clock, without zenoh.
+scan and the traces of ``bench_opcua_publish.py``: the real :class:`Recorder` (MCAP, zstd,
+no Rerun), fed classified messages on a simulated 1 kHz clock, without zenoh.
 
 Each run is what a CAN station's line recorder files of it: its tool state
 ``running``, ``samples`` samples in batches of 50 (an edge station's
@@ -50,25 +50,25 @@ def record_runs(
         )
     loaded = load_station(station_file)
     recordings = loaded.recordings_folder
-    st = loaded.station_id
+    station = loaded.station_id
     limits = FileLimits(1000 * MS, 1 << 40, 3600 * 1000 * MS)
     recorder = Recorder(recordings, limits, FileMetadata(loaded))
     rng = random.Random(seed)
     now_ns = start_ns
 
     def put(topic: str, message: object) -> None:
-        recorder.write(classify(f"boltwatch/{st}/{topic}", encode(message), now_ns))
+        recorder.write(classify(f"boltwatch/{station}/{topic}", encode(message), now_ns))
 
     every = max(1, samples // (EVENTS + 1))
     for run_id in range(1, runs + 1):
         started_ns = now_ns
-        put("tool", ToolState(st, run_id, 7, 1, "running", now_ns))
+        put("tool", ToolState(station, run_id, 7, 1, "running", now_ns))
         batch = []
         for n in range(samples):
             now_ns += MS
             share = n / samples
             sample = Sample(
-                st,
+                station,
                 run_id,
                 n,
                 now_ns,
@@ -76,30 +76,33 @@ def record_runs(
                 round(60.0 * share + rng.gauss(0.0, 0.01), 2),
                 round(56_000.0 * share + rng.gauss(0.0, 5.0), 1),
             )
-            batch.append(classify(f"boltwatch/{st}/samples", encode(sample), now_ns))
+            batch.append(classify(f"boltwatch/{station}/samples", encode(sample), now_ns))
             if len(batch) == BATCH:
-                recorder.write_samples(st, batch)
+                recorder.write_samples(station, batch)
                 batch = []
             if n % every == every - 1 and n // every < EVENTS:
                 index = n // every + 1
-                event = factories.event(run_id, index, station=st, time_ns=now_ns, time_s=n / 1000)
+                time_s = n / 1000
+                event = factories.event(
+                    run_id, index, station=station, time_ns=now_ns, time_s=time_s
+                )
                 put("events", event)
-                put("intensity", Intensity(st, run_id, now_ns, 0.5, 0.5 * index))
+                put("intensity", Intensity(station, run_id, now_ns, 0.5, 0.5 * index))
             if n % 500 == 499:
                 recorder.tick(now_ns)
-        recorder.write_samples(st, batch)
+        recorder.write_samples(station, batch)
         decision = StopDecision(
-            st, run_id, now_ns, samples / 1000, "plateau_closest", "", 190.0, 55_800.0,
+            station, run_id, now_ns, samples / 1000, "plateau_closest", "", 190.0, 55_800.0,
             56_000.0, now_ns + 5,
         )  # fmt: skip
         put("decision", decision)
-        put("tool", ToolState(st, run_id, 7, 1, "done", now_ns + 1))
+        put("tool", ToolState(station, run_id, 7, 1, "done", now_ns + 1))
         summary = factories.summary(
-            run_id, station=st, samples=samples, started_ns=started_ns, ended_ns=now_ns + 1
+            run_id, station=station, samples=samples, started_ns=started_ns, ended_ns=now_ns + 1
         )
         put("runs", summary)
         result = factories.result(
-            run_id, station=st, time_ns=now_ns + 1, part_id=f"L1-P{run_id // 5:07d}"
+            run_id, station=station, time_ns=now_ns + 1, part_id=f"L1-P{run_id // 5:07d}"
         )
         put("results", result)
         now_ns += 27_000 * MS  # the next part's bolt: a run every 30 s or so
