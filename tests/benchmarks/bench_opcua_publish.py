@@ -9,12 +9,12 @@ Run on demand::
         [--samples 1700] [--folder FOLDER]
 
 Real processes on loopback: a router, ``serve recorder`` (MCAP only, the line
-server's configuration; its results store SQLite beside the recordings) and
-``serve opcua`` (Basic256Sha256 sign and encrypt, client certificates signed by a
-CA it trusts) serving ``--stations`` stations, and ``--clients`` node-opcua
-clients (``opcua_publish_client.js``, a process each: subscribed to every
-station's result-ready events, each result's trace asked by ``GetResultById``
-one call at a time, oldest first).
+server's configuration; its results store SQLite beside the recordings) and ``serve
+opcua`` (Basic256Sha256 sign and encrypt, client certificates signed by a CA it
+trusts, each client logged in as a user of its users file) serving ``--stations``
+stations, and ``--clients`` node-opcua clients (``opcua_publish_client.js``, a
+process each: subscribed to every station's result-ready events, each result's trace
+asked by ``GetResultById`` one call at a time, oldest first).
 
 Before: each station's runs (``--samples`` samples at 1 kHz) recorded by the real
 recorder (``run_recordings``) and put into the results store by ``boltwatch

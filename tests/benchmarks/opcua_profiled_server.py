@@ -2,11 +2,11 @@
 
     python tests/benchmarks/opcua_profiled_server.py FILE opcua --config ...
 
-The service as shipped, with two of its functions wrapped on the way in: the
-work thread's (the asyncio loop: zenoh's results into the address space and the
-events, asyncua's requests, its encoding and encryption) and the
-``GetResultById`` callback, which asyncua runs in its thread pool (each thread
-its own profiler, on for the calls only). When the service stops, every
+The service as shipped, with its functions wrapped on the way in: the work
+thread's (the asyncio loop: zenoh's results into the address space and the
+events, asyncua's requests, its encoding and encryption) and ResultManagement's
+method callbacks (``GetResultById``...), which asyncua runs in its thread pool
+(each thread its own profiler, on for the calls only). When the service stops, every
 profile is merged into ``FILE`` (``pstats``); the bench prints its heaviest.
 """
 
@@ -58,7 +58,7 @@ def profiled(function: Any) -> Any:
 def install(path: Path) -> None:
     """The wrappers, and ``path`` written when the work thread ends."""
     work = service.OpcuaService.work
-    method = service.get_result_by_id_method
+    methods = service.result_management_methods
 
     def profiled_work(self: service.OpcuaService, stop: threading.Event) -> None:
         try:
@@ -71,7 +71,9 @@ def install(path: Path) -> None:
             merged.dump_stats(path)
 
     service.OpcuaService.work = profiled_work  # type: ignore[method-assign]
-    service.get_result_by_id_method = lambda *args: profiled(method(*args))
+    service.result_management_methods = lambda *args: {
+        name: profiled(callback) for name, callback in methods(*args).items()
+    }
 
 
 if __name__ == "__main__":

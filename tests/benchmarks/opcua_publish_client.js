@@ -3,7 +3,7 @@
 //   node opcua_publish_client.js '{"endpoint": "opc.tcp://127.0.0.1:4840", "certificate": "c.pem",
 //                                  "privateKey": "c.key", "applicationUri": "urn:...",
 //                                  "security": "SignAndEncrypt" | "None", "stations": ["st01"],
-//                                  "publishingIntervalMs": 100}'
+//                                  "userName": "u", "password": "p", "publishingIntervalMs": 100}'
 //
 // Subscribes to the result-ready events of every station's joining system and asks the
 // trace of each result received by its id (ResultManagement's GetResultById), one call at
@@ -49,7 +49,11 @@ async function connect() {
     });
     client.on("backoff", () => {});
     await client.connect(options.endpoint);
-    const session = await client.createSession({ type: UserTokenType.Anonymous });
+    const session = await client.createSession({
+        type: UserTokenType.UserName,
+        userName: options.userName,
+        password: options.password,
+    });
     return { client, session };
 }
 

@@ -54,6 +54,7 @@ class LoadClient:
         certificates: OpcuaCertificates,
         stations: Sequence[str],
         security: str,
+        user: tuple[str, str],
         publishing_interval_ms: float,
         log: Path,
     ) -> None:
@@ -65,6 +66,8 @@ class LoadClient:
             "applicationUri": client_uri(name),
             "security": security,
             "stations": list(stations),
+            "userName": user[0],
+            "password": user[1],
             "publishingIntervalMs": publishing_interval_ms,
         }
         self.name = name

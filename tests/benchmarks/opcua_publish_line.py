@@ -1,12 +1,13 @@
 """The line of ``bench_opcua_publish.py``: its processes, its recordings and the results put.
 
-:class:`Line`: a router and ``serve recorder`` (MCAP only) for the stations'
-files, and, when asked, ``serve opcua`` (Basic256Sha256 sign and encrypt, the
-clients' CA trusted) with its node-opcua clients (:mod:`.opcua_publish_clients`),
-warmed up before it is measured. :func:`recorded`: each station's runs recorded
-by the real recorder (:mod:`.run_recordings`) and stored by ``results rebuild``,
-so each result served has its real trace. :class:`Results`: those results put on
-``boltwatch/<st>/results`` at a rate, each once, with the time of each put.
+:class:`Line`: a router and ``serve recorder`` (MCAP only) for the stations' files,
+and, when asked, ``serve opcua`` (Basic256Sha256 sign and encrypt, the clients' CA
+trusted, a users file: the clients log in) with its node-opcua clients
+(:mod:`.opcua_publish_clients`), warmed up before it is measured. :func:`recorded`:
+each station's runs recorded by the real recorder (:mod:`.run_recordings`) and
+stored by ``results rebuild``, so each result served has its real trace.
+:class:`Results`: those results put on ``boltwatch/<st>/results`` at a rate, each
+once, with the time of each put.
 """
 
 from __future__ import annotations
@@ -22,7 +23,9 @@ from pathlib import Path
 import zenoh
 
 from services.cli.station_supervisor import stop_process
+from services.opcua.password_hashes import hash_password
 from services.opcua.result_values import result_id
+from services.opcua.users_file import OpcuaUser, write_users
 from shared.config import load_station
 from shared.contract import TighteningResult, channels, encode
 from shared.results import ResultsQuery, ResultsStore, StoreError, station_store
@@ -41,6 +44,8 @@ from tests.support.station_files import free_tcp_port, serve
 RUN_SPACING_NS = 30 * 1_000_000_000  # record_runs: a run every 30 s or so
 STORE_TIMEOUT_S = 60.0  # the results store there once the recorder started
 PROFILED_SERVER = Path(__file__).with_name("opcua_profiled_server.py")
+#: the clients' user in the server's users file
+USER, PASSWORD = "line-mes", "the benchmark's password"
 WARM_UP_S = 60.0
 WARM_MS = 500.0
 WARM_IN_A_ROW = 3
@@ -60,6 +65,8 @@ class Line:
         self.certificates = make_opcua_certificates(
             folder / "pki", clients=tuple(f"client{n}" for n in range(1, args.clients + 1))
         )
+        self.users = folder / "opcua-users.toml"
+        write_users(self.users, {USER: OpcuaUser(USER, hash_password(PASSWORD))})
         self.processes: list[subprocess.Popen[bytes]] = []
         self.server: subprocess.Popen[bytes] | None = None
         self.clients: list[LoadClient] = []
@@ -87,6 +94,7 @@ class Line:
             *("--certificate", str(certificates.server_certificate)),
             *("--private-key", str(certificates.server_key)),
             *("--trusted-clients", str(certificates.trusted_clients)),
+            *("--users", str(self.users)),
         ]
         log = self.folder / "opcua.log"
         if profile is None:
@@ -108,6 +116,7 @@ class Line:
                 certificates,
                 self.stations,
                 "SignAndEncrypt",
+                (USER, PASSWORD),
                 self.args.publishing_interval_ms,
                 self.folder / f"{name}.log",
             )
