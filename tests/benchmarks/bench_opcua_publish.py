@@ -32,7 +32,9 @@ every client within 0.5 s (the first ones after subscribing take seconds: up to
    every client's, CLOCK_MONOTONIC on both sides), the traces answered (all
    clients) and a call's latency p50/p99, the server's CPU (share of one core,
    first put to the step's end). A step waits up to ``--drain-s`` for the last
-   events; the traces not asked by then are dropped (the clients' queues).
+   events, then for the traces until twice ``--seconds`` after the first put
+   (the traces a second: those answered over that time); the traces not asked
+   by then are dropped (the clients' queues).
 2. **The recorder with and without the server**: ``--rounds`` pairs A/B, A
    without the server, B with it and its clients: the line load of
    ``bench_line.py``'s generator (a ``SampleBatch`` of 50 samples every 50 ms
