@@ -22,7 +22,7 @@ import stat
 import struct
 from collections.abc import Iterator
 from pathlib import Path
-from typing import BinaryIO
+from typing import IO, BinaryIO, cast
 
 import zstandard
 from mcap.exceptions import EndOfFile, InvalidMagic, McapError
@@ -51,6 +51,21 @@ _KINDS = (
 McapRecord = object
 
 
+class _CountedReads:
+    """A file read through, counting the bytes read: where the reading is, without asking
+    the file (``tell()`` is a system call that lets go of the GIL; once a record, it cost
+    a thread of the OPC UA server's pool most of a trace's reading)."""
+
+    def __init__(self, handle: BinaryIO) -> None:
+        self._handle = handle
+        self.position = 0
+
+    def read(self, size: int = -1) -> bytes:
+        data = self._handle.read(size)
+        self.position += len(data)
+        return data
+
+
 class RecordingScan:
     """One pass over the records of ``path``; afterwards, whether it was whole.
 
@@ -73,7 +88,9 @@ class RecordingScan:
         handle = self._open()
         with handle:
             self.file_bytes = os.fstat(handle.fileno()).st_size
-            reader = StreamReader(handle, validate_crcs=True, record_size_limit=self.file_bytes)
+            counted = _CountedReads(handle)
+            stream = cast(IO[bytes], counted)  # mcap's reader calls read() only
+            reader = StreamReader(stream, validate_crcs=True, record_size_limit=self.file_bytes)
             iterator = iter(reader.records)
             while True:
                 try:
@@ -96,7 +113,7 @@ class RecordingScan:
                             f"({type(err).__name__}: {err}); nothing after it can be read"
                         )
                     return
-                self.good_bytes = handle.tell()
+                self.good_bytes = counted.position
                 if isinstance(record, Schema):
                     self.schemas[record.id] = record
                 elif isinstance(record, Channel):
