@@ -18,42 +18,22 @@
 "use strict";
 const readline = require("readline");
 const {
-    OPCUAClient,
-    MessageSecurityMode,
-    SecurityPolicy,
     AttributeIds,
     TimestampsToReturn,
     makeBrowsePath,
     constructEventFilter,
-    UserTokenType,
     DataType,
     StatusCodes,
 } = require("node-opcua-client");
+const { createClient, openSession } = require("../support/opcua_connect.js");
 
 const options = JSON.parse(process.argv[2]);
 const say = (object) => process.stdout.write(JSON.stringify(object) + "\n");
 const now = () => process.hrtime.bigint().toString();
 
 async function connect() {
-    const secure = options.security === "SignAndEncrypt";
-    const client = OPCUAClient.create({
-        applicationName: "boltwatch benchmark client",
-        applicationUri: options.applicationUri,
-        securityMode: secure ? MessageSecurityMode.SignAndEncrypt : MessageSecurityMode.None,
-        securityPolicy: secure ? SecurityPolicy.Basic256Sha256 : SecurityPolicy.None,
-        certificateFile: options.certificate,
-        privateKeyFile: options.privateKey,
-        endpointMustExist: false,
-        connectionStrategy: { maxRetry: 240, initialDelay: 250, maxDelay: 500 },
-        requestedSessionTimeout: 600000,
-    });
-    client.on("backoff", () => {});
-    await client.connect(options.endpoint);
-    const session = await client.createSession({
-        type: UserTokenType.UserName,
-        userName: options.userName,
-        password: options.password,
-    });
+    const client = createClient(options, "boltwatch benchmark client", 240, 600000);
+    const session = await openSession(client, options);
     return { client, session };
 }
 

@@ -15,13 +15,16 @@ one, and the line's page and the OPC UA server listen on free ports of
 
 from __future__ import annotations
 
+import contextlib
 import re
 import subprocess
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 import zenoh
 
+from services.cli.station_supervisor import stop_process
 from shared.config import load_station
 from shared.runtime import open_session
 from tests.support.compose_layout import (
@@ -103,3 +106,17 @@ class ComposeLine:
 
     def log(self, name: str) -> str:
         return (self.folder / f"{name}.log").read_text(errors="replace")[-3000:]
+
+
+@contextlib.contextmanager
+def running_line(folder: Path, names: Sequence[str]) -> Iterator[ComposeLine]:
+    """The compose line in ``folder`` with the services ``names`` started in that order, each
+    stopped (SIGTERM, then SIGKILL after 10 s) in the reverse order at the end."""
+    started = ComposeLine(folder)
+    try:
+        for name in names:
+            started.start(name)
+        yield started
+    finally:
+        for name in reversed(list(started.processes)):
+            stop_process(started.processes[name], grace_s=10.0)

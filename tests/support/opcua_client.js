@@ -28,18 +28,15 @@
 // (its line: {"type": "error", "message"}).
 "use strict";
 const {
-    OPCUAClient,
-    MessageSecurityMode,
-    SecurityPolicy,
     AttributeIds,
     TimestampsToReturn,
     makeBrowsePath,
     constructEventFilter,
-    UserTokenType,
     DataType,
     StatusCodes,
 } = require("node-opcua-client");
 const { browseTree } = require("./opcua_browse_tree.js");
+const { createClient, openSession } = require("./opcua_connect.js");
 
 const options = JSON.parse(process.argv[2]);
 const say = (object) => process.stdout.write(JSON.stringify(object) + "\n");
@@ -56,26 +53,10 @@ function plain(value) {
 
 async function main() {
     const secure = options.security === "SignAndEncrypt";
-    const client = OPCUAClient.create({
-        applicationName: "boltwatch test client",
-        applicationUri: options.applicationUri,
-        securityMode: secure ? MessageSecurityMode.SignAndEncrypt : MessageSecurityMode.None,
-        securityPolicy: secure ? SecurityPolicy.Basic256Sha256 : SecurityPolicy.None,
-        certificateFile: options.certificate,
-        privateKeyFile: options.privateKey,
-        endpointMustExist: false,
-        connectionStrategy: { maxRetry: options.connectRetries ?? 40, initialDelay: 250, maxDelay: 500 },
-        requestedSessionTimeout: 60000,
-    });
-    client.on("backoff", () => {});
+    const client = createClient(options, "boltwatch test client", options.connectRetries ?? 40, 60000);
     let session;
     try {
-        await client.connect(options.endpoint);
-        session = await client.createSession(
-            options.userName === undefined
-                ? { type: UserTokenType.Anonymous }
-                : { type: UserTokenType.UserName, userName: options.userName, password: options.password },
-        );
+        session = await openSession(client, options);
     } catch (err) {
         say({ type: "refused", reason: String(err && err.message ? err.message : err) });
         await client.disconnect().catch(() => {});

@@ -25,10 +25,9 @@ from asyncua import Client, ua
 from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
 from asyncua.crypto.uacrypto import CertProperties
 
-from services.cli.station_supervisor import stop_process
 from services.opcua.joining_systems import BOLTWATCH_NAMESPACE
 from services.opcua.nodeset_files import missing_files, nodeset_folder
-from tests.support.compose_line import ComposeLine
+from tests.support.compose_line import ComposeLine, running_line
 
 pytestmark = [
     pytest.mark.system,
@@ -47,14 +46,8 @@ CLIENT_TIMEOUT_S = 30.0
 def line(tmp_path: Path) -> Iterator[ComposeLine]:
     if missing_files(nodeset_folder()):
         pytest.skip("the OPC UA models are not fetched (`make opcua-nodesets` needs npm)")
-    started = ComposeLine(tmp_path)
-    try:
-        for name in RUNNING:
-            started.start(name)
+    with running_line(tmp_path, RUNNING) as started:
         yield started
-    finally:
-        for name in reversed(list(started.processes)):
-            stop_process(started.processes[name], grace_s=10.0)
 
 
 async def joining_systems(line: ComposeLine) -> list[str]:

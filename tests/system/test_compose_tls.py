@@ -27,7 +27,7 @@ import zenoh
 from services.cli.station_supervisor import stop_process
 from shared.contract import RunSummary, StopDecision, channels, decode, keys
 from shared.errors import BoltwatchError
-from tests.support.compose_line import TLS_STATIONS, ComposeLine
+from tests.support.compose_line import TLS_STATIONS, ComposeLine, running_line
 from tests.support.live_recorder import has_subscribers
 from tests.support.router_process import boltwatch
 
@@ -47,14 +47,8 @@ RUNS = channels.RUNS.key("st1")
 
 @pytest.fixture
 def line(tmp_path: Path) -> Iterator[ComposeLine]:
-    started = ComposeLine(tmp_path)
-    try:
-        for name in RUNNING:
-            started.start(name)
+    with running_line(tmp_path, RUNNING) as started:
         yield started
-    finally:
-        for name in reversed(list(started.processes)):
-            stop_process(started.processes[name], grace_s=10.0)
 
 
 def test_every_service_is_healthy_with_its_own_identity_and_status_sees_them(
