@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import re
 import subprocess
+import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -40,6 +41,10 @@ from tests.support.router_process import boltwatch
 from tests.support.station_files import free_tcp_port, free_udp_port, serve
 
 TLS_STATIONS = "/etc/boltwatch/compose/tls"
+
+
+#: ``boltwatch health``'s status for a service not alive (yet)
+NOT_ALIVE = 1
 
 
 class ComposeLine:
@@ -97,6 +102,22 @@ class ComposeLine:
         if service is not None:
             arguments[1] = service
         return boltwatch(*arguments)
+
+    def wait_healthy(self, names: Sequence[str], within_s: float) -> None:
+        """Each of ``names`` healthy in turn, as compose waits on health before it counts a
+        service up; AssertionError (with its log) when one fails its check, exits or is not
+        healthy within ``within_s`` of the call."""
+        deadline = time.monotonic() + within_s
+        for name in names:
+            while (checked := self.health(name)).returncode != 0:
+                said = f"{checked.stdout}{checked.stderr}"
+                assert checked.returncode == NOT_ALIVE, f"{name}'s health check failed: {said}"
+                exited = self.processes[name].poll()
+                assert exited is None, f"{name} exited ({exited}):\n{self.log(name)}"
+                assert time.monotonic() < deadline, (
+                    f"{name} never healthy: {said}\n{self.log(name)}"
+                )
+                time.sleep(0.5)
 
     def session(self, name: str, identity: str | None = None) -> zenoh.Session:
         """A session as service ``name``'s container opens it (its station file's [zenoh])."""

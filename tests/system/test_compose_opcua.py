@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import asyncio
 import shutil
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -38,7 +37,6 @@ RUNNING = ("router", "opcua")
 STATIONS = ["st1", "st2"]
 CLIENT = "mes"  # make-compose-certs.sh's default OPC UA client
 HEALTHY_WITHIN_S = 90.0  # the models load before the server reaches the line
-NOT_ALIVE = 1
 CLIENT_TIMEOUT_S = 30.0
 
 
@@ -78,13 +76,5 @@ async def joining_systems(line: ComposeLine) -> list[str]:
 def test_the_opcua_service_serves_both_stations_with_the_scripts_files(
     line: ComposeLine,
 ) -> None:
-    deadline = time.monotonic() + HEALTHY_WITHIN_S
-    for name in RUNNING:  # as compose waits on health before it counts the service up
-        while (checked := line.health(name)).returncode != 0:
-            said = f"{checked.stdout}{checked.stderr}"
-            assert checked.returncode == NOT_ALIVE, f"{name}'s health check failed: {said}"
-            exited = line.processes[name].poll()
-            assert exited is None, f"{name} exited ({exited}):\n{line.log(name)}"
-            assert time.monotonic() < deadline, f"{name} never healthy: {said}\n{line.log(name)}"
-            time.sleep(0.5)
+    line.wait_healthy(RUNNING, HEALTHY_WITHIN_S)
     assert asyncio.run(joining_systems(line)) == STATIONS, line.log("opcua")

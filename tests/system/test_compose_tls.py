@@ -27,7 +27,7 @@ import zenoh
 from services.cli.station_supervisor import stop_process
 from shared.contract import RunSummary, StopDecision, channels, decode, keys
 from shared.errors import BoltwatchError
-from tests.support.compose_line import TLS_STATIONS, ComposeLine, running_line
+from tests.support.compose_line import NOT_ALIVE, TLS_STATIONS, ComposeLine, running_line
 from tests.support.live_recorder import has_subscribers
 from tests.support.router_process import boltwatch
 
@@ -38,7 +38,7 @@ pytestmark = [
 
 RUNNING = ("router", "acquisition-st1", "rig-st1", "recorder", "dashboard")
 HEALTHY_WITHIN_S = 60.0
-NOT_ALIVE = 1  # `boltwatch health`: 1 not alive (yet), 2 router unreachable or bad file
+
 HEARD_WITHIN_S = 60.0
 DECISION = channels.DECISION.key("st1")
 SAMPLES = channels.SAMPLE_BATCHES.key("st1")  # an edge station: its samples in batches
@@ -60,15 +60,7 @@ def test_every_service_is_healthy_with_its_own_identity_and_status_sees_them(
     status`` with the line-monitor identity sees st1's services, its predictor among them."""
     line.session("router").close()  # the router takes TLS sessions now: 2 is a real failure
     assert not any(name.startswith("predictor") for name in line.services), "edge layout"
-    deadline = time.monotonic() + HEALTHY_WITHIN_S
-    for name in RUNNING:
-        while (checked := line.health(name)).returncode != 0:
-            said = f"{checked.stdout}{checked.stderr}"
-            assert checked.returncode == NOT_ALIVE, f"{name}'s health check failed: {said}"
-            exited = line.processes[name].poll()
-            assert exited is None, f"{name} exited ({exited}):\n{line.log(name)}"
-            assert time.monotonic() < deadline, f"{name} never healthy: {said}\n{line.log(name)}"
-            time.sleep(0.5)
+    line.wait_healthy(RUNNING, HEALTHY_WITHIN_S)
     # Its predictor's token is declared before its own: healthy acquisition, alive predictor.
     predictor = line.health("acquisition-st1", service="predictor")
     assert predictor.returncode == 0, f"{predictor.stdout}{predictor.stderr}"
