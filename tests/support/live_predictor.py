@@ -14,6 +14,7 @@ from pathlib import Path
 import zenoh
 
 from shared.contract import Sample, StopReasonName, ToolState, channels, codec, keys
+from shared.runtime import declare_channel
 from tests.support.live_recorder import has_subscribers, wait_until
 from tests.support.paths import REPO
 
@@ -66,12 +67,14 @@ def wait_for_subscriber(publisher: zenoh.Publisher) -> None:
 
 
 class StationFeed:
-    """Publishers of one station's ``tool`` and ``samples``, as its acquisition would."""
+    """Publishers of one station's ``tool`` and ``samples``, as its acquisition declares them
+    (:func:`~shared.runtime.declare_channel`: congestion control BLOCK, so a sample put in a
+    burst under load waits instead of being dropped, as zenoh's default would)."""
 
     def __init__(self, session: zenoh.Session, station_id: str, wait: bool = True) -> None:
         self.station_id = station_id
-        self.tool = session.declare_publisher(channels.TOOL.key(station_id))
-        self.samples = session.declare_publisher(channels.SAMPLES.key(station_id))
+        self.tool = declare_channel(session, channels.TOOL, station_id)
+        self.samples = declare_channel(session, channels.SAMPLES, station_id)
         if wait:  # the predictor's subscribers must be known before the first put
             for publisher in (self.tool, self.samples):
                 wait_for_subscriber(publisher)
