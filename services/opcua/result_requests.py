@@ -74,18 +74,13 @@ APPLICATION = "boltwatch serve opcua"
 _RELATIVE_PATH_ENCODING = ua.NodeId(ua.Int32(ua.ObjectIds.RelativePath_Encoding_DefaultBinary))
 
 
-def _stored(target: StoreTarget, query: ResultsQuery) -> list[StoredResult]:
-    with ResultsStore(target, create=False, application=APPLICATION) as store:
-        return store.find(query)
-
-
-def stored_by_id(target: StoreTarget, station: str, identifier: str) -> StoredResult | None:
-    """The stored tightening whose ResultId is ``identifier``, if it is ``station``'s."""
+def _id_query(station: str, identifier: str) -> ResultsQuery | None:
+    """The query of the tightening whose ResultId is ``identifier``, if it is ``station``'s
+    (None: no tightening of the station has it)."""
     parsed = parse_result_id(identifier)
     if parsed is None or parsed[0] != station:
         return None
-    found = _stored(target, ResultsQuery(stations=[station], run_id=parsed[1], limit=1))
-    return found[0] if found else None
+    return ResultsQuery(stations=[station], run_id=parsed[1], limit=1)
 
 
 def result_with_trace(stored: StoredResult) -> dict[str, Any]:
@@ -114,22 +109,26 @@ def result_with_trace(stored: StoredResult) -> dict[str, Any]:
 
 def result_by_id(target: StoreTarget, station: str, identifier: str) -> list[ua.Variant]:
     """GetResultById's output arguments (ResultHandle, Result, Error) for ``identifier``."""
-    try:
-        stored = stored_by_id(target, station, identifier)
-    except StoreError as err:
-        LOG.warning("GetResultById %s: %s", identifier, err)
-        return _result_outputs(None, ERROR_STORE)
-    if stored is None:
-        return _result_outputs(None, ERROR_UNKNOWN_RESULT)
-    return _result_outputs(result_data(result_with_trace(stored)), 0)
+    query = _id_query(station, identifier)
+    return _one_result(target, query, f"GetResultById {identifier}")
 
 
 def latest_result(target: StoreTarget, station: str) -> list[ua.Variant]:
     """GetLatestResult's output arguments (ResultHandle, Result, Error): the station's newest."""
+    query = ResultsQuery(stations=[station], limit=1)
+    return _one_result(target, query, f"GetLatestResult of {station}")
+
+
+def _one_result(target: StoreTarget, query: ResultsQuery | None, asked: str) -> list[ua.Variant]:
+    """(ResultHandle, Result, Error) of the tightening ``query`` finds first, with its trace
+    (None: none can match, the store is not opened); ``asked``: the call, for the log."""
+    if query is None:
+        return _result_outputs(None, ERROR_UNKNOWN_RESULT)
     try:
-        found = _stored(target, ResultsQuery(stations=[station], limit=1))
+        with ResultsStore(target, create=False, application=APPLICATION) as store:
+            found = store.find(query)
     except StoreError as err:
-        LOG.warning("GetLatestResult of %s: %s", station, err)
+        LOG.warning("%s: %s", asked, err)
         return _result_outputs(None, ERROR_STORE)
     if not found:
         return _result_outputs(None, ERROR_UNKNOWN_RESULT)
