@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections import Counter, defaultdict
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -111,7 +112,7 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
     for (program_id, *group), runs in counted.items():
         grouped[program_id].append((*group, runs))
     for program_id in sorted(grouped):
-        name, newest = _latest(store, everything, program_id, set(refused))
+        name, newest = _latest(store, everything, program_id, refused.keys())
         of_program = figures[figures[:, 0] == program_id]
         groups = grouped[program_id]
         stop_reasons: Counter[str] = Counter()
@@ -173,7 +174,7 @@ def _refused(
 
 
 def _latest(
-    store: ResultsStore, query: ResultsQuery, program_id: int, refused: set[tuple[str, int]]
+    store: ResultsStore, query: ResultsQuery, program_id: int, refused: AbstractSet[tuple[str, int]]
 ) -> tuple[str, list[Any]]:
     """The name and windows of ``program_id``'s newest tightening ``query`` asks for, not one
     of ``refused`` (by the index of program_id)."""
