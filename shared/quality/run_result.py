@@ -65,4 +65,5 @@ def tightening_result(
         events=summary.events,
         process_intensity=summary.process_intensity,
         source="predictor",
+        pulses=summary.pulses if summary.commands == "staged" else None,
     )
