@@ -113,6 +113,7 @@ class FinalStageRun:
         self._since_halt = 0
         self._still: deque[float] = deque(maxlen=SETTLE_SAMPLES)
         self._switch_nm = math.nan  # the predicted switch point
+        self._rundown_step_nm = math.nan  # r̂ when the stage first switched (rundown speed)
         self._rundown_line = SlidingLine(LINE_SAMPLES)  # the rise when no step is known
 
     # -- what the core tells it ---------------------------------------------------------
@@ -143,7 +144,8 @@ class FinalStageRun:
         """One sample the core used; a command for the tool, the first halt's Stop, or None.
 
         ``rundown_step_nm``: r̂, the stick ramp's rise per sample at the rundown speed
-        (NaN: unknown, then the line through the rundown's newest samples gives it);
+        (NaN: unknown, then the line through the rundown's newest samples gives it; once
+        the stage has switched, the r̂ of that moment holds: later ramps ran slower);
         ``noise_sigma_nm``: the torque's noise; ``drop_nm``: a typical slip's torque drop
         (NaN: none seen yet).
         """
@@ -151,7 +153,7 @@ class FinalStageRun:
         if phase is StagePhase.RUNDOWN:
             return self._rundown(time_s, torque_nm, rundown_step_nm, noise_sigma_nm)
         if phase is StagePhase.FINAL:
-            return self._final(time_s, torque_nm, rundown_step_nm, noise_sigma_nm, drop_nm)
+            return self._final(time_s, torque_nm, noise_sigma_nm, drop_nm)
         if phase is StagePhase.HALTED:
             return self._settling(time_s, torque_nm, noise_sigma_nm, drop_nm)
         return None
@@ -170,7 +172,11 @@ class FinalStageRun:
             return None
         line = self._rundown_line
         line.add(torque_nm)
-        if not step_nm > 0.0:
+        if self._rundown_step_nm > 0.0:
+            # back in the rundown after a slip: the ramps measured since ran at the final
+            # speed, the step of the rundown is the one measured before the first switch
+            step_nm = self._rundown_step_nm
+        elif not step_nm > 0.0:
             step_nm = line.slope if len(line) >= MIN_LINE_SAMPLES else math.nan
         if not step_nm > 0.0:
             return None
@@ -180,6 +186,7 @@ class FinalStageRun:
         if torque_nm < switch_nm:
             return None
         self._switch_nm = switch_nm
+        self._rundown_step_nm = step_nm
         return self._switch(
             time_s,
             torque_nm,
@@ -204,7 +211,7 @@ class FinalStageRun:
         self._skipping = self._skip
 
     def _final(
-        self, time_s: float, torque_nm: float, step_nm: float, sigma_nm: float, drop_nm: float
+        self, time_s: float, torque_nm: float, sigma_nm: float, drop_nm: float
     ) -> CoreCommand | Stop | None:
         if self._skipping > 0:  # the command has not taken effect yet
             self._skipping -= 1
@@ -219,8 +226,7 @@ class FinalStageRun:
             if (
                 self.stage.switch == "predicted"
                 and self.pulses == 0
-                and step_nm > 0.0
-                and torque_nm < self._switch_nm - 2.0 * step_nm
+                and torque_nm < self._switch_nm - 2.0 * self._rundown_step_nm
             ):
                 self.phase = StagePhase.RUNDOWN
                 return CoreCommand(
