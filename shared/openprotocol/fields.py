@@ -198,18 +198,27 @@ class LayoutMessage:
     __slots__ = ()
     MID: ClassVar[int]
     LAYOUTS: ClassVar[Mapping[int, Layout]]
+    #: a message with no data at any revision whose revision asks nothing of the answer
+    #: (an acknowledge, an unsubscribe, 0003, 9999): read and written at every revision
+    ANY_REVISION: ClassVar[bool] = False
 
     @classmethod
     def revisions(cls) -> tuple[int, ...]:
         return tuple(sorted(cls.LAYOUTS))
 
     @classmethod
+    def layout(cls, revision: int) -> Layout:
+        if cls.ANY_REVISION:
+            return ()
+        return cls.LAYOUTS[revision]
+
+    @classmethod
     def from_data(cls, data: bytes, revision: int, dialect: Dialect = DEFAULT_DIALECT) -> Self:
-        values = decode_fields(data, cls.LAYOUTS[revision], cls.MID, revision)
+        values = decode_fields(data, cls.layout(revision), cls.MID, revision)
         build: Callable[..., Self] = cls
         return build(revision=revision, **values)
 
     def to_data(self, revision: int, dialect: Dialect = DEFAULT_DIALECT) -> bytes:
-        layout = self.LAYOUTS[revision]
+        layout = self.layout(revision)
         values = {spec.attr: getattr(self, spec.attr) for spec in layout}
         return encode_fields(values, layout, self.MID, revision)
