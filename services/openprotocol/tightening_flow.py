@@ -12,7 +12,13 @@ reading: :mod:`.published_ids`) is written after its last message was put.
   what is pending of the old epoch, then starts the new one;
 - curves are checked against their result (:mod:`.curve_check`); the first
   reading that agrees is kept for the controller (logged, saved); a curve that
-  agrees with no reading is refused and counted, its result goes without it.
+  agrees with no reading is refused and counted, its result goes without it;
+- each figure is judged against its pset's window: a controller station's
+  file's (``[[programs]]`` of that id, where it gives the figure a bound; a CAN
+  station's programs are the simulated controller's, whose 0061 says them), else the
+  controller's: the result's own limits (0061), or, for a result fetched by id
+  (0065 carries none), the limits the controller's last 0061 of that pset
+  gave (kept while the bridge runs).
 """
 
 from __future__ import annotations
@@ -28,8 +34,15 @@ from services.openprotocol.curve_check import Reading, check_curves, readings
 from services.openprotocol.pending_tightenings import PendingTightenings, Take
 from services.openprotocol.published_ids import BridgePosition, read_position, write_position
 from services.openprotocol.tightening_messages import tightening_messages
-from shared.config import AnyStation, OpenProtocolSection
+from shared.config import (
+    AnyStation,
+    ControllerProgram,
+    ControllerStation,
+    OpenProtocolSection,
+    Program,
+)
 from shared.contract import INT64_MAX
+from shared.quality import Window
 
 LOG = logging.getLogger(__name__)
 
@@ -65,6 +78,8 @@ class TighteningFlow:
         #: the controller's name as it said it on the link in use ("" not known)
         self.controller_name = self.position.controller_name
         self._given_up_before = 0  # ids given up in epochs before this one
+        #: per pset, the torque and angle windows the controller's last 0061 of it gave
+        self._controller_windows: dict[int, dict[str, Window]] = {}
 
     @property
     def watermark(self) -> int:
@@ -177,16 +192,24 @@ class TighteningFlow:
             return
         tightening = self._checked(tightening)
         station = self._station
+        program: Program | ControllerProgram | None
         try:
-            program_name = station.config.program(result.program_id).name
+            program = station.config.program(result.program_id)
         except KeyError:
-            program_name = f"pset {result.program_id}"
+            program = None
+        program_name = f"pset {result.program_id}" if program is None else program.name
+        windows = self._windows(result)
+        if isinstance(station, ControllerStation) and program is not None:
+            for figure in ("torque", "angle"):
+                if program.window(figure) != (None, None):
+                    windows[figure] = program.window(figure)
         for message in tightening_messages(
             station.station_id,
             station.config.station.tool_id,
             run_id,
             tightening,
             program_name,
+            windows,
         ):
             self._publish(message)
         counts = self._counts
@@ -199,6 +222,18 @@ class TighteningFlow:
                 "trace", f"tightening {result.tightening_id}: published without its curves"
             )
         counts.last_tightening_id = result.tightening_id
+
+    def _windows(self, result: ResultFigures) -> dict[str, Window]:
+        """The controller's windows of ``result``'s pset: a 0061's own are kept for the
+        pset; a 0065 (no limits) gets those the pset's last 0061 gave."""
+        own = {
+            "torque": (result.torque_min_nm, result.torque_max_nm),
+            "angle": (result.angle_min_deg, result.angle_max_deg),
+        }
+        if not result.filled:
+            self._controller_windows[result.program_id] = own
+            return {}  # the result's own limits: judged as the controller gave them
+        return dict(self._controller_windows.get(result.program_id, {}))
 
     def _checked(self, tightening: Tightening) -> Tightening:
         """The tightening with its curves read the way that agrees with its result."""

@@ -20,6 +20,9 @@ from typing import Any
 import pytest
 import zenoh
 
+from services.opcua.result_values import EVALUATION_NOT_OK, result_values
+from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget
+from shared.results.results_table import row
 from tests.support.bridge_harness import RunningBridge, bridge_station_file
 from tests.support.listener import Listener
 from tests.support.live_recorder import wait_until
@@ -224,3 +227,34 @@ def test_a_time_stamp_no_clock_holds_is_replaced_by_the_time_received(
     assert running.counts.clock_refused == 1
     (summary,) = heard.of("runs") or [None]
     assert summary is not None and summary.ended_ns <= time.time_ns()
+
+
+def test_a_controller_that_says_ok_outside_its_own_window_gives_a_nok_saying_so(
+    controller: SpecController, bridge: tuple[RunningBridge, Listener], tmp_path: Path
+) -> None:
+    """Before: 9999.99 Nm in a 100-250 Nm window was published OK with the NOK reason
+    "torque high" beside it: OK in the results store, ``results``, ``report`` and OPC UA."""
+    _, heard = bridge
+    tightening_id = controller.tighten(
+        torque_nm=9999.99, ok=True, torque_min_nm=100.0, torque_max_nm=250.0,
+        torque_target_nm=200.0,
+    )  # fmt: skip
+    wait_until(lambda: result_ids(heard) == [tightening_id], "the result")
+    (result,) = heard.of("results")
+    (said,) = heard.of("controller")
+    assert said.result == "OK", "the controller's own message stays what it said"
+    assert result.result == "NOK"
+    assert result.final_torque_nm.status == "high"
+    assert result.nok_reasons == (
+        "the controller said OK, the windows NOK; torque high: 9999.99 Nm, window 100 to 250 Nm"
+    )
+    stored = StoredResult(result)
+    with ResultsStore(StoreTarget(sqlite_path=tmp_path / "results.sqlite")) as store:
+        store.add([stored])
+        (back,) = store.find(ResultsQuery())
+    assert back.result.result == "NOK" and back.result.nok_reasons == result.nok_reasons
+    shown = row(back)
+    assert shown[8] == "NOK" and shown[14] == result.nok_reasons  # `boltwatch results`
+    meta = result_values(back.result)["ResultMetaData"]
+    assert meta["ResultEvaluation"] == EVALUATION_NOT_OK
+    assert meta["ResultEvaluationDetails"] == result.nok_reasons
