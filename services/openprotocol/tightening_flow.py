@@ -31,7 +31,7 @@ from pathlib import Path
 from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.controller_tightening import Curve, ResultFigures, Tightening
 from services.openprotocol.curve_check import Reading, check_curves, readings
-from services.openprotocol.pending_tightenings import PendingTightenings, Take
+from services.openprotocol.pending_tightenings import MAX_FILL, PendingTightenings, Take
 from services.openprotocol.published_ids import BridgePosition, read_position, write_position
 from services.openprotocol.tightening_messages import tightening_messages
 from shared.config import (
@@ -71,7 +71,11 @@ class TighteningFlow:
         self._clock = clock
         self.position = read_position(position_file)
         self._pending = PendingTightenings.resume(
-            self.position.watermark, self.position.keys, section.traces, trace_timeout_s
+            self.position.watermark,
+            self.position.keys,
+            section.traces,
+            trace_timeout_s,
+            self.position.previous_keys,
         )
         self._reading = Reading.parse(self.position.trace_reading)
         counts.trace_reading = None if self._reading is None else str(self._reading)
@@ -80,6 +84,9 @@ class TighteningFlow:
         self._given_up_before = 0  # ids given up in epochs before this one
         #: per pset, the torque and angle windows the controller's last 0061 of it gave
         self._controller_windows: dict[int, dict[str, Window]] = {}
+        #: the newest id the controller is known to have on this link (0: none; None: not
+        #: known): a live id more than MAX_FILL past it is a jump, not a gap to fetch
+        self.session_newest: int | None = None
 
     @property
     def watermark(self) -> int:
@@ -88,6 +95,13 @@ class TighteningFlow:
     def known_key(self, tightening_id: int) -> str | None:
         """The key of a published id, when it is kept."""
         return self._pending.published_keys.get(tightening_id)
+
+    def last_kept_at_or_below(self, tightening_id: int) -> tuple[int, str] | None:
+        """The highest id up to ``tightening_id`` whose key is kept (this epoch's or one
+        before), with its key; None: none kept."""
+        kept = {**self._pending.previous_keys, **self._pending.published_keys}
+        below = [i for i in kept if i <= tightening_id]
+        return None if not below else (max(below), kept[max(below)])
 
     # -- in -----------------------------------------------------------------------------
 
@@ -102,14 +116,24 @@ class TighteningFlow:
                 f"tightening {figures.tightening_id}: the controller's time stamp is one no "
                 "clock holds: the time it was received is taken",
             )
+        tightening_id = figures.tightening_id
+        newest = self.session_newest
+        if not figures.filled and newest is not None and tightening_id > newest + MAX_FILL:
+            self._jump(newest, tightening_id)
         take = self._pending.result(figures, self._clock())
         if take is Take.CONFLICT:
+            # live: the controller pushes every result, so its ids went back to this one;
+            # fetched (a catch-up): the ids before it may be new too
             self.new_epoch(
-                f"tightening {figures.tightening_id} came with other values than the one "
+                f"tightening {tightening_id} came with other values than the one "
                 "published under its id: the controller's ids started again",
                 self.controller_name,
+                start_after=0 if figures.filled else tightening_id - 1,
             )
             take = self._pending.result(figures, self._clock())
+            self.session_newest = tightening_id  # the controller's ids go on from here
+        else:
+            self.session_newest = max(newest or 0, tightening_id)
         if take is Take.REPEAT and not figures.filled:
             self._counts.repeated_results += 1
             self._counts.note(
@@ -141,21 +165,40 @@ class TighteningFlow:
 
     # -- epochs -------------------------------------------------------------------------
 
-    def new_epoch(self, why: str, controller_name: str) -> None:
-        """The controller's ids start again: what is pending of the old epoch goes out
-        first; the new epoch's run ids come after every one published."""
+    def _jump(self, newest: int, tightening_id: int) -> None:
+        """A live id more than MAX_FILL past the newest the controller had on this link: its
+        counter jumped (no controller makes that many while it pushes each). The ids between
+        were never made: none is asked for; a new epoch starts just before it."""
+        why = f"its tightening id jumped from {newest} to {tightening_id} within a session"
+        if self._pending.watermark == 0 and not self._pending.published_keys:
+            LOG.warning("%s: %s: the ids before it are not asked for", self._counts.controller, why)
+            self._pending = PendingTightenings.resume(
+                tightening_id - 1,
+                {},
+                self._pending.wait_for_curves,
+                self._pending.trace_timeout_s,
+                self._pending.previous_keys,
+                new_epoch=True,
+            )
+            return
+        self.new_epoch(why, self.controller_name, start_after=tightening_id - 1)
+
+    def new_epoch(self, why: str, controller_name: str, start_after: int = 0) -> None:
+        """The controller's ids start again after ``start_after``: what is pending of the
+        old epoch goes out first; the new epoch's run ids come after every one published."""
         for tightening in self._pending.drain():
             self._publish_one(tightening)
         self._count_given_up()
         self._given_up_before += self._pending.given_up
-        self.position = self._current_position().new_epoch(controller_name)
+        self.position = self._current_position().new_epoch(controller_name, start_after)
         self.controller_name = controller_name
         self._pending = PendingTightenings.resume(
-            0,
+            start_after,
             {},
             self._pending.wait_for_curves,
             self._pending.trace_timeout_s,
-            previous_keys=self._pending.published_keys,
+            previous_keys=self.position.previous_keys,
+            new_epoch=True,
         )
         self._reading = None
         self._counts.trace_reading = None
@@ -268,6 +311,7 @@ class TighteningFlow:
             self.controller_name,
             dict(self._pending.published_keys),
             "" if self._reading is None else self._reading.text,
+            self.position.previous_keys,
         )
 
     def _write_position(self) -> None:
