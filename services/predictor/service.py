@@ -6,7 +6,9 @@ only those: per served station it subscribes to ``boltwatch/<st>/samples``,
 another station's data must never reach this process's decisions, nor
 another station's part its results); each message is handled in its zenoh
 callback, one at a time (:mod:`services.predictor.station_inbox`), so a part
-scanned before a run's ``running`` is the part of that run.
+scanned before a run's ``running`` is the part of that run. At start it asks
+the line for each station's last part in the background
+(:mod:`services.predictor.part_at_start`).
 Each run is predicted with its own station's programs, force sensor, joint
 constants and ``[predictor]`` section. Out, per station: ``events`` and ``intensity``
 per stick-slip event, ``decision`` (REAL_TIME priority, express, blocking
@@ -42,6 +44,7 @@ import time
 from collections.abc import Sequence
 
 from services.predictor.active_run import Outgoing
+from services.predictor.part_at_start import PartAtStart
 from services.predictor.served_station import ServedStation
 from services.predictor.station_counts import StationCounts
 from services.predictor.station_inbox import Inbox, InboxFactory, StationInbox
@@ -102,6 +105,9 @@ class PredictorService:
         self._log_bad_payload = RateLimitedLog(LOG)
         self._inbox: Inbox = inbox(self._session, list(self._stations), self.handle)
         skeleton.on_stop(Stop.INPUT, self._inbox.close)
+        # the part at each station until a scan is heard: asked of the line, never waited for
+        self._part_at_start = PartAtStart(self._session, self._runs)
+        skeleton.on_stop(Stop.INPUT, self._part_at_start.close)
         for station_id in self._stations:
             skeleton.health_token(station_id, "predictor")
 
@@ -194,7 +200,8 @@ class PredictorService:
 
     @property
     def part_ids(self) -> dict[str, str | None]:
-        """The part at each served station: the last one scanned (None: none yet)."""
+        """The part at each served station: the last one scanned, else the line's at start
+        (None: none known)."""
         return {station_id: runs.part_id for station_id, runs in self._runs.items()}
 
     @property
