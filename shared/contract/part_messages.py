@@ -29,7 +29,9 @@ class PartScan:
     Its id holds until the next scan: a part with four bolts is scanned once,
     before its first run. A scan that arrives while a run is in progress
     belongs to the next run (the one in progress started on the part before).
-    No scan since the predictor started: the results name no part (None).
+    No scan since the predictor started: the results name the part the line's
+    recorder last heard of, as its answer when the predictor started (``restored``),
+    else none (None).
     """
 
     __pydantic_config__ = WIRE_CONFIG
