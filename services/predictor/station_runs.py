@@ -90,7 +90,7 @@ class StationRuns:
             state.run_id,
             state.state,
             result.result,
-            run.part_id or "-",
+            f"{run.part_id} ({run.part_source})" if run.part_id else "-",
             summary.events,
             summary.stop_reason or "by the tool",
             f" (late decision: {summary.late_decision})" if summary.late_decision else "",
