@@ -223,8 +223,11 @@ class OpenProtocolBridge:
         """The controller's newest result (0064 id 0), after a new epoch is started if its
         ids started again since the watermark; None: it has none, or it was not given."""
         flow = self._flow
+        flow.session_newest = None
         reply = self._old_result(session, 0)
         if isinstance(reply, CommandError):
+            if reply.error_code == NOT_FOUND:
+                flow.session_newest = 0
             if reply.error_code == NOT_FOUND and flow.watermark > 0:
                 # no newest result: reset, unless it gives the published one (a controller
                 # that does not take id 0 for its newest)
@@ -240,8 +243,31 @@ class OpenProtocolBridge:
         if newest is not None:
             why = self._epoch_ended(session, newest)
             if why is not None:
-                flow.new_epoch(why, flow.controller_name)
+                flow.new_epoch(why, flow.controller_name, self._epoch_start(session, newest))
+            flow.session_newest = newest.tightening_id
         return newest
+
+    def _epoch_start(self, session: ControllerSession, newest: Any) -> int:
+        """After which id a new epoch starts: where the controller's ids went back below
+        the watermark to ones it still keeps (the last id up to its newest whose key is
+        kept, and its result there is that one), after that one; else after 0 (reset)."""
+        if newest.tightening_id >= self._flow.watermark:
+            return 0  # its result at the watermark is another one: its ids started again
+        kept = self._flow.last_kept_at_or_below(newest.tightening_id)
+        if kept is None:
+            return 0
+        tightening_id, key = kept
+        there = newest
+        if tightening_id != newest.tightening_id:
+            there = self._figures(self._old_result(session, tightening_id))
+        if there is None or there.key != key:
+            return 0
+        LOG.info(
+            "%s keeps tightening %d as published: the new epoch starts after it",
+            self._counts.controller,
+            tightening_id,
+        )
+        return int(tightening_id)
 
     def _catch_up(self, session: ControllerSession) -> None:
         """The newest result and the gap up to it (a pushed 0061 was refused)."""

@@ -105,9 +105,12 @@ class PendingTightenings:
         wait_for_curves: bool,
         trace_timeout_s: float,
         previous_keys: Mapping[int, str] | None = None,
+        *,
+        new_epoch: bool = False,
     ) -> PendingTightenings:
         """Where a bridge was: its watermark and the keys of the ids it published last
-        (``previous_keys``: the last ones of the epoch before, never published again)."""
+        (``previous_keys``: the last ones of the epochs before, never published again;
+        ``new_epoch``: an epoch that starts after ``watermark``, nothing published in it)."""
         kept = OrderedDict(sorted((i, k) for i, k in keys.items() if i <= watermark))
         return cls(
             watermark,
@@ -115,7 +118,7 @@ class PendingTightenings:
             trace_timeout_s,
             published_keys=kept,
             previous_keys=dict(previous_keys or {}),
-            keys_complete=bool(kept) or watermark == 0,
+            keys_complete=bool(kept) or watermark == 0 or new_epoch,
         )
 
     # -- in ---------------------------------------------------------------------------

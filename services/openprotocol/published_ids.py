@@ -25,11 +25,18 @@ A controller whose ids started again is a new **epoch** of the station's
 controller (:mod:`.bridge` tells when: it has no result though some were
 published, its newest id is below the watermark, its result at the watermark
 is another one, an id at or below the watermark comes with another key: reset,
-replaced, or wrapped after 9999999999; or it names itself differently in MID
-0002): its runs get run ids past every run id published before
+replaced, or wrapped after 9999999999; it names itself differently in MID
+0002; or, within a session, a live id jumps more than a gap can hold past the
+newest one): its runs get run ids past every run id published before
 (``run_id = run_id_offset + tightening_id``; the offset is the last run id
-published), and none of them is taken for one published already. The
-tightening id of each result stays the controller's own.
+published less the id after which the epoch starts, so the run ids go on one
+by one: an epoch that starts after id 3117 gives id 3118 the run id after the
+last one; the offset may be negative), and none of them is taken for one
+published already. The tightening id of each result stays the controller's
+own. The keys of the epochs before (``previous_keys``, the newest
+:data:`PREVIOUS_KEYS_KEPT`) are kept too: a result of an epoch before is
+never published again, and where the controller's ids went back to ones it
+still keeps, the new epoch starts after the last of them.
 """
 
 from __future__ import annotations
@@ -43,6 +50,9 @@ from pathlib import Path
 from shared.files import write_json_atomically
 
 LOG = logging.getLogger(__name__)
+
+#: how many keys of the epochs before are kept
+PREVIOUS_KEYS_KEPT = 200
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,13 +69,20 @@ class BridgePosition:
     keys: Mapping[int, str] = field(default_factory=dict)
     #: how the controller's 0900 samples read right (``Reading.text``); "" not known yet
     trace_reading: str = ""
+    #: the keys of the ids published last in the epochs before, by id (newest last)
+    previous_keys: Mapping[int, str] = field(default_factory=dict)
 
     def run_id(self, tightening_id: int) -> int:
         return self.run_id_offset + tightening_id
 
-    def new_epoch(self, controller_name: str) -> BridgePosition:
-        """The controller's ids start again: run ids go on past the last one published."""
-        return BridgePosition(0, self.run_id(self.watermark), controller_name)
+    def new_epoch(self, controller_name: str, start_after: int = 0) -> BridgePosition:
+        """The controller's ids start again after ``start_after``: the run ids go on after
+        the last one published; this epoch's keys join those of the epochs before."""
+        merged = {i: k for i, k in self.previous_keys.items() if i not in self.keys}
+        merged.update(sorted(self.keys.items()))
+        kept = dict(list(merged.items())[-PREVIOUS_KEYS_KEPT:])
+        offset = self.run_id(self.watermark) - start_after
+        return BridgePosition(start_after, offset, controller_name, previous_keys=kept)
 
 
 def position_path(recordings: Path, station: str) -> Path:
@@ -83,10 +100,11 @@ def read_position(path: Path) -> BridgePosition:
         document = json.loads(path.read_text(encoding="utf-8"))
         position = BridgePosition(
             watermark=_count(document, "watermark"),
-            run_id_offset=_count(document, "run_id_offset"),
+            run_id_offset=_whole(document, "run_id_offset"),
             controller_name=str(document.get("controller_name", "")),
-            keys=_keys(document),
+            keys=_keys(document, "keys"),
             trace_reading=str(document.get("trace_reading", "")),
+            previous_keys=_keys(document, "previous_keys"),
         )
     except FileNotFoundError:
         return BridgePosition()
@@ -108,14 +126,22 @@ def _document(position: BridgePosition) -> dict[str, object]:
         "controller_name": position.controller_name,
         "keys": {str(tightening_id): key for tightening_id, key in position.keys.items()},
         "trace_reading": position.trace_reading,
+        "previous_keys": {str(i): key for i, key in position.previous_keys.items()},
     }
 
 
-def _keys(document: dict[str, object]) -> dict[int, str]:
-    keys = document.get("keys", {})
+def _keys(document: dict[str, object], name: str) -> dict[int, str]:
+    keys = document.get(name, {})
     if not isinstance(keys, dict):
-        raise ValueError(f"keys: expected an object, got {keys!r}")
+        raise ValueError(f"{name}: expected an object, got {keys!r}")
     return {int(tightening_id): str(key) for tightening_id, key in keys.items()}
+
+
+def _whole(document: dict[str, object], key: str) -> int:
+    value = document.get(key, 0)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"{key}: expected a whole number, got {value!r}")
+    return value
 
 
 def _count(document: dict[str, object], key: str) -> int:

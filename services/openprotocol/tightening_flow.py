@@ -12,7 +12,13 @@ reading: :mod:`.published_ids`) is written after its last message was put.
   what is pending of the old epoch, then starts the new one;
 - curves are checked against their result (:mod:`.curve_check`); the first
   reading that agrees is kept for the controller (logged, saved); a curve that
-  agrees with no reading is refused and counted, its result goes without it.
+  agrees with no reading is refused and counted, its result goes without it;
+- each figure is judged against its pset's window: a controller station's
+  file's (``[[programs]]`` of that id, where it gives the figure a bound; a CAN
+  station's programs are the simulated controller's, whose 0061 says them), else the
+  controller's: the result's own limits (0061), or, for a result fetched by id
+  (0065 carries none), the limits the controller's last 0061 of that pset
+  gave (kept while the bridge runs).
 """
 
 from __future__ import annotations
@@ -25,11 +31,18 @@ from pathlib import Path
 from services.openprotocol.bridge_counts import BridgeCounts
 from services.openprotocol.controller_tightening import Curve, ResultFigures, Tightening
 from services.openprotocol.curve_check import Reading, check_curves, readings
-from services.openprotocol.pending_tightenings import PendingTightenings, Take
+from services.openprotocol.pending_tightenings import MAX_FILL, PendingTightenings, Take
 from services.openprotocol.published_ids import BridgePosition, read_position, write_position
 from services.openprotocol.tightening_messages import tightening_messages
-from shared.config import AnyStation, OpenProtocolSection
+from shared.config import (
+    AnyStation,
+    ControllerProgram,
+    ControllerStation,
+    OpenProtocolSection,
+    Program,
+)
 from shared.contract import INT64_MAX
+from shared.quality import Window
 
 LOG = logging.getLogger(__name__)
 
@@ -58,13 +71,22 @@ class TighteningFlow:
         self._clock = clock
         self.position = read_position(position_file)
         self._pending = PendingTightenings.resume(
-            self.position.watermark, self.position.keys, section.traces, trace_timeout_s
+            self.position.watermark,
+            self.position.keys,
+            section.traces,
+            trace_timeout_s,
+            self.position.previous_keys,
         )
         self._reading = Reading.parse(self.position.trace_reading)
         counts.trace_reading = None if self._reading is None else str(self._reading)
         #: the controller's name as it said it on the link in use ("" not known)
         self.controller_name = self.position.controller_name
         self._given_up_before = 0  # ids given up in epochs before this one
+        #: per pset, the torque and angle windows the controller's last 0061 of it gave
+        self._controller_windows: dict[int, dict[str, Window]] = {}
+        #: the newest id the controller is known to have on this link (0: none; None: not
+        #: known): a live id more than MAX_FILL past it is a jump, not a gap to fetch
+        self.session_newest: int | None = None
 
     @property
     def watermark(self) -> int:
@@ -73,6 +95,13 @@ class TighteningFlow:
     def known_key(self, tightening_id: int) -> str | None:
         """The key of a published id, when it is kept."""
         return self._pending.published_keys.get(tightening_id)
+
+    def last_kept_at_or_below(self, tightening_id: int) -> tuple[int, str] | None:
+        """The highest id up to ``tightening_id`` whose key is kept (this epoch's or one
+        before), with its key; None: none kept."""
+        kept = {**self._pending.previous_keys, **self._pending.published_keys}
+        below = [i for i in kept if i <= tightening_id]
+        return None if not below else (max(below), kept[max(below)])
 
     # -- in -----------------------------------------------------------------------------
 
@@ -87,14 +116,24 @@ class TighteningFlow:
                 f"tightening {figures.tightening_id}: the controller's time stamp is one no "
                 "clock holds: the time it was received is taken",
             )
+        tightening_id = figures.tightening_id
+        newest = self.session_newest
+        if not figures.filled and newest is not None and tightening_id > newest + MAX_FILL:
+            self._jump(newest, tightening_id)
         take = self._pending.result(figures, self._clock())
         if take is Take.CONFLICT:
+            # live: the controller pushes every result, so its ids went back to this one;
+            # fetched (a catch-up): the ids before it may be new too
             self.new_epoch(
-                f"tightening {figures.tightening_id} came with other values than the one "
+                f"tightening {tightening_id} came with other values than the one "
                 "published under its id: the controller's ids started again",
                 self.controller_name,
+                start_after=0 if figures.filled else tightening_id - 1,
             )
             take = self._pending.result(figures, self._clock())
+            self.session_newest = tightening_id  # the controller's ids go on from here
+        else:
+            self.session_newest = max(newest or 0, tightening_id)
         if take is Take.REPEAT and not figures.filled:
             self._counts.repeated_results += 1
             self._counts.note(
@@ -126,21 +165,40 @@ class TighteningFlow:
 
     # -- epochs -------------------------------------------------------------------------
 
-    def new_epoch(self, why: str, controller_name: str) -> None:
-        """The controller's ids start again: what is pending of the old epoch goes out
-        first; the new epoch's run ids come after every one published."""
+    def _jump(self, newest: int, tightening_id: int) -> None:
+        """A live id more than MAX_FILL past the newest the controller had on this link: its
+        counter jumped (no controller makes that many while it pushes each). The ids between
+        were never made: none is asked for; a new epoch starts just before it."""
+        why = f"its tightening id jumped from {newest} to {tightening_id} within a session"
+        if self._pending.watermark == 0 and not self._pending.published_keys:
+            LOG.warning("%s: %s: the ids before it are not asked for", self._counts.controller, why)
+            self._pending = PendingTightenings.resume(
+                tightening_id - 1,
+                {},
+                self._pending.wait_for_curves,
+                self._pending.trace_timeout_s,
+                self._pending.previous_keys,
+                new_epoch=True,
+            )
+            return
+        self.new_epoch(why, self.controller_name, start_after=tightening_id - 1)
+
+    def new_epoch(self, why: str, controller_name: str, start_after: int = 0) -> None:
+        """The controller's ids start again after ``start_after``: what is pending of the
+        old epoch goes out first; the new epoch's run ids come after every one published."""
         for tightening in self._pending.drain():
             self._publish_one(tightening)
         self._count_given_up()
         self._given_up_before += self._pending.given_up
-        self.position = self._current_position().new_epoch(controller_name)
+        self.position = self._current_position().new_epoch(controller_name, start_after)
         self.controller_name = controller_name
         self._pending = PendingTightenings.resume(
-            0,
+            start_after,
             {},
             self._pending.wait_for_curves,
             self._pending.trace_timeout_s,
-            previous_keys=self._pending.published_keys,
+            previous_keys=self.position.previous_keys,
+            new_epoch=True,
         )
         self._reading = None
         self._counts.trace_reading = None
@@ -177,16 +235,24 @@ class TighteningFlow:
             return
         tightening = self._checked(tightening)
         station = self._station
+        program: Program | ControllerProgram | None
         try:
-            program_name = station.config.program(result.program_id).name
+            program = station.config.program(result.program_id)
         except KeyError:
-            program_name = f"pset {result.program_id}"
+            program = None
+        program_name = f"pset {result.program_id}" if program is None else program.name
+        windows = self._windows(result)
+        if isinstance(station, ControllerStation) and program is not None:
+            for figure in ("torque", "angle"):
+                if program.window(figure) != (None, None):
+                    windows[figure] = program.window(figure)
         for message in tightening_messages(
             station.station_id,
             station.config.station.tool_id,
             run_id,
             tightening,
             program_name,
+            windows,
         ):
             self._publish(message)
         counts = self._counts
@@ -199,6 +265,18 @@ class TighteningFlow:
                 "trace", f"tightening {result.tightening_id}: published without its curves"
             )
         counts.last_tightening_id = result.tightening_id
+
+    def _windows(self, result: ResultFigures) -> dict[str, Window]:
+        """The controller's windows of ``result``'s pset: a 0061's own are kept for the
+        pset; a 0065 (no limits) gets those the pset's last 0061 gave."""
+        own = {
+            "torque": (result.torque_min_nm, result.torque_max_nm),
+            "angle": (result.angle_min_deg, result.angle_max_deg),
+        }
+        if not result.filled:
+            self._controller_windows[result.program_id] = own
+            return {}  # the result's own limits: judged as the controller gave them
+        return dict(self._controller_windows.get(result.program_id, {}))
 
     def _checked(self, tightening: Tightening) -> Tightening:
         """The tightening with its curves read the way that agrees with its result."""
@@ -233,6 +311,7 @@ class TighteningFlow:
             self.controller_name,
             dict(self._pending.published_keys),
             "" if self._reading is None else self._reading.text,
+            self.position.previous_keys,
         )
 
     def _write_position(self) -> None:

@@ -22,18 +22,21 @@ too):
    step made of its torque and angle limits, targets and finals);
 6. ``results``: the :class:`TighteningResult` made from it
    (:func:`shared.quality.controller_result.controller_result`, source
-   ``controller``);
+   ``controller``), its figures judged against ``windows`` where the caller
+   gives one (the station's pset, else the controller's pset as its last 0061
+   said: :mod:`.tightening_flow`), else against the result's own limits;
 7. ``runs``: the replay's :class:`RunSummary` (stop reason None).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 from services.openprotocol.controller_tightening import ResultFigures, Tightening
 from shared.contract import ControllerFunction, ControllerResult, ControllerStep, Sample, ToolState
-from shared.quality import controller_result
+from shared.quality import Window, controller_result
 from shared.stickslip import StoppedRun, replay_run
 
 #: the name of the one step a bridge's ControllerResult has (Open Protocol gives no steps)
@@ -91,8 +94,10 @@ def tightening_messages(
     run_id: int,
     tightening: Tightening,
     program_name: str = "",
+    windows: Mapping[str, Window] | None = None,
 ) -> list[Any]:
-    """Every message of the tightening, in the order a CAN station publishes them."""
+    """Every message of the tightening, in the order a CAN station publishes them;
+    ``windows``: "torque" / "angle" -> the window its figure is judged against."""
     run, samples = stopped_run(station, tool_id, run_id, tightening)
     replayed = replay_run(run)
     result = tightening.result
@@ -112,7 +117,12 @@ def tightening_messages(
     messages.append(controller)
     messages.append(
         controller_result(
-            controller, replayed.summary, program_name, "controller", result.tightening_id
+            controller,
+            replayed.summary,
+            program_name,
+            "controller",
+            result.tightening_id,
+            windows,
         )
     )
     messages.append(replayed.summary)

@@ -7,6 +7,8 @@
   :mod:`.active_run` (one run's core and summary)
 - :mod:`.station_counts` (what it could not use, per station: PredictorStats),
   :mod:`.station_refusal` (one predictor per station)
+- :mod:`.part_at_start` (the part at each station when the predictor starts: asked of
+  the line in the background)
 - :mod:`.edge_predictor` (the station's predictor on its acquisition's CAN thread,
   ``[predictor] placement = "edge"``, the default; the command line hands it to the
   acquisition through the acquisition's ``Decider`` seam)

@@ -13,6 +13,7 @@ import math
 from shared.config import Program
 from shared.contract import (
     Intensity,
+    PartSource,
     RunClock,
     RunSummary,
     Sample,
@@ -44,11 +45,14 @@ class ActiveRun:
         program: Program,
         settings: PredictorSettings,
         part_id: str | None = None,
+        part_source: PartSource = "unknown",
     ) -> None:
-        """``part_id``: the part at the station when the run started (None: none scanned)."""
+        """``part_id``: the part at the station when the run started (None: none known);
+        ``part_source``: where it came from."""
         self.state = state
         self.program = program
         self.part_id = part_id
+        self.part_source: PartSource = part_source if part_id is not None else "unknown"
         self.settings = settings
         self.core = PredictorCore(settings)
         self.started_ns = state.time_ns

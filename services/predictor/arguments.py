@@ -8,6 +8,7 @@ import argparse
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The predictor needs only the station file (``--config``, added by ``serve``)."""
     parser.epilog = (
-        "Subscribes to boltwatch/<station>/samples and /tool, publishes /events, "
-        "/intensity, /decision and /runs."
+        "Subscribes to boltwatch/<station>/samples, /tool and /part, publishes /events, "
+        "/intensity, /decision, /results and /runs (kept in the station's spool until the "
+        "line's recorder has them); asks the line for each station's last part at start."
     )

@@ -21,7 +21,9 @@ current part; a run started on the CAN thread takes the part current then.
 A part scan that does not decode, or names another station, is counted as a
 bad payload. A part must reach the edge box before its run starts: one
 scanned while the box is cut off from the line never arrives, and the runs
-go on naming the part before.
+go on naming the part before. At start it asks the line for the station's
+last part in the background (:mod:`.part_at_start`): the runs before an answer
+(or a scan) name none, the ones after name the line's part as ``restored``.
 
 What it counts (samples its core could not use, runs that started again,
 part scans refused, ...) goes out once a second as the station's
@@ -40,6 +42,7 @@ from collections.abc import Callable
 
 import zenoh
 
+from services.predictor.part_at_start import PartAtStart
 from services.predictor.served_station import ServedStation
 from services.predictor.station_refusal import refuse_stations_served_elsewhere
 from services.predictor.station_runs import StationRuns
@@ -68,6 +71,8 @@ class EdgePredictor:
         # before the health token: a predictor the line sees alive hears the station's parts
         skeleton.subscriber(channels.PART.key(station.station_id), self._on_part)
         skeleton.health_token(station.station_id, "predictor")
+        # the part at the station until a scan is heard: asked of the line, never waited for
+        self._part_at_start = PartAtStart(skeleton.session, {station.station_id: self._runs})
         self._started_ns = time.time_ns()
         self._closed = threading.Event()
         self._stats = threading.Thread(
@@ -117,6 +122,8 @@ class EdgePredictor:
             self._publish(self._runs.counts.stats(time.time_ns(), self._started_ns))
 
     def close(self) -> None:
-        """Stop the stats thread (its token goes with the acquisition's, in its skeleton)."""
+        """Stop asking the line and the stats thread (its token goes with the acquisition's,
+        in its skeleton)."""
+        self._part_at_start.close()
         self._closed.set()
         self._stats.join(timeout=5.0)

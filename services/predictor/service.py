@@ -6,7 +6,9 @@ only those: per served station it subscribes to ``boltwatch/<st>/samples``,
 another station's data must never reach this process's decisions, nor
 another station's part its results); each message is handled in its zenoh
 callback, one at a time (:mod:`services.predictor.station_inbox`), so a part
-scanned before a run's ``running`` is the part of that run.
+scanned before a run's ``running`` is the part of that run. At start it asks
+the line for each station's last part in the background
+(:mod:`services.predictor.part_at_start`).
 Each run is predicted with its own station's programs, force sensor, joint
 constants and ``[predictor]`` section. Out, per station: ``events`` and ``intensity``
 per stick-slip event, ``decision`` (REAL_TIME priority, express, blocking
@@ -16,6 +18,14 @@ station whose acquisition decides (``[predictor] placement = "edge"``, the
 default) is refused at once, from its file, and a station that already has
 a predictor on the line is refused at start-up, so two predictors never both
 decide for one station (:mod:`services.predictor.station_refusal`).
+
+Everything it puts for a station goes through that station's queued publisher
+(:class:`~shared.runtime.QueuedPublisher`, the ``predictor`` source of the
+station's spool, ``[spool]``): kept in ``<spool folder>/<st>-predictor.sqlite``
+until the line's recorder has it, so a recorder that was down, or a cut
+between this process and the recorder, loses none of its events, intensities,
+decisions, results, summaries or counters. The callback that decides only
+queues; the publisher's thread keeps and puts, in order.
 
 No payload stops the service: what does not decode (bad JSON, nested too
 deeply, too large, a wrong type, a value out of its bounds or an id wider
@@ -33,9 +43,8 @@ import threading
 import time
 from collections.abc import Sequence
 
-import zenoh
-
 from services.predictor.active_run import Outgoing
+from services.predictor.part_at_start import PartAtStart
 from services.predictor.served_station import ServedStation
 from services.predictor.station_counts import StationCounts
 from services.predictor.station_inbox import Inbox, InboxFactory, StationInbox
@@ -45,14 +54,23 @@ from services.predictor.station_refusal import (
 )
 from services.predictor.station_runs import StationRuns
 from shared.config import LoadedStation, load_line, stations_by_id
-from shared.contract import Sample, StopDecision, ToolState, channels, codec, keys
+from shared.contract import Sample, StopDecision, ToolState, channels, keys
 from shared.errors import InputError
-from shared.runtime import RateLimitedLog, ServiceSkeleton, Stop, use_one_receive_thread
+from shared.runtime import (
+    QueuedPublisher,
+    RateLimitedLog,
+    ServiceSkeleton,
+    Stop,
+    station_spool,
+    use_one_receive_thread,
+)
 
 LOG = logging.getLogger(__name__)
 
 #: how often each served station's PredictorStats goes out
 STATS_PERIOD_S = 1.0
+#: the source of a line predictor's messages in its stations' spools
+SPOOL_SOURCE = "predictor"
 
 
 class PredictorService:
@@ -67,7 +85,6 @@ class PredictorService:
         """Declares through ``skeleton`` (its session, inbox, publishers, health tokens),
         which undeclares them when it closes."""
         served = [stations] if isinstance(stations, LoadedStation) else list(stations)
-        self._skeleton = skeleton
         self._session = skeleton.session
         self._stations = {
             station_id: ServedStation(station)
@@ -77,11 +94,20 @@ class PredictorService:
         self._runs = {
             station_id: StationRuns(served) for station_id, served in self._stations.items()
         }
-        self._publishers: dict[tuple[str, str], zenoh.Publisher] = {}
+        #: per station, its queued publisher (with the station's spool, source "predictor")
+        self._publishers: dict[str, QueuedPublisher] = {}
+        for station_id, served_station in self._stations.items():
+            spool = station_spool(served_station.station, SPOOL_SOURCE)
+            publisher = QueuedPublisher(self._session, station_id, spool=spool)
+            skeleton.on_stop(Stop.OUTPUT, publisher.close)
+            self._publishers[station_id] = publisher
         self.started_ns = time.time_ns()
         self._log_bad_payload = RateLimitedLog(LOG)
         self._inbox: Inbox = inbox(self._session, list(self._stations), self.handle)
         skeleton.on_stop(Stop.INPUT, self._inbox.close)
+        # the part at each station until a scan is heard: asked of the line, never waited for
+        self._part_at_start = PartAtStart(self._session, self._runs)
+        skeleton.on_stop(Stop.INPUT, self._part_at_start.close)
         for station_id in self._stations:
             skeleton.health_token(station_id, "predictor")
 
@@ -111,12 +137,8 @@ class PredictorService:
     def _publish_stats_until(self, stop: threading.Event, done: threading.Event) -> None:
         while not (stop.is_set() or done.wait(STATS_PERIOD_S)):
             now_ns = time.time_ns()
-            for runs in self._runs.values():
-                stats = runs.counts.stats(now_ns, self.started_ns)
-                try:
-                    self._session.put(channels.PREDICTOR.key(stats.station), codec.encode(stats))
-                except zenoh.ZError as err:  # the session is closing
-                    LOG.debug("predictor stats of %s not published: %s", stats.station, err)
+            for station_id, runs in self._runs.items():
+                self._publishers[station_id].publish(runs.counts.stats(now_ns, self.started_ns))
 
     def handle(self, station_id: str, topic: str, payload: bytes) -> None:
         """Dispatch one message received on a served station's ``topic`` key."""
@@ -178,7 +200,8 @@ class PredictorService:
 
     @property
     def part_ids(self) -> dict[str, str | None]:
-        """The part at each served station: the last one scanned (None: none yet)."""
+        """The part at each served station: the last one scanned, else the line's at start
+        (None: none known)."""
         return {station_id: runs.part_id for station_id, runs in self._runs.items()}
 
     @property
@@ -209,14 +232,9 @@ class PredictorService:
             )
 
     def _publish(self, station: str, message: object) -> None:
-        """``message`` on its channel of ``station``."""
-        channel = channels.of_message(message)
-        publisher = self._publishers.get((station, channel.topic))
-        if publisher is None:  # the channel's options: decisions REAL_TIME and express;
-            # every channel BLOCK (zenoh's default DROP lost events under load, silently)
-            publisher = self._skeleton.publisher(channel, station)
-            self._publishers[(station, channel.topic)] = publisher
-        publisher.put(codec.encode(message))
+        """``message`` on its channel of ``station``, through the station's queued publisher
+        (the channel's options: decisions REAL_TIME and express; every channel BLOCK)."""
+        self._publishers[station].publish(message)
 
 
 def main(args: argparse.Namespace) -> int:

@@ -17,7 +17,12 @@ predictor (:mod:`.service`, fed from zenoh) and the edge predictor
 - a sample of no running run is dropped and counted;
 - a :class:`PartScan` makes its part the station's current part; a run takes
   the part current when it starts, and its result names it (a part scanned
-  during a run belongs to the next run; none scanned yet: None).
+  during a run belongs to the next run; none scanned yet: None) and where it
+  came from (``part_source``: ``scanned``);
+- the line's answer at start (:meth:`StationRuns.restore_part`: the last part
+  the line's recorder heard, asked by :mod:`.part_at_start`) is the current
+  part until a scan comes (``restored``: it may be stale); a scan heard first
+  wins, the answer is then dropped. No part: ``unknown``.
 
 What it counts (:attr:`counts`, a :class:`~.station_counts.StationCounts`:
 runs that started again, runs whose end never arrived, samples of no
@@ -29,12 +34,20 @@ repeat are rate-limited.
 from __future__ import annotations
 
 import logging
+import threading
 from collections import deque
 
 from services.predictor.active_run import ActiveRun, Outgoing
 from services.predictor.served_station import ServedStation
 from services.predictor.station_counts import StationCounts
-from shared.contract import PartScan, RunSummary, Sample, TighteningResult, ToolState
+from shared.contract import (
+    PartScan,
+    PartSource,
+    RunSummary,
+    Sample,
+    TighteningResult,
+    ToolState,
+)
 from shared.quality import tightening_result
 from shared.runtime import RateLimitedLog
 
@@ -52,8 +65,10 @@ class StationRuns:
         self._runs: dict[int, ActiveRun] = {}
         self._started: deque[int] = deque(maxlen=STARTED_RUNS_KEPT)
         self.counts = StationCounts(served.station_id)
-        #: the part at the station: the last one scanned (None: none since the start)
-        self.part_id: str | None = None
+        #: the part at the station and where it came from, one reference (replaced whole:
+        #: the edge predictor's CAN thread reads it while a zenoh thread sets it)
+        self._part: tuple[str | None, PartSource] = (None, "unknown")
+        self._part_set = threading.Lock()  # between the two that set it: a scan, the line
         self._log_no_program = RateLimitedLog(LOG, logging.ERROR)
         self._log_unfinished = RateLimitedLog(LOG)
 
@@ -73,7 +88,7 @@ class StationRuns:
         if run is None:
             return []
         summary = run.summary(state)
-        result = tightening_result(summary, run.program, run.part_id)
+        result = tightening_result(summary, run.program, run.part_id, run.part_source)
         self.counts.run_ended(run.core.input_report)
         LOG.info(
             "%s run %s %s %s, part %s: %d events, stop %s%s, error %s %%, %s",
@@ -81,7 +96,7 @@ class StationRuns:
             state.run_id,
             state.state,
             result.result,
-            run.part_id or "-",
+            f"{run.part_id} ({run.part_source})" if run.part_id else "-",
             summary.events,
             summary.stop_reason or "by the tool",
             f" (late decision: {summary.late_decision})" if summary.late_decision else "",
@@ -90,11 +105,42 @@ class StationRuns:
         )
         return [result, summary]
 
+    @property
+    def part_id(self) -> str | None:
+        """The part at the station (None: none known)."""
+        return self._part[0]
+
+    @property
+    def part_source(self) -> PartSource:
+        """Where the part at the station came from (``unknown``: there is none)."""
+        return self._part[1]
+
+    @property
+    def part_scanned(self) -> bool:
+        """A scan was heard since the start (the line's answer is no longer wanted)."""
+        return self._part[1] == "scanned"
+
     def on_part(self, scan: PartScan) -> None:
         """A part arrived at the station: the runs that start from now on tighten it."""
-        if scan.part_id != self.part_id:
-            LOG.info("%s: part %s at the station", scan.station, scan.part_id)
-        self.part_id = scan.part_id
+        with self._part_set:
+            if scan.part_id != self.part_id:
+                LOG.info("%s: part %s at the station", scan.station, scan.part_id)
+            self._part = (scan.part_id, "scanned")
+
+    def restore_part(self, scan: PartScan) -> bool:
+        """The line's last scan of the station, asked at start: the current part until a scan
+        is heard; False (and nothing changes) when one was heard already."""
+        with self._part_set:
+            if self.part_scanned:
+                return False
+            LOG.info(
+                "%s: part %s at the station, as the line last heard it (a part that arrived "
+                "while the station was down is not known until its next scan)",
+                scan.station,
+                scan.part_id,
+            )
+            self._part = (scan.part_id, "restored")
+            return True
 
     def on_sample(self, sample: Sample, wall_ns: int) -> list[Outgoing]:
         """Feed a sample to its run; the events, intensities and decision it produced."""
@@ -117,9 +163,10 @@ class StationRuns:
         except KeyError as err:
             self._log_no_program("run %s: %s; not predicting this run", state.run_id, err.args[0])
             return
-        part_id = self.part_id  # read once: an edge predictor's scans come on another thread
+        part_id, part_source = self._part  # read once: an edge predictor's scans come on
+        # another thread
         settings = self.served.settings(program, state.commands or "stop")
-        self._runs[state.run_id] = ActiveRun(state, program, settings, part_id)
+        self._runs[state.run_id] = ActiveRun(state, program, settings, part_id, part_source)
         LOG.debug(
             "%s run %s started (program %s, part %s)",
             state.station,

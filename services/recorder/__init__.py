@@ -3,6 +3,8 @@ store and the wear ledger.
 
 - :mod:`.service` (the zenoh wiring: subscriptions per station, RecorderStats,
   the flush ticks), :mod:`.wear_queryable` (``boltwatch/<st>/wear`` answered),
+  :mod:`.last_parts` (each station's last part scan, kept, saved and answered on
+  ``boltwatch/<st>/part``),
   :mod:`.arguments` (its options),
   :mod:`.served_stations` (the station files it serves, which must agree),
   :mod:`.station_holder` (one recorder per station: the folder's lock, the station's token),

@@ -23,7 +23,9 @@ sample crosses to this line for it). No payload stops it: what it refuses
 ``RecorderStats.bad_payloads``. Every TighteningResult it files feeds the quality alert
 (:mod:`services.recorder.quality_watch`, on ``quality/alert``) and the results store
 (:mod:`services.recorder.results_watch`), every RunSummary the wear ledger
-(``wear/alert``); a view-only recorder keeps none of them. With a ``[retention]`` rule,
+(``wear/alert``), every part scan the station's last part, which it answers on
+``boltwatch/<st>/part`` (:mod:`services.recorder.last_parts`); a view-only recorder keeps
+none of them. With a ``[retention]`` rule,
 a thread of its own deletes the recordings the policy lets go
 (:mod:`services.recorder.retention_watch`; the worker only tells it, at each tick, which
 files it has open).
@@ -53,6 +55,7 @@ from typing import TYPE_CHECKING
 
 import zenoh
 
+from services.recorder.last_parts import LastParts
 from services.recorder.live.line_inbox import LineInbox, Message
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.recorder_health import RecorderHealth
@@ -111,6 +114,7 @@ _BUS_STATS = channels.BUS.schema_name
 _SAMPLE = channels.SAMPLES.schema_name
 _BATCH = channels.SAMPLE_BATCHES.schema_name
 _SPOOL = channels.SPOOL.schema_name
+_PART = channels.PART.schema_name
 
 
 class RecorderService:
@@ -151,6 +155,8 @@ class RecorderService:
         self.quality: QualityWatch | None = None
         self.results: ResultsWatch | None = None
         self.retention: RetentionWatch | None = None
+        #: the last part scanned at each station (a view keeps none, answers none)
+        self.last_parts: LastParts | None = None
         #: what the line's recorder filed of the stations' spools (a view acknowledges nothing)
         self.spooling = (
             None
@@ -160,6 +166,7 @@ class RecorderService:
             )
         )
         if not view_only:
+            self.last_parts = LastParts(first.recordings_folder, self.station_ids)
             settings = {station.station_id: station.config.quality for station in stations}
             self.quality = QualityWatch(settings, self._publish_alert)
             self.wear = WearWatch(
@@ -184,6 +191,8 @@ class RecorderService:
                 keys.station_key(station, keys.WEAR),
                 wear_replier(self._ledger_file, self._host, station),
             )
+            if self.last_parts is not None:
+                skeleton.queryable(channels.PART.key(station), self.last_parts.replier(station))
         for station in self.station_ids:
             skeleton.health_token(station, VIEWER if view_only else "recorder")
         LOG.info(
@@ -213,11 +222,7 @@ class RecorderService:
                     self._release_results(time.time_ns())
                     next_results = now + RESULTS_FLUSH_S
                 if now >= next_tick:
-                    self.recorder.tick(time.time_ns())
-                    if self.retention is not None:
-                        self.retention.open_files(self.recorder.open_paths())
-                    if self.wear is not None:
-                        self.wear.tick(time.time_ns())
+                    self._tick()
                     next_tick = now + self._tick_s
                 if now >= next_stats and not self.view_only:
                     self._acknowledge(time.time_ns())
@@ -233,12 +238,25 @@ class RecorderService:
                 LOG.warning("not recorded, arrived while stopping: %d", self._inbox.after_close)
             if self.wear is not None:
                 self.wear.close()
+            if self.last_parts is not None:
+                self.last_parts.save()
             if self.retention is not None:
                 self.retention.close()
             closed = self.recorder.close()
             if self.results is not None:
                 self.results.close()  # after the files are finished
             LOG.info("recorder stopped: %d messages, %d files", self.recorder.messages, len(closed))
+
+    def _tick(self) -> None:
+        """Every half flush interval: flush and close what is due, tell the retention which
+        files are open, the wear ledger's timers, save the stations' last parts."""
+        self.recorder.tick(time.time_ns())
+        if self.retention is not None:
+            self.retention.open_files(self.recorder.open_paths())
+        if self.wear is not None:
+            self.wear.tick(time.time_ns())
+        if self.last_parts is not None:
+            self.last_parts.save()
 
     def stats(self, now_ns: int) -> list[RecorderStats]:
         """RecorderStats of every station now (starts the next lag window)."""
@@ -346,6 +364,8 @@ class RecorderService:
                 self.wear.on_summary(message, now_ns)
         elif schema == channels.TOOL_DATA.schema_name and self.wear is not None:
             self.wear.on_tool_data(message, now_ns)
+        elif schema == _PART and self.last_parts is not None:
+            self.last_parts.on_scan(message, received.station)
 
     def _file_batch(self, batch: Received, filed_ns: int, hole: StationFiles | None) -> None:
         """Each sample of a batch, then its events and intensities, as if each had come alone

@@ -12,7 +12,8 @@ may declare subscribers, queryables and liveliness tokens under
   ``decision``, ``runs``, ``results``, ``predictor`` (its stats) (it hosts the
   station's predictor: ``[predictor] placement = "edge"``, the default),
 - ``<st>-predictor`` may put the predictor's keys (a line predictor,
-  ``boltwatch serve predictor`` for a station with ``placement = "line"``),
+  ``boltwatch serve predictor`` for a station with ``placement = "line"``; with
+  its spool's counters, ``spool``),
 - ``<st>-openprotocol`` may put what an Open Protocol bridge publishes for its
   station (``boltwatch serve openprotocol``: the run's samples, tool states,
   the advisory predictor's keys, the controller's result, tool data, alarms and
@@ -22,8 +23,8 @@ may declare subscribers, queryables and liveliness tokens under
   stands in for the PLC),
 - ``line-recorder`` may put ``boltwatch/<st>/recorder``, ``quality/alert``,
   ``wear/**`` and ``spool/ack`` (what it has of a station's spool);
-- the station's spooling services (``acquisition``, ``openprotocol``) may put
-  ``again/**`` too (what their spool sends again).
+- the station's spooling services (``acquisition``, ``openprotocol``, a line
+  ``predictor``) may put ``again/**`` too (what their spool sends again).
 
 No one else may put a station's decision; in a plant of several lines the
 router of another line (``--peer NAME=ST,...``: the common name of that
@@ -52,10 +53,13 @@ from typing import Any
 
 from shared.contract import channels, keys
 
-#: what a station's spool sends again (the spooling services: acquisition, openprotocol)
+#: what a station's spool sends again (the spooling services: acquisition, openprotocol,
+#: a line predictor)
 AGAIN_TOPICS = (f"{keys.AGAIN}/**",)
 ACQUISITION_TOPICS = (*channels.topics_of("acquisition"), *AGAIN_TOPICS)
 PREDICTOR_TOPICS = channels.topics_of("predictor")
+#: a line predictor spools what it puts, as the station's services do
+LINE_PREDICTOR_TOPICS = (*PREDICTOR_TOPICS, *AGAIN_TOPICS)
 BRIDGE_TOPICS = (*channels.topics_of("openprotocol"), *AGAIN_TOPICS)
 #: the part at a station: the line's PLC (or scanner), and the rig in its place
 PLC_TOPICS = channels.topics_of("plc")
@@ -111,14 +115,19 @@ def line_access_control(
             everyone.append(name)
         for role, topics in (
             ("acquisition", ACQUISITION_TOPICS + PREDICTOR_TOPICS),  # + the edge predictor
-            ("predictor", PREDICTOR_TOPICS),
+            ("predictor", LINE_PREDICTOR_TOPICS),
             ("openprotocol", BRIDGE_TOPICS),
             ("plc", PLC_TOPICS),
             ("rig", RIG_TOPICS),
         ):
             rule_id = f"{station}-{role}-puts"
             rules.append(
-                _rule(rule_id, ["put"], ["ingress"], [keys.station_key(station, t) for t in topics])
+                _rule(
+                    rule_id,
+                    ["put"],
+                    ["ingress"],
+                    [keys.station_key(station, t) for t in dict.fromkeys(topics)],
+                )
             )
             policies.append({"id": rule_id, "rules": [rule_id], "subjects": [names[role]]})
     for router, its_stations in (peers or {}).items():

@@ -32,10 +32,13 @@ torque and angle, no preload). A plant engineer who writes one of them
 expects it to act; silence would let them believe it does.
 
 **What a pset's entry does**: its name names the pset's runs (results,
-recordings, status); its windows are kept with each run's recording (the
-``program`` metadata record). The controller judges its own tightenings:
-the verdict, the windows and the target of a result are the controller's
-(MID 0061), and ``boltwatch inspect`` draws those.
+recordings, status); its windows judge the pset's runs (each figure with a
+bound here; the others against the controller's own limits, MID 0061) and
+are kept with each run's recording (the ``program`` metadata record). A
+result is OK only where the controller said OK and every figure is in its
+window; where they disagree it is NOK and says so
+(:mod:`shared.quality.controller_result`). ``boltwatch inspect`` draws the
+controller's own window and target.
 
 **Sensor range**: the contract's (:data:`shared.contract.sensor_range.CONTRACT_RANGE`,
 the range of ``config/can/station.dbc``: torque ±8388 Nm, angle ±83886 deg):

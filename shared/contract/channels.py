@@ -187,7 +187,8 @@ CONTROLLER = Channel("controller", ControllerResult, "import", also_by=_BRIDGE)
 TOOL_DATA = Channel("tool_data", ToolData, "openprotocol")
 ALARMS = Channel("alarms", ControllerAlarm, "openprotocol")
 OPENPROTOCOL = Channel("openprotocol", BridgeStats, "openprotocol")
-SPOOL = Channel("spool", SpoolStats, "acquisition", also_by=_BRIDGE)
+#: every spooling service's: a station's acquisition, its bridge, a line predictor
+SPOOL = Channel("spool", SpoolStats, "acquisition", also_by=(*_BRIDGE, "predictor"))
 SPOOL_ACK = Channel("spool/ack", SpoolAck, "recorder")
 #: the line's PLC or the station's scanner; the simulated rig stands in for it
 PART = Channel("part", PartScan, "plc", Qos(express=True), ("rig",))

@@ -39,6 +39,7 @@ from shared.contract.controller_messages import (  # noqa: F401  (re-exported: o
 from shared.contract.message_fields import WIRE_CONFIG, Count, Id, Measured, StationId, TimeNs
 from shared.contract.part_messages import (  # noqa: F401  (re-exported: one import for every message)
     PartScan,
+    PartSource,
 )
 from shared.contract.spool_messages import (  # noqa: F401  (re-exported: one import for every message)
     SeqRange,
@@ -487,6 +488,10 @@ class TighteningResult:
     process_intensity: float | None  # I_process, eq. 68; None: no predictor saw the run
     source: ResultSource
     steps: list[ResultStep] = field(default_factory=list)  # a controller's; empty live
+    # where the part a live run names came from (:data:`PartSource`: scanned before the run,
+    # restored from the line when the predictor started, unknown); None: not said (a result
+    # of a controller, which names its own VIN, or one made before this field)
+    part_source: PartSource | None = None
     # a final stage (a staged tool): the pulses back to the target the run took (a pulse
     # won back a slip drop lost during the halt); None: the run had no final stage
     pulses: Count | None = None

@@ -8,7 +8,8 @@ decoding.
   :func:`~.framing.frame_bytes`, :class:`~.framing.FrameReader` (frames out of a
   TCP stream: partial reads, garbage, bad lengths)
 - :mod:`.codec`: :func:`~.codec.decode` / :func:`~.codec.encode` by MID and
-  revision, :data:`~.codec.SUPPORTED_REVISIONS`, :class:`~.codec.UnknownMessage`
+  revision, :data:`~.codec.SUPPORTED_REVISIONS` (:func:`~.codec.implements`: and the
+  MIDs read at any revision), :class:`~.codec.UnknownMessage`
 - :mod:`.dialect`: what controllers differ on when writing (header fill, NUL
   terminator, 0900 byte order and separator) and the defaults
 - :mod:`.errors`: :class:`~.errors.OpenProtocolError`, the one exception
@@ -31,12 +32,15 @@ from shared.openprotocol.alarms import (
     AlarmUnsubscribe,
 )
 from shared.openprotocol.codec import (
+    ANY_REVISION_MIDS,
+    HIGHEST_REVISION,
     KNOWN_MIDS,
     SUPPORTED_REVISIONS,
     UnknownMessage,
     WireMessage,
     decode,
     encode,
+    implements,
 )
 from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect
 from shared.openprotocol.errors import OpenProtocolError
@@ -78,8 +82,10 @@ from shared.openprotocol.traces import (
 )
 
 __all__ = [
+    "ANY_REVISION_MIDS",
     "BINARY_MIDS",
     "DEFAULT_DIALECT",
+    "HIGHEST_REVISION",
     "KNOWN_MIDS",
     "SUPPORTED_REVISIONS",
     "UNIT_DEGREE",
@@ -125,6 +131,7 @@ __all__ = [
     "encode",
     "format_timestamp",
     "frame_bytes",
+    "implements",
     "timestamp_ns",
     "trace_extra_data",
     "trace_types_of",

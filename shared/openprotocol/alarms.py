@@ -71,6 +71,7 @@ class Alarm(LayoutMessage):
 class AlarmAcknowledge(LayoutMessage):
     MID: ClassVar[int] = 72
     LAYOUTS: ClassVar[dict[int, Layout]] = {1: ()}
+    ANY_REVISION: ClassVar[bool] = True
     revision: int = 1
 
 
@@ -78,6 +79,7 @@ class AlarmAcknowledge(LayoutMessage):
 class AlarmUnsubscribe(LayoutMessage):
     MID: ClassVar[int] = 73
     LAYOUTS: ClassVar[dict[int, Layout]] = {1: ()}
+    ANY_REVISION: ClassVar[bool] = True
     revision: int = 1
 
 
@@ -95,6 +97,7 @@ class AlarmAcknowledgedOnController(LayoutMessage):
 class AlarmAcknowledgedOnControllerAck(LayoutMessage):
     MID: ClassVar[int] = 75
     LAYOUTS: ClassVar[dict[int, Layout]] = {1: ()}
+    ANY_REVISION: ClassVar[bool] = True
     revision: int = 1
 
 
@@ -119,4 +122,5 @@ class AlarmStatus(LayoutMessage):
 class AlarmStatusAck(LayoutMessage):
     MID: ClassVar[int] = 77
     LAYOUTS: ClassVar[dict[int, Layout]] = {1: ()}
+    ANY_REVISION: ClassVar[bool] = True
     revision: int = 1

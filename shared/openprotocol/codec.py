@@ -10,7 +10,15 @@
   2.2.4, "no NUL character is sent after the binary data").
 - :data:`SUPPORTED_REVISIONS`: the revisions implemented per MID, lowest
   first, so an integrator can ask the highest and fall back, and a controller
-  can refuse the others.
+  can refuse the others. :data:`ANY_REVISION_MIDS` are read and written at
+  every revision (1-999) besides: messages with no data whose revision asks
+  nothing of an answer (0003, 0062, 0063, 0072, 0073, 0075, 0077, 9999). The
+  specification gives them no data and no list of revisions ("For header
+  description see section 2.2.2"), and integrators send them above 1:
+  OpenProtocolInterpreter writes 0062 at revision 5 or 6 and 0063, 0072 and
+  0073 at 2 (its ``TestMid00xx.cs``). A MID whose revision names the revision
+  of its answer (0001, 0040, 0060, 0064, 0070) is read at the revisions
+  implemented only: a controller answers another with 0004 error 97.
 """
 
 from __future__ import annotations
@@ -115,11 +123,23 @@ SUPPORTED_REVISIONS: Final[Mapping[int, tuple[int, ...]]] = {
     mid: cls.revisions() for mid, cls in sorted(MESSAGE_TYPES.items())
 }
 KNOWN_MIDS: Final = frozenset(SUPPORTED_REVISIONS)
+ANY_REVISION_MIDS: Final = frozenset(
+    mid for mid, cls in MESSAGE_TYPES.items() if getattr(cls, "ANY_REVISION", False)
+)
+#: the highest revision a header holds (three digits)
+HIGHEST_REVISION: Final = 999
+
+
+def implements(mid: int, revision: int) -> bool:
+    """Whether the codec reads and writes ``mid`` at ``revision``."""
+    if mid in ANY_REVISION_MIDS:
+        return 1 <= revision <= HIGHEST_REVISION
+    return revision in SUPPORTED_REVISIONS.get(mid, ())
 
 
 def _check_revision(mid: int, revision: int) -> None:
     known = SUPPORTED_REVISIONS[mid]
-    if revision not in known:
+    if not implements(mid, revision):
         why = f"revision {revision} is not implemented ({', '.join(map(str, known))})"
         raise OpenProtocolError(mid, "revision", why, revision=revision)
 

@@ -10,7 +10,10 @@ Kinds:
 - ``int``: digits (spaces around are tolerated on reading), in [``low``, ``high``]
   (``high`` defaults to what the width can hold);
 - ``centi``: a decimal sent as an integer number of hundredths (torques in Nm:
-  "001234" is 12.34 Nm), read as float;
+  "001234" is 12.34 Nm), read as float; written "multiplied by 100 and sent as
+  an integer (2 decimals truncated)", as the specification words every such
+  field of 0041, 0061 and 0065: 12.349 Nm is "001234", never "001235" (the
+  decimal as written, so 0.29 is "000029", not the float's 28.999...);
 - ``flag``: one digit 0/1, read as bool;
 - ``enum``: digits read as the ``enum`` IntEnum given; other values refused;
 - ``text``: characters (latin-1), written left-aligned (padded with spaces at
@@ -26,6 +29,7 @@ is refused, as is a wrong parameter id.
 
 from __future__ import annotations
 
+import decimal
 import enum
 import math
 from collections.abc import Callable, Mapping
@@ -163,7 +167,7 @@ def _write(spec: Spec, value: object) -> str:
     if spec.kind == "centi":
         if not isinstance(value, int | float) or not math.isfinite(value):
             raise ValueError(f"{value!r} is not a number")
-        number = round(value * 100)
+        number = _hundredths_truncated(value)
         if not 0 <= number < 10**spec.width:
             raise ValueError(f"{value} is not in [0, {(10**spec.width - 1) / 100}]")
         return f"{number:0{spec.width}d}"
@@ -176,6 +180,14 @@ def _write(spec: Spec, value: object) -> str:
     return f"{number:0{spec.width}d}"
 
 
+def _hundredths_truncated(value: float) -> int:
+    """``value`` * 100 with the decimals after the second cut off (toward zero), taken
+    from the shortest decimal that reads back as ``value`` (``repr``), not the binary
+    float: 0.29 is 29 hundredths, 12.349 is 1234."""
+    exact = decimal.Decimal(repr(float(value))).scaleb(2)
+    return int(exact.to_integral_value(rounding=decimal.ROUND_DOWN))
+
+
 class LayoutMessage:
     """Mixin of a message whose data is one layout per revision (``LAYOUTS``).
 
@@ -186,18 +198,27 @@ class LayoutMessage:
     __slots__ = ()
     MID: ClassVar[int]
     LAYOUTS: ClassVar[Mapping[int, Layout]]
+    #: a message with no data at any revision whose revision asks nothing of the answer
+    #: (an acknowledge, an unsubscribe, 0003, 9999): read and written at every revision
+    ANY_REVISION: ClassVar[bool] = False
 
     @classmethod
     def revisions(cls) -> tuple[int, ...]:
         return tuple(sorted(cls.LAYOUTS))
 
     @classmethod
+    def layout(cls, revision: int) -> Layout:
+        if cls.ANY_REVISION:
+            return ()
+        return cls.LAYOUTS[revision]
+
+    @classmethod
     def from_data(cls, data: bytes, revision: int, dialect: Dialect = DEFAULT_DIALECT) -> Self:
-        values = decode_fields(data, cls.LAYOUTS[revision], cls.MID, revision)
+        values = decode_fields(data, cls.layout(revision), cls.MID, revision)
         build: Callable[..., Self] = cls
         return build(revision=revision, **values)
 
     def to_data(self, revision: int, dialect: Dialect = DEFAULT_DIALECT) -> bytes:
-        layout = self.LAYOUTS[revision]
+        layout = self.layout(revision)
         values = {spec.attr: getattr(self, spec.attr) for spec in layout}
         return encode_fields(values, layout, self.MID, revision)

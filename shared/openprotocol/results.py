@@ -119,6 +119,7 @@ class ResultAcknowledge(LayoutMessage):
 
     MID: ClassVar[int] = 62
     LAYOUTS: ClassVar[dict[int, Layout]] = {1: _NO_DATA}
+    ANY_REVISION: ClassVar[bool] = True
     revision: int = 1
 
 
@@ -128,6 +129,7 @@ class ResultUnsubscribe(LayoutMessage):
 
     MID: ClassVar[int] = 63
     LAYOUTS: ClassVar[dict[int, Layout]] = {1: _NO_DATA}
+    ANY_REVISION: ClassVar[bool] = True
     revision: int = 1
 
 

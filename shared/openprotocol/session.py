@@ -115,6 +115,7 @@ class CommunicationStop(LayoutMessage):
 
     MID: ClassVar[int] = 3
     LAYOUTS: ClassVar[dict[int, Layout]] = {1: _NO_DATA}
+    ANY_REVISION: ClassVar[bool] = True
     revision: int = 1
 
 
@@ -156,4 +157,5 @@ class KeepAlive(LayoutMessage):
 
     MID: ClassVar[int] = 9999
     LAYOUTS: ClassVar[dict[int, Layout]] = {1: _NO_DATA}
+    ANY_REVISION: ClassVar[bool] = True
     revision: int = 1

@@ -13,7 +13,7 @@
 
 from shared.quality.capability import capability, window_text
 from shared.quality.control_chart import c4, control_chart
-from shared.quality.controller_result import controller_result
+from shared.quality.controller_result import SAID_OK_WINDOWS_NOK, Window, controller_result
 from shared.quality.plausible_result import figures_fault, implausible, refusal_line
 from shared.quality.program_columns import ProgramColumns, columns_of
 from shared.quality.program_statistics import (
@@ -26,9 +26,11 @@ from shared.quality.run_result import tightening_result
 from shared.quality.verdict import cut_text, judge
 
 __all__ = [
+    "SAID_OK_WINDOWS_NOK",
     "FigureStatistics",
     "ProgramColumns",
     "ProgramStatistics",
+    "Window",
     "c4",
     "capability",
     "columns_of",

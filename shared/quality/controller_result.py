@@ -9,8 +9,15 @@ from the file, the bridge makes one step of the result's torque and angle
 limits, targets and finals). The result is made from those, not from our
 samples:
 
-- verdict: the controller's ``result`` (``OK`` / ``NOK``); where it wrote
-  neither, the figures judged against their windows decide (as for a live run);
+- verdict: OK only where the controller's ``result`` and the windows agree:
+  NOK when the controller wrote NOK, and NOK when a figure is out of its window
+  though the controller wrote OK (a controller that says OK to 9999.99 Nm in a
+  100-250 Nm window), the first reason then saying so ("the controller said
+  OK, the windows NOK"); where it wrote neither, the windows decide (as for a
+  live run). A result never says OK beside a NOK reason;
+- windows: the station's own for a figure where the caller gives one
+  (``windows``: a controller station's pset in its station file), else the
+  controller's (its monitoring functions: for the bridge, the 0061's limits);
 - final torque: the last step's ``TF Torque`` actual (else the actual of its
   torque monitoring functions, else of a function named ``Torque`` alone: a
   final value with no function, as a bridge gives a result fetched by id),
@@ -36,6 +43,8 @@ unit`` Nm; Open Protocol gives Nm).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from shared.contract import (
     ControllerFunction,
     ControllerResult,
@@ -54,19 +63,29 @@ from shared.quality.verdict import cut_text, figure_reasons, judge, reasons_text
 MONITORS = ("TorqueMin", "TorqueMax", "AngleMin", "AngleMax")
 
 
+#: a figure's window: (minimum, maximum), either None for no bound
+Window = tuple[float | None, float | None]
+#: what the result says first when the controller's verdict and the windows disagree
+SAID_OK_WINDOWS_NOK = "the controller said OK, the windows NOK"
+
+
 def controller_result(
     controller: ControllerResult,
     summary: RunSummary | None,
     program_name: str,
     source: ResultSource,
     tightening_id: int | None = None,
+    windows: Mapping[str, Window] | None = None,
 ) -> TighteningResult:
     """The result of the controller's run; ``summary``: the predictor's replay of it;
     ``tightening_id``: the controller's own id when it is not the run id (a bridge's
-    controller whose ids started again: :mod:`services.openprotocol.published_ids`)."""
+    controller whose ids started again: :mod:`services.openprotocol.published_ids`);
+    ``windows``: ``"torque"`` / ``"angle"`` -> the station's window for that figure,
+    judged in place of the controller's (a window of two None: the controller's)."""
     last = controller.steps[-1] if controller.steps else None
-    torque = _figure(last, "Torque", "TF Torque")
-    angle = _figure(last, "Angle", "TF Angle")
+    own = windows or {}
+    torque = _figure(last, "Torque", "TF Torque", own.get("torque"))
+    angle = _figure(last, "Angle", "TF Angle", own.get("angle"))
     force = judge(None, None, None)
     reasons = [
         f"step {step.name!r} NOK"
@@ -74,7 +93,15 @@ def controller_result(
         for step in controller.steps
         if step.result.upper() == "NOK"
     ]
-    reasons += figure_reasons({"torque": (torque, "Nm"), "angle": (angle, "deg")})
+    out_of_window = figure_reasons({"torque": (torque, "Nm"), "angle": (angle, "deg")})
+    said = controller.result.strip().upper()
+    if said == "OK" and out_of_window:
+        reasons.insert(0, SAID_OK_WINDOWS_NOK)
+    elif said == "OK" and reasons:
+        reasons.insert(0, "the controller said OK, a step NOK")
+    elif said == "NOK" and not reasons and not out_of_window:
+        reasons.append("the controller said NOK")
+    reasons += out_of_window
     return TighteningResult(
         station=controller.station,
         tightening_id=controller.run_id if tightening_id is None else tightening_id,
@@ -103,14 +130,17 @@ def controller_result(
 
 
 def _verdict(controller_says: str, reasons: list[str]) -> Verdict:
-    said = controller_says.strip().upper()
-    if said in ("OK", "NOK"):
-        return "OK" if said == "OK" else "NOK"
+    """NOK when the controller said so or any reason holds (OK never beside a reason)."""
+    if controller_says.strip().upper() == "NOK":
+        return "NOK"
     return verdict(reasons)
 
 
-def _figure(step: ControllerStep | None, quantity: str, tightening: str) -> JudgedFigure:
-    """The step's final ``quantity`` ("Torque" or "Angle") against its monitoring window."""
+def _figure(
+    step: ControllerStep | None, quantity: str, tightening: str, window: Window | None = None
+) -> JudgedFigure:
+    """The step's final ``quantity`` ("Torque" or "Angle") against ``window`` where it has a
+    bound, else against the step's monitoring window."""
     if step is None:
         return judge(None, None, None)
     monitors = {_monitor(f): f for f in step.functions if _monitor(f) is not None}
@@ -122,6 +152,8 @@ def _figure(step: ControllerStep | None, quantity: str, tightening: str) -> Judg
         (f.actual for f in (ends, low, high, alone) if f is not None and f.actual is not None),
         None,
     )
+    if window is not None and (window[0] is not None or window[1] is not None):
+        return judge(value, window[0], window[1])
     return judge(
         value,
         low.nominal if low is not None else None,

@@ -17,14 +17,15 @@ unless they aborted or ended on a fault.
 The tightening id of a live run is its run id (the tool controller's count
 of its tightenings, ``RunId`` on CAN). The part is what the line scanned
 last before the run started (``boltwatch/<st>/part``), passed in by the
-caller; None when no part was scanned. The batch is unknown to the station
+caller with where it came from (a scan, the line's answer at the predictor's
+start); None when no part is known. The batch is unknown to the station
 (None).
 """
 
 from __future__ import annotations
 
 from shared.config import Program
-from shared.contract import RunSummary, TighteningResult
+from shared.contract import PartSource, RunSummary, TighteningResult
 from shared.quality.verdict import cut_text, figure_reasons, judge, reasons_text, verdict
 
 #: stops boltwatch sends on a fault, not on a good joint: the run is NOK
@@ -32,10 +33,13 @@ FAULT_STOPS = frozenset({"torque_limit", "force_limit", "angle_limit", "input_fa
 
 
 def tightening_result(
-    summary: RunSummary, program: Program, part_id: str | None = None
+    summary: RunSummary,
+    program: Program,
+    part_id: str | None = None,
+    part_source: PartSource | None = None,
 ) -> TighteningResult:
     """The result of the run of ``summary``, tightened with ``program`` on part ``part_id``
-    (None: unknown)."""
+    (None: unknown), which came from ``part_source`` (None: not said)."""
     torque = judge(summary.reached_torque_nm, *program.window("torque"))
     angle = judge(summary.reached_angle_deg, *program.window("angle"))
     force = judge(summary.reached_force_n, *program.window("force"))
@@ -65,5 +69,6 @@ def tightening_result(
         events=summary.events,
         process_intensity=summary.process_intensity,
         source="predictor",
+        part_source=part_source,
         pulses=summary.pulses if summary.commands == "staged" else None,
     )

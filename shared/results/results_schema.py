@@ -2,10 +2,12 @@
 
 ``tightenings``: one row per tightening, keyed by (station, run_id), so a
 result heard twice (a spool's resend, a rebuild over files already read) is
-one row. It holds what a quality engineer asks about: the part, the program,
-the tool, where it was tightened (the plant, the line, the station's name for
-people: the station file's ``[station]`` when it was stored), when it ended,
-OK/NOK and why, the final torque, angle and preload each with its window and
+one row. It holds what a quality engineer asks about: the part (and where a
+live run's part came from, ``part_source``: scanned, restored from the line
+when the predictor started, unknown; NULL: not said), the program, the tool,
+where it was tightened (the plant, the line, the station's name for people:
+the station file's ``[station]`` when it was stored), when it ended, OK/NOK
+and why, the final torque, angle and preload each with its window and
 status, what stopped the tool, the stick-slip events and intensity, who judged
 it (``source``), and where its recording is (``recording``: the MCAP file's
 path on ``recording_host``).
@@ -26,7 +28,7 @@ from __future__ import annotations
 from shared.results.results_database import ResultsDatabase, StoreError
 
 #: the version this boltwatch writes; MIGRATIONS[v - 1] makes version v
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 
 TIGHTENING_COLUMNS = (
     "station", "run_id", "plant", "line", "station_name", "tightening_id", "tool_id",
@@ -35,7 +37,7 @@ TIGHTENING_COLUMNS = (
     "angle_deg", "angle_min_deg", "angle_max_deg", "angle_status",
     "force_n", "force_min_n", "force_max_n", "force_status",
     "stop_reason", "events", "process_intensity", "source",
-    "recording", "recording_host", "stored_ns",
+    "recording", "recording_host", "stored_ns", "part_source",
 )  # fmt: skip
 STEP_COLUMNS = (
     "station", "run_id", "step_index", "name", "function", "nominal", "actual", "status",
@@ -109,8 +111,13 @@ _VERSION_2 = (
     "CREATE INDEX tightenings_by_plant ON tightenings (plant, ended_ns)",
 )
 
+# where a live run's part came from (TighteningResult.part_source): a row made before says
+# nothing (NULL), as a result recorded before does. ADD COLUMN of a nullable column with no
+# default rewrites no row in either database.
+_VERSION_3 = ("ALTER TABLE tightenings ADD COLUMN part_source TEXT",)
+
 #: the statements that bring a store from version v - 1 to v, for v = 1, 2, ...
-MIGRATIONS: tuple[tuple[str, ...], ...] = (_VERSION_1, _VERSION_2)
+MIGRATIONS: tuple[tuple[str, ...], ...] = (_VERSION_1, _VERSION_2, _VERSION_3)
 
 
 def migrate(database: ResultsDatabase, migrations: tuple[tuple[str, ...], ...] = MIGRATIONS) -> int:

@@ -1,9 +1,10 @@
 """Stored tightenings for people and programs: a table, CSV, JSON (``boltwatch results``).
 
 The table has one line per tightening, newest first (the station by its id,
-its name for people beside it), its last column the recording (``boltwatch
-inspect <it> --run <run>`` draws the run); CSV has every column of the store,
-JSON every field with the steps.
+its name for people beside it; a part restored from the line when the
+predictor started, not scanned before the run, marked so), its last column
+the recording (``boltwatch inspect <it> --run <run>`` draws the run); CSV has
+every column of the store, JSON every field with the steps.
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ HEADER = (
 )  # fmt: skip
 CSV_HEADER = (
     "ended_utc", "station", "station_name", "plant", "line", "run_id", "tightening_id",
-    "part_id", "program_id", "program_name", "tool_id", "batch_counter", "result", "nok_reasons",
+    "part_id", "part_source", "program_id", "program_name", "tool_id", "batch_counter",
+    "result", "nok_reasons",
     "torque_nm", "torque_min_nm", "torque_max_nm", "torque_status",
     "angle_deg", "angle_min_deg", "angle_max_deg", "angle_status",
     "force_n", "force_min_n", "force_max_n", "force_status",
@@ -43,6 +45,14 @@ def _figure(figure: JudgedFigure, scale: float = 1.0) -> str:
     return f"{figure.value / scale:.4g}{mark}"
 
 
+def _part(part_id: str | None, source: str | None) -> str:
+    """The part, marked when it was not scanned before the run (restored from the line when
+    the predictor started: it may be stale)."""
+    if part_id is None:
+        return "-"
+    return f"{part_id} ({source})" if source == "restored" else part_id
+
+
 def row(stored: StoredResult) -> tuple[str, ...]:
     r = stored.result
     return (
@@ -51,7 +61,7 @@ def row(stored: StoredResult) -> tuple[str, ...]:
         stored.plant or "-",
         stored.line or "-",
         str(r.run_id),
-        r.part_id or "-",
+        _part(r.part_id, r.part_source),
         f"{r.program_id} {r.program_name}".strip(),
         str(r.tool_id),
         r.result,
@@ -81,7 +91,8 @@ def csv_row(stored: StoredResult) -> list[Any]:
         figures += [figure.value, figure.min, figure.max, figure.status]
     return [
         utc_text(r.time_ns), r.station, stored.station_name, stored.plant, stored.line,
-        r.run_id, r.tightening_id, r.part_id, r.program_id, r.program_name, r.tool_id,
+        r.run_id, r.tightening_id, r.part_id, r.part_source, r.program_id, r.program_name,
+        r.tool_id,
         r.batch_counter, r.result, r.nok_reasons,
         *figures, r.stop_reason, r.events, r.process_intensity, r.source, stored.recording,
         stored.recording_host,

@@ -46,6 +46,7 @@ from shared.results import (
     migrate,
 )
 from shared.results.results_schema import STEP_COLUMNS, TIGHTENING_COLUMNS
+from tests.support.old_results_store import columns_of
 
 STATIONS = 20
 LINES = 2
@@ -210,6 +211,7 @@ def _row(
         None if controller else rng.uniform(0.1, 3.0),
         "controller" if controller else "predictor",
         recording, HOST, ended_ns + 200_000_000 + rng.randrange(50_000_000),
+        None if controller else "scanned",
     )  # fmt: skip
     steps = _steps(station.station, run_id, program, t) if controller else []
     return row, steps
@@ -296,8 +298,7 @@ def _make(target: StoreTarget, version: int) -> tuple[str, ...]:
         return TIGHTENING_COLUMNS
     with ResultsDatabase(target) as database:
         migrate(database, MIGRATIONS[:version])
-    assert version == 1, "only version 1 is older"
-    return tuple(c for c in TIGHTENING_COLUMNS if c not in ("plant", "station_name"))
+    return columns_of(version)
 
 
 def _chunks(

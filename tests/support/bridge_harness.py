@@ -41,6 +41,30 @@ def bridge_station_file(folder: Path, port: int, endpoint: str, **section: Any) 
     return path
 
 
+CONTROLLER_STATION = Path(__file__).parents[2] / "config" / "controller-station.toml"
+
+
+def controller_station_file(
+    folder: Path, port: int, endpoint: str, programs: list[dict[str, Any]]
+) -> Path:
+    """The shipped controller station file (no [can]) as a zenoh peer of ``endpoint``,
+    its controller on 127.0.0.1:``port`` (short timers), with ``programs`` as its psets."""
+    data = tomllib.loads(CONTROLLER_STATION.read_text(encoding="utf-8"))
+    data["zenoh"] = {"mode": "peer", "connect": [endpoint]}
+    data["recorder"]["folder"] = str(folder / "recordings")
+    data["openprotocol"] = {
+        "host": "127.0.0.1",
+        "port": port,
+        "keep_alive_s": 0.5,
+        "reconnect_min_s": 0.05,
+        "reconnect_max_s": 0.2,
+    }
+    data["programs"] = programs
+    path = folder / "controller-station.toml"
+    path.write_text(toml_writer.dumps(data))
+    return path
+
+
 class RunningBridge:
     """The bridge of a station file, working in a thread until :meth:`finish`."""
 

@@ -24,7 +24,22 @@ START_NS = 1_700_000_000_000_000_000
 PROGRAM_OF = {"pt1": 1, "pt2": 2}
 
 
-def station_text(tmp_path: Path, station_id: str, program_id: int, endpoint: str) -> str:
+def station_text(
+    tmp_path: Path,
+    station_id: str,
+    program_id: int,
+    endpoint: str,
+    *,
+    connect: bool = False,
+    extra: str = "",
+) -> str:
+    """A station file's text: a peer listening on ``endpoint`` (``connect``: a client of the
+    router there, as a station's services reach their line), ``extra`` sections at its end."""
+    zenoh_endpoints = (
+        f'mode = "client"\nconnect = ["{endpoint}"]'
+        if connect
+        else f'mode = "peer"\nlisten = ["{endpoint}"]'
+    )
     return f"""
 [station]
 id = "{station_id}"
@@ -35,8 +50,7 @@ interface = "virtual"
 channel = "{station_id}"
 dbc = "{REPO / "config/can/station.dbc"}"
 [zenoh]
-mode = "peer"
-listen = ["{endpoint}"]
+{zenoh_endpoints}
 [[programs]]
 id = {program_id}
 name = "test"
@@ -51,7 +65,7 @@ max_time_s = 6.0
 window_samples = 5
 [recorder]
 folder = "{tmp_path / "rec"}"
-"""
+{extra}"""
 
 
 def wait_for_token(session: zenoh.Session, key: str) -> None:

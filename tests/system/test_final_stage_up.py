@@ -6,9 +6,10 @@ edge predictor switches it to the final speed, halts it on the target, gives
 pulses back to the target (made likely here by asking for one whenever the
 settled torque is 0.05 % short) and finishes each run. Every command is
 recorded on ``boltwatch/st1/stage``, every stage the tool reports on
-``boltwatch/st1/tool``, and lands in the run's summary and result. The same program on a controller that only stops (``[rig]
-stage_commands = false``: no ToolStage) runs stop-only: no StageCommand goes
-out, and the acquisition says why.
+``boltwatch/st1/tool``, and lands in the run's summary and result. The same
+program on a controller that only stops (``[rig] stage_commands = false``: no
+ToolStage) runs stop-only: no StageCommand goes out, and the acquisition says
+why.
 """
 
 from __future__ import annotations
@@ -60,9 +61,7 @@ def test_a_staged_program_switches_halts_pulses_and_finishes_every_run(tmp_path:
 
 
 def test_a_controller_that_only_stops_gets_only_stops(tmp_path: Path) -> None:
-    station = write_station(
-        tmp_path, replacements={"[rig]\n": "[rig]\nstage_commands = false\n"}
-    )
+    station = write_station(tmp_path, replacements={"[rig]\n": "[rig]\nstage_commands = false\n"})
     run_up(station, 2, "--program", "3")
     recorded = read_recordings(tmp_path / "recordings")
     assert "boltwatch/st1/stage" not in recorded

@@ -104,13 +104,15 @@ class FaultStation:
         wait_supervised(self.supervisor, condition, what, DONE_TIMEOUT_S, 0.05, exits, self.logs)
 
     def finish(self) -> BridgeStats:
-        """Wait for the controller's N tightenings and the bridge to publish the last one."""
+        """Wait for the controller's N tightenings and the bridge to publish the last one;
+        the bridge's counters as it published it (the controller, done, then closes the
+        link: a counter sent after that has one link drop more, whenever it came)."""
         self.wait_for(lambda: self.rig.exit_code() == 0, "the controller's runs delivered")
         self.wait_for(
             lambda: any(s.last_tightening_id == RUNS for s in self.stats[-3:]),
             f"the bridge to publish tightening {RUNS}",
         )
-        return self.stats[-1]
+        return next(s for s in self.stats if s.last_tightening_id == RUNS)
 
     def status(self) -> dict[str, Any]:
         """``boltwatch status``, as text and as JSON: the station's bridge and its text lines."""

@@ -141,6 +141,42 @@ def test_only_the_stations_acquisition_and_predictor_may_put_its_decision(
             session.close()
 
 
+def test_a_stations_services_may_ask_the_lines_recorder_for_its_part(line: SecureLine) -> None:
+    """A predictor that starts asks the line for the part at its station
+    (``boltwatch/<st>/part``): st1-acquisition (its edge predictor) and st1-predictor (a line
+    predictor) query, line-recorder answers, through the access control."""
+    part = channels.PART.key("st1")
+    sessions = []
+    try:
+        recorder = open_session(line.section("line-recorder"))
+        sessions.append(recorder)
+
+        def answer(query: zenoh.Query) -> None:
+            with query:
+                query.reply(part, b'{"station": "st1", "part_id": "WHEEL-A", "time_ns": 1}')
+
+        queryable = recorder.declare_queryable(part, answer)
+        for name in ("st1-acquisition", "st1-predictor"):
+            asking = open_session(line.section(name))
+            sessions.append(asking)
+            answered: list[bytes] = []
+            deadline = time.monotonic() + OPEN_TIMEOUT_S
+            while not answered:  # until the queryable's declaration reached the router
+                assert time.monotonic() < deadline, f"{name}: the line never answered"
+                answered = [
+                    reply.ok.payload.to_bytes()
+                    for reply in asking.get(part, timeout=2.0)
+                    if reply.ok is not None
+                ]
+                if not answered:
+                    time.sleep(0.1)
+            assert b"WHEEL-A" in answered[0], name
+        queryable.undeclare()
+    finally:
+        for session in sessions:
+            session.close()
+
+
 def test_a_session_without_client_certificate_is_rejected(line: SecureLine) -> None:
     _wait_for_router(line)
     started = time.monotonic()

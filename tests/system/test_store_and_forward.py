@@ -172,6 +172,30 @@ def test_cables_cut_and_the_recorder_killed_lose_nothing(tmp_path: Path) -> None
     for index in range(1, STATIONS + 1):
         station = f"st{index}"
         check_station(station, recordings[station], counted[(station,)], cut_off=index == 2)
+    with sqlite3.connect(tmp_path / "recordings" / "results.sqlite") as store:
+        parts = store.execute(
+            "SELECT station, part_id, part_source FROM tightenings ORDER BY station, run_id"
+        ).fetchall()
+    for index in range(1, STATIONS + 1):
+        check_parts(f"st{index}", [(p, s) for st, p, s in parts if st == f"st{index}"], index == 2)
+
+
+def check_parts(station: str, parts: list[tuple[str | None, str]], cut_off: bool) -> None:
+    """Each result says where its part came from. The station whose acquisition restarted
+    while its cable was out names no part (``unknown``) until the line answers when its
+    cable is back (``restored``), then the next scan's (``scanned``): in that order, never
+    back; the others name the parts their line scanned."""
+    assert all((part_id is None) == (source == "unknown") for part_id, source in parts), parts
+    sources = [source for _, source in parts]
+    if not cut_off:
+        assert set(sources) == {"scanned"}, f"{station}: {Counter(sources)}"
+        return
+    # before the restart every part was scanned; from the first run that names none (or the
+    # line's) on, it goes one way: unknown, restored, scanned
+    restart = next((i for i, source in enumerate(sources) if source != "scanned"), len(sources))
+    order = {"unknown": 0, "restored": 1, "scanned": 2}
+    ranks = [order[source] for source in sources[restart:]]
+    assert ranks == sorted(ranks), f"{station}: {sources}"
 
 
 def check_station(station: str, runs: dict[int, RunRecord], counted: int, cut_off: bool) -> None:

@@ -26,6 +26,7 @@ CHECKED_SERVICES = (
     "viewer",
     "dashboard",
     "opcua",
+    "openprotocol",
 )
 CONNECT_TIMEOUT_MS = 2000
 LIVELINESS_TIMEOUT_S = 2.0

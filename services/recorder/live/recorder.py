@@ -20,6 +20,11 @@ reached the disk). ``write_errors``, ``last_write_error`` and
 ``recording_ok`` say the same to whoever publishes the recorder's state.
 Free space below the reserve (:mod:`.free_space`) is such a fault, met
 before the disk is full: no new file is opened, none is cut.
+
+What a source that starts no runs (a line predictor) sends again goes into the
+open file of its run (:meth:`Recorder.files_of_run`), else into files of the
+station's own for such messages, a file per run, finished once nothing came for
+:data:`LATE_FILES_IDLE_NS`.
 """
 
 from __future__ import annotations
@@ -43,6 +48,8 @@ LOG = logging.getLogger(__name__)
 
 RETRY_INTERVAL_NS = 3_000_000_000
 REMINDER_INTERVAL_NS = 10_000_000_000
+#: a station's files of late messages are finished when nothing came for them this long
+LATE_FILES_IDLE_NS = 10_000_000_000
 
 
 class Recorder:
@@ -61,6 +68,9 @@ class Recorder:
         self._metadata = metadata
         self._stations: dict[str, StationFiles] = {}
         self._holes: list[StationFiles] = []  # the files of holes of stations' spools
+        #: per station, files of late messages of runs no file is open for (among the holes'
+        #: files), with how many they had written and since when
+        self._late: dict[str, tuple[StationFiles, int, int]] = {}
         self._closed_holes: list[Path] = []
         self.messages = 0
         self.refused: Counter[str] = Counter()  # per station: refused payloads, recorded raw
@@ -143,6 +153,34 @@ class Recorder:
         """A hole caught up with the live messages: the live files go on with its open run."""
         self._files(files.station).adopt(files.hand_over())
 
+    def files_of_run(self, station: str, run_id: int | None) -> StationFiles:
+        """Where a message of run ``run_id`` of ``station``, sent again by a source that starts
+        no runs, goes: the files (live, or a hole's) that have its run open; else the
+        station's files of late messages (a file of the run of their own). No run: the live
+        files."""
+        live = self._files(station)
+        if run_id is None:
+            return live
+        for files in (live, *self._holes):
+            if files.station == station and files.holds_run(run_id):
+                return files
+        late = self._late.get(station)
+        if late is None:
+            files = StationFiles(
+                station, self._folder, self._limits, self._metadata, None, True, runs_by_id=True
+            )
+            self._holes.append(files)
+            late = self._late[station] = (files, 0, 0)
+        return late[0]
+
+    def _finish_idle_late_files(self, now_ns: int) -> None:
+        for station, (files, written, since_ns) in list(self._late.items()):
+            if files.written != written or not since_ns:
+                self._late[station] = (files, files.written, now_ns)
+            elif now_ns - since_ns >= LATE_FILES_IDLE_NS:
+                del self._late[station]
+                self.close_hole(files)
+
     def close_hole(self, files: StationFiles) -> None:
         """The hole is filled: its files are finished."""
         if files in self._holes:
@@ -173,6 +211,7 @@ class Recorder:
                 self._fault(files, err, now_ns, unwritten=0)
             else:
                 self._maybe_recovered(files, now_ns)
+        self._finish_idle_late_files(now_ns)
         if not self.recording_ok:
             self._remind(now_ns)
 

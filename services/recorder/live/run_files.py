@@ -8,6 +8,10 @@ never ends) continues in ``..._part<N>.mcap``. After a rotation the previous
 run's file stays open for ``late_grace_s`` so late messages carrying its
 run id (a RunSummary racing the next run's start) still land in it.
 
+Files that hear no run's start (``runs_by_id``: what a line predictor's spool
+sends again, events to summaries of runs whose files are closed) open a run's
+file at the first message of that run, named by that message's time.
+
 With ``rerun`` options each run file (not the idle ones) has a companion
 :class:`RerunSink` writing ``<same stem>.rrd``; it receives what its MCAP
 file receives, is flushed and closed with it, and never stops the MCAP file.
@@ -88,10 +92,13 @@ class StationFiles:
         metadata: FileMetadata,
         rerun: RerunOptions | None = None,
         sent_again: bool = False,
+        runs_by_id: bool = False,
     ) -> None:
-        """``sent_again``: the files of what a station's spool sends again (a hole)."""
+        """``sent_again``: the files of what a station's spool sends again (a hole).
+        ``runs_by_id``: a message of a run with no file open here opens that run's file."""
         self.station = station
         self.sent_again = sent_again
+        self.runs_by_id = runs_by_id
         self._folder = folder
         self._limits = limits
         self._metadata = metadata
@@ -121,6 +128,10 @@ class StationFiles:
             self._program_id = received.message.program_id
             self._run_started = (received.run_id, received.message.time_ns)
             self._resume = (received.run_id, 1)  # should the disk fail before the file opens
+            self._start_run(received.run_id, now_ns)
+        elif self._opens_its_run(received.run_id):
+            assert received.run_id is not None
+            self._run_started = (received.run_id, _run_time_ns(received, now_ns))
             self._start_run(received.run_id, now_ns)
         else:
             self._open_or_continue(received.run_id, now_ns)
@@ -259,6 +270,16 @@ class StationFiles:
         self._tool_id, self._program_id = run.tool_id, run.program_id
         self._started_runs.append(run.sink.run_id)
 
+    def _opens_its_run(self, run_id: int | None) -> bool:
+        """A message of ``run_id`` opens that run's file (``runs_by_id``: none is open)."""
+        return self.runs_by_id and run_id is not None and not self.holds_run(run_id)
+
+    def holds_run(self, run_id: int) -> bool:
+        """Whether a file of run ``run_id`` is open here (the current, or the one before)."""
+        return any(
+            sink is not None and sink.run_id == run_id for sink in (self.current, self.previous)
+        )
+
     @property
     def unflushed_messages(self) -> int:
         """Messages of the open files not yet on the disk."""
@@ -351,3 +372,14 @@ class StationFiles:
             if companion is not None:
                 companion.close()  # never raises: a Rerun failure is logged, not fatal
         self.closed_paths.append(sink.path)
+
+
+def _run_time_ns(received: Received, default_ns: int) -> int:
+    """When a run began, as well as one of its messages says (a summary its start, any other
+    message its own time)."""
+    message = received.message
+    started_ns = getattr(message, "started_ns", None)
+    if isinstance(started_ns, int):
+        return started_ns
+    time_ns = getattr(message, "time_ns", None)
+    return time_ns if isinstance(time_ns, int) else default_ns

@@ -9,6 +9,11 @@ memory (:mod:`.waiting_live`) and is filed as soon as the hole reaches it,
 and a hole filled to its end has its files finished. A station's messages
 that carry no number (its spool's own counters) go where its run in progress
 is: an open hole's files while there is one.
+
+A source that starts no runs (a line predictor, :attr:`SpoolOrder.in_order`
+False) has no holes: a live message goes where an unnumbered one goes, one
+sent again into the file of its run wherever that is open (the live files, a
+hole's), else into a file of that run of its own (:meth:`Recorder.files_of_run`).
 """
 
 from __future__ import annotations
@@ -18,7 +23,7 @@ from collections.abc import Callable
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.run_files import StationFiles
 from services.recorder.live.spool_keeper import SpoolKeeper
-from services.recorder.live.spool_order import Fate
+from services.recorder.live.spool_order import Fate, Routing
 from services.recorder.live.waiting_live import WaitingLive
 from shared.contract import SeqMark, SpoolAck
 from shared.recordings import Received
@@ -79,6 +84,10 @@ class SpoolFiling:
             return
         if routing.fate is Fate.SKIP:
             return
+        order = self.keeper.order_of(station, mark.source)
+        if order is not None and not order.in_order:
+            self._file_of_run(received, mark, filed_ns, routing)
+            return
         if routing.caught_up and hole is not None and isinstance(hole.files, StationFiles):
             self._recorder.hand_back(hole.files)
         files = hole.files if routing.fate is Fate.HOLE and hole is not None else None
@@ -86,6 +95,20 @@ class SpoolFiling:
         self._file(received, filed_ns, files)
         self.keeper.filed_as(station, mark, routing)
         self._close_holes()
+
+    def _file_of_run(
+        self, received: Received, mark: SeqMark, filed_ns: int, routing: Routing
+    ) -> None:
+        """A message of a source that starts no runs: live, where an unnumbered one goes; sent
+        again, into a file of its run."""
+        station = received.station
+        if mark.again:
+            files: StationFiles | None = self._recorder.files_of_run(station, received.run_id)
+            self.refiling = True
+        else:
+            files = self.unnumbered_files(station)
+        self._file(received, filed_ns, files)
+        self.keeper.filed_as(station, mark, routing)
 
     def _close_holes(self) -> None:
         for hole in self.keeper.holes_done():

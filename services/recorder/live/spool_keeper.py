@@ -16,6 +16,10 @@ what was saved, and the station sends the rest again once the disk takes it
 (at least once: what the failed files held may come twice, never not at
 all). A message from a spool of another id (the station's spool was made
 again: its numbers start from 1 again) starts that source afresh.
+
+A source that may start a run (it puts ``tool``: the station's acquisition, a
+controller bridge) is filed in order; any other (a line predictor) as its
+messages first come (:attr:`SpoolOrder.in_order`).
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ from pathlib import Path
 from typing import Final
 
 from services.recorder.live.spool_order import Hole, Routing, SpoolOrder
-from shared.contract import SeqMark, SeqRange, SpoolAck, SpoolStats
+from shared.contract import SeqMark, SeqRange, SpoolAck, SpoolStats, channels
 from shared.files import describe_os_error, write_json_atomically
 from shared.spool import SeqRanges
 
@@ -39,6 +43,13 @@ STATE_FOLDER: Final = ".spool"
 #: at most this many ranges above ``through`` in one acknowledgement (the station sends the
 #: rest again, and they are skipped)
 MAX_ACK_RANGES: Final = 256
+#: the sources whose messages may start a run (they put tool states): filed in order
+RUN_STARTING_SOURCES: Final = frozenset(channels.TOOL.publishers)
+
+
+def in_order(source: str) -> bool:
+    """Whether ``source``'s messages are filed in order (it starts the runs they belong to)."""
+    return source in RUN_STARTING_SOURCES
 
 
 @dataclass
@@ -132,7 +143,9 @@ class SpoolKeeper:
                     self._save(source)
                 else:
                     self._closing.extend(source.order.holes)
-                    source.order = SpoolOrder.resumed(SeqRanges(source.saved), source.saved_gone)
+                    source.order = SpoolOrder.resumed(
+                        SeqRanges(source.saved), source.saved_gone, in_order(source.source)
+                    )
                 publish(source.ack(now_ns))
 
     def _source(self, station: str, name: str, spool_id: int) -> SpoolSource:
@@ -164,9 +177,8 @@ class SpoolKeeper:
             pass
         except (OSError, ValueError, KeyError, TypeError) as err:
             LOG.error("%s: unreadable, the spool of %s starts afresh: %s", path, station, err)
-        return SpoolSource(
-            station, name, spool_id, SpoolOrder.resumed(filed, gone), path, SeqRanges(filed), gone
-        )
+        order = SpoolOrder.resumed(filed, gone, in_order(name))
+        return SpoolSource(station, name, spool_id, order, path, SeqRanges(filed), gone)
 
     def _save(self, source: SpoolSource) -> None:
         order = source.order

@@ -32,6 +32,12 @@ becomes of each numbered message (pure: no file, no zenoh):
   number its spool holds before it (every number between is gone), and the
   station's counters name its oldest (:meth:`SpoolOrder.station_has_from`).
 
+A source that starts no runs (a line predictor: its events, decisions, results
+and summaries belong to the runs the station's acquisition starts) is not
+**in order** (``in_order=False``): its messages are not kept in the order of
+runs it does not see; each number is filed when it first comes, live or sent
+again, and skipped after (the recorder puts it in the file of its run).
+
 :attr:`SpoolOrder.filed` (every number filed, or gone) is what the recorder
 acknowledges once its files are flushed, and keeps across its restarts.
 """
@@ -92,13 +98,16 @@ class SpoolOrder:
     seen: int = 0  # the highest number that came (nothing above it is ever taken as gone)
     deferred: int = 0
     skipped: int = 0
+    #: its messages start runs, and are filed in order (False: each as it first comes)
+    in_order: bool = True
 
     @classmethod
-    def resumed(cls, filed: SeqRanges, gone: int = 0) -> SpoolOrder:
+    def resumed(cls, filed: SeqRanges, gone: int = 0, in_order: bool = True) -> SpoolOrder:
         """The order of a recorder that saved what it had filed (and restarted, or failed to
-        write): every number missing below the highest is a hole to fill."""
-        holes = [Hole(first, first, last) for first, last in filed.missing(filed.highest)]
-        return cls(filed, holes, gone, seen=filed.highest)
+        write): every number missing below the highest is a hole to fill (in order)."""
+        missing = filed.missing(filed.highest) if in_order else []
+        holes = [Hole(first, first, last) for first, last in missing]
+        return cls(filed, holes, gone, seen=filed.highest, in_order=in_order)
 
     @property
     def open_hole(self) -> Hole | None:
@@ -128,6 +137,8 @@ class SpoolOrder:
             self._gone(kept_before + 1, seq - 1)  # not in the spool, not filed: gone
             if seq in self.filed:
                 return self._skip()
+        if not self.in_order:
+            return Routing(Fate.LIVE)
         hole = next((hole for hole in self.holes if hole.holds(seq)), None)
         if kept_before is not None:
             if hole is not None:

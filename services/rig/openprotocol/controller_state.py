@@ -43,6 +43,8 @@ from services.rig.openprotocol.result_store import ResultStore
 from services.rig.openprotocol.tightening import Tightening
 from shared.config import OpenProtocolSection, Program, RigOpenProtocolSection
 from shared.openprotocol import (
+    ANY_REVISION_MIDS,
+    HIGHEST_REVISION,
     SUPPORTED_REVISIONS,
     Alarm,
     AlarmAcknowledgedOnController,
@@ -110,6 +112,8 @@ class ControllerState:
 
     def highest_revision(self, mid: int) -> int:
         """The highest revision of ``mid`` the controller answers (0: an MID it does not know)."""
+        if mid in ANY_REVISION_MIDS:  # an acknowledge, 0003, 9999: no data at any revision
+            return HIGHEST_REVISION
         revisions = SUPPORTED_REVISIONS.get(mid, ())
         highest = max(revisions, default=0)
         if mid in RESULT_MIDS:

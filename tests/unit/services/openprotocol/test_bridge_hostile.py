@@ -20,6 +20,9 @@ from typing import Any
 import pytest
 import zenoh
 
+from services.opcua.result_values import EVALUATION_NOT_OK, result_values
+from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget
+from shared.results.results_table import row
 from tests.support.bridge_harness import RunningBridge, bridge_station_file
 from tests.support.listener import Listener
 from tests.support.live_recorder import wait_until
@@ -187,7 +190,7 @@ def test_a_repeat_is_counted_and_an_old_id_with_other_values_is_a_new_run(
     time.sleep(0.5)
     assert result_ids(heard) == [1, 2, 3, 2], "1 and 3 of the epoch before: not again"
     run_ids = [result.run_id for result in heard.of("results")]
-    assert run_ids == [1, 2, 3, 3 + 2], "the new epoch's run ids after the last one"
+    assert run_ids == [1, 2, 3, 4], "the new epoch's run ids go on after the last one"
     assert running.counts.epochs == 1
 
 
@@ -224,3 +227,91 @@ def test_a_time_stamp_no_clock_holds_is_replaced_by_the_time_received(
     assert running.counts.clock_refused == 1
     (summary,) = heard.of("runs") or [None]
     assert summary is not None and summary.ended_ns <= time.time_ns()
+
+
+def test_a_controller_that_says_ok_outside_its_own_window_gives_a_nok_saying_so(
+    controller: SpecController, bridge: tuple[RunningBridge, Listener], tmp_path: Path
+) -> None:
+    """Before: 9999.99 Nm in a 100-250 Nm window was published OK with the NOK reason
+    "torque high" beside it: OK in the results store, ``results``, ``report`` and OPC UA."""
+    _, heard = bridge
+    tightening_id = controller.tighten(
+        torque_nm=9999.99, ok=True, torque_min_nm=100.0, torque_max_nm=250.0,
+        torque_target_nm=200.0,
+    )  # fmt: skip
+    wait_until(lambda: result_ids(heard) == [tightening_id], "the result")
+    (result,) = heard.of("results")
+    (said,) = heard.of("controller")
+    assert said.result == "OK", "the controller's own message stays what it said"
+    assert result.result == "NOK"
+    assert result.final_torque_nm.status == "high"
+    assert result.nok_reasons == (
+        "the controller said OK, the windows NOK; torque high: 9999.99 Nm, window 100 to 250 Nm"
+    )
+    stored = StoredResult(result)
+    with ResultsStore(StoreTarget(sqlite_path=tmp_path / "results.sqlite")) as store:
+        store.add([stored])
+        (back,) = store.find(ResultsQuery())
+    assert back.result.result == "NOK" and back.result.nok_reasons == result.nok_reasons
+    shown = row(back)
+    assert shown[8] == "NOK" and shown[14] == result.nok_reasons  # `boltwatch results`
+    meta = result_values(back.result)["ResultMetaData"]
+    assert meta["ResultEvaluation"] == EVALUATION_NOT_OK
+    assert meta["ResultEvaluationDetails"] == result.nok_reasons
+
+
+def test_an_id_that_jumps_to_9999999999_and_back_publishes_each_tightening_once(
+    controller: SpecController, bridge: tuple[RunningBridge, Listener]
+) -> None:
+    """Ids 1-60, then 9999999999, then 61 on (the controller's counter jumped and came
+    back), with a link drop after. Before: the bridge asked 0064 a thousand times,
+    published none of 61-65 while the link stayed up, and after the drop published them
+    and 58 earlier tightenings again under new run ids (the wear ledger counted them
+    twice)."""
+    running, heard = bridge
+    made = [controller.tighten(curves=False) for _ in range(60)]
+    wait_until(lambda: len(result_ids(heard)) == 60, "the first 60")
+    controller.count_from(9_999_999_999)
+    made.append(controller.tighten(curves=False))
+    controller.count_from(61)
+    made += [controller.tighten(curves=False) for _ in range(5)]
+    wait_until(lambda: result_ids(heard) == made, "the jump and 61-65", timeout_s=20.0)
+    controller.drop()
+    assert controller.wait_for(lambda: 61 not in controller.subscriptions, 5.0)
+    assert controller.wait_subscribed(10.0, mids=(61,)), "the bridge is back"
+    made += [controller.tighten(curves=False) for _ in range(2)]
+    wait_until(lambda: len(result_ids(heard)) >= len(made), "66 and 67 after the drop")
+    time.sleep(0.5)  # nothing more may come
+    assert result_ids(heard) == made, "each tightening once, in the order made"
+    run_ids = [result.run_id for result in heard.of("results")]
+    assert run_ids == sorted(set(run_ids)), "run ids go on, never one twice"
+    asked = [wanted for wanted, _ in controller.old_result_requests if wanted != 0]
+    assert len(asked) <= 5, f"0064 asked for {len(asked)} ids"
+    assert running.counts.results_given_up == 0
+
+
+def test_ids_back_below_the_watermark_while_the_link_was_down_go_on_after_the_kept_ones(
+    controller: SpecController, bridge: tuple[RunningBridge, Listener]
+) -> None:
+    """Ids 1-150, then 9999999999; the link drops; the controller goes on at 151 while
+    the bridge is away. Its newest (153) is below the watermark: a new epoch, which starts
+    after 150 (the controller still keeps 150 as published), not at 1. Before: ids 1-50
+    (older than the keys kept) were published again under new run ids."""
+    running, heard = bridge
+    assert running.counts.epochs == 0
+    made = [controller.tighten(push=False, curves=False) for _ in range(150)]
+    controller.send_raw(b"".join(controller.result_wire(i, 2) for i in made))
+    wait_until(lambda: len(result_ids(heard)) == 150, "the first 150", timeout_s=30.0)
+    controller.count_from(9_999_999_999)
+    made.append(controller.tighten(curves=False))
+    wait_until(lambda: len(result_ids(heard)) == 151, "the jump")
+    controller.drop()
+    controller.count_from(151)
+    made += [controller.tighten(curves=False) for _ in range(3)]
+    wait_until(lambda: len(result_ids(heard)) >= len(made), "151-153 after the drop")
+    time.sleep(0.5)  # nothing more may come
+    assert result_ids(heard) == made, "each tightening once"
+    run_ids = [result.run_id for result in heard.of("results")]
+    assert run_ids == list(range(1, 155)), "run ids go on one by one"
+    asked = [wanted for wanted, _ in controller.old_result_requests if wanted != 0]
+    assert len(asked) <= 10, f"0064 asked for {len(asked)} ids"

@@ -18,7 +18,11 @@ from typing import Any
 import pytest
 import zenoh
 
-from tests.support.bridge_harness import RunningBridge, bridge_station_file
+from tests.support.bridge_harness import (
+    RunningBridge,
+    bridge_station_file,
+    controller_station_file,
+)
 from tests.support.listener import Listener
 from tests.support.live_recorder import wait_until
 from tests.support.openprotocol_controller import SpecController
@@ -244,3 +248,48 @@ def test_the_alarm_active_on_the_controller_is_in_the_bridges_counters(line_of: 
         controller.raise_alarm("E501", "low battery")
         wait_until(lambda: line.bridge.counts.active_alarm is not None, "a 0071")
         assert line.bridge.counts.stats().active_alarm is not None
+
+
+def test_a_controller_station_judges_with_its_psets_windows_else_the_controllers(
+    tmp_path: Path, sessions: tuple[Any, Any]
+) -> None:
+    """Pset 1's torque window is the station file's (20-27 Nm: 28 Nm is high, though the
+    controller's own 20-30 Nm said OK); pset 2 has none there: the controller's (its
+    0061's 100-250 Nm), also for a result fetched by id (0065 has no limits). Before: the
+    station file's windows were only kept with the recording; a fetched result was not
+    judged at all."""
+    served, feeding = sessions
+    with SpecController() as controller:
+        heard = Listener(served, "op1", samples_from_batches=True)
+        station_file = controller_station_file(
+            tmp_path,
+            controller.port,
+            "tcp/127.0.0.1:1",
+            [
+                {"id": 1, "name": "cover", "torque_min_nm": 20.0, "torque_max_nm": 27.0},
+                {"id": 2, "name": "flange"},
+            ],
+        )
+        bridge = RunningBridge(station_file, feeding)
+        try:
+            assert controller.wait_subscribed(10.0, mids=(61,))
+            controller.tighten(torque_nm=28.0, pset=1)
+            controller.tighten(torque_nm=200.0, pset=2, torque_min_nm=100.0, torque_max_nm=250.0)
+            wait_until(lambda: len(heard.of("results")) == 2, "two results")
+            controller.drop()  # pset 2 again while the bridge is away: fetched by id
+            controller.tighten(torque_nm=300.0, pset=2, torque_min_nm=100.0, torque_max_nm=250.0)
+            wait_until(lambda: len(heard.of("results")) == 3, "the one fetched by id")
+        finally:
+            bridge.finish()
+            heard.close()
+    first, second, fetched = heard.of("results")
+    assert (first.result, first.final_torque_nm.status) == ("NOK", "high")
+    assert (first.final_torque_nm.min, first.final_torque_nm.max) == (20.0, 27.0)
+    assert first.nok_reasons == (
+        "the controller said OK, the windows NOK; torque high: 28 Nm, window 20 to 27 Nm"
+    )
+    assert (second.result, second.final_torque_nm.status) == ("OK", "ok")
+    assert (second.final_torque_nm.min, second.final_torque_nm.max) == (100.0, 250.0)
+    assert (fetched.program_name, fetched.final_torque_nm.status) == ("flange", "high")
+    assert (fetched.final_torque_nm.min, fetched.final_torque_nm.max) == (100.0, 250.0)
+    assert fetched.result == "NOK"

@@ -12,6 +12,7 @@ from services.openprotocol.pending_tightenings import (
 )
 from services.openprotocol.published_ids import (
     BridgePosition,
+    position_path,
     read_position,
     write_position,
 )
@@ -158,3 +159,25 @@ def test_a_live_result_of_one_fetched_by_id_is_no_repeat_and_takes_its_place() -
     first, second = pending.ready(0.0)
     assert first.result.filled and not second.result.filled
     assert pending.result(figures(1), 0.0) is Take.FETCHED, "published from its 0065"
+
+
+def test_an_epoch_that_starts_after_an_id_goes_on_with_the_next_run_id_and_is_kept(
+    tmp_path: Path,
+) -> None:
+    """The ids jumped to 9999999999 after 3117, then went back to 3118: run ids go on
+    one by one (the offset may be negative), and the keys of the epochs before are kept
+    in the file."""
+    position = BridgePosition(3117, 0, "a", {3116: key(3116), 3117: key(3117)})
+    jumped = position.new_epoch("a", start_after=9_999_999_998)
+    assert jumped.run_id(9_999_999_999) == 3118
+    assert jumped.previous_keys == {3116: key(3116), 3117: key(3117)}
+    published = BridgePosition(
+        9_999_999_999, jumped.run_id_offset, "a", {9_999_999_999: key(9)}, "",
+        jumped.previous_keys,
+    )  # fmt: skip
+    back = published.new_epoch("a", start_after=3117)
+    assert back.run_id(3118) == 3119
+    assert list(back.previous_keys) == [3116, 3117, 9_999_999_999]
+    path = position_path(tmp_path, "op1")
+    write_position(path, jumped)
+    assert read_position(path) == jumped

@@ -8,6 +8,7 @@ import pytest
 
 from services.router.access_control import (
     ACQUISITION_TOPICS,
+    AGAIN_TOPICS,
     BRIDGE_TOPICS,
     PLC_TOPICS,
     PREDICTOR_TOPICS,
@@ -35,9 +36,13 @@ def test_the_acquisition_hosts_the_stations_predictor_and_may_put_its_keys(stati
 
 @pytest.mark.parametrize("station", STATIONS)
 def test_a_line_predictor_may_put_only_the_predictors_keys(station: str) -> None:
-    """placement "line": ``boltwatch serve predictor`` presents ``<st>-predictor``."""
+    """placement "line": ``boltwatch serve predictor`` presents ``<st>-predictor``; it spools
+    what it puts, so it also puts its spool's counters and what its spool sends again."""
     acl = line_access_control(STATIONS)
-    assert put_keys_granted(acl, f"{station}-predictor") == station_keys(station, PREDICTOR_TOPICS)
+    granted = put_keys_granted(acl, f"{station}-predictor")
+    assert granted == station_keys(station, (*PREDICTOR_TOPICS, *AGAIN_TOPICS))
+    assert {channels.SPOOL.key(station), keys.again_key(station, "**")} <= granted
+    assert not {channels.SAMPLES.key(station), channels.TOOL.key(station)} & granted
 
 
 @pytest.mark.parametrize("station", STATIONS)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import jsonschema
 import pytest
@@ -10,13 +11,16 @@ import pytest
 from shared.contract import (
     PART_ID_CHARS,
     PartScan,
+    TighteningResult,
     channels,
     decode,
     decoder,
     encode,
     json_schema,
+    to_dict,
 )
 from shared.errors import InputError
+from tests.support import factories
 
 T_NS = 1_700_000_000_000_000_000
 
@@ -92,3 +96,17 @@ def test_the_part_channel_is_put_by_the_lines_plc_or_the_rig_express() -> None:
     assert channel.qos.express and not channel.qos.real_time
     assert channels.of_message(PartScan("st1", "P1", T_NS)) is channel
     assert channels.topics_of("rig") == ("part",) == channels.topics_of("plc")
+
+
+def test_a_result_recorded_before_it_said_where_its_part_came_from_still_decodes() -> None:
+    """``TighteningResult.part_source`` is optional: a result in a recording (or from a
+    station) made before it decodes, saying nothing of its part's source; one that says it
+    must say one of the three."""
+    result = factories.result(1, part_id="WHEEL-A", part_source="restored")
+    older = to_dict(result)
+    del older["part_source"]
+    decoded = decode(TighteningResult, json.dumps(older).encode())
+    assert decoded == replace(result, part_source=None)
+    assert decode(TighteningResult, encode(result)) == result
+    with pytest.raises(InputError, match="part_source"):
+        decode(TighteningResult, json.dumps({**older, "part_source": "guessed"}).encode())

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from shared.openprotocol import (
@@ -10,6 +12,8 @@ from shared.openprotocol import (
     CommunicationStart,
     CommunicationStartAck,
     FrameReader,
+    LastTighteningResult,
+    ToolData,
     decode,
     encode,
 )
@@ -60,3 +64,22 @@ def test_result_lengths_are_the_specifications() -> None:
     assert len(LAST_RESULT_1_WIRE) - 1 == 231
     assert len(LAST_RESULT_2_WIRE) - 1 == 385
     assert len(OLD_RESULT_1_WIRE) - 1 == 118
+
+
+@pytest.mark.parametrize(
+    ("torque_nm", "sent_nm"),
+    [(12.349, 12.34), (12.345, 12.34), (0.29, 0.29), (1.1, 1.1), (9999.999, 9999.99)],
+)
+def test_a_torque_is_sent_with_two_decimals_truncated_as_the_specification_says(
+    torque_nm: float, sent_nm: float
+) -> None:
+    """R2.8.0, 0061 parameters 12-15 (and 0041, 0065): "multiplied by 100 and sent as an
+    integer (2 decimals truncated)". Before: rounded, 12.349 Nm went out as 12.35 Nm."""
+    sent = replace(LAST_RESULT_1, torque_nm=torque_nm, torque_max_nm=torque_nm)
+    (frame,) = FrameReader().feed(encode(sent))
+    read = decode(frame)
+    assert isinstance(read, LastTighteningResult)
+    assert (read.torque_nm, read.torque_max_nm) == (sent_nm, sent_nm)
+    (frame,) = FrameReader().feed(encode(replace(TOOL_DATA_2, calibration_value_nm=torque_nm)))
+    tool = decode(frame)
+    assert isinstance(tool, ToolData) and tool.calibration_value_nm == sent_nm

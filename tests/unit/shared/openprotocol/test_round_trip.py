@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from shared.openprotocol import (
+    ANY_REVISION_MIDS,
     BINARY_MIDS,
     KNOWN_MIDS,
     SUPPORTED_REVISIONS,
@@ -13,8 +14,8 @@ from shared.openprotocol import (
     Dialect,
     Frame,
     FrameReader,
-    KeepAlive,
     OpenProtocolError,
+    ResultSubscribe,
     UnknownMessage,
     WireMessage,
     decode,
@@ -66,10 +67,23 @@ def test_a_revision_not_implemented_is_refused_naming_it() -> None:
     )
     assert refused.value.field == "revision"
     with pytest.raises(OpenProtocolError) as refused:
-        encode(KeepAlive(), revision=2)
+        encode(ResultSubscribe(), revision=3)
     assert (
-        str(refused.value) == "MID 9999 rev 2, field 'revision': revision 2 is not implemented (1)"
+        str(refused.value)
+        == "MID 0060 rev 3, field 'revision': revision 3 is not implemented (1, 2)"
     )
+
+
+@pytest.mark.parametrize("mid", sorted(ANY_REVISION_MIDS))
+def test_a_message_without_data_is_read_and_written_at_any_revision(mid: int) -> None:
+    """0062, 0063, 0072, 0073, 0075, 0077, 0003 and 9999 carry no data at any revision (and
+    OpenProtocolInterpreter writes 0062 at revision 5 or 6). Before: refused above 1."""
+    assert {3, 62, 63, 72, 73, 75, 77, 9999} == ANY_REVISION_MIDS
+    for revision in (2, 6, 999):
+        message = decode(Frame(mid=mid, revision=revision))
+        assert not isinstance(message, UnknownMessage)
+        assert message.revision == revision
+        assert encode(message)[:11] == f"0020{mid:04d}{revision:03d}".encode()
 
 
 def test_encode_takes_a_revision_fill_and_no_ack() -> None:

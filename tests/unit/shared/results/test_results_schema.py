@@ -1,5 +1,6 @@
 """The store's versions: a new store is made whole, an older one migrated with nothing
-lost (a store of version 1, before the plant model, among them), a newer one refused, a
+lost (a store of version 1, before the plant model, and of version 2, before the part's
+source, among them), a newer one refused, a
 reader of a current one takes no lock, writers starting together migrate once, a damaged
 file is named and left as it is."""
 
@@ -24,7 +25,7 @@ from shared.results import (
     version_of,
 )
 from tests.support import factories
-from tests.support.old_results_store import version_1_store
+from tests.support.old_results_store import version_1_store, version_2_store
 
 #: a later version, as the next boltwatch would bring one: a column added
 NEXT_VERSION = (*MIGRATIONS, ("ALTER TABLE tightenings ADD COLUMN operator TEXT",))
@@ -68,7 +69,7 @@ def test_a_version_1_store_is_migrated_at_start_with_every_row_kept(target: Stor
     ]
     version_1_store(target, old)
     with ResultsStore(target) as store:
-        assert (store.migrated_from, store.version) == (1, 2)
+        assert (store.migrated_from, store.version) == (1, SCHEMA_VERSION)
         assert store.find(ResultsQuery(oldest_first=True)) == old
         assert {(s.plant, s.station_name) for s in old} == {("", "")}
         new = stored_result(
@@ -84,6 +85,27 @@ def test_a_version_1_store_is_migrated_at_start_with_every_row_kept(target: Stor
             else "SELECT indexname FROM pg_indexes WHERE tablename = 'tightenings'"
         )
     assert ("tightenings_by_plant",) in indexes
+
+
+def test_a_version_2_store_is_migrated_at_start_and_its_parts_source_is_not_said(
+    target: StoreTarget,
+) -> None:
+    """Version 3 adds ``part_source`` (where the part of a live run came from: scanned, or
+    restored from the line when the predictor started): the rows stored before say nothing
+    (None), as a result recorded before says nothing; new rows keep theirs."""
+    old = [
+        stored_result(factories.result(run, part_id=f"P{run}"), "A", f"/rec/{run}.mcap", "box", run)
+        for run in (1, 2)
+    ]
+    version_2_store(target, old)
+    with ResultsStore(target) as store:
+        assert (store.migrated_from, store.version) == (2, 3)
+        kept = store.find(ResultsQuery(oldest_first=True))
+        assert kept == old and {s.result.part_source for s in kept} == {None}
+        restored = factories.result(3, part_id="P2", part_source="restored")
+        store.add([stored_result(restored, "A", None, None, 3)])
+        newest = store.find(ResultsQuery(part_id="P2"))[0]  # newest first
+        assert newest.result == restored
 
 
 def test_a_store_of_a_newer_boltwatch_is_not_written_into(target: StoreTarget) -> None:

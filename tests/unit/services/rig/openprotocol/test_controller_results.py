@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from shared.openprotocol import (
     UNIT_DEGREE,
     UNIT_NM,
@@ -109,14 +111,17 @@ def test_an_unacknowledged_result_is_sent_three_times_more_then_the_link_dropped
             assert old.revision == 2 and old.batch_size == 10
 
 
-def test_an_acknowledged_result_is_not_sent_again(tmp_path: Path) -> None:
+@pytest.mark.parametrize("ack_revision", [1, 6])
+def test_an_acknowledged_result_is_not_sent_again(tmp_path: Path, ack_revision: int) -> None:
+    """0062 at revision 6 is what OpenProtocolInterpreter's ``new Mid0062()`` writes. Before:
+    refused with error 97, the result sent again three times, then the link dropped."""
     station = write_controller_station(
         tmp_path, rig={"ack_timeout_s": 0.3}, pause_between_runs_s=30.0
     )
     with running_controller(station, wait_for_integrator=True) as controller:
         with subscribed(controller.server.port) as integrator:
             integrator.expect(LastTighteningResult)
-            integrator.send(ResultAcknowledge())
+            integrator.send_frame(ResultAcknowledge.MID, b"", revision=ack_revision)
             for _ in range(5):  # 1.5 s of keep-alives: no result comes again
                 assert isinstance(integrator.request(KeepAlive()), KeepAlive)
                 integrator.socket.settimeout(0.3)
