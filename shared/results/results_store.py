@@ -5,26 +5,33 @@ or PostgreSQL).
 The recorder adds each result as it files it (``services/recorder/results_watch.py``),
 ``boltwatch results rebuild`` those of existing recordings; both may write at once.
 :meth:`ResultsStore.add` is idempotent by (station, run_id): a result stored
-again is left as it is (the first one stored stays) and not counted as new.
-:meth:`ResultsStore.verdicts` says which runs are stored (the retention policy
-deletes no recording whose results are not). Readers (``boltwatch results``,
+again is left as it is (the first one stored stays) and not counted as new. A
+tightening whose figures cannot be a measurement is kept aside and named, never
+a result to a reader (:mod:`.refused_results`; :meth:`ResultsStore.refused`
+names those a question asks for). :meth:`ResultsStore.verdicts` says which runs
+are stored, kept aside or not (the retention policy deletes no recording whose
+results are not). Readers (``boltwatch results``,
 ``report``, ``recordings prune``) open it without making one:
 :class:`~.results_database.StoreError` says where none is and how one comes.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from collections.abc import Iterator, Sequence
 from typing import Any
 
 from shared.contract import ResultStep
+from shared.quality import implausible, refusal_line
+from shared.results.refused_results import LINE_COLUMNS, refused_line
 from shared.results.results_database import ResultsDatabase, StoreError, StoreTarget
 from shared.results.results_query import ResultsQuery
 from shared.results.results_schema import (
     SCHEMA_VERSION,
     STEP_COLUMNS,
     TIGHTENING_COLUMNS,
+    TIGHTENING_TYPES,
     migrate,
     version_of,
 )
@@ -36,11 +43,18 @@ LOG = logging.getLogger(__name__)
 #: run ids of one station per statement when rows are read by key (steps, verdicts)
 _RUNS_PER_QUERY = 500
 
-_INSERT_TIGHTENING = (
-    f"INSERT INTO tightenings ({', '.join(TIGHTENING_COLUMNS)}) "
-    f"VALUES ({', '.join('?' * len(TIGHTENING_COLUMNS))}) "
+#: the table of results, and the one of tightenings kept aside (:mod:`.refused_results`)
+RESULTS_TABLE, REFUSED_TABLE = "tightenings", "refused_tightenings"
+#: a tightening into one table unless the other has its run: the first stored stays,
+#: wherever it went (each value cast to its column's type: PostgreSQL types no bare
+#: parameter of a SELECT's list by the column it goes into)
+_INSERT = {
+    table: f"INSERT INTO {table} ({', '.join(TIGHTENING_COLUMNS)}) "
+    f"SELECT {', '.join(f'CAST(? AS {TIGHTENING_TYPES[c]})' for c in TIGHTENING_COLUMNS)} "
+    f"WHERE NOT EXISTS (SELECT 1 FROM {other} WHERE station = ? AND run_id = ?) "
     "ON CONFLICT (station, run_id) DO NOTHING"
-)
+    for table, other in ((RESULTS_TABLE, REFUSED_TABLE), (REFUSED_TABLE, RESULTS_TABLE))
+}
 _INSERT_STEP = (
     f"INSERT INTO tightening_steps ({', '.join(STEP_COLUMNS)}) "
     f"VALUES ({', '.join('?' * len(STEP_COLUMNS))}) "
@@ -90,14 +104,24 @@ class ResultsStore:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def add(self, results: Sequence[StoredResult]) -> int:
-        """Store ``results`` in one transaction; how many were new (not stored before)."""
+    def add(self, results: Sequence[StoredResult], refused: list[str] | None = None) -> int:
+        """Store ``results`` in one transaction; how many were new results (not stored
+        before). One whose figures cannot be a measurement is kept aside instead (not a
+        result: not counted), a line naming it in ``refused``, stored before or not."""
         new = 0
         with self.database.transaction():
             for stored in results:
-                if self.database.execute(_INSERT_TIGHTENING, to_row(stored)) == 1:
-                    new += 1
+                result = stored.result
+                fault = implausible(result)
+                table = RESULTS_TABLE if fault is None else REFUSED_TABLE
+                key = (result.station, result.run_id)
+                if self.database.execute(_INSERT[table], (*to_row(stored), *key)) == 1:
+                    new += fault is None
                     self.database.execute_many(_INSERT_STEP, step_rows(stored))
+                if fault is not None and refused is not None:
+                    refused.append(
+                        refusal_line(result.station, result.run_id, result.tool_id, fault)
+                    )
         self._added_since_statistics += new
         if self._added_since_statistics >= max(self._statistics_rows, FEWEST_ROWS):
             self._keep_statistics()
@@ -169,27 +193,44 @@ class ResultsStore:
                 (host, recording, size_bytes, modified_ns, results, now_ns),
             )
 
-    def last_stored_ns(self, stations: Sequence[str]) -> int | None:
-        """When the newest result of ``stations`` was stored; None: none stored."""
-        where, parameters = ResultsQuery(stations=stations).where()
+    def refused(self, query: ResultsQuery) -> list[str]:
+        """A line naming each tightening ``query`` asks for (its limit aside) that was kept
+        aside (:mod:`.refused_results`), in the order they ended: what ``report`` says of the
+        same results read from their files."""
+        where, parameters = dataclasses.replace(query, limit=None, oldest_first=True).where()
+        order = " ORDER BY ended_ns, station, run_id"
         with self.database.transaction():
-            (row,) = self.database.rows(
-                "SELECT MAX(stored_ns) FROM tightenings" + where, parameters
+            rows = self.database.rows(
+                f"SELECT {LINE_COLUMNS} FROM {REFUSED_TABLE}{where}{order}", parameters
             )
-        return None if row[0] is None else int(row[0])
+        return [refused_line(row) for row in rows]
+
+    def last_stored_ns(self, stations: Sequence[str]) -> int | None:
+        """When the newest tightening of ``stations`` was stored (kept aside or not); None:
+        none stored."""
+        where, parameters = ResultsQuery(stations=stations).where()
+        newest = []
+        with self.database.transaction():
+            for table in (RESULTS_TABLE, REFUSED_TABLE):
+                (row,) = self.database.rows(
+                    f"SELECT MAX(stored_ns) FROM {table}" + where, parameters
+                )
+                newest += [int(row[0])] if row[0] is not None else []
+        return max(newest, default=None)
 
     def verdicts(self, keys: Sequence[tuple[str, int]]) -> dict[tuple[str, int], str]:
-        """The result (``OK``/``NOK``) of each of ``keys`` (station, run_id) that is stored;
-        a key not stored is not in the answer."""
+        """The result (``OK``/``NOK``) of each of ``keys`` (station, run_id) that is stored,
+        kept aside or not; a key not stored is not in the answer."""
         found: dict[tuple[str, int], str] = {}
         with self.database.transaction():
             for station, run_ids in _runs_by_station(keys):
-                rows = self.database.rows(
-                    "SELECT run_id, result FROM tightenings "
-                    f"WHERE station = ? AND run_id IN ({', '.join('?' * len(run_ids))})",
-                    [station, *run_ids],
-                )
-                found.update({(station, int(row[0])): row[1] for row in rows})
+                for table in (RESULTS_TABLE, REFUSED_TABLE):
+                    rows = self.database.rows(
+                        f"SELECT run_id, result FROM {table} "
+                        f"WHERE station = ? AND run_id IN ({', '.join('?' * len(run_ids))})",
+                        [station, *run_ids],
+                    )
+                    found.update({(station, int(row[0])): row[1] for row in rows})
         return found
 
     def _steps_of(self, keys: list[tuple[Any, Any]]) -> dict[tuple[str, int], list[ResultStep]]:

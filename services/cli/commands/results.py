@@ -11,18 +11,22 @@
 The store is the station file's (``recorder.results_database``: a plant's
 PostgreSQL; none: ``results.sqlite`` in its recordings folder) or
 ``--database``. Each row names its recording: ``boltwatch inspect FILE --run
-RUN`` draws it. Nothing matching: one line on stderr, exit status 1.
+RUN`` draws it. Nothing matching: one line on stderr, exit status 1. A
+tightening whose figures cannot be a measurement is no result (the store keeps
+it aside): each matching one is named on stderr, as ``report`` names it.
 
 ``rebuild`` reads the recordings of the station files (or every station
 folder of ``--recordings``) into the store: a line with years of MCAP files gets its history.
 Progress on stderr; stopped (Ctrl-C) and started again it goes on where it
 stopped (files read whole are skipped); a result stored already is not
-stored twice.
+stored twice; one whose figures cannot be a measurement is named, counted and
+kept aside, as the recorder does.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import socket
 import sys
 import time
@@ -136,7 +140,13 @@ def run(args: argparse.Namespace) -> int:
     with ResultsStore(target, create=False) as store:
         found = store.find(query)
         total = store.count(query) if len(found) == args.limit else len(found)
+        if len(found) == args.limit:  # those kept aside among the rows answered
+            oldest_ns = found[-1].result.time_ns
+            query = dataclasses.replace(query, since_ns=max(oldest_ns, query.since_ns or 0))
+        refused = store.refused(query)
     from shared.results.results_table import format_csv, format_json, format_table
+
+    warn_left_out(NAME, [], [], refused)
 
     if args.json:
         print(format_json(found))

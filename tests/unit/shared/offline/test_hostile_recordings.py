@@ -118,13 +118,45 @@ def test_results_rebuild_stores_every_readable_result(
     assert status == 0, error
     for path in unreadable:
         assert sum(str(path) in line and "skipped" in line for line in error.splitlines()) == 1
-    assert sum("refused" in line for line in error.splitlines()) == len(WRONG_PAYLOADS)
-    stored = GOOD_RUNS - len(unreadable) + 1 + len(ABSURD_NM)  # as the recorder stores them
-    assert re.search(rf"2 not readable, skipped; 4 refused\): {stored} results", printed), printed
+    refused = [line for line in error.splitlines() if "refused" in line]
+    assert len(refused) == len(WRONG_PAYLOADS) + len(ABSURD_NM)
+    assert sum("final torque 1e+308 Nm" in line or "-1e+308" in line for line in refused) == 2
+    stored = GOOD_RUNS - len(unreadable) + 1  # the absurd ones are no result
+    assert re.search(rf"2 not readable, skipped; 6 refused\): {stored} results", printed), printed
     with ResultsStore(store_target(folder, None), create=False) as opened:
         assert ("st1", 20) in opened.verdicts([("st1", 20)])  # beside the wrong payloads
     status, printed, _ = _run(capsys, "results", "rebuild", "--recordings", str(folder))
     assert "0 results" in printed  # the file with refused payloads was read whole: not again
+
+
+def test_rebuild_results_and_report_agree_on_what_is_a_result(
+    hostile: tuple[Path, Path, list[Path]], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """What ``results rebuild`` stores, ``results`` lists and ``report`` counts, from the store
+    and from the files: the same results, the same absurd ones refused in the same words."""
+    station, folder, unreadable = hostile
+    kept = GOOD_RUNS - len(unreadable) + 1
+    status, printed, error = _run(capsys, "results", "rebuild", "--recordings", str(folder))
+    assert status == 0, error
+    rebuilt = sorted(line.split("refused ", 1)[1] for line in error.splitlines() if "(tool" in line)
+    assert len(rebuilt) == len(ABSURD_NM) and f": {kept} results, {kept} new" in printed
+
+    status, printed, error = _run(capsys, "results", "--recordings", str(folder), "--csv")
+    assert status == 0 and len(printed.splitlines()) == 1 + kept  # the header, each result
+    listed = sorted(line.split("refused ", 1)[1] for line in error.splitlines() if "(tool" in line)
+    assert listed == rebuilt
+
+    reports = {}
+    for source in ([], ["--from-recordings"]):
+        out = tmp_path / f"report{len(source)}"
+        args = ["report", "--config", str(station), "--out", str(out), *source]
+        status, printed, error = _run(capsys, *args)
+        assert status == 0, error
+        assert printed.startswith(f"{kept} results (from ") and f": {kept} runs" in printed
+        reports[len(source)] = sorted(
+            line.split("refused ", 1)[1] for line in error.splitlines() if "(tool" in line
+        )
+    assert reports[0] == reports[1] == rebuilt
 
 
 def test_overlay_skips_a_part_that_cannot_be_read(

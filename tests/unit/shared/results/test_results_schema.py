@@ -68,7 +68,7 @@ def test_a_version_1_store_is_migrated_at_start_with_every_row_kept(target: Stor
     ]
     version_1_store(target, old)
     with ResultsStore(target) as store:
-        assert (store.migrated_from, store.version) == (1, 2)
+        assert (store.migrated_from, store.version) == (1, SCHEMA_VERSION)
         assert store.find(ResultsQuery(oldest_first=True)) == old
         assert {(s.plant, s.station_name) for s in old} == {("", "")}
         new = stored_result(
