@@ -145,6 +145,19 @@ class ResultsDatabase:
         except (sqlite3.Error, psycopg.Error) as err:
             raise StoreError(f"results store {self.target}: {one_line(err)}") from err
 
+    @contextlib.contextmanager
+    def not_waiting(self) -> Iterator[None]:
+        """SQLite: a lock another connection holds fails at once (a StoreError), instead of
+        being waited for :data:`SQLITE_BUSY_TIMEOUT_S` (a reader's optional write)."""
+        if self._sqlite is None:
+            yield
+            return
+        self._sqlite.execute("PRAGMA busy_timeout = 0")
+        try:
+            yield
+        finally:
+            self._sqlite.execute(f"PRAGMA busy_timeout = {int(SQLITE_BUSY_TIMEOUT_S * 1000)}")
+
     def execute(self, sql: str, parameters: Sequence[Any] = ()) -> int:
         """Run one statement; the number of rows it changed."""
         return self._run(sql, parameters).rowcount

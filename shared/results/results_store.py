@@ -35,7 +35,7 @@ from shared.results.results_schema import (
     migrate,
     version_of,
 )
-from shared.results.sqlite_statistics import FEWEST_ROWS, keep_statistics
+from shared.results.sqlite_statistics import FEWEST_ROWS, keep_statistics, statistics_missing
 from shared.results.stored_result import StoredResult, from_row, step_of, step_rows, to_row
 
 LOG = logging.getLogger(__name__)
@@ -71,7 +71,8 @@ class ResultsStore:
     def __init__(self, target: StoreTarget, *, create: bool = True, application: str = "") -> None:
         """``create``: make the store when there is none (a writer); else StoreError.
         An older store is migrated either way; a reader (``create=False``) of a store at
-        this version changes nothing (no write lock: the recorder is never kept waiting)."""
+        this version changes nothing but SQLite's planner statistics when it has none, and
+        waits for no writer (:meth:`_describe_for_readers`: the recorder is never kept waiting)."""
         self.target = target
         nowhere = StoreError(
             f"no results store at {target}: the line's recorder makes it, "
@@ -89,6 +90,7 @@ class ResultsStore:
                 if found == 0:
                     raise nowhere
                 self.migrated_from = found if found == SCHEMA_VERSION else migrate(self.database)
+                self._describe_for_readers()
         except BaseException:
             self.database.close()
             raise
@@ -136,6 +138,17 @@ class ResultsStore:
             self._statistics_rows = keep_statistics(self.database)
         except StoreError as err:
             LOG.warning("results store %s: planner statistics not written: %s", self.target, err)
+
+    def _describe_for_readers(self) -> None:
+        """A reader's open: a SQLite store no writer has described (:mod:`.sqlite_statistics`)
+        gets its statistics now, as best effort: when the file is writable and no writer holds
+        the store (waited for by no one); otherwise it is read as it is."""
+        try:
+            if statistics_missing(self.database):
+                with self.database.not_waiting():
+                    keep_statistics(self.database)
+        except StoreError as err:
+            LOG.info("results store %s: planner statistics not written: %s", self.target, err)
 
     def find(self, query: ResultsQuery) -> list[StoredResult]:
         """The tightenings ``query`` asks for, with their steps, in its order."""
