@@ -70,6 +70,7 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
     everything = dataclasses.replace(query, limit=None, oldest_first=True)
     where, parameters = everything.where()
     arrays: list[np.ndarray] = []
+    ids: list[np.ndarray] = []  # each run's program id, as it is (a float holds 53 bits)
     nok_reasons: dict[int, list[str]] = defaultdict(list)
     counted: Counter[tuple[Any, ...]] = Counter()
     for batch in store.database.row_batches(
@@ -77,19 +78,21 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
         parameters,
         _BATCH_ROWS,
     ):
-        arrays.append(np.array([row[:6] for row in batch], dtype=np.float64).reshape(-1, 6))
+        ids.append(np.array([row[0] for row in batch], dtype=np.int64))
+        arrays.append(np.array([row[1:6] for row in batch], dtype=np.float64).reshape(-1, 5))
         for row in batch:
             if row[6] is not None:
                 nok_reasons[row[0]].append(row[6])
         counted.update(row[_GROUP_AT:] for row in batch)
-    figures = np.concatenate(arrays) if arrays else np.empty((0, 6))
+    figures = np.concatenate(arrays) if arrays else np.empty((0, 5))
+    program_ids = np.concatenate(ids) if ids else np.empty(0, dtype=np.int64)
     read = StoredColumns(refused=store.refused(everything))
     grouped: dict[int, list[tuple[Any, ...]]] = defaultdict(list)
     for (program_id, *group), runs in counted.items():
         grouped[program_id].append((*group, runs))
     for program_id in sorted(grouped):
         name, newest = _latest(store, everything, program_id)
-        of_program = figures[figures[:, 0] == program_id]
+        of_program = figures[program_ids == program_id]
         groups = grouped[program_id]
         stop_reasons: Counter[str] = Counter()
         for _station, _tool, reason, *_windows, runs in groups:
@@ -104,7 +107,7 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
                 runs=len(of_program),
                 noks=len(nok_reasons[program_id]),
                 values={
-                    key: _measured(of_program[:, 1 + index])
+                    key: _measured(of_program[:, index])
                     for index, key in enumerate((*JUDGED_FIGURES, "intensity"))
                 },
                 latest_windows={
@@ -117,7 +120,7 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
                 },
                 nok_reasons=reasons,
                 stop_reasons=stop_reasons,
-                events_per_run=[int(events) for events in _measured(of_program[:, 5])],
+                events_per_run=[int(events) for events in _measured(of_program[:, 4])],
                 stations=sorted({group[0] for group in groups}),
                 tools=sorted({int(group[1]) for group in groups}),
             )
