@@ -37,6 +37,8 @@ from typing import TYPE_CHECKING
 
 from services.cli.command_options import (
     add_station_file_option,
+    result_program_id,
+    result_tool_id,
     utc_end,
     utc_moment,
     warn_left_out,
@@ -89,8 +91,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     which.add_argument("--plant", default=None, metavar="P", help="a plant (station.plant)")
     which.add_argument("--line", default=None, metavar="L", help="a line (station.line)")
-    which.add_argument("--program", type=int_in(0, 2**63 - 1, "a program id"), default=None)
-    which.add_argument("--tool", type=int_in(0, 2**63 - 1, "a tool id"), default=None)
+    which.add_argument("--program", type=result_program_id, default=None)
+    which.add_argument("--tool", type=result_tool_id, default=None)
     which.add_argument(
         "--since",
         type=utc_moment,
