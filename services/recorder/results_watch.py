@@ -38,6 +38,7 @@ from pathlib import Path
 
 from shared.config import StationPlace
 from shared.contract import RunSummary, TighteningResult
+from shared.recordings import loop_lines
 from shared.results import ResultsStore, StoredResult, StoreError, StoreTarget, stored_result
 from shared.results.recordings_reading import fill_from_recordings, station_recordings
 from shared.runtime.log_limit import RateLimitedLog
@@ -229,11 +230,14 @@ class ResultsWatch:
         # a file is in the day folder of its opening (UTC): the day before may hold one
         # written since
         first_day = datetime.fromtimestamp(since_ns / 1e9, UTC).date() - timedelta(days=1)
+        loops: list[Path] = []
         files = [
             path
-            for path in station_recordings(self._folder, self._places, first_day)
+            for path in station_recordings(self._folder, self._places, first_day, loops)
             if since_ns <= _modified_ns(path) <= self._started_ns
         ]
+        for line in loop_lines(loops):
+            LOG.warning("results store %s: catch-up: %s; skipped", self.target, line)
         if files:
             counts = fill_from_recordings(store, files, self._places, self._host, time.time_ns)
             LOG.info(

@@ -53,16 +53,20 @@ class FillCounts:
 
 
 def station_recordings(
-    folder: Path, stations: Iterable[str], first_day: date | None = None
+    folder: Path,
+    stations: Iterable[str],
+    first_day: date | None = None,
+    loops: list[Path] | None = None,
 ) -> list[Path]:
     """Every MCAP file of ``stations`` under the recordings ``folder``, oldest day first
-    (``first_day``: only the day folders from it on)."""
+    (``first_day``: only the day folders from it on); symlink loops met on the way: skipped,
+    in ``loops`` (``folder`` one: InputError)."""
     return [
         path
         for station in stations
-        for day_date, day in station_days(folder, station)
+        for day_date, day in station_days(folder, station, loops)
         if first_day is None or day_date >= first_day
-        for path in recording_files(day)
+        for path in recording_files(day, loops=loops)
     ]
 
 

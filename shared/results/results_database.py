@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import psycopg
 
 from shared.errors import StoreError
+from shared.files import real_path
 
 if TYPE_CHECKING:
     from shared.config import AnyStation
@@ -74,7 +75,7 @@ def store_target(recordings_folder: Path, database: str | None) -> StoreTarget:
 def station_store(station: AnyStation) -> StoreTarget:
     """The results store a loaded station file names (its recordings folder resolved)."""
     database = station.config.recorder.results_database
-    return store_target(station.recordings_folder.resolve(), database)
+    return store_target(real_path(station.recordings_folder), database)
 
 
 def postgres_target(url: str) -> StoreTarget:

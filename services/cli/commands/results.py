@@ -17,6 +17,8 @@ it aside): each matching one is named on stderr, as ``report`` names it.
 
 ``rebuild`` reads the recordings of the station files (or every station
 folder of ``--recordings``) into the store: a line with years of MCAP files gets its history.
+A recordings folder that is a symlink loop is one line (exit status 2); a
+station folder, day folder or file in it that is one is named and skipped.
 Progress on stderr; stopped (Ctrl-C) and started again it goes on where it
 stopped (files read whole are skipped); a result stored already is not
 stored twice; one whose figures cannot be a measurement is named, counted and
@@ -176,20 +178,27 @@ class Source:
 def _sources(args: argparse.Namespace) -> list[Source]:
     """``--recordings DIR`` (every station folder in it), else the station files."""
     from shared.config import StationPlace, load_any_station
+    from shared.files import loop_text, real_path, symlink_loop
+    from shared.recordings import check_walkable
 
     if args.recordings is not None:
         folder: Path = args.recordings
+        if symlink_loop(folder) is not None:
+            raise ConfigError(f"--recordings: {folder}: {loop_text(folder)}")
         if not folder.is_dir():
             raise ConfigError(f"--recordings: {folder} is not a folder")
-        stations = sorted(
-            path.name for path in folder.iterdir() if path.is_dir() and path.name[0] != "."
+        stations = sorted(  # a station folder that is a symlink loop: named when read
+            path.name
+            for path in folder.iterdir()
+            if (path.is_dir() or symlink_loop(path) == path) and path.name[0] != "."
         )
         return [Source(folder, {station: StationPlace() for station in stations}, None)]
 
     sources: dict[Path, Source] = {}
     for path in args.config:
         station = load_any_station(path)
-        folder = station.recordings_folder.resolve()
+        folder = real_path(station.recordings_folder)
+        check_walkable(folder)
         source = sources.setdefault(
             folder, Source(folder, {}, station.config.recorder.results_database)
         )
@@ -219,6 +228,7 @@ def _target(args: argparse.Namespace, sources: Sequence[Source]) -> StoreTarget:
 
 
 def _rebuild(target: StoreTarget, sources: Sequence[Source]) -> int:
+    from shared.recordings import loop_lines
     from shared.results import ResultsStore
     from shared.results.recordings_reading import (
         FillCounts,
@@ -227,7 +237,8 @@ def _rebuild(target: StoreTarget, sources: Sequence[Source]) -> int:
     )
 
     places = {station: place for source in sources for station, place in source.places.items()}
-    files = [path for s in sources for path in station_recordings(s.folder, s.places)]
+    loops: list[Path] = []
+    files = [path for s in sources for path in station_recordings(s.folder, s.places, None, loops)]
     told_s = [0.0]
 
     def progress(counts: FillCounts) -> None:
@@ -245,11 +256,12 @@ def _rebuild(target: StoreTarget, sources: Sequence[Source]) -> int:
         counts = fill_from_recordings(
             store, files, places, socket.gethostname(), time.time_ns, progress
         )
-    warn_left_out("results rebuild", counts.damaged, counts.skipped, counts.refused)
+    skipped = [*loop_lines(loops), *counts.skipped]
+    warn_left_out("results rebuild", counts.damaged, skipped, counts.refused)
     before = counts.files - counts.read - len(counts.skipped)
     left_out = [
         f"{len(lines)} {what}"
-        for lines, what in ((counts.skipped, "not readable, skipped"), (counts.refused, "refused"))
+        for lines, what in ((skipped, "not readable, skipped"), (counts.refused, "refused"))
         if lines
     ]
     print(
