@@ -26,7 +26,7 @@ from shared.results.results_database import (
     store_target,
     without_password,
 )
-from shared.results.results_query import DEFAULT_LIMIT, ResultsQuery
+from shared.results.results_query import DEFAULT_LIMIT, ResultsQuery, time_ns_of
 from shared.results.results_schema import MIGRATIONS, SCHEMA_VERSION, migrate, version_of
 from shared.results.results_store import ResultsStore
 from shared.results.stored_result import StoredResult, stored_result
@@ -49,6 +49,7 @@ __all__ = [
     "station_store",
     "store_target",
     "stored_result",
+    "time_ns_of",
     "version_of",
     "without_password",
 ]

@@ -123,7 +123,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from shared.results import ResultsQuery, ResultsStore
+    from shared.results import ResultsQuery, ResultsStore, time_ns_of
 
     sources = _sources(args)
     target = _target(args, sources)
@@ -136,8 +136,8 @@ def run(args: argparse.Namespace) -> int:
         line=args.line,
         program_id=args.program,
         tool_id=args.tool,
-        since_ns=None if args.since is None else round(args.since.timestamp() * 1e9),
-        until_ns=None if args.until is None else round(args.until.timestamp() * 1e9),
+        since_ns=None if args.since is None else time_ns_of(args.since),
+        until_ns=None if args.until is None else time_ns_of(args.until),
         verdict="NOK" if args.nok else None,
         limit=args.limit,
     )

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from datetime import UTC, date, datetime, timedelta
+from datetime import date, datetime, timedelta
 from pathlib import Path
 
 from shared.contract import RunSummary, TighteningResult, channels, decode
@@ -32,7 +32,7 @@ from shared.errors import InputError
 from shared.quality import ProgramColumns, columns_of, implausible, refusal_line
 from shared.recordings import loop_lines, recording_files, station_days
 from shared.recordings.mcap import RecordingScan
-from shared.results import ResultsQuery, ResultsStore, program_columns
+from shared.results import ResultsQuery, ResultsStore, program_columns, time_ns_of
 
 #: progress is told every this many files (when there are more)
 PROGRESS_EVERY_FILES = 50
@@ -48,11 +48,21 @@ class ResultFilter:
     program_id: int | None = None
     tool_id: int | None = None
 
+    @property
+    def since_ns(self) -> int | None:
+        return None if self.since is None else time_ns_of(self.since)
+
+    @property
+    def until_ns(self) -> int | None:
+        return None if self.until is None else time_ns_of(self.until)
+
     def keeps(self, result: TighteningResult) -> bool:
-        ended = datetime.fromtimestamp(result.time_ns / 1e9, UTC)
+        """Whether ``result`` is in the range (to the nanosecond, as the store's query) and
+        of the program and tool asked for."""
+        since_ns, until_ns = self.since_ns, self.until_ns
         return (
-            (self.since is None or ended >= self.since)
-            and (self.until is None or ended < self.until)
+            (since_ns is None or result.time_ns >= since_ns)
+            and (until_ns is None or result.time_ns < until_ns)
             and (self.program_id is None or result.program_id == self.program_id)
             and (self.tool_id is None or result.tool_id == self.tool_id)
         )
@@ -170,8 +180,8 @@ def read_stored(store: ResultsStore, rule: ResultFilter) -> RecordedResults:
         stations=[station for station, _ in rule.stations],
         program_id=rule.program_id,
         tool_id=rule.tool_id,
-        since_ns=None if rule.since is None else round(rule.since.timestamp() * 1e9),
-        until_ns=None if rule.until is None else round(rule.until.timestamp() * 1e9),
+        since_ns=rule.since_ns,
+        until_ns=rule.until_ns,
         limit=None,
         oldest_first=True,
     )

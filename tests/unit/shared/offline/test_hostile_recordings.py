@@ -213,3 +213,32 @@ def test_figures_at_the_bounds_are_measurements() -> None:
     )
     assert implausible(edge) is None
     assert implausible(factories.result(1, events=None, process_intensity=None)) is None
+
+
+@pytest.mark.parametrize("source", [[], ["--from-recordings"]])
+def test_a_result_ending_a_nanosecond_from_a_bound_is_in_the_range_it_is_in(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], source: list[str]
+) -> None:
+    """``--since`` and ``--until`` hold to the nanosecond, from the store (integer
+    nanoseconds in SQL) and from the files alike (a float of seconds since 1970 holds about a
+    quarter of a microsecond): each run is its own program, so the report says which."""
+    folder = tmp_path / "recordings"
+    since_ns, until_ns = DAY_NS + 10**9, DAY_NS + 5 * 10**9  # 08:00:01 and 08:00:05
+    ended = {1: since_ns - 1, 2: since_ns, 3: until_ns - 1, 4: until_ns}
+    for run_id, time_ns in ended.items():
+        result = factories.result(
+            run_id, time_ns=time_ns, program_id=run_id, program_name=f"P{run_id}"
+        )
+        write_result_file(folder, result)
+    station = write_station_file(tmp_path / "station.toml", folder, connect=CONNECT)
+    assert main(["results", "rebuild", "--config", str(station)]) == 0
+    window = ["--since", "2026-03-02T08:00:01", "--until", "2026-03-02T08:00:05"]
+    capsys.readouterr()
+    status, printed, _ = _run(capsys, "results", "--config", str(station), *window, "--csv")
+    assert status == 0 and len(printed.splitlines()) == 3  # the header, runs 3 and 2
+    out = str(tmp_path / "out")
+    args = ["report", "--config", str(station), "--out", out, *window, *source]
+    status, printed, error = _run(capsys, *args)
+    assert status == 0, error
+    counted = sorted(int(n) for n in re.findall(r"^program (\d+) \(", printed, re.MULTILINE))
+    assert counted == [2, 3]
