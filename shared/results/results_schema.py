@@ -32,10 +32,6 @@ from shared.results.results_database import ResultsDatabase, StoreError
 #: the version this boltwatch writes; MIGRATIONS[v - 1] makes version v
 SCHEMA_VERSION = 3
 
-_INTEGERS = (
-    "run_id", "tightening_id", "tool_id", "program_id", "batch_counter", "ended_ns", "events",
-    "stored_ns",
-)  # fmt: skip
 TIGHTENING_COLUMNS = (
     "station", "run_id", "plant", "line", "station_name", "tightening_id", "tool_id",
     "program_id", "program_name", "part_id", "batch_counter", "ended_ns", "result", "nok_reasons",
@@ -45,15 +41,6 @@ TIGHTENING_COLUMNS = (
     "stop_reason", "events", "process_intensity", "source",
     "recording", "recording_host", "stored_ns",
 )  # fmt: skip
-#: each column's type (as CREATE TABLE says it)
-TIGHTENING_TYPES = {
-    column: "BIGINT"
-    if column in _INTEGERS
-    else "DOUBLE PRECISION"
-    if column.endswith(("_nm", "_deg", "_n", "_intensity"))
-    else "TEXT"
-    for column in TIGHTENING_COLUMNS
-}
 STEP_COLUMNS = (
     "station", "run_id", "step_index", "name", "function", "nominal", "actual", "status",
 )  # fmt: skip

@@ -31,7 +31,6 @@ from shared.results.results_schema import (
     SCHEMA_VERSION,
     STEP_COLUMNS,
     TIGHTENING_COLUMNS,
-    TIGHTENING_TYPES,
     migrate,
     version_of,
 )
@@ -45,15 +44,11 @@ _RUNS_PER_QUERY = 500
 
 #: the table of results, and the one of tightenings kept aside (:mod:`.refused_results`)
 RESULTS_TABLE, REFUSED_TABLE = "tightenings", "refused_tightenings"
-#: a tightening into one table unless the other has its run: the first stored stays,
-#: wherever it went (each value cast to its column's type: PostgreSQL types no bare
-#: parameter of a SELECT's list by the column it goes into)
 _INSERT = {
     table: f"INSERT INTO {table} ({', '.join(TIGHTENING_COLUMNS)}) "
-    f"SELECT {', '.join(f'CAST(? AS {TIGHTENING_TYPES[c]})' for c in TIGHTENING_COLUMNS)} "
-    f"WHERE NOT EXISTS (SELECT 1 FROM {other} WHERE station = ? AND run_id = ?) "
+    f"VALUES ({', '.join('?' * len(TIGHTENING_COLUMNS))}) "
     "ON CONFLICT (station, run_id) DO NOTHING"
-    for table, other in ((RESULTS_TABLE, REFUSED_TABLE), (REFUSED_TABLE, RESULTS_TABLE))
+    for table in (RESULTS_TABLE, REFUSED_TABLE)
 }
 _INSERT_STEP = (
     f"INSERT INTO tightening_steps ({', '.join(STEP_COLUMNS)}) "
@@ -110,24 +105,56 @@ class ResultsStore:
         """Store ``results`` in one transaction; how many were new results (not stored
         before). One whose figures cannot be a measurement is kept aside instead (not a
         result: not counted), a line naming it in ``refused``, stored before or not."""
-        new = 0
+        inserted: dict[tuple[str, int], tuple[StoredResult, str | None]] = {}
         with self.database.transaction():
             for stored in results:
                 result = stored.result
                 fault = implausible(result)
-                table = RESULTS_TABLE if fault is None else REFUSED_TABLE
                 key = (result.station, result.run_id)
-                if self.database.execute(_INSERT[table], (*to_row(stored), *key)) == 1:
-                    new += fault is None
-                    self.database.execute_many(_INSERT_STEP, step_rows(stored))
+                table = RESULTS_TABLE if fault is None else REFUSED_TABLE
+                if key not in inserted and self.database.execute(_INSERT[table], to_row(stored)):
+                    inserted[key] = (stored, fault)
                 if fault is not None and refused is not None:
                     refused.append(
                         refusal_line(result.station, result.run_id, result.tool_id, fault)
                     )
+            # the first stored stays, whichever table it went into: one just inserted whose
+            # run the other table holds (two payloads of one run) is taken back (after the
+            # inserts: a SQLite transaction that reads first cannot write when another
+            # writer has written meanwhile)
+            for key in self._held_by_the_other_table(inserted):
+                fault = inserted.pop(key)[1]
+                self.database.execute(
+                    f"DELETE FROM {RESULTS_TABLE if fault is None else REFUSED_TABLE} "
+                    "WHERE station = ? AND run_id = ?",
+                    key,
+                )
+            for stored, _ in inserted.values():
+                self.database.execute_many(_INSERT_STEP, step_rows(stored))
+        new = sum(1 for _, fault in inserted.values() if fault is None)
         self._added_since_statistics += new
         if self._added_since_statistics >= max(self._statistics_rows, FEWEST_ROWS):
             self._keep_statistics()
         return new
+
+    def _held_by_the_other_table(
+        self, inserted: dict[tuple[str, int], tuple[StoredResult, str | None]]
+    ) -> set[tuple[str, int]]:
+        """The keys of ``inserted`` (each with its fault: None went into tightenings) that
+        the other table holds."""
+        held: set[tuple[str, int]] = set()
+        for other, keys in (
+            (REFUSED_TABLE, [key for key, (_, fault) in inserted.items() if fault is None]),
+            (RESULTS_TABLE, [key for key, (_, fault) in inserted.items() if fault is not None]),
+        ):
+            for station, run_ids in _runs_by_station(keys):
+                rows = self.database.rows(
+                    f"SELECT run_id FROM {other} "
+                    f"WHERE station = ? AND run_id IN ({', '.join('?' * len(run_ids))})",
+                    [station, *run_ids],
+                )
+                held.update((station, int(row[0])) for row in rows)
+        return held
 
     def _keep_statistics(self) -> None:
         """SQLite's planner statistics brought up to date (:mod:`.sqlite_statistics`), as best

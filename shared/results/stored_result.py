@@ -6,8 +6,9 @@ events of a run whose result has none, as ``report`` counts them);
 :meth:`StoredResult.result` gives the TighteningResult back, equal to the
 one stored, so what reads the store (``report``) computes what it computed
 from the files; its part id as the part search asks for one
-(:func:`stored_part_id`: no spaces at either end, "" none). :func:`to_row` / :func:`from_row` are its rows, in the
-order of :data:`~shared.results.results_schema.TIGHTENING_COLUMNS`.
+(:func:`stored_part_id`: no spaces at either end, "" none). :func:`to_row` /
+:func:`from_row` are its rows, in the order of
+:data:`~shared.results.results_schema.TIGHTENING_COLUMNS`.
 """
 
 from __future__ import annotations

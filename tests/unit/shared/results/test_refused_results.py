@@ -7,6 +7,7 @@ at its first open; the retention policy counts a refused result as stored."""
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 from shared.contract import JudgedFigure, ResultStep, TighteningResult
@@ -87,6 +88,11 @@ def test_a_result_that_cannot_be_a_measurement_is_kept_aside_and_named(
         assert store.add([stored_result(_good(10), "A", None, None, 3)]) == 0
         assert store.count(everything) == len(good)
         assert store.add([stored_result(absurd[1], "A", None, None, 3)], []) == 0
+        # in one batch too: a run's absurd tightening, then a result of the same run
+        late = dataclasses.replace(absurd[0], run_id=30)
+        assert store.add([stored_result(r, "A", None, None, 4) for r in (late, _good(30))]) == 0
+        assert store.count(everything) == len(good)
+        assert store.refused(ResultsQuery(run_id=30, stations=["st1"])) == [_line(late)]
         assert store.refused(ResultsQuery(run_id=1, stations=["st1"])) == []
         assert store.find(ResultsQuery(run_id=1, stations=["st1"]))[0].result == good[0]
 
