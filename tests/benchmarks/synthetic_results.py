@@ -296,8 +296,10 @@ def _make(target: StoreTarget, version: int) -> tuple[str, ...]:
         return TIGHTENING_COLUMNS
     with ResultsDatabase(target) as database:
         migrate(database, MIGRATIONS[:version])
-    assert version == 1, "only version 1 is older"
-    return tuple(c for c in TIGHTENING_COLUMNS if c not in ("plant", "station_name"))
+    if version == 1:  # before the plant model
+        return tuple(c for c in TIGHTENING_COLUMNS if c not in ("plant", "station_name"))
+    assert version == 2, f"no version {version}"  # 3 added a table, no column
+    return TIGHTENING_COLUMNS
 
 
 def _chunks(
