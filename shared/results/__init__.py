@@ -7,7 +7,10 @@ plant, line, program, tool, time), in SQLite beside the recordings or a plant's 
 - :mod:`.stored_result` (a result as a row, and back)
 - :mod:`.results_store` (add idempotently, find, a query's keys only, what was read
   of which recording)
-- :mod:`.sqlite_statistics` (SQLite's planner statistics, written by the store's writer)
+- :mod:`.refused_results` (the tightenings kept aside: figures that cannot be a
+  measurement, never a result to a reader; named in the report's words)
+- :mod:`.sqlite_statistics` (SQLite's planner statistics, written by the store's writer,
+  and by a reader that finds none)
 - :mod:`.results_query` (which tightenings a question asks for)
 - :mod:`.program_columns` (a report's columns per program, in one scan)
 
