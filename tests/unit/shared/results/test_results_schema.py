@@ -99,7 +99,7 @@ def test_a_version_2_store_is_migrated_at_start_and_its_parts_source_is_not_said
     ]
     version_2_store(target, old)
     with ResultsStore(target) as store:
-        assert (store.migrated_from, store.version) == (2, 3)
+        assert (store.migrated_from, store.version) == (2, SCHEMA_VERSION)
         kept = store.find(ResultsQuery(oldest_first=True))
         assert kept == old and {s.result.part_source for s in kept} == {None}
         restored = factories.result(3, part_id="P2", part_source="restored")
