@@ -106,7 +106,13 @@ class ExtremumTracker:
 
     def min_drop_nm(self, peak_torque_nm: float) -> float:
         """The noise floor a drop must exceed to count as a slip."""
-        return max(NOISE_FACTOR * self.noise_d2_nm, REL_FLOOR * abs(peak_torque_nm))
+        return slip_floor_nm(self.noise_d2_nm, peak_torque_nm)
+
+
+def slip_floor_nm(noise_d2_nm: float, peak_torque_nm: float) -> float:
+    """The floor a drop from ``peak_torque_nm`` must exceed to be a slip, with the torque's
+    running median |d2| at ``noise_d2_nm`` (module docstring)."""
+    return max(NOISE_FACTOR * noise_d2_nm, REL_FLOOR * abs(peak_torque_nm))
 
 
 def _extremum(window: InclinationWindow, slot: int) -> Extremum:
