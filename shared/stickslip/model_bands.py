@@ -90,8 +90,13 @@ class ModelBandCheck:
         force_step_n: float | None,
         motor_speed_rad_s: float | None,
         noise_nm: float = 0.0,
+        floor_nm: float | None = None,
     ) -> BandVerdict | None:
-        """Add event j's figures; a verdict when a median has left its widened band."""
+        """Add event j's figures; a verdict when a median has left its widened band.
+
+        ``noise_nm``: the torque's median |d2|; ``floor_nm``: the drop a slip had to
+        exceed (None: :func:`slip_floor_nm` of the noise).
+        """
         previous_trough_nm = self._previous_trough_nm
         self._previous_trough_nm = peak_torque_nm - torque_drop_nm
         if not self._noise_settled:
@@ -112,7 +117,9 @@ class ModelBandCheck:
             # events a few ms apart)
             stick_rise_nm = MIN_STICK_SHARE * self.constants.k_e_nm_per_rad * speed * period_s
             rise_nm = peak_torque_nm - previous_trough_nm
-            if not (rise_nm >= stick_rise_nm > slip_floor_nm(noise_nm, peak_torque_nm)):
+            if floor_nm is None:
+                floor_nm = slip_floor_nm(noise_nm, peak_torque_nm)
+            if not (rise_nm >= stick_rise_nm > floor_nm):
                 self.not_stick_periods += 1
                 period_s = None  # smooth sliding or noise in between (or no trough): no K1, K2
         if period_s is not None and period_s > 0.0:
