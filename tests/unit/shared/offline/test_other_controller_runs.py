@@ -15,6 +15,7 @@ import pytest
 from mcap.reader import make_reader
 
 from shared.offline.controller_import import read_controller_run
+from shared.offline.post_mortem import build_figure, read_run
 from shared.offline.report import ResultFilter, read_results
 from shared.stickslip import EventFigures, PredictorCore, PredictorSettings
 from shared.wear import WearLedger, ledger_path
@@ -133,6 +134,12 @@ def test_a_loosening_is_recorded_as_a_loosening_and_counted_as_none_of_the_tight
     assert tool.total_intensity == pytest.approx(
         tightening_summary["process_intensity"] + summary["process_intensity"]
     )
+
+    # its post-mortem draws the torque as the replay saw it: its magnitude
+    figure = build_figure(read_run(recording))
+    lines = {line.get_label(): line for line in figure.axes[0].get_lines()}
+    assert min(lines["torque |T| (a loosening)"].get_ydata()) >= 0.0
+    assert "a loosening: torque drawn as its magnitude" in figure.get_suptitle()
 
 
 def _replay_drops(path: Path) -> list[float]:
