@@ -15,9 +15,9 @@ torque_resolution_nm``, from :func:`signal_resolution` of its torque values:
 
 Why the resolution and not the tool's nominal torque: a share of the nominal
 torque that refuses a drop of 0.03 Nm on a 12 Nm tool (0.25 %) also refuses
-11 of the 74 events of the ten real CS351 runs (drops of 0.012-0.015 Nm on
-their 6 Nm tool, 0.2-0.25 %), well above their own noise (median |d2| 0.005
-Nm, at 0.001 Nm resolution).
+9 of the 74 events of the ten real CS351 runs (drops of 0.012-0.015 Nm on
+their 6 Nm tool, 0.2-0.25 %), each above its run's own noise floor and
+12-15 steps of its 0.001 Nm resolution.
 """
 
 from __future__ import annotations

@@ -11,6 +11,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 from mcap.reader import make_reader
 
@@ -138,7 +139,7 @@ def test_a_loosening_is_recorded_as_a_loosening_and_counted_as_none_of_the_tight
     # its post-mortem draws the torque as the replay saw it: its magnitude
     figure = build_figure(read_run(recording))
     lines = {line.get_label(): line for line in figure.axes[0].get_lines()}
-    assert min(lines["torque |T| (a loosening)"].get_ydata()) >= 0.0
+    assert float(np.min(lines["torque |T| (a loosening)"].get_ydata())) >= 0.0
     assert "a loosening: torque drawn as its magnitude" in figure.get_suptitle()
 
 
