@@ -32,6 +32,7 @@ from shared.contract.controller_messages import (  # noqa: F401  (re-exported: o
     ControllerFunction,
     ControllerResult,
     ControllerStep,
+    RunOperation,
     ToolData,
 )
 from shared.contract.message_fields import WIRE_CONFIG, Count, Id, Measured, StationId, TimeNs
@@ -275,6 +276,9 @@ class RunSummary:
     late_decision: StopReasonName | None = None
     # the angle of the run's last measured sample (deg since the run started); None: unknown
     reached_angle_deg: float | None = None
+    # a loosening (an imported controller run turning the tool back) is no tightening: the
+    # wear ledger counts its intensity, not the run among the tool's tightenings
+    operation: RunOperation = "tightening"
 
 
 @dataclass(frozen=True, slots=True)
