@@ -11,6 +11,8 @@ command that takes it:
 - ``--recordings DIR`` and ``--config FILE`` (wear, import): the recordings
   folder, by default the station file's ``recorder.folder``;
 - ``--since`` / ``--until`` (report, results): moments in UTC, a bare date a whole day;
+- ``--program`` / ``--tool`` (report, results): any id a result may carry
+  (:data:`RESULT_ID_MAX`), so what the store holds can be asked for;
 - a PNG to draw (inspect ``--out``, model ``--plot``/``--out``): checked
   before the work, see :func:`check_png_target`.
 
@@ -27,9 +29,16 @@ from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from shared.errors import InputError
+from shared.option_types import int_in
 
 #: The station file a command reads when none is given.
 DEFAULT_STATION_FILE = Path("config/station.toml")
+#: the largest program or tool id a result may carry: the contract's (64 signed bits,
+#: ``shared.contract.INT64_MAX``; a controller's, imported, may be that wide)
+RESULT_ID_MAX = 2**63 - 1
+#: ``--program ID`` and ``--tool ID`` of a command that asks for results
+result_program_id = int_in(0, RESULT_ID_MAX, "a program id")
+result_tool_id = int_in(0, RESULT_ID_MAX, "a tool id")
 
 
 def add_recording_argument(parser: argparse.ArgumentParser) -> None:

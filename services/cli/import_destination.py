@@ -101,8 +101,9 @@ class RecordingsWriter:
             return False
         extra = f" + {imported.rrd.name}" if imported.rrd is not None else ""
         replaced = "".join(f"; replaced the unfinished {path.name}" for path in imported.replaced)
+        what = "a loosening, " if summary.operation == "loosening" else ""
         print(
-            f"{run.source} -> {imported.mcap}{extra} ({imported.samples} samples, "
+            f"{run.source} -> {imported.mcap}{extra} ({what}{imported.samples} samples, "
             f"{summary.events} events, I_process {summary.process_intensity:.3g}{replaced})"
         )
         return True

@@ -4,7 +4,9 @@ A RUN is a run id (all digits, and no file of that name): its MCAP files are
 found in the ``--config`` station's recordings folder; anything else is the
 path of an MCAP file. The runs are read, aligned and drawn by
 :mod:`shared.offline.overlay`; a run that never reaches the alignment
-point is drawn unaligned, with a warning line naming it.
+point is drawn unaligned, with a warning line naming it; a symlink loop met in
+the recordings folder is named in a warning line and skipped (the folder itself
+one: one line, exit status 2).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from shared.offline.overlay import (
     read_overlay_run,
     save_figure,
 )
+from shared.recordings import loop_lines
 
 DEFAULT_TARGET = Path("overlay.png")
 
@@ -33,12 +36,16 @@ class RunFinder:
     def __init__(self, station_file: Path) -> None:
         self.station_file = station_file
         self._station: AnyStation | None = None
+        self.loops: list[Path] = []  # symlink loops met in the recordings, each once
 
     def run(self, name: str) -> OverlayRun:
         path = Path(name)
         if name.isdigit() and not path.exists():
             station = self._loaded()
-            files = find_run_files(station.recordings_folder, station.station_id, int(name))
+            loops: list[Path] = []
+            folder, station_id = station.recordings_folder, station.station_id
+            files = find_run_files(folder, station_id, int(name), loops)
+            self.loops += [loop for loop in loops if loop not in self.loops]
             return read_overlay_run(name, files, int(name))
         return read_overlay_run(name, [path])
 
@@ -57,6 +64,8 @@ def run_overlay(args: argparse.Namespace) -> int:
     finder = RunFinder(args.config)
     runs = [finder.run(name) for name in args.overlay]
     reference = finder.run(args.reference) if args.reference is not None else None
+    for line in loop_lines(finder.loops):
+        print(f"boltwatch inspect: warning: {line}; skipped", file=sys.stderr)
     overlay = build_overlay(runs, reference, alignment)
     for run in [*runs, *([reference] if reference else [])]:
         if run.damage:

@@ -38,8 +38,10 @@ from pathlib import Path
 
 from shared.config import StationPlace
 from shared.contract import RunSummary, TighteningResult
+from shared.recordings import loop_lines
 from shared.results import ResultsStore, StoredResult, StoreError, StoreTarget, stored_result
 from shared.results.recordings_reading import fill_from_recordings, station_recordings
+from shared.runtime.log_limit import RateLimitedLog
 
 LOG = logging.getLogger(__name__)
 
@@ -87,6 +89,9 @@ class ResultsWatch:
         self.stored = 0  # results new to the store
         self.repeated = 0  # results it had already
         self.let_go = 0  # waiting results let go from memory (they are in the recordings)
+        #: results whose figures cannot be a measurement: kept aside by the store, no result
+        self.refused = 0
+        self._refusal_log = RateLimitedLog(LOG)
         self.errors = 0
         self.last_error: str | None = None
         self._failing_since_s: float | None = None
@@ -190,12 +195,15 @@ class ResultsWatch:
                     batch = list(self._waiting)
                 if not batch:
                     break
-                new = store.add(batch)
+                refused: list[str] = []
+                new = store.add(batch, refused)
                 with self._lock:
                     for _ in batch:
                         self._waiting.popleft()
                 self.stored += new
-                self.repeated += len(batch) - new
+                self.repeated += len(batch) - new - len(refused)
+                self.refused += len(refused)
+                self._name_refused(refused)
         except StoreError as err:
             self._failed(err)
         else:
@@ -222,11 +230,14 @@ class ResultsWatch:
         # a file is in the day folder of its opening (UTC): the day before may hold one
         # written since
         first_day = datetime.fromtimestamp(since_ns / 1e9, UTC).date() - timedelta(days=1)
+        loops: list[Path] = []
         files = [
             path
-            for path in station_recordings(self._folder, self._places, first_day)
+            for path in station_recordings(self._folder, self._places, first_day, loops)
             if since_ns <= _modified_ns(path) <= self._started_ns
         ]
+        for line in loop_lines(loops):
+            LOG.warning("results store %s: catch-up: %s; skipped", self.target, line)
         if files:
             counts = fill_from_recordings(store, files, self._places, self._host, time.time_ns)
             LOG.info(
@@ -237,7 +248,15 @@ class ResultsWatch:
                 counts.new,
             )
             self.stored += counts.new
+            self.refused += counts.refused_results
+            self._name_refused(counts.refused)
         self._caught_up = True
+
+    def _name_refused(self, lines: list[str]) -> None:
+        """Each payload or result refused, in the log: the first at once, then at most one
+        line per 10 s (a faulty controller's every result must not flood it)."""
+        for line in lines:
+            self._refusal_log("results store %s: refused %s", self.target, line)
 
     def _failed(self, err: StoreError) -> None:
         self.errors += 1

@@ -79,6 +79,7 @@ class RetentionWatch:
         self._wake = threading.Event()
         self._closing = threading.Event()
         self.passes = 0
+        self._named_skipped: set[str] = set()  # symlink loops met, logged once each
         self.deleted: Counter[str] = Counter()  # per station, since the recorder started
         self.kept_not_stored: dict[str, int] = {}  # per station, at the last pass
         self.failed_deletions = 0
@@ -196,6 +197,10 @@ class RetentionWatch:
                 why,
             )
         self._warn_kept(plan)
+        for line in plan.skipped:  # each once, not every pass
+            if line not in self._named_skipped:
+                self._named_skipped.add(line)
+                LOG.warning("retention: %s; skipped, never touched", line)
 
     def _warn_kept(self, plan: RetentionPlan) -> None:
         """Files kept past their time, the disk above its limit: said when it changes, and

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from services.recorder.live.run_files import FileLimits
 from shared.config import AnyStation, ControllerStation, LoadedStation
 from shared.errors import ConfigError
+from shared.files import real_path
 from shared.retention import retention_scopes
 
 
@@ -30,7 +31,7 @@ def served_stations(loaded: AnyStation | Sequence[AnyStation]) -> list[AnyStatio
     first = stations[0]
     settings = first.config.recorder.model_dump(exclude={"folder"})
     for other in stations[1:]:
-        if other.recordings_folder.resolve() != first.recordings_folder.resolve():
+        if real_path(other.recordings_folder) != real_path(first.recordings_folder):
             raise ConfigError(
                 f"{other.path}: recorder.folder: {other.recordings_folder} differs from "
                 f"{first.recordings_folder} of {first.path}; one recorder writes one folder"

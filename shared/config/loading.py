@@ -16,6 +16,7 @@ from typing import Any, TypeVar
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from shared.errors import ConfigError
+from shared.files import real_path
 
 ModelT = TypeVar("ModelT", bound=BaseModel)
 
@@ -127,5 +128,6 @@ def _model_in(annotation: Any) -> type[BaseModel] | None:
 
 
 def resolve_relative(path: Path, base_file: Path) -> Path:
-    """A path from a config file, taken relative to that file's folder when not absolute."""
-    return path if path.is_absolute() else (base_file.parent / path).resolve()
+    """A path from a config file, taken relative to that file's folder when not absolute
+    (its links followed; one that never ends left for what reads the path to name)."""
+    return path if path.is_absolute() else real_path(base_file.parent / path)

@@ -43,6 +43,8 @@ Revision = Annotated[int, NumberRange(1, 999)]
 #: what an alarm message says: raised (0071), acknowledged on the controller (0074), the
 #: controller's alarm status (0076)
 AlarmKind = Literal["raised", "acknowledged", "status"]
+#: what a run did to its joint: tightened it (turning forward), or loosened it (turning back)
+RunOperation = Literal["tightening", "loosening"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -106,6 +108,8 @@ class ControllerResult:
     batch_direction_ok: Int64 | None
     batch_direction_nok: Int64 | None
     steps: list[ControllerStep] = field(default_factory=list)
+    # a loosening: every step that says its speed turns the tool back (a negative speed)
+    operation: RunOperation = "tightening"
 
 
 @dataclass(frozen=True, slots=True)

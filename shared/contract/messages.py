@@ -34,6 +34,7 @@ from shared.contract.controller_messages import (  # noqa: F401  (re-exported: o
     ControllerFunction,
     ControllerResult,
     ControllerStep,
+    RunOperation,
     ToolData,
 )
 from shared.contract.message_fields import WIRE_CONFIG, Count, Id, Measured, StationId, TimeNs
@@ -301,6 +302,9 @@ class RunSummary:
     late_decision: StopReasonName | None = None
     # the angle of the run's last measured sample (deg since the run started); None: unknown
     reached_angle_deg: float | None = None
+    # a loosening (an imported controller run turning the tool back) is no tightening: the
+    # wear ledger counts its intensity, not the run among the tool's tightenings
+    operation: RunOperation = "tightening"
     # what the station could command the tool in this run ("staged": a final stage and
     # pulses; None: not said, stop only); a final stage: when it began, seconds since the
     # run's start (None: none ran), and the pulses back to the target the run took

@@ -18,7 +18,10 @@ files of one run past the recorder's size or duration limit; ``copy`` a name
 taken already. Every writer (the recorder, ``boltwatch import``) names its
 files with :func:`file_path`, every reader (``inspect``, ``report``, the
 overlay, the import's look for a run it did already, the retention policy)
-finds them with the functions below; only regular files are ever returned.
+finds them with the functions below; only regular files are ever returned. A
+folder to walk that is a symbolic link that never ends (to itself, round a
+circle) is one line (:func:`check_walkable`); such a link inside it is skipped
+and told to the caller (``loops``), to be named (:func:`loop_lines`).
 :func:`file_name_of` reads a file's name back: its run, when it was opened,
 its part and copy.
 """
@@ -31,6 +34,9 @@ from dataclasses import dataclass
 from datetime import UTC, date, datetime
 from pathlib import Path
 from typing import Final
+
+from shared.errors import InputError
+from shared.files import SYMLINK_LOOP, loop_text, symlink_loop
 
 #: what a station id may hold in a file name; anything else becomes "_"
 _UNSAFE: Final = re.compile(r"[^A-Za-z0-9_-]")
@@ -100,10 +106,23 @@ def rerun_path(mcap: Path) -> Path:
     return mcap.with_suffix(RERUN_SUFFIX)
 
 
-def station_days(folder: Path, station: str) -> Iterator[tuple[date, Path]]:
-    """The day folders of ``station`` under ``folder``, oldest first."""
+def check_walkable(folder: Path) -> None:
+    """InputError (one line: the folder, and that it is a symlink loop) when ``folder``, or a
+    link on the way to it, is a symbolic link that never ends: nothing in it can be read."""
+    if symlink_loop(folder) is not None:
+        raise InputError(f"{folder}: {loop_text(folder)}")
+
+
+def station_days(
+    folder: Path, station: str, loops: list[Path] | None = None
+) -> Iterator[tuple[date, Path]]:
+    """The day folders of ``station`` under ``folder``, oldest first. ``folder`` a symlink
+    loop: InputError (:func:`check_walkable`); the station's folder or a day folder one:
+    skipped, put in ``loops``."""
+    check_walkable(folder)
     base = folder / station_folder_name(station)
     if not base.is_dir():
+        _note_loop(base, loops)
         return
     for day in sorted(base.iterdir()):
         try:
@@ -112,19 +131,44 @@ def station_days(folder: Path, station: str) -> Iterator[tuple[date, Path]]:
             continue
         if day.is_dir():
             yield day_date, day
+        else:
+            _note_loop(day, loops)
 
 
-def recording_files(day: Path, prefix: str = "") -> list[Path]:
-    """The MCAP files of one day folder whose name starts with ``prefix``, in name order."""
-    return sorted(
-        path for path in day.glob(f"{glob_escape(prefix)}*{MCAP_SUFFIX}") if path.is_file()
-    )
+def recording_files(day: Path, prefix: str = "", loops: list[Path] | None = None) -> list[Path]:
+    """The MCAP files of one day folder whose name starts with ``prefix``, in name order; one
+    that is a symlink loop is put in ``loops``."""
+    files = []
+    for path in sorted(day.glob(f"{glob_escape(prefix)}*{MCAP_SUFFIX}")):
+        if path.is_file():
+            files.append(path)
+        else:
+            _note_loop(path, loops)
+    return files
 
 
-def run_files(folder: Path, station: str, run_id: int) -> list[Path]:
-    """Every MCAP file of run ``run_id`` of ``station``, in any day folder, oldest first."""
+def run_files(
+    folder: Path, station: str, run_id: int, loops: list[Path] | None = None
+) -> list[Path]:
+    """Every MCAP file of run ``run_id`` of ``station``, in any day folder, oldest first
+    (symlink loops met: in ``loops``, as :func:`station_days` says)."""
     prefix = run_file_prefix(station, run_id)
-    return [path for _, day in station_days(folder, station) for path in recording_files(day, prefix)]
+    return [
+        path
+        for _, day in station_days(folder, station, loops)
+        for path in recording_files(day, prefix, loops)
+    ]
+
+
+def loop_lines(loops: list[Path]) -> list[str]:
+    """A line naming each of ``loops`` (what a command skipped: it is a symlink loop)."""
+    return [f"{path}: {SYMLINK_LOOP}" for path in loops]
+
+
+def _note_loop(path: Path, loops: list[Path] | None) -> None:
+    """Put ``path`` in ``loops`` when it is a symlink loop itself."""
+    if loops is not None and symlink_loop(path) == path:
+        loops.append(path)
 
 
 @dataclass(frozen=True, slots=True)

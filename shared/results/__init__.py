@@ -7,7 +7,10 @@ plant, line, program, tool, time), in SQLite beside the recordings or a plant's 
 - :mod:`.stored_result` (a result as a row, and back)
 - :mod:`.results_store` (add idempotently, find, a query's keys only, what was read
   of which recording)
-- :mod:`.sqlite_statistics` (SQLite's planner statistics, written by the store's writer)
+- :mod:`.refused_results` (the tightenings kept aside: figures that cannot be a
+  measurement, never a result to a reader; named in the report's words)
+- :mod:`.sqlite_statistics` (SQLite's planner statistics, written by the store's writer,
+  and by a reader that finds none)
 - :mod:`.results_query` (which tightenings a question asks for)
 - :mod:`.program_columns` (a report's columns per program, in one scan)
 
@@ -26,7 +29,7 @@ from shared.results.results_database import (
     store_target,
     without_password,
 )
-from shared.results.results_query import DEFAULT_LIMIT, ResultsQuery
+from shared.results.results_query import DEFAULT_LIMIT, ResultsQuery, time_ns_of
 from shared.results.results_schema import MIGRATIONS, SCHEMA_VERSION, migrate, version_of
 from shared.results.results_store import ResultsStore
 from shared.results.stored_result import StoredResult, stored_result
@@ -49,6 +52,7 @@ __all__ = [
     "station_store",
     "store_target",
     "stored_result",
+    "time_ns_of",
     "version_of",
     "without_password",
 ]

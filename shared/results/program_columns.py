@@ -14,70 +14,50 @@ The latest result's name and windows of each program are read by its index.
 The same columns as :func:`shared.quality.program_columns.columns_of` makes
 from the results themselves: one report either way. A tightening whose
 figures cannot be a measurement (:mod:`shared.quality.plausible_result`: a
-torque of 1e308 Nm) is flagged in the scan, read again by its key, named
-(:attr:`StoredColumns.refused`) and taken out of what is counted.
+torque of 1e308 Nm) is no result in the store (:mod:`.refused_results`): it is
+named (:attr:`StoredColumns.refused`), in the words the report uses for it
+read from its file, and never counted.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from collections import Counter, defaultdict
-from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from shared.quality import figures_fault, refusal_line
-from shared.quality.plausible_result import EVENTS_LIMIT, FIGURE_LIMITS, INTENSITY_LIMIT
 from shared.quality.program_columns import (
     JUDGED_FIGURES,
     TOOL_STOPPED,
     ProgramColumns,
     reason_kinds,
 )
+from shared.results.refused_results import JUDGED_COLUMNS
 from shared.results.results_query import ResultsQuery
 from shared.results.results_store import ResultsStore
 
-#: each judged figure's value and window, in the order of JUDGED_FIGURES
-_JUDGED = (
-    ("torque_nm", "torque_min_nm", "torque_max_nm"),
-    ("angle_deg", "angle_min_deg", "angle_max_deg"),
-    ("force_n", "force_min_n", "force_max_n"),
-)
-_WINDOWS = ", ".join(column for _value, *window in _JUDGED for column in window)
+_WINDOWS = ", ".join(column for _value, *window in JUDGED_COLUMNS for column in window)
 #: what is counted: of each program, its runs by station, tool, stop reason and windows
 _GROUPS = f"program_id, station, tool_id, stop_reason, {_WINDOWS}"
-#: true for a tightening whose figures cannot be a measurement; NULL (not measured) is
-#: never beyond, so this is for CASE WHEN only (NOT of it is NULL, not true, for a NULL)
-_IMPLAUSIBLE = " OR ".join(
-    [
-        f"{column} NOT BETWEEN {-limit!r} AND {limit!r}"
-        for (_, limit, _), columns in zip(FIGURE_LIMITS, _JUDGED, strict=True)
-        for column in columns
-    ]
-    + [f"events > {EVENTS_LIMIT}", f"process_intensity NOT BETWEEN 0 AND {INTENSITY_LIMIT!r}"]
-)
-#: what each run gives, in the order the runs ended: the figures' arrays, NOK reasons, the
-#: run id of a tightening whose figures cannot be a measurement, and what it is counted by
+#: what each run gives, in the order the runs ended: the figures' arrays, NOK reasons, and
+#: what it is counted by
 _RUN_COLUMNS = (
     "program_id, torque_nm, angle_deg, force_n, process_intensity, events, "
-    f"CASE WHEN result = 'NOK' THEN nok_reasons END, CASE WHEN ({_IMPLAUSIBLE}) THEN run_id END, "
-    + _GROUPS
+    "CASE WHEN result = 'NOK' THEN nok_reasons END, " + _GROUPS
 )
 #: where the columns of _GROUPS start in a row of _RUN_COLUMNS
-_GROUP_AT = 8
+_GROUP_AT = 7
 #: rows of the scan made into Python at once (a month of a line is a million and more: as
 #: one list of tuples, 464 bytes a row)
 _BATCH_ROWS = 50_000
-#: run ids per statement when flagged tightenings are read again
-_RUNS_PER_QUERY = 500
 
 
 @dataclass
 class StoredColumns:
     """What :func:`program_columns` read: each program's columns, and a line for each
-    tightening left out because its figures cannot be a measurement."""
+    tightening kept aside because its figures cannot be a measurement."""
 
     programs: list[ProgramColumns] = field(default_factory=list)
     refused: list[str] = field(default_factory=list)
@@ -85,12 +65,12 @@ class StoredColumns:
 
 def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
     """The columns of each program of the tightenings ``query`` asks for (its limit and
-    order ignored: every one, in the order the runs ended), by program id; those whose
-    figures cannot be a measurement are flagged in the same scan, left out and named."""
+    order ignored: every one, in the order the runs ended), by program id, and those it
+    asks for whose figures cannot be a measurement, named."""
     everything = dataclasses.replace(query, limit=None, oldest_first=True)
     where, parameters = everything.where()
-    flagged: set[int] = set()
     arrays: list[np.ndarray] = []
+    ids: list[np.ndarray] = []  # each run's program id, as it is (a float holds 53 bits)
     nok_reasons: dict[int, list[str]] = defaultdict(list)
     counted: Counter[tuple[Any, ...]] = Counter()
     for batch in store.database.row_batches(
@@ -98,22 +78,21 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
         parameters,
         _BATCH_ROWS,
     ):
-        rows = [row for row in batch if row[7] is None]
-        flagged.update(row[7] for row in batch if row[7] is not None)
-        arrays.append(np.array([row[:6] for row in rows], dtype=np.float64).reshape(-1, 6))
-        for row in rows:
+        ids.append(np.array([row[0] for row in batch], dtype=np.int64))
+        arrays.append(np.array([row[1:6] for row in batch], dtype=np.float64).reshape(-1, 5))
+        for row in batch:
             if row[6] is not None:
                 nok_reasons[row[0]].append(row[6])
-        counted.update(row[_GROUP_AT:] for row in rows)
-    figures = np.concatenate(arrays) if arrays else np.empty((0, 6))
-    refused = _refused(store, everything, sorted(flagged))
-    read = StoredColumns(refused=list(refused.values()))
+        counted.update(row[_GROUP_AT:] for row in batch)
+    figures = np.concatenate(arrays) if arrays else np.empty((0, 5))
+    program_ids = np.concatenate(ids) if ids else np.empty(0, dtype=np.int64)
+    read = StoredColumns(refused=store.refused(everything))
     grouped: dict[int, list[tuple[Any, ...]]] = defaultdict(list)
     for (program_id, *group), runs in counted.items():
         grouped[program_id].append((*group, runs))
     for program_id in sorted(grouped):
-        name, newest = _latest(store, everything, program_id, refused.keys())
-        of_program = figures[figures[:, 0] == program_id]
+        name, newest = _latest(store, everything, program_id)
+        of_program = figures[program_ids == program_id]
         groups = grouped[program_id]
         stop_reasons: Counter[str] = Counter()
         for _station, _tool, reason, *_windows, runs in groups:
@@ -128,7 +107,7 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
                 runs=len(of_program),
                 noks=len(nok_reasons[program_id]),
                 values={
-                    key: _measured(of_program[:, 1 + index])
+                    key: _measured(of_program[:, index])
                     for index, key in enumerate((*JUDGED_FIGURES, "intensity"))
                 },
                 latest_windows={
@@ -141,7 +120,7 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
                 },
                 nok_reasons=reasons,
                 stop_reasons=stop_reasons,
-                events_per_run=[int(events) for events in _measured(of_program[:, 5])],
+                events_per_run=[int(events) for events in _measured(of_program[:, 4])],
                 stations=sorted({group[0] for group in groups}),
                 tools=sorted({int(group[1]) for group in groups}),
             )
@@ -149,50 +128,15 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
     return read
 
 
-def _refused(
-    store: ResultsStore, query: ResultsQuery, run_ids: list[int]
-) -> dict[tuple[str, int], str]:
-    """(station, run id) -> why (a line), of each tightening ``query`` asks for with one of
-    ``run_ids`` whose figures cannot be a measurement, in the order they ended."""
-    where, parameters = query.where()
-    judged = ", ".join(column for columns in _JUDGED for column in columns)
-    found = []
-    for first in range(0, len(run_ids), _RUNS_PER_QUERY):
-        some = run_ids[first : first + _RUNS_PER_QUERY]
-        flagged = f"run_id IN ({', '.join('?' * len(some))}) AND ({_IMPLAUSIBLE})"
-        found += store.database.rows(
-            f"SELECT ended_ns, station, run_id, tool_id, {judged}, events, process_intensity "
-            f"FROM tightenings{_and(where, flagged)}",
-            [*parameters, *some],
-        )
-    refused = {}
-    for _ended_ns, station, run_id, tool_id, *figures in sorted(found):
-        judged_figures = [tuple(figures[index : index + 3]) for index in (0, 3, 6)]
-        why = figures_fault(judged_figures, figures[9], figures[10]) or "beyond the bounds"
-        refused[(station, run_id)] = refusal_line(station, run_id, tool_id, why)
-    return refused
-
-
-def _latest(
-    store: ResultsStore, query: ResultsQuery, program_id: int, refused: AbstractSet[tuple[str, int]]
-) -> tuple[str, list[Any]]:
-    """The name and windows of ``program_id``'s newest tightening ``query`` asks for, not one
-    of ``refused`` (by the index of program_id)."""
-    latest = dataclasses.replace(query, program_id=program_id, oldest_first=False, limit=None)
+def _latest(store: ResultsStore, query: ResultsQuery, program_id: int) -> tuple[str, list[Any]]:
+    """The name and windows of ``program_id``'s newest tightening ``query`` asks for (by the
+    index of program_id)."""
+    latest = dataclasses.replace(query, program_id=program_id, oldest_first=False, limit=1)
     where, parameters = latest.where()
-    for station, run_id, name, *windows in store.database.rows(
-        f"SELECT station, run_id, program_name, {_WINDOWS} FROM tightenings{where}"
-        f"{latest.order()} LIMIT {len(refused) + 1}",
-        parameters,
-    ):
-        if (station, run_id) not in refused:
-            return name, windows
-    raise AssertionError(f"program {program_id}: no tightening counted")
-
-
-def _and(where: str, condition: str) -> str:
-    """``where`` (`` WHERE ...`` or empty) and ``condition``."""
-    return f"{where} AND ({condition})" if where else f" WHERE ({condition})"
+    ((name, *windows),) = store.database.rows(
+        f"SELECT program_name, {_WINDOWS} FROM tightenings{where}{latest.order()}", parameters
+    )
+    return name, windows
 
 
 def _measured(column: np.ndarray) -> np.ndarray:

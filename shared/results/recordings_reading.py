@@ -11,8 +11,10 @@ goes, warned of, and not marked: it is read again next time. A payload the
 recorder refused (kept raw on the topic's raw channel) is no result; one on a
 typed channel that does not decode (a file not written by our recorder: a
 Sample where a result belongs, ``{}``, binary) is refused and counted, the
-file's other results stored. A file that cannot be read at all (empty, not
-MCAP, not a regular file) is named, skipped and counted.
+file's other results stored. A result whose figures cannot be a measurement is
+no result: the store keeps it aside (:mod:`.refused_results`), and it is named
+and counted with the refused payloads. A file that cannot be read at all
+(empty, not MCAP, not a regular file) is named, skipped and counted.
 """
 
 from __future__ import annotations
@@ -41,24 +43,30 @@ class FillCounts:
     files: int = 0  # files it was given
     done: int = 0  # of them, looked at so far
     read: int = 0  # files it read (not skipped as read before)
-    results: int = 0  # results found in what it read
+    results: int = 0  # results found in what it read (not those refused)
     new: int = 0  # of them, new to the store
     damaged: list[str] = field(default_factory=list)  # one line per damaged file
     skipped: list[str] = field(default_factory=list)  # one line per file not read at all
-    refused: list[str] = field(default_factory=list)  # one line per payload refused
+    #: one line per payload refused, and per result whose figures cannot be a measurement
+    refused: list[str] = field(default_factory=list)
+    refused_results: int = 0  # of them, results (kept aside by the store)
 
 
 def station_recordings(
-    folder: Path, stations: Iterable[str], first_day: date | None = None
+    folder: Path,
+    stations: Iterable[str],
+    first_day: date | None = None,
+    loops: list[Path] | None = None,
 ) -> list[Path]:
     """Every MCAP file of ``stations`` under the recordings ``folder``, oldest day first
-    (``first_day``: only the day folders from it on)."""
+    (``first_day``: only the day folders from it on); symlink loops met on the way: skipped,
+    in ``loops`` (``folder`` one: InputError)."""
     return [
         path
         for station in stations
-        for day_date, day in station_days(folder, station)
+        for day_date, day in station_days(folder, station, loops)
         if first_day is None or day_date >= first_day
-        for path in recording_files(day)
+        for path in recording_files(day, loops=loops)
     ]
 
 
@@ -129,8 +137,10 @@ def fill_from_recordings(
                 counts.skipped.append(str(err))
             else:
                 counts.read += 1
-                counts.results += len(stored)
-                counts.new += store.add(stored)
+                refused = len(counts.refused)
+                counts.new += store.add(stored, counts.refused)
+                counts.refused_results += len(counts.refused) - refused
+                counts.results += len(stored) - (len(counts.refused) - refused)
                 if scan.complete:
                     store.mark_read(
                         host, recording, stat.st_size, stat.st_mtime_ns, len(stored), clock_ns()

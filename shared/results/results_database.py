@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import psycopg
 
 from shared.errors import StoreError
+from shared.files import real_path
 
 if TYPE_CHECKING:
     from shared.config import AnyStation
@@ -74,7 +75,7 @@ def store_target(recordings_folder: Path, database: str | None) -> StoreTarget:
 def station_store(station: AnyStation) -> StoreTarget:
     """The results store a loaded station file names (its recordings folder resolved)."""
     database = station.config.recorder.results_database
-    return store_target(station.recordings_folder.resolve(), database)
+    return store_target(real_path(station.recordings_folder), database)
 
 
 def postgres_target(url: str) -> StoreTarget:
@@ -144,6 +145,19 @@ class ResultsDatabase:
                     yield
         except (sqlite3.Error, psycopg.Error) as err:
             raise StoreError(f"results store {self.target}: {one_line(err)}") from err
+
+    @contextlib.contextmanager
+    def not_waiting(self) -> Iterator[None]:
+        """SQLite: a lock another connection holds fails at once (a StoreError), instead of
+        being waited for :data:`SQLITE_BUSY_TIMEOUT_S` (a reader's optional write)."""
+        if self._sqlite is None:
+            yield
+            return
+        self._sqlite.execute("PRAGMA busy_timeout = 0")
+        try:
+            yield
+        finally:
+            self._sqlite.execute(f"PRAGMA busy_timeout = {int(SQLITE_BUSY_TIMEOUT_S * 1000)}")
 
     def execute(self, sql: str, parameters: Sequence[Any] = ()) -> int:
         """Run one statement; the number of rows it changed."""

@@ -5,17 +5,27 @@ a run id (with one station: a tightening by the table's primary key), a plant,
 a line, a program, a tool, a range of end times (``since`` included, ``until``
 not), a verdict (OK or NOK only). Each but the verdict is a column with an index in front
 (:mod:`.results_schema`), so a part's tightenings are found by the index of
-``part_id`` however large the store.
+``part_id`` however large the store. :func:`time_ns_of`: a moment as the
+nanoseconds the bounds are.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from datetime import UTC, datetime, timedelta
 from typing import Any
 
 #: rows a query gives when it says nothing (``results`` prints the newest)
 DEFAULT_LIMIT = 100
+_EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
+
+
+def time_ns_of(moment: datetime) -> int:
+    """``moment`` (aware) in nanoseconds since 1970, exactly (a datetime holds microseconds;
+    ``timestamp() * 1e9``, a float of seconds, holds about a quarter of a microsecond): what
+    a range's bounds are compared with, by the store and by the files alike."""
+    return (moment - _EPOCH) // timedelta(microseconds=1) * 1000
 
 
 @dataclass(frozen=True, slots=True)

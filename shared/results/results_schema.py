@@ -12,6 +12,9 @@ status, what stopped the tool, the stick-slip events and intensity, who judged
 it (``source``), and where its recording is (``recording``: the MCAP file's
 path on ``recording_host``).
 ``tightening_steps``: the steps of a controller's program, one row each.
+``refused_tightenings``: the columns of ``tightenings``, for the tightenings
+whose figures cannot be a measurement (:mod:`.refused_results`): kept aside,
+never a result to a reader.
 ``recordings_read``: which recordings ``results rebuild`` (and the
 recorder's catch-up at start) has read, so reading again skips them.
 ``store_version``: the schema version.
@@ -25,10 +28,11 @@ boltwatch knows is refused, never written into.
 
 from __future__ import annotations
 
+from shared.results.refused_results import IMPLAUSIBLE_SQL
 from shared.results.results_database import ResultsDatabase, StoreError
 
 #: the version this boltwatch writes; MIGRATIONS[v - 1] makes version v
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
 
 TIGHTENING_COLUMNS = (
     "station", "run_id", "plant", "line", "station_name", "tightening_id", "tool_id",
@@ -116,12 +120,66 @@ _VERSION_2 = (
 # default rewrites no row in either database.
 _VERSION_3 = ("ALTER TABLE tightenings ADD COLUMN part_source TEXT",)
 
+#: the columns of tightenings at version 4 (a later version's are not there yet)
+_COLUMNS_4 = TIGHTENING_COLUMNS[: TIGHTENING_COLUMNS.index("part_source") + 1]
+
+# one rule for what a result is (.refused_results): a tightening whose figures cannot be a
+# measurement is kept aside, in a table of the same columns, and no reader counts it. The
+# rows an older boltwatch stored in tightenings (results rebuild stored every result) are
+# moved there, their steps where they are: two reads of the table, once.
+_VERSION_4 = (
+    """CREATE TABLE refused_tightenings (
+        station TEXT NOT NULL,
+        run_id BIGINT NOT NULL,
+        plant TEXT NOT NULL,
+        line TEXT NOT NULL,
+        station_name TEXT NOT NULL,
+        tightening_id BIGINT NOT NULL,
+        tool_id BIGINT NOT NULL,
+        program_id BIGINT NOT NULL,
+        program_name TEXT NOT NULL,
+        part_id TEXT,
+        batch_counter BIGINT,
+        ended_ns BIGINT NOT NULL,
+        result TEXT NOT NULL,
+        nok_reasons TEXT NOT NULL,
+        torque_nm DOUBLE PRECISION, torque_min_nm DOUBLE PRECISION,
+        torque_max_nm DOUBLE PRECISION, torque_status TEXT NOT NULL,
+        angle_deg DOUBLE PRECISION, angle_min_deg DOUBLE PRECISION,
+        angle_max_deg DOUBLE PRECISION, angle_status TEXT NOT NULL,
+        force_n DOUBLE PRECISION, force_min_n DOUBLE PRECISION,
+        force_max_n DOUBLE PRECISION, force_status TEXT NOT NULL,
+        stop_reason TEXT,
+        events BIGINT,
+        process_intensity DOUBLE PRECISION,
+        source TEXT NOT NULL,
+        recording TEXT,
+        recording_host TEXT,
+        stored_ns BIGINT NOT NULL,
+        part_source TEXT,
+        PRIMARY KEY (station, run_id)
+    )""",
+    f"INSERT INTO refused_tightenings ({', '.join(_COLUMNS_4)}) "
+    f"SELECT {', '.join(_COLUMNS_4)} FROM tightenings WHERE {IMPLAUSIBLE_SQL}",
+    f"DELETE FROM tightenings WHERE {IMPLAUSIBLE_SQL}",
+)
+
 # a final stage's pulses back to the target (TighteningResult.pulses): NULL for a run without
-# a final stage, and for a row made before (nothing rewritten, as in version 3)
-_VERSION_4 = ("ALTER TABLE tightenings ADD COLUMN pulses BIGINT",)
+# a final stage, and for a row made before (nothing rewritten, as in version 3), in both
+# tables of tightenings
+_VERSION_5 = (
+    "ALTER TABLE tightenings ADD COLUMN pulses BIGINT",
+    "ALTER TABLE refused_tightenings ADD COLUMN pulses BIGINT",
+)
 
 #: the statements that bring a store from version v - 1 to v, for v = 1, 2, ...
-MIGRATIONS: tuple[tuple[str, ...], ...] = (_VERSION_1, _VERSION_2, _VERSION_3, _VERSION_4)
+MIGRATIONS: tuple[tuple[str, ...], ...] = (
+    _VERSION_1,
+    _VERSION_2,
+    _VERSION_3,
+    _VERSION_4,
+    _VERSION_5,
+)
 
 
 def migrate(database: ResultsDatabase, migrations: tuple[tuple[str, ...], ...] = MIGRATIONS) -> int:

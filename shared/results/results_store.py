@@ -5,20 +5,26 @@ or PostgreSQL).
 The recorder adds each result as it files it (``services/recorder/results_watch.py``),
 ``boltwatch results rebuild`` those of existing recordings; both may write at once.
 :meth:`ResultsStore.add` is idempotent by (station, run_id): a result stored
-again is left as it is (the first one stored stays) and not counted as new.
-:meth:`ResultsStore.verdicts` says which runs are stored (the retention policy
-deletes no recording whose results are not). Readers (``boltwatch results``,
+again is left as it is (the first one stored stays) and not counted as new. A
+tightening whose figures cannot be a measurement is kept aside and named, never
+a result to a reader (:mod:`.refused_results`; :meth:`ResultsStore.refused`
+names those a question asks for). :meth:`ResultsStore.verdicts` says which runs
+are stored, kept aside or not (the retention policy deletes no recording whose
+results are not). Readers (``boltwatch results``,
 ``report``, ``recordings prune``) open it without making one:
 :class:`~.results_database.StoreError` says where none is and how one comes.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from collections.abc import Iterator, Sequence
 from typing import Any
 
 from shared.contract import ResultStep
+from shared.quality import implausible, refusal_line
+from shared.results.refused_results import LINE_COLUMNS, refused_line
 from shared.results.results_database import ResultsDatabase, StoreError, StoreTarget
 from shared.results.results_query import ResultsQuery
 from shared.results.results_schema import (
@@ -28,7 +34,7 @@ from shared.results.results_schema import (
     migrate,
     version_of,
 )
-from shared.results.sqlite_statistics import FEWEST_ROWS, keep_statistics
+from shared.results.sqlite_statistics import FEWEST_ROWS, keep_statistics, statistics_missing
 from shared.results.stored_result import StoredResult, from_row, step_of, step_rows, to_row
 
 LOG = logging.getLogger(__name__)
@@ -36,11 +42,14 @@ LOG = logging.getLogger(__name__)
 #: run ids of one station per statement when rows are read by key (steps, verdicts)
 _RUNS_PER_QUERY = 500
 
-_INSERT_TIGHTENING = (
-    f"INSERT INTO tightenings ({', '.join(TIGHTENING_COLUMNS)}) "
+#: the table of results, and the one of tightenings kept aside (:mod:`.refused_results`)
+RESULTS_TABLE, REFUSED_TABLE = "tightenings", "refused_tightenings"
+_INSERT = {
+    table: f"INSERT INTO {table} ({', '.join(TIGHTENING_COLUMNS)}) "
     f"VALUES ({', '.join('?' * len(TIGHTENING_COLUMNS))}) "
     "ON CONFLICT (station, run_id) DO NOTHING"
-)
+    for table in (RESULTS_TABLE, REFUSED_TABLE)
+}
 _INSERT_STEP = (
     f"INSERT INTO tightening_steps ({', '.join(STEP_COLUMNS)}) "
     f"VALUES ({', '.join('?' * len(STEP_COLUMNS))}) "
@@ -57,7 +66,8 @@ class ResultsStore:
     def __init__(self, target: StoreTarget, *, create: bool = True, application: str = "") -> None:
         """``create``: make the store when there is none (a writer); else StoreError.
         An older store is migrated either way; a reader (``create=False``) of a store at
-        this version changes nothing (no write lock: the recorder is never kept waiting)."""
+        this version changes nothing but SQLite's planner statistics when it has none, and
+        waits for no writer (:meth:`_describe_for_readers`: the recorder is never kept waiting)."""
         self.target = target
         nowhere = StoreError(
             f"no results store at {target}: the line's recorder makes it, "
@@ -75,6 +85,7 @@ class ResultsStore:
                 if found == 0:
                     raise nowhere
                 self.migrated_from = found if found == SCHEMA_VERSION else migrate(self.database)
+                self._describe_for_readers()
         except BaseException:
             self.database.close()
             raise
@@ -90,18 +101,60 @@ class ResultsStore:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def add(self, results: Sequence[StoredResult]) -> int:
-        """Store ``results`` in one transaction; how many were new (not stored before)."""
-        new = 0
+    def add(self, results: Sequence[StoredResult], refused: list[str] | None = None) -> int:
+        """Store ``results`` in one transaction; how many were new results (not stored
+        before). One whose figures cannot be a measurement is kept aside instead (not a
+        result: not counted), a line naming it in ``refused``, stored before or not."""
+        inserted: dict[tuple[str, int], tuple[StoredResult, str | None]] = {}
         with self.database.transaction():
             for stored in results:
-                if self.database.execute(_INSERT_TIGHTENING, to_row(stored)) == 1:
-                    new += 1
-                    self.database.execute_many(_INSERT_STEP, step_rows(stored))
+                result = stored.result
+                fault = implausible(result)
+                key = (result.station, result.run_id)
+                table = RESULTS_TABLE if fault is None else REFUSED_TABLE
+                if key not in inserted and self.database.execute(_INSERT[table], to_row(stored)):
+                    inserted[key] = (stored, fault)
+                if fault is not None and refused is not None:
+                    refused.append(
+                        refusal_line(result.station, result.run_id, result.tool_id, fault)
+                    )
+            # the first stored stays, whichever table it went into: one just inserted whose
+            # run the other table holds (two payloads of one run) is taken back (after the
+            # inserts: a SQLite transaction that reads first cannot write when another
+            # writer has written meanwhile)
+            for key in self._held_by_the_other_table(inserted):
+                fault = inserted.pop(key)[1]
+                self.database.execute(
+                    f"DELETE FROM {RESULTS_TABLE if fault is None else REFUSED_TABLE} "
+                    "WHERE station = ? AND run_id = ?",
+                    key,
+                )
+            for stored, _ in inserted.values():
+                self.database.execute_many(_INSERT_STEP, step_rows(stored))
+        new = sum(1 for _, fault in inserted.values() if fault is None)
         self._added_since_statistics += new
         if self._added_since_statistics >= max(self._statistics_rows, FEWEST_ROWS):
             self._keep_statistics()
         return new
+
+    def _held_by_the_other_table(
+        self, inserted: dict[tuple[str, int], tuple[StoredResult, str | None]]
+    ) -> set[tuple[str, int]]:
+        """The keys of ``inserted`` (each with its fault: None went into tightenings) that
+        the other table holds."""
+        held: set[tuple[str, int]] = set()
+        for other, keys in (
+            (REFUSED_TABLE, [key for key, (_, fault) in inserted.items() if fault is None]),
+            (RESULTS_TABLE, [key for key, (_, fault) in inserted.items() if fault is not None]),
+        ):
+            for station, run_ids in _runs_by_station(keys):
+                rows = self.database.rows(
+                    f"SELECT run_id FROM {other} "
+                    f"WHERE station = ? AND run_id IN ({', '.join('?' * len(run_ids))})",
+                    [station, *run_ids],
+                )
+                held.update((station, int(row[0])) for row in rows)
+        return held
 
     def _keep_statistics(self) -> None:
         """SQLite's planner statistics brought up to date (:mod:`.sqlite_statistics`), as best
@@ -112,6 +165,17 @@ class ResultsStore:
             self._statistics_rows = keep_statistics(self.database)
         except StoreError as err:
             LOG.warning("results store %s: planner statistics not written: %s", self.target, err)
+
+    def _describe_for_readers(self) -> None:
+        """A reader's open: a SQLite store no writer has described (:mod:`.sqlite_statistics`)
+        gets its statistics now, as best effort: when the file is writable and no writer holds
+        the store (waited for by no one); otherwise it is read as it is."""
+        try:
+            if statistics_missing(self.database):
+                with self.database.not_waiting():
+                    keep_statistics(self.database)
+        except StoreError as err:
+            LOG.info("results store %s: planner statistics not written: %s", self.target, err)
 
     def find(self, query: ResultsQuery) -> list[StoredResult]:
         """The tightenings ``query`` asks for, with their steps, in its order."""
@@ -169,27 +233,44 @@ class ResultsStore:
                 (host, recording, size_bytes, modified_ns, results, now_ns),
             )
 
-    def last_stored_ns(self, stations: Sequence[str]) -> int | None:
-        """When the newest result of ``stations`` was stored; None: none stored."""
-        where, parameters = ResultsQuery(stations=stations).where()
+    def refused(self, query: ResultsQuery) -> list[str]:
+        """A line naming each tightening ``query`` asks for (its limit aside) that was kept
+        aside (:mod:`.refused_results`), in the order they ended: what ``report`` says of the
+        same results read from their files."""
+        where, parameters = dataclasses.replace(query, limit=None, oldest_first=True).where()
+        order = " ORDER BY ended_ns, station, run_id"
         with self.database.transaction():
-            (row,) = self.database.rows(
-                "SELECT MAX(stored_ns) FROM tightenings" + where, parameters
+            rows = self.database.rows(
+                f"SELECT {LINE_COLUMNS} FROM {REFUSED_TABLE}{where}{order}", parameters
             )
-        return None if row[0] is None else int(row[0])
+        return [refused_line(row) for row in rows]
+
+    def last_stored_ns(self, stations: Sequence[str]) -> int | None:
+        """When the newest tightening of ``stations`` was stored (kept aside or not); None:
+        none stored."""
+        where, parameters = ResultsQuery(stations=stations).where()
+        newest = []
+        with self.database.transaction():
+            for table in (RESULTS_TABLE, REFUSED_TABLE):
+                (row,) = self.database.rows(
+                    f"SELECT MAX(stored_ns) FROM {table}" + where, parameters
+                )
+                newest += [int(row[0])] if row[0] is not None else []
+        return max(newest, default=None)
 
     def verdicts(self, keys: Sequence[tuple[str, int]]) -> dict[tuple[str, int], str]:
-        """The result (``OK``/``NOK``) of each of ``keys`` (station, run_id) that is stored;
-        a key not stored is not in the answer."""
+        """The result (``OK``/``NOK``) of each of ``keys`` (station, run_id) that is stored,
+        kept aside or not; a key not stored is not in the answer."""
         found: dict[tuple[str, int], str] = {}
         with self.database.transaction():
             for station, run_ids in _runs_by_station(keys):
-                rows = self.database.rows(
-                    "SELECT run_id, result FROM tightenings "
-                    f"WHERE station = ? AND run_id IN ({', '.join('?' * len(run_ids))})",
-                    [station, *run_ids],
-                )
-                found.update({(station, int(row[0])): row[1] for row in rows})
+                for table in (RESULTS_TABLE, REFUSED_TABLE):
+                    rows = self.database.rows(
+                        f"SELECT run_id, result FROM {table} "
+                        f"WHERE station = ? AND run_id IN ({', '.join('?' * len(run_ids))})",
+                        [station, *run_ids],
+                    )
+                    found.update({(station, int(row[0])): row[1] for row in rows})
         return found
 
     def _steps_of(self, keys: list[tuple[Any, Any]]) -> dict[tuple[str, int], list[ResultStep]]:

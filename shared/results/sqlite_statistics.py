@@ -1,4 +1,5 @@
-"""The SQLite store's planner statistics, kept by its writer: :func:`keep_statistics`.
+"""The SQLite store's planner statistics, kept by its writer (and written by a reader that
+finds none): :func:`keep_statistics`.
 
 SQLite picks an index by its statistics (the ``sqlite_stat1`` table). With
 none, it guesses that an index's first column is selective: for a month of a
@@ -15,7 +16,8 @@ beforehand, so its writer writes ``sqlite_stat1`` itself, as SQLite's
 documentation allows (https://sqlite.org/fileformat2.html#stat1tab), for the
 ``tightenings`` table:
 
-- its rows: the table's largest rowid (rows are never deleted);
+- its rows: the table's largest rowid (rows are deleted only by the migration
+  to version 4, which moves the few a reader may not count aside);
 - each index's rows per value of its first column: the rows over the number
   of values, counted by one index seek a value (20 stations: 20 seeks, about
   a millisecond); beyond :data:`SEEKS` values (a part, a time), the rows per
@@ -24,9 +26,14 @@ documentation allows (https://sqlite.org/fileformat2.html#stat1tab), for the
 
 They are written at the writer's open and again whenever the rows have
 doubled since or an index has none (one made by a later migration), in one
-short transaction; a store of fewer than :data:`FEWEST_ROWS` rows keeps
-SQLite's guesses (any plan is quick there), and so does an index on an
-expression (none of the store's own). The writer takes them as best effort:
+short transaction. A store only readers open (a ``results rebuild`` of an
+older boltwatch, a copy of a line's store given to ``report``) would plan
+with SQLite's guesses until a recorder opens it: a reader that finds none
+(:func:`statistics_missing`) writes them, when the file is writable and no
+writer holds the store (it waits for none; the next reader tries again).
+A store of fewer than :data:`FEWEST_ROWS` rows keeps SQLite's guesses (any
+plan is quick there), and so does an index on an expression (none of the
+store's own). The writer takes them as best effort:
 a failure is logged and tried again later, its results stored all the same
 (:class:`~.results_store.ResultsStore`).
 Each connection opened after reads them; PostgreSQL keeps its own
@@ -53,16 +60,9 @@ def keep_statistics(database: ResultsDatabase) -> int:
     if database.dialect != "sqlite":
         return 0
     with database.transaction(lock=True):
-        ((rows,),) = database.rows(f"SELECT COALESCE(MAX(rowid), 0) FROM {TABLE}")
+        rows, indexes = _rows_and_indexes(database)
         if rows < FEWEST_ROWS:
             return 0
-        indexes = {
-            name: columns
-            for (name,) in database.rows(
-                "SELECT name FROM sqlite_master WHERE type = 'index' AND tbl_name = ?", (TABLE,)
-            )
-            if None not in (columns := _columns(database, name))  # not on an expression
-        }
         written, described = _written_for(database)
         if written and rows < 2 * written and described >= set(indexes):
             return written
@@ -75,6 +75,19 @@ def keep_statistics(database: ResultsDatabase) -> int:
         )
         database.execute("ANALYZE sqlite_schema")  # this connection plans with them too
     return int(rows)
+
+
+def statistics_missing(database: ResultsDatabase) -> bool:
+    """Whether a SQLite store of :data:`FEWEST_ROWS` rows or more has no statistics, or none
+    of an index: what a reader looks at (without a lock) before it writes them."""
+    if database.dialect != "sqlite":
+        return False
+    with database.transaction():
+        rows, indexes = _rows_and_indexes(database)
+        if rows < FEWEST_ROWS:
+            return False
+        written, described = _written_for(database)
+    return not written or not described >= set(indexes)
 
 
 def statistics_rows(database: ResultsDatabase) -> int:
@@ -91,6 +104,20 @@ def _written_for(database: ResultsDatabase) -> tuple[int, set[str]]:
         "SELECT idx, stat FROM sqlite_stat1 WHERE tbl = ? AND idx IS NOT NULL", (TABLE,)
     )
     return (int(found[0][1].split()[0]) if found else 0), {name for name, _stat in found}
+
+
+def _rows_and_indexes(database: ResultsDatabase) -> tuple[int, dict[str, list[str | None]]]:
+    """The table's rows (its largest rowid), and the columns of each of its indexes that is
+    not on an expression."""
+    ((rows,),) = database.rows(f"SELECT COALESCE(MAX(rowid), 0) FROM {TABLE}")
+    indexes = {
+        name: columns
+        for (name,) in database.rows(
+            "SELECT name FROM sqlite_master WHERE type = 'index' AND tbl_name = ?", (TABLE,)
+        )
+        if None not in (columns := _columns(database, name))  # not on an expression
+    }
+    return int(rows), indexes
 
 
 def _quoted(name: str) -> str:

@@ -5,8 +5,10 @@ tightened (plant, line, the station's name), where its recording is, and when it
 events of a run whose result has none, as ``report`` counts them);
 :meth:`StoredResult.result` gives the TighteningResult back, equal to the
 one stored, so what reads the store (``report``) computes what it computed
-from the files. :func:`to_row` / :func:`from_row` are its rows, in the
-order of :data:`~shared.results.results_schema.TIGHTENING_COLUMNS`.
+from the files; its part id as the part search asks for one
+(:func:`stored_part_id`: no spaces at either end, "" none). :func:`to_row` /
+:func:`from_row` are its rows, in the order of
+:data:`~shared.results.results_schema.TIGHTENING_COLUMNS`.
 """
 
 from __future__ import annotations
@@ -49,12 +51,19 @@ def stored_result(
     return StoredResult(result, line, recording, recording_host, stored_ns, plant, station_name)
 
 
+def stored_part_id(part_id: str | None) -> str | None:
+    """A result's part id as the store keeps it: without spaces at either end (a scanner's
+    padding, as every writer of ours trims it and the part search asks), "" none (None)."""
+    return (part_id or "").strip() or None
+
+
 def to_row(stored: StoredResult) -> tuple[Any, ...]:
     r = stored.result
     torque, angle, force = r.final_torque_nm, r.final_angle_deg, r.final_force_n
     return (
         r.station, r.run_id, stored.plant, stored.line, stored.station_name, r.tightening_id,
-        r.tool_id, r.program_id, r.program_name, r.part_id, r.batch_counter, r.time_ns,
+        r.tool_id, r.program_id, r.program_name, stored_part_id(r.part_id), r.batch_counter,
+        r.time_ns,
         r.result, r.nok_reasons,
         torque.value, torque.min, torque.max, torque.status,
         angle.value, angle.min, angle.max, angle.status,

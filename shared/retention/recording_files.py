@@ -46,10 +46,15 @@ class RecordingFile:
 
 
 def list_recordings(
-    folder: Path, stations: Iterable[str], now_ns: int, open_paths: Collection[Path] = ()
+    folder: Path,
+    stations: Iterable[str],
+    now_ns: int,
+    open_paths: Collection[Path] = (),
+    loops: list[Path] | None = None,
 ) -> list[RecordingFile]:
     """Every run file of ``stations`` under ``folder``, oldest day first; a file gone while
-    it is listed (deleted by a person, another pass) is left out."""
+    it is listed (deleted by a person, another pass) is left out; a symlink loop met on the
+    way (never touched) is put in ``loops`` (``folder`` one: InputError)."""
     opened = set()  # the open files by (device, inode): whatever path names them
     for path in open_paths:
         try:
@@ -60,8 +65,8 @@ def list_recordings(
     found: list[RecordingFile] = []
     for station in stations:
         named: list[tuple[RecordingFile, FileName | None]] = []
-        for _, day in station_days(folder, station):
-            for path in recording_files(day):
+        for _, day in station_days(folder, station, loops):
+            for path in recording_files(day, loops=loops):
                 name = file_name_of(path, station)
                 recording = _recording(path, station, name, now_ns, opened)
                 if recording is not None:

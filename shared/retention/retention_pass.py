@@ -19,6 +19,8 @@ from pathlib import Path
 
 from shared.config import AnyStation, RetentionSection
 from shared.errors import ConfigError
+from shared.files import real_path
+from shared.recordings import loop_lines
 from shared.results import ResultsStore, StoreTarget, store_target
 from shared.retention.disk_usage import Measure, disk_usage_of
 from shared.retention.file_holdings import FileHoldings, FileResultsCache
@@ -44,7 +46,7 @@ def retention_scopes(stations: Sequence[AnyStation]) -> list[RetentionScope]:
     """One scope per recordings folder of ``stations`` (in the order first named)."""
     by_folder: dict[Path, list[AnyStation]] = {}
     for station in stations:
-        by_folder.setdefault(station.recordings_folder.resolve(), []).append(station)
+        by_folder.setdefault(real_path(station.recordings_folder), []).append(station)
     scopes = []
     for folder, sharing in by_folder.items():
         first = sharing[0]
@@ -88,8 +90,11 @@ def plan_pass(
     """What the policy deletes in ``scope`` now (``open_paths``: files the recorder has
     open; ``measure``: the disk, as :func:`shutil.disk_usage`; ``stop`` set: no file more
     is read, the rest are kept: a recorder stopping in a long first pass stops now).
-    StoreError when the store cannot be asked: then nothing is planned."""
-    files = list_recordings(scope.folder, scope.stations, now_ns, open_paths)
+    StoreError when the store cannot be asked: then nothing is planned; InputError when the
+    folder is a symlink loop. A symlink loop in it is never touched: a line in the plan's
+    ``skipped``."""
+    loops: list[Path] = []
+    files = list_recordings(scope.folder, scope.stations, now_ns, open_paths, loops)
     cache.keep_only(files)
     usage = None
     if scope.policy.max_disk_used_pct is not None:
@@ -100,7 +105,9 @@ def plan_pass(
             return FileHoldings(unreadable=STOPPED)
         return cache.holdings(recording, store)
 
-    return plan_retention(files, scope.policy, now_ns, holdings, usage)
+    plan = plan_retention(files, scope.policy, now_ns, holdings, usage)
+    plan.skipped = loop_lines(loops)
+    return plan
 
 
 def _text(value: object) -> str:

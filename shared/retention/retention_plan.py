@@ -57,6 +57,7 @@ class RetentionPlan:
     kept: list[Decision] = field(default_factory=list)  # a rule would delete them, but
     usage: DiskUsage | None = None  # the disk before (None: no disk rule)
     disk_short_bytes: int = 0  # what the disk rule could not free (0: at its limit)
+    skipped: list[str] = field(default_factory=list)  # a line per entry not looked at
 
     @property
     def freed_bytes(self) -> int:

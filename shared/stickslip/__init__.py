@@ -9,6 +9,7 @@ the Open Protocol bridge and the tests. Files, one concept each:
 - :mod:`.inclination_window` the window of n samples and its mean inclination, eqs. 43-51
 - :mod:`.second_difference`  a signal's noise: the running median of its |second difference|
 - :mod:`.extremum_tracker`   maxima and minima paired into slips, with a noise floor
+- :mod:`.signal_resolution`  the step a recorded signal is written to: a floor under a slip
 - :mod:`.motor_motion`       did the motor drive through a drop (a slip) or not (a release, pause)
 - :mod:`.force_history`      force sums per sample: the plateau of any stick phase in O(1)
 - :mod:`.event_figures`      EventFigures: event j with ΔT, ΔF, Δt, f_ss, K1-K3, I_j, I_process
@@ -61,6 +62,7 @@ from shared.stickslip.run_messages import (
 from shared.stickslip.scoring import PredictionScores
 from shared.stickslip.second_difference import SEED_SAMPLES
 from shared.stickslip.settings import DEFAULT_WINDOW_SAMPLES, PlateauMethod, PredictorSettings
+from shared.stickslip.signal_resolution import signal_resolution
 from shared.stickslip.stop_policy import StopPolicy
 from shared.stickslip.stopped_run import PredictorReplay, StoppedRun
 from shared.stickslip.trace_replay import json_safe, output_record, replay
@@ -110,6 +112,7 @@ __all__ = [
     "predict_plateaus",
     "replay",
     "replay_run",
+    "signal_resolution",
     "stage_message",
     "stick_slip_event",
     "torque_mean_nm",

@@ -6,10 +6,12 @@ then without any slip; such a wiggle pairs a maximum with a minimum only a
 few noise amplitudes below it. A pair counts as a slip only when its drop
 T_max - T_min exceeds the noise floor::
 
-    drop > max(NOISE_FACTOR · d2, REL_FLOOR · |T_max|)
+    drop > max(NOISE_FACTOR · d2, REL_FLOOR · |T_max|, RESOLUTION_STEPS · q)
 
 where d2 is the running median of |T_i - 2 T_(i-1) + T_(i-2)| (for white
-noise of σ, about 1.65 σ; :mod:`.second_difference`).
+noise of σ, about 1.65 σ; :mod:`.second_difference`) and q the resolution of
+the recorded torque, when known (:mod:`.signal_resolution`: a signal flat at
+its resolution has a median |d2| of 0).
 
 Below about 100 Hz the kinks of the slips are a small share of the samples
 and barely lift that median; above, they are most samples and it sees them:
@@ -34,6 +36,9 @@ from shared.stickslip.second_difference import SecondDifferenceNoise
 
 NOISE_FACTOR = 3.0
 REL_FLOOR = 0.002
+#: a drop must span more than this many steps of the torque's resolution (three, as three
+#: median |d2|, and half a step so that three steps read in floating point stay under it)
+RESOLUTION_STEPS = NOISE_FACTOR + 0.5
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,8 +62,9 @@ class Slip:
 class ExtremumTracker:
     """Feed flips of an :class:`InclinationWindow`; get a :class:`Slip` when one is confirmed."""
 
-    def __init__(self, motion: MotorMotion) -> None:
+    def __init__(self, motion: MotorMotion, torque_resolution_nm: float = 0.0) -> None:
         self._motion = motion
+        self.torque_resolution_nm = torque_resolution_nm  # q, 0: not known
         self._pending_max: Extremum | None = None
         self.last_trough: Extremum | None = None
         #: the torque's noise: feed it every accepted torque sample (``torque_noise.add``)
@@ -106,7 +112,19 @@ class ExtremumTracker:
 
     def min_drop_nm(self, peak_torque_nm: float) -> float:
         """The noise floor a drop must exceed to count as a slip."""
-        return max(NOISE_FACTOR * self.noise_d2_nm, REL_FLOOR * abs(peak_torque_nm))
+        return slip_floor_nm(self.noise_d2_nm, peak_torque_nm, self.torque_resolution_nm)
+
+
+def slip_floor_nm(
+    noise_d2_nm: float, peak_torque_nm: float, torque_resolution_nm: float = 0.0
+) -> float:
+    """The floor a drop from ``peak_torque_nm`` must exceed to be a slip, with the torque's
+    running median |d2| at ``noise_d2_nm`` and its resolution (module docstring)."""
+    return max(
+        NOISE_FACTOR * noise_d2_nm,
+        REL_FLOOR * abs(peak_torque_nm),
+        RESOLUTION_STEPS * torque_resolution_nm,
+    )
 
 
 def _extremum(window: InclinationWindow, slot: int) -> Extremum:

@@ -8,7 +8,8 @@ outside those bands is not the joint the program was written for:
 model cannot see at 1 kHz (:data:`PERIOD_SLACK_SAMPLES`, :data:`MODEL_SLACK`),
 the median of the last n_K events is judged, and only events that are
 evidence of a slip count (the noise floor settled, a period of one stick
-phase: :data:`MIN_STICK_SHARE`). Why each rule, and what it prevented:
+phase: :data:`MIN_STICK_SHARE` of the stick ramp, a rise the noise alone does
+not make). Why each rule, and what it prevented:
 ``docs/explanation/algorithm.md``, "Eq. 71 against the joint model".
 """
 
@@ -20,10 +21,12 @@ from collections import deque
 from dataclasses import dataclass
 
 from shared.model import JointConstants, angle_ratio, expected_constant_bands
+from shared.stickslip.extremum_tracker import slip_floor_nm
 
 PERIOD_SLACK_SAMPLES = 2.0  # each of the two peaks of a period is read to ±1 sample
 MODEL_SLACK = 2.5  # bounds widened ×/÷ this: μ scatter, nominal μ, a missed event
-#: a period counts when the torque rose by at least this share of the stick ramp k_e φ̇_m Δt
+#: a period counts when the torque rose by at least this share of the stick ramp k_e φ̇_m Δt,
+#: and that share is above the slip floor (:func:`~.extremum_tracker.slip_floor_nm`)
 MIN_STICK_SHARE = 0.5
 
 
@@ -87,8 +90,13 @@ class ModelBandCheck:
         force_step_n: float | None,
         motor_speed_rad_s: float | None,
         noise_nm: float = 0.0,
+        floor_nm: float | None = None,
     ) -> BandVerdict | None:
-        """Add event j's figures; a verdict when a median has left its widened band."""
+        """Add event j's figures; a verdict when a median has left its widened band.
+
+        ``noise_nm``: the torque's median |d2|; ``floor_nm``: the drop a slip had to
+        exceed (None: :func:`slip_floor_nm` of the noise).
+        """
         previous_trough_nm = self._previous_trough_nm
         self._previous_trough_nm = peak_torque_nm - torque_drop_nm
         if not self._noise_settled:
@@ -103,10 +111,17 @@ class ModelBandCheck:
         t_model = self.model_time_s(peak_torque_nm, speed)
         slack_s = PERIOD_SLACK_SAMPLES * self.sample_period_s
         if period_s is not None and period_s > 0.0:
-            stick_ramp_nm = self.constants.k_e_nm_per_rad * speed * period_s
-            if not peak_torque_nm - previous_trough_nm >= MIN_STICK_SHARE * stick_ramp_nm:
+            # a stick phase rises by at least MIN_STICK_SHARE of the stick ramp; noise alone
+            # rises by about a slip floor (a noise "slip" is a peak and a trough of the noise),
+            # so a rise asked for that is not above the floor says nothing (a slow ramp, noise
+            # events a few ms apart)
+            stick_rise_nm = MIN_STICK_SHARE * self.constants.k_e_nm_per_rad * speed * period_s
+            rise_nm = peak_torque_nm - previous_trough_nm
+            if floor_nm is None:
+                floor_nm = slip_floor_nm(noise_nm, peak_torque_nm)
+            if not (rise_nm >= stick_rise_nm > floor_nm):
                 self.not_stick_periods += 1
-                period_s = None  # smooth sliding in between (or no trough before): no K1, K2
+                period_s = None  # smooth sliding or noise in between (or no trough): no K1, K2
         if period_s is not None and period_s > 0.0:
             longest, shortest = period_s + slack_s, max(period_s - slack_s, 0.5 * period_s)
             self._k1.append((t_model / longest, t_model / shortest))

@@ -69,7 +69,7 @@ class PredictorCore:
         self._guard = InputGuard(settings.has_force, settings.sensor_range)
         self._window = InclinationWindow(settings.window_samples)
         self._motion = MotorMotion()
-        self._tracker = ExtremumTracker(self._motion)
+        self._tracker = ExtremumTracker(self._motion, settings.torque_resolution_nm)
         self._add_torque_noise = self._tracker.torque_noise.add
         self._forces = ForceHistory()
         self._screw = ScrewPlateaus()
@@ -293,6 +293,7 @@ class PredictorCore:
                 event.force_step_n,
                 speed,
                 self._tracker.noise_d2_nm,
+                self._tracker.min_drop_nm(peak.torque_nm),
             )
         by_angle = None
         if not settings.force_mode:

@@ -50,6 +50,9 @@ class PredictorSettings:
     advisory: bool = False
     # what the sensors can measure: a value outside is bad input (see input_guard)
     sensor_range: SensorRange = CONTRACT_RANGE
+    # the step the recorded torque is written to (Nm; 0: not known): a drop of no more than
+    # a few steps is no slip (see signal_resolution)
+    torque_resolution_nm: float = 0.0
     # the program's final stage, when the tool runs it (its controller takes StageCommand):
     # the core then also commands the switch, the pulses and the finish (final_stage_run)
     final_stage: FinalStage | None = None

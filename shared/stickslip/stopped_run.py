@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from shared.contract import RunSummary
+from shared.contract import RunOperation, RunSummary
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,6 +49,10 @@ class StoppedRun:
     reached_torque_nm: float | None
     #: the controller's own final angle (deg), when it gives one
     reached_angle_deg: float | None = None
+    #: the step the controller writes its torque to (Nm; 0: not known)
+    torque_resolution_nm: float = 0.0
+    #: a loosening (the tool turned back) or a tightening
+    operation: RunOperation = "tightening"
 
 
 @dataclass(frozen=True, slots=True)

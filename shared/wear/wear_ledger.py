@@ -2,7 +2,12 @@
 
 Every RunSummary adds its run's process intensity I_process (eq. 68) to its
 tool; a tool's accumulated intensity is the paper's eq. 69,
-``I_total = Σ_runs I_process``. Runs are keyed by (station, run_id), so a
+``I_total = Σ_runs I_process``. A loosening (``RunSummary.operation``: an
+imported controller run that turned the tool back) vibrates the tool too: its
+intensity counts in the tool's totals, since service as well, but it is not
+one of the tool's tightenings (``runs``, ``runs_since_service``: what the
+OPC UA server gives as the tool's tightenings); ``loosenings`` counts it.
+Runs are keyed by (station, run_id), so a
 summary delivered twice, or seen again after a recorder restart, is counted
 once. Tools are physical assets (a tool id is unique in the plant): a tool's
 totals count its runs at every station, and each run keeps the station it
@@ -41,16 +46,18 @@ from shared.errors import InputError
 from shared.wear import wear_tool_data
 from shared.wear.wear_bound import RefusedSummaryError, RunLimits, refusal
 from shared.wear.wear_ledger_file import (
+    COLUMNS,
     LEDGER_VERSION,
     BrokenLedgerError,
     create_ledger,
     file_problem,
+    has_column,
     identity,
     is_broken_error,
     migrate,
     schema_problem,
 )
-from shared.wear.wear_since_service import ServiceInterval, SinceServiceTally
+from shared.wear.wear_since_service import TIGHTENING, ServiceInterval, SinceServiceTally
 from shared.wear.wear_tool_data import ControllerTool
 
 LOG = logging.getLogger(__name__)
@@ -72,6 +79,7 @@ CREATE TABLE IF NOT EXISTS runs (
     started_ns INTEGER NOT NULL,
     ended_ns INTEGER NOT NULL,
     recorded_ns INTEGER NOT NULL,
+    operation TEXT NOT NULL DEFAULT 'tightening',
     PRIMARY KEY (station, run_id)
 );
 CREATE INDEX IF NOT EXISTS runs_by_tool ON runs (tool_id, ended_ns);
@@ -100,9 +108,9 @@ class ToolWear:
     """One tool's line of the ledger."""
 
     tool_id: int
-    runs: int
-    total_intensity: float  # I_total, eq. 69
-    intensity_per_run: float
+    runs: int  # its tightenings
+    total_intensity: float  # I_total, eq. 69: of its tightenings and loosenings
+    intensity_per_run: float  # of every run, tightening or loosening
     last_service_ns: int | None
     last_service_note: str | None
     runs_since_service: int
@@ -112,6 +120,7 @@ class ToolWear:
     # what its controller said of it last (serial, counters, calibration, service); None:
     # no controller bridge spoke of it
     controller: ControllerTool | None = None
+    loosenings: int = 0  # its loosenings (their intensity is in the totals)
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -156,6 +165,8 @@ class WearLedger:
             if not read_only:
                 db.execute("PRAGMA journal_mode=WAL")
                 self._migrate(db)
+            #: SQL true for a tightening (a ledger before version 3 holds tightenings only)
+            self._tightening = TIGHTENING if has_column(db, "runs", "operation") else "1"
         except (sqlite3.Error, BrokenLedgerError) as err:
             if db is not None:
                 db.close()
@@ -165,7 +176,7 @@ class WearLedger:
                 raise BrokenLedgerError(self.path, str(err)) from err
             raise InputError(f"{self.path}: not a usable wear ledger: {err}") from err
         self._db = db
-        self._since_service = SinceServiceTally()
+        self._since_service = SinceServiceTally(self._tightening)
 
     def _migrate(self, db: sqlite3.Connection) -> None:
         was = migrate(db, _SCHEMA)
@@ -216,7 +227,8 @@ class WearLedger:
             raise RefusedSummaryError(summary, reason)
         with self._reading_the_file(), self._db:
             cursor = self._db.execute(
-                "INSERT OR IGNORE INTO runs VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                f"INSERT OR IGNORE INTO runs ({', '.join(COLUMNS['runs'])}) "
+                "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 (
                     summary.station,
                     summary.run_id,
@@ -229,6 +241,7 @@ class WearLedger:
                     summary.started_ns,
                     summary.ended_ns,
                     recorded_ns,
+                    summary.operation,
                 ),
             )
         return cursor.rowcount == 1
@@ -277,9 +290,10 @@ class WearLedger:
         # One read transaction, so the figures agree with each other under a live writer.
         with self._reading_the_file(), self._db:
             self._db.execute("BEGIN")
-            runs, total = self._db.execute(
-                "SELECT COUNT(*), COALESCE(SUM(process_intensity), 0.0) FROM runs "
-                "WHERE tool_id = ?",
+            tightening = self._tightening
+            every, runs, total = self._db.execute(
+                f"SELECT COUNT(*), COALESCE(SUM({tightening}), 0), "
+                "COALESCE(SUM(process_intensity), 0.0) FROM runs WHERE tool_id = ?",
                 (tool_id,),
             ).fetchone()
             service = self._db.execute(
@@ -289,8 +303,8 @@ class WearLedger:
             ).fetchone()
             since_ns = service[0] if service else None
             runs_since, total_since = self._db.execute(
-                "SELECT COUNT(*), COALESCE(SUM(process_intensity), 0.0) FROM runs "
-                "WHERE tool_id = ? AND ended_ns > ?",
+                f"SELECT COALESCE(SUM({tightening}), 0), COALESCE(SUM(process_intensity), 0.0) "
+                "FROM runs WHERE tool_id = ? AND ended_ns > ?",
                 (tool_id, since_ns if since_ns is not None else -1),
             ).fetchone()
             worst = self._db.execute(
@@ -306,7 +320,7 @@ class WearLedger:
             tool_id=tool_id,
             runs=int(runs),
             total_intensity=float(total),
-            intensity_per_run=float(total) / runs if runs else 0.0,
+            intensity_per_run=float(total) / every if every else 0.0,
             last_service_ns=since_ns,
             last_service_note=service[1] if service else None,
             runs_since_service=int(runs_since),
@@ -314,6 +328,7 @@ class WearLedger:
             worst_runs=[RunWear(str(s), int(r), float(i), int(e)) for s, r, i, e in worst],
             stations=[str(name) for (name,) in stations],
             controller=controller,
+            loosenings=int(every) - int(runs),
         )
 
     def close(self) -> None:

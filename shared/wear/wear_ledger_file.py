@@ -16,11 +16,13 @@ kept, so SQLite still reads them together) and starts a new ledger.
 
 The ledger's version is SQLite's ``PRAGMA user_version``
 (:data:`LEDGER_VERSION`): 0 or 1 for a ledger of runs and services only, 2
-with the ``tool_data`` table (:mod:`.wear_tool_data`). A table that came
-with a later version may be missing (the writer adds it, :func:`migrate`:
-nothing of the file is lost); every table that is there must have its
-columns; a ledger of a newer version than this boltwatch knows is not
-written into.
+with the ``tool_data`` table (:mod:`.wear_tool_data`), 3 with the runs'
+``operation`` (a tightening or a loosening). A table or a last column that
+came with a later version may be missing (the writer adds it, :func:`migrate`:
+nothing of the file is lost; a reader takes every run of such a ledger for a
+tightening, as the boltwatch that wrote it did); every table that is there
+must have its columns; a ledger of a newer version than this boltwatch knows
+is not written into.
 
 Whether a process has the ledger open is what SQLite's WAL mode itself
 shows (:func:`holder_pid`): every connection holds a read lock on the "DMS"
@@ -57,15 +59,19 @@ COMPANIONS = ("-wal", "-shm")
 COLUMNS = {
     "runs": (
         "station", "run_id", "tool_id", "program_id", "tool_state", "stop_reason", "events",
-        "process_intensity", "started_ns", "ended_ns", "recorded_ns",
+        "process_intensity", "started_ns", "ended_ns", "recorded_ns", "operation",
     ),
     "services": ("id", "tool_id", "serviced_ns", "note"),
     wear_tool_data.TABLE: wear_tool_data.COLUMNS,
 }  # fmt: skip
-#: ``PRAGMA user_version`` of a ledger this boltwatch writes: 2 since the tool_data table
-LEDGER_VERSION = 2
+#: ``PRAGMA user_version`` of a ledger this boltwatch writes: 2 since the tool_data table,
+#: 3 since the runs' operation
+LEDGER_VERSION = 3
 #: tables added by a later version (table -> its version): missing in an older ledger
 ADDED_IN = {wear_tool_data.TABLE: 2}
+#: last columns added by a later version (table -> (column, its definition)): missing in an
+#: older ledger
+ADDED_COLUMNS = {"runs": (("operation", "TEXT NOT NULL DEFAULT 'tightening'"),)}
 _NEW_PREFIX = "new-"
 
 
@@ -125,9 +131,15 @@ def schema_problem(db: sqlite3.Connection) -> str | None:
             continue  # an older ledger: the writer adds it (migrate)
         if not columns:
             return f"another schema: no table {table!r}"
-        if columns != expected:
+        added = len(ADDED_COLUMNS.get(table, ()))
+        if columns != expected and columns != expected[: len(expected) - added]:
             return f"another schema: table {table!r} has columns {', '.join(columns)}"
     return None
+
+
+def has_column(db: sqlite3.Connection, table: str, column: str) -> bool:
+    """Whether ``table`` of the open ledger has ``column`` (an older ledger may lack it)."""
+    return any(row[1] == column for row in db.execute(f"PRAGMA table_info({table})"))
 
 
 def migrate(db: sqlite3.Connection, schema: str) -> int | None:
@@ -138,7 +150,13 @@ def migrate(db: sqlite3.Connection, schema: str) -> int | None:
     if version == LEDGER_VERSION:
         db.executescript(schema)  # nothing to add; indexes of a ledger made by hand
         return None
-    db.executescript(f"BEGIN; {schema} PRAGMA user_version = {LEDGER_VERSION}; COMMIT;")
+    columns = "".join(
+        f"ALTER TABLE {table} ADD COLUMN {column} {definition}; "
+        for table, added in ADDED_COLUMNS.items()
+        for column, definition in added
+        if not has_column(db, table, column)
+    )
+    db.executescript(f"BEGIN; {schema} {columns}PRAGMA user_version = {LEDGER_VERSION}; COMMIT;")
     return int(version)
 
 

@@ -9,7 +9,7 @@ answered (``host`` and ``ledger`` say which). Merging:
 - replies of the same ledger carry the same tool lines (several stations of
   one line): each tool is taken once per ledger (the one with the most runs,
   should a run have been added between two replies);
-- across ledgers a tool's figures add up: runs, ``I_total`` (eq. 69: a sum
+- across ledgers a tool's figures add up: runs (and loosenings), ``I_total`` (eq. 69: a sum
   over runs, and each run is in exactly one ledger: runs are keyed by station,
   and a station belongs to one line), the runs and intensity since service;
   its worst runs are the worst of all; its stations the union; its last
@@ -71,7 +71,7 @@ def merge(replies: Iterable[WearReply], station: str | None = None) -> list[Tool
         tools = per_ledger.setdefault(reply.ledger, {})
         for tool in reply.tools:
             kept = tools.get(tool.tool_id)
-            if kept is None or tool.runs > kept.runs:
+            if kept is None or tool.runs + tool.loosenings > kept.runs + kept.loosenings:
                 tools[tool.tool_id] = tool
     by_tool: dict[int, list[ToolWear]] = {}
     for tools in per_ledger.values():
@@ -87,6 +87,7 @@ def _merged(parts: list[ToolWear]) -> ToolWear:
     if len(parts) == 1:
         return parts[0]
     runs = sum(part.runs for part in parts)
+    loosenings = sum(part.loosenings for part in parts)
     total = sum(part.total_intensity for part in parts)
     serviced = [part for part in parts if part.last_service_ns is not None]
     latest = max(serviced, key=lambda part: part.last_service_ns or 0) if serviced else None
@@ -99,7 +100,7 @@ def _merged(parts: list[ToolWear]) -> ToolWear:
         tool_id=parts[0].tool_id,
         runs=runs,
         total_intensity=total,
-        intensity_per_run=total / runs if runs else 0.0,
+        intensity_per_run=total / (runs + loosenings) if runs + loosenings else 0.0,
         last_service_ns=latest.last_service_ns if latest else None,
         last_service_note=latest.last_service_note if latest else None,
         runs_since_service=sum(part.runs_since_service for part in parts),
@@ -107,4 +108,5 @@ def _merged(parts: list[ToolWear]) -> ToolWear:
         worst_runs=worst,
         stations=sorted({name for part in parts for name in part.stations}),
         controller=max(said, key=lambda tool: tool.received_ns) if said else None,
+        loosenings=loosenings,
     )

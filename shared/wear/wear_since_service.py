@@ -20,16 +20,19 @@ from __future__ import annotations
 import sqlite3
 from dataclasses import dataclass
 
-#: a tool's runs since a service, found by the tool's index; bounded by rowid so the next
-#: read starts there (tool_id, since_ns, up to rowid)
+#: SQL true for a run that is a tightening (not a loosening)
+TIGHTENING = "operation = 'tightening'"
+#: a tool's tightenings and the intensity of all its runs since a service, found by the
+#: tool's index; bounded by rowid so the next read starts there (tool_id, since_ns, up to
+#: rowid)
 WHOLE_INTERVAL = (
-    "SELECT COUNT(*), COALESCE(SUM(process_intensity), 0.0) FROM runs "
+    f"SELECT COALESCE(SUM({TIGHTENING}), 0), COALESCE(SUM(process_intensity), 0.0) FROM runs "
     "WHERE tool_id = ? AND ended_ns > ? AND rowid <= ?"
 )
-#: the tool's runs among the rows added since (from rowid, up to rowid, tool_id, since_ns);
+#: the same among the rows added since (from rowid, up to rowid, tool_id, since_ns);
 #: ``+tool_id`` keeps SQLite on the rowids rather than the tool's whole index
 ADDED_SINCE = (
-    "SELECT COUNT(*), COALESCE(SUM(process_intensity), 0.0) FROM runs "
+    f"SELECT COALESCE(SUM({TIGHTENING}), 0), COALESCE(SUM(process_intensity), 0.0) FROM runs "
     "WHERE rowid > ? AND rowid <= ? AND +tool_id = ? AND ended_ns > ?"
 )
 
@@ -40,8 +43,8 @@ class ServiceInterval:
 
     tool_id: int
     last_service_ns: int | None
-    runs: int
-    intensity: float  # Σ I_process of the runs that ended after the service
+    runs: int  # its tightenings that ended after the service
+    intensity: float  # Σ I_process of the runs (loosenings too) that ended after the service
 
 
 @dataclass(frozen=True, slots=True)
@@ -54,8 +57,11 @@ class _Read:
 class SinceServiceTally:
     """Per tool, its :class:`ServiceInterval` and how far into the runs it has read."""
 
-    def __init__(self) -> None:
+    def __init__(self, tightening: str = TIGHTENING) -> None:
+        """``tightening``: SQL true for a tightening ("1" in a ledger before operations)."""
         self._reads: dict[int, _Read] = {}
+        self._whole = WHOLE_INTERVAL.replace(TIGHTENING, tightening)
+        self._added = ADDED_SINCE.replace(TIGHTENING, tightening)
 
     def interval(self, db: sqlite3.Connection, tool_id: int) -> ServiceInterval:
         """The tool's interval now; call inside one read transaction of ``db``."""
@@ -69,13 +75,11 @@ class SinceServiceTally:
         (newest_rowid,) = db.execute("SELECT COALESCE(MAX(rowid), 0) FROM runs").fetchone()
         before = self._reads.get(tool_id)
         if before is None or before.service_id != service_id or before.up_to_rowid > newest_rowid:
-            runs, intensity = db.execute(
-                WHOLE_INTERVAL, (tool_id, after_ns, newest_rowid)
-            ).fetchone()
+            runs, intensity = db.execute(self._whole, (tool_id, after_ns, newest_rowid)).fetchone()
             counted = ServiceInterval(tool_id, since_ns, int(runs), float(intensity))
         else:
             runs, intensity = db.execute(
-                ADDED_SINCE, (before.up_to_rowid, newest_rowid, tool_id, after_ns)
+                self._added, (before.up_to_rowid, newest_rowid, tool_id, after_ns)
             ).fetchone()
             was = before.interval
             counted = ServiceInterval(

@@ -4,7 +4,9 @@ Beside each tool: its serial, and the dates of its last calibration and
 service, when a controller said them (a controller bridge's ToolData: ``-``
 otherwise). ``last service`` is the service recorded in boltwatch (``boltwatch
 wear service``), from which "since service" counts; ``tool service`` is the
-controller's date.
+controller's date. ``runs`` are the tool's tightenings; its loosenings (runs
+that turned it back) are counted beside them, and their intensity is in
+``I_total`` and ``I/run`` (of every run) and since service.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ HEADER = (
     "I/run",
     "I since service",
     "runs since",
+    "loosenings",
     "last service",
     "calibrated",
     "tool service",
@@ -51,6 +54,7 @@ def row(wear: ToolWear) -> tuple[str, ...]:
         f"{wear.intensity_per_run:.3g}",
         f"{wear.intensity_since_service:.4g}",
         str(wear.runs_since_service),
+        str(wear.loosenings),
         service,
         _said_date(said.last_calibration_ns if said else None),
         _said_date(said.last_service_ns if said else None),
@@ -67,7 +71,7 @@ def _said_date(time_ns: int | None) -> str:
 
 
 #: the columns of numbers, right-aligned
-_NUMBERS = frozenset(("runs", "I_total", "I/run", "I since service", "runs since"))
+_NUMBERS = frozenset(("runs", "I_total", "I/run", "I since service", "runs since", "loosenings"))
 
 
 def format_table(tools: list[ToolWear], station: str | None = None) -> str:

@@ -5,7 +5,7 @@ Run on demand::
 
     .venv/bin/python tests/benchmarks/bench_results_store.py [--rows 10000000]
         [--steps 1234] [--databases sqlite postgresql] [--folder FOLDER]
-        [--postgres-url URL] [--explain]
+        [--postgres-url URL] [--explain] [--readers-only]
 
 1. **Ingest while recording** (goal ≥ 200 results a second): a real recorder
    serving ``--stations`` stations hears their results over zenoh on loopback
@@ -25,6 +25,9 @@ Run on demand::
    ``program_statistics`` on what it read (goal ≤ 5 s; the median of
    ``--repeats``). ``--explain``: the plan of each statement ``find`` runs
    (SQLite ``EXPLAIN QUERY PLAN``, PostgreSQL ``EXPLAIN (ANALYZE, BUFFERS)``).
+   ``--readers-only``: no writer opens the store first (as a recorder's start does) and
+   its SQLite statistics are deleted: a store only readers open (an older boltwatch's
+   ``results rebuild``, a copy), with the first reader's open timed.
 4. **The file scan it replaces**: ``read_results`` over ``--files`` run files
    written by the real recorder (``run_recordings``), per file, extrapolated
    to the month of a 20-station line at a run every 30 s (1 728 000 files).
@@ -57,7 +60,7 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
 
 from shared.offline.report import ResultFilter, read_results, read_stored
 from shared.quality import statistics_of
-from shared.results import ResultsQuery, ResultsStore, StoreError, StoreTarget
+from shared.results import ResultsDatabase, ResultsQuery, ResultsStore, StoreError, StoreTarget
 from tests.benchmarks.results_ingest import add_rates, live_ingest
 from tests.benchmarks.run_recordings import record_runs
 from tests.benchmarks.synthetic_results import (
@@ -173,6 +176,15 @@ def filled(args: argparse.Namespace, target: StoreTarget) -> dict[str, Any]:
     return {"generation_s": round(took), "steps": made.steps}
 
 
+def without_statistics(target: StoreTarget) -> None:
+    """The SQLite store as one only readers ever opened: no ``sqlite_stat1``."""
+    if target.sqlite_path is None:
+        return
+    with ResultsDatabase(target) as database, database.transaction():
+        if database.rows("SELECT name FROM sqlite_master WHERE name = 'sqlite_stat1'"):
+            database.execute("DELETE FROM sqlite_stat1")
+
+
 def random_parts(store: ResultsStore, rows: int, count: int, seed: int) -> list[str]:
     """``count`` distinct part ids that exist: those of random (station, run) rows."""
     rng = random.Random(seed)
@@ -233,8 +245,15 @@ def _cut(text: str, chars: int = 200) -> str:
 def queries(args: argparse.Namespace, target: StoreTarget) -> dict[str, Any]:
     """Step 3 on ``target``."""
     figures = filled(args, target)
-    with ResultsStore(target):  # opened by its writer, as a recorder starts: its statistics
-        pass
+    if args.readers_only:  # a store no writer opens (an older rebuild's, a copy)
+        without_statistics(target)
+        started = time.perf_counter()
+        ResultsStore(target, create=False).close()  # the first reader: its statistics
+        figures["first_reader_open_s"] = round(time.perf_counter() - started, 3)
+        print(f"3. {target.dialect}: the first reader's open: {figures['first_reader_open_s']} s")
+    else:
+        with ResultsStore(target):  # opened by its writer, as a recorder starts: statistics
+            pass
     with ResultsStore(target, create=False) as store:
         size = store_size_bytes(store)
         figures["bytes_per_million_rows"] = round(size / args.rows * 1e6)
@@ -369,6 +388,12 @@ def main() -> int:
     parser.add_argument("--folder", type=Path, default=None, help="keep and reuse files here")
     parser.add_argument("--postgres-url", default=None, help="a server's database for step 3")
     parser.add_argument("--explain", action="store_true", help="print each query's plan")
+    parser.add_argument(
+        "--readers-only",
+        action="store_true",
+        help="step 3 on a store no writer opens (its SQLite statistics deleted): the first "
+        "reader's open and what the readers after it find",
+    )
     args = parser.parse_args()
     figures: dict[str, Any] = {"rows": args.rows}
     with contextlib.ExitStack() as stack:

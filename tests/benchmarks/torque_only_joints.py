@@ -45,6 +45,7 @@ from tests.support.model_band_runs import drawn_program
 REPO = Path(__file__).resolve().parents[2]
 SAMPLE_S = 1e-3
 START_SHARE = 0.25  # a run starts at this share of the target preload
+RAMPS_SAMPLES_PER_PCT = (1.0, 20.0)  # the drawn families' stick ramps, samples per % of T*
 
 #: name -> (role, seed). Rules are tuned on the "tune" families only and judged on the rest.
 FAMILIES: dict[str, tuple[str, int]] = {
@@ -122,15 +123,23 @@ def _noise(
     )
 
 
-def drawn_joint(family: str, number: int, rng: np.random.Generator, seed: int) -> Joint:
-    """One joint of a drawn family (module docstring)."""
+def drawn_joint(
+    family: str,
+    number: int,
+    rng: np.random.Generator,
+    seed: int,
+    ramps_samples_per_pct: tuple[float, float] = RAMPS_SAMPLES_PER_PCT,
+) -> Joint:
+    """One joint of a drawn family (module docstring); its stick ramp log-uniform within
+    ``ramps_samples_per_pct`` (samples per percent of the target torque)."""
     k_e = rng.uniform(200.0, 2000.0)
     k_s = rng.uniform(30_000.0, 180_000.0)
     r = rng.uniform(0.008, 0.014)
     mu_stick = rng.uniform(0.1, 0.4)
     share = math.exp(rng.uniform(math.log(0.02), math.log(0.25)))
     scatter = rng.uniform(0.0, 0.05)
-    ramp = math.exp(rng.uniform(0.0, math.log(20.0)))
+    fast, slow = ramps_samples_per_pct
+    ramp = math.exp(rng.uniform(math.log(fast), math.log(slow)))
     target_n = rng.uniform(30_000.0, 60_000.0)
     rig = _noise(rng, target_n * r * mu_stick, target_n, scatter)
     mu_slip = mu_slip_for_drop(k_e, k_s, r, mu_stick, share, rig.damping_ratio)

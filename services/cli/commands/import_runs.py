@@ -7,7 +7,10 @@ recording would be: ``<recordings>/<station>/<YYYY-MM-DD>/<station>_run<id>_<HHM
 timing kept, the controller's result on ``boltwatch/<st>/controller``, and
 the predictor's replay of the run (:mod:`shared.offline.controller_import.controller_replay`):
 its events, intensity, advisory decision and run summary. Each run is
-counted in the wear ledger under the controller's tool serial, once.
+counted in the wear ledger under the controller's tool serial, once. A
+loosening (every step turning the tool back) is recorded as one: no
+tightening result, its summary and metadata say so, and the ledger adds its
+intensity to the tool but not to its tightenings.
 ``--csv DIR`` writes offline trace CSVs instead (header
 ``time_s,torque_nm,angle_deg,force_n``, force empty, time from the run's
 first sample, like ``boltwatch export``) for ``boltwatch predict``.
@@ -41,7 +44,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "(OK/NOK, each step's nominal and actual values). The predictor is replayed over "
         "each run (torque only, to the last step's torque target): its events, intensity "
         "and the stop it would have decided are recorded, marked as a replay, and the run "
-        "counts in the wear ledger under the controller's tool serial, once. A run already "
+        "counts in the wear ledger under the controller's tool serial, once. A loosening "
+        "(every step at a negative speed) is recorded as a loosening: no tightening result, "
+        "its intensity in the tool's wear but not among its tightenings. A run already "
         "in the folder is skipped. With --csv DIR, write trace CSVs for 'boltwatch predict' "
         "instead. Bad files are reported one line each; the rest are still imported."
     )

@@ -14,7 +14,8 @@ written in the last hour (a recorder may have it open). Station files
 sharing a recordings folder must agree on ``[retention]`` and the store. No
 results store there: one line, exit status 2 (``boltwatch results rebuild``
 makes one); a file that could not be deleted: one line each on stderr, exit
-status 2.
+status 2. A recordings folder that is a symlink loop: one line, exit status 2; a
+symlink loop in it is named on stderr and never touched.
 """
 
 from __future__ import annotations
@@ -65,10 +66,12 @@ def run(args: argparse.Namespace) -> int:
 
 def _prune(scope: RetentionScope, dry_run: bool) -> int:
     """Prune one folder, saying what goes; the number of files that could not be deleted."""
+    from shared.recordings import check_walkable
     from shared.results import ResultsStore
     from shared.retention import FileResultsCache, delete_planned, plan_pass
 
     policy = scope.policy
+    check_walkable(scope.folder)
     print(f"recordings of {scope.folder} ({', '.join(scope.stations)}): {policy.describe()}")
     if not policy.deletes:
         print("nothing deleted: [retention] keep_days or max_disk_used_pct in the station file")
@@ -77,6 +80,8 @@ def _prune(scope: RetentionScope, dry_run: bool) -> int:
         scope.target, create=False, application="boltwatch recordings prune"
     ) as store:
         plan = plan_pass(scope, store, FileResultsCache(), time.time_ns())
+    for line in plan.skipped:
+        print(f"boltwatch recordings prune: warning: {line}; skipped", file=sys.stderr)
     deleted, failed = plan.deletions, []
     if not dry_run:
         outcome = delete_planned(plan)

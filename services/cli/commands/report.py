@@ -26,6 +26,8 @@ from typing import TYPE_CHECKING
 
 from services.cli.command_options import (
     add_station_file_option,
+    result_program_id,
+    result_tool_id,
     utc_end,
     utc_moment,
     warn_left_out,
@@ -74,8 +76,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--line", default=None, metavar="L", help="only the stations on line L (station.line)"
     )
-    parser.add_argument("--program", type=int_in(0, 65535, "a program id"), default=None)
-    parser.add_argument("--tool", type=int_in(0, 65535, "a tool id"), default=None)
+    parser.add_argument("--program", type=result_program_id, default=None)
+    parser.add_argument("--tool", type=result_tool_id, default=None)
     parser.add_argument(
         "--subgroup-size",
         type=int_in(2, MAX_SUBGROUP, "runs per subgroup"),

@@ -11,18 +11,24 @@
 The store is the station file's (``recorder.results_database``: a plant's
 PostgreSQL; none: ``results.sqlite`` in its recordings folder) or
 ``--database``. Each row names its recording: ``boltwatch inspect FILE --run
-RUN`` draws it. Nothing matching: one line on stderr, exit status 1.
+RUN`` draws it. Nothing matching: one line on stderr, exit status 1. A
+tightening whose figures cannot be a measurement is no result (the store keeps
+it aside): each matching one is named on stderr, as ``report`` names it.
 
 ``rebuild`` reads the recordings of the station files (or every station
 folder of ``--recordings``) into the store: a line with years of MCAP files gets its history.
+A recordings folder that is a symlink loop is one line (exit status 2); a
+station folder, day folder or file in it that is one is named and skipped.
 Progress on stderr; stopped (Ctrl-C) and started again it goes on where it
 stopped (files read whole are skipped); a result stored already is not
-stored twice.
+stored twice; one whose figures cannot be a measurement is named, counted and
+kept aside, as the recorder does.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import socket
 import sys
 import time
@@ -33,6 +39,8 @@ from typing import TYPE_CHECKING
 
 from services.cli.command_options import (
     add_station_file_option,
+    result_program_id,
+    result_tool_id,
     utc_end,
     utc_moment,
     warn_left_out,
@@ -85,8 +93,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     which.add_argument("--plant", default=None, metavar="P", help="a plant (station.plant)")
     which.add_argument("--line", default=None, metavar="L", help="a line (station.line)")
-    which.add_argument("--program", type=int_in(0, 2**63 - 1, "a program id"), default=None)
-    which.add_argument("--tool", type=int_in(0, 2**63 - 1, "a tool id"), default=None)
+    which.add_argument("--program", type=result_program_id, default=None)
+    which.add_argument("--tool", type=result_tool_id, default=None)
     which.add_argument(
         "--since",
         type=utc_moment,
@@ -115,7 +123,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from shared.results import ResultsQuery, ResultsStore
+    from shared.results import ResultsQuery, ResultsStore, time_ns_of
 
     sources = _sources(args)
     target = _target(args, sources)
@@ -128,15 +136,21 @@ def run(args: argparse.Namespace) -> int:
         line=args.line,
         program_id=args.program,
         tool_id=args.tool,
-        since_ns=None if args.since is None else round(args.since.timestamp() * 1e9),
-        until_ns=None if args.until is None else round(args.until.timestamp() * 1e9),
+        since_ns=None if args.since is None else time_ns_of(args.since),
+        until_ns=None if args.until is None else time_ns_of(args.until),
         verdict="NOK" if args.nok else None,
         limit=args.limit,
     )
     with ResultsStore(target, create=False) as store:
         found = store.find(query)
         total = store.count(query) if len(found) == args.limit else len(found)
+        if len(found) == args.limit:  # those kept aside among the rows answered
+            oldest_ns = found[-1].result.time_ns
+            query = dataclasses.replace(query, since_ns=max(oldest_ns, query.since_ns or 0))
+        refused = store.refused(query)
     from shared.results.results_table import format_csv, format_json, format_table
+
+    warn_left_out(NAME, [], [], refused)
 
     if args.json:
         print(format_json(found))
@@ -164,20 +178,27 @@ class Source:
 def _sources(args: argparse.Namespace) -> list[Source]:
     """``--recordings DIR`` (every station folder in it), else the station files."""
     from shared.config import StationPlace, load_any_station
+    from shared.files import loop_text, real_path, symlink_loop
+    from shared.recordings import check_walkable
 
     if args.recordings is not None:
         folder: Path = args.recordings
+        if symlink_loop(folder) is not None:
+            raise ConfigError(f"--recordings: {folder}: {loop_text(folder)}")
         if not folder.is_dir():
             raise ConfigError(f"--recordings: {folder} is not a folder")
-        stations = sorted(
-            path.name for path in folder.iterdir() if path.is_dir() and path.name[0] != "."
+        stations = sorted(  # a station folder that is a symlink loop: named when read
+            path.name
+            for path in folder.iterdir()
+            if (path.is_dir() or symlink_loop(path) == path) and path.name[0] != "."
         )
         return [Source(folder, {station: StationPlace() for station in stations}, None)]
 
     sources: dict[Path, Source] = {}
     for path in args.config:
         station = load_any_station(path)
-        folder = station.recordings_folder.resolve()
+        folder = real_path(station.recordings_folder)
+        check_walkable(folder)
         source = sources.setdefault(
             folder, Source(folder, {}, station.config.recorder.results_database)
         )
@@ -207,6 +228,7 @@ def _target(args: argparse.Namespace, sources: Sequence[Source]) -> StoreTarget:
 
 
 def _rebuild(target: StoreTarget, sources: Sequence[Source]) -> int:
+    from shared.recordings import loop_lines
     from shared.results import ResultsStore
     from shared.results.recordings_reading import (
         FillCounts,
@@ -215,7 +237,8 @@ def _rebuild(target: StoreTarget, sources: Sequence[Source]) -> int:
     )
 
     places = {station: place for source in sources for station, place in source.places.items()}
-    files = [path for s in sources for path in station_recordings(s.folder, s.places)]
+    loops: list[Path] = []
+    files = [path for s in sources for path in station_recordings(s.folder, s.places, None, loops)]
     told_s = [0.0]
 
     def progress(counts: FillCounts) -> None:
@@ -233,11 +256,12 @@ def _rebuild(target: StoreTarget, sources: Sequence[Source]) -> int:
         counts = fill_from_recordings(
             store, files, places, socket.gethostname(), time.time_ns, progress
         )
-    warn_left_out("results rebuild", counts.damaged, counts.skipped, counts.refused)
+    skipped = [*loop_lines(loops), *counts.skipped]
+    warn_left_out("results rebuild", counts.damaged, skipped, counts.refused)
     before = counts.files - counts.read - len(counts.skipped)
     left_out = [
         f"{len(lines)} {what}"
-        for lines, what in ((counts.skipped, "not readable, skipped"), (counts.refused, "refused"))
+        for lines, what in ((skipped, "not readable, skipped"), (counts.refused, "refused"))
         if lines
     ]
     print(

@@ -4,7 +4,10 @@ Each :class:`ControllerRun` becomes the messages a live station publishes
 (``ToolState`` running, one ``Sample`` per controller sample with ``force_n``
 None, ``ToolState`` done), the controller's own result (``ControllerResult``
 on ``boltwatch/<st>/controller``), the run's ``TighteningResult`` made from
-it (:mod:`shared.quality.controller_result`, on ``boltwatch/<st>/results``) and, when
+it (:mod:`shared.quality.controller_result`, on ``boltwatch/<st>/results``;
+a loosening has none: it is no tightening, so the results store, the report
+and its Cpk never count it; its ``ControllerResult``, ``RunSummary`` and the
+``controller`` metadata record say ``operation`` loosening) and, when
 given, what the predictor made of it
 (:class:`~shared.stickslip.stopped_run.PredictorReplay`: events,
 intensities, the advisory decision after the sample that caused each, and
@@ -130,8 +133,9 @@ def controller_messages(
     controller = run.result(station, end_ns)
     yield channels.CONTROLLER.topic, controller, end_ns
     summary = replay.summary if replay is not None else None
-    result = controller_result(controller, summary, run.header.get("prg name", ""), "import")
-    yield channels.RESULTS.topic, result, end_ns
+    if run.operation == "tightening":  # a loosening is no tightening: no tightening result
+        result = controller_result(controller, summary, run.header.get("prg name", ""), "import")
+        yield channels.RESULTS.topic, result, end_ns
     if replay is not None:
         yield channels.RUNS.topic, replay.summary, end_ns
 
@@ -217,6 +221,7 @@ def controller_record(run: ControllerRun) -> dict[str, str]:
         "date_timezone": "none in the file; taken as UTC",
         "steps": ",".join(run.step_names),
         "samples": str(len(run)),
+        "operation": run.operation,
     }
     record.update(run.header)
     return record

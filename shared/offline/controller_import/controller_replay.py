@@ -6,7 +6,8 @@ shared with the Open Protocol bridge); here a :class:`ControllerRun` becomes a
 
 A CS351 run's target is its last step's ``TF Torque`` nominal (the torque the
 controller tightened to), its reached torque the ``TF Torque`` actual (the
-highest torque measured where the last step has none).
+highest torque measured where the last step has none); the resolution of its
+torque and whether it was a loosening come with it.
 """
 
 from __future__ import annotations
@@ -31,6 +32,8 @@ def stopped_run(station: str, run: ControllerRun) -> StoppedRun:
         angle_deg=run.angle_deg,
         target_torque_nm=run.final_torque_nominal_nm,
         reached_torque_nm=run.final_torque_actual_nm,
+        torque_resolution_nm=run.torque_resolution_nm,
+        operation=run.operation,
     )
 
 

@@ -5,7 +5,21 @@ keeping the controller's own timing: repeated timestamps and gaps of tens of
 milliseconds stay as they are (about 833 Hz, torque and angle only, no
 preload). The run's identity comes from the file's header: ``cycle`` (the
 run id, as in the dataset's labels), ``tool serial``, ``prg nr``, ``date``
-(controller local time, no zone in the file: taken as UTC).
+(controller local time, no zone in the file: taken as UTC). Other controllers
+of the family write the same layout with identifiers as text (``"tool
+serial": "520000905"``): an identifier is an integer from 0 up, written as a
+number or as its digits; a serial that is no such number (``"GP1010003"``)
+cannot be a tool id of the wear ledger and is refused, naming the key. The
+serial as written is kept in the ``controller`` metadata record.
+
+What the run did: a **loosening** when every step that says its ``speed``
+turns the tool back (a negative speed), else a tightening
+(:func:`~shared.offline.controller_import.controller_steps.run_operation`).
+
+The torque's **resolution** (:attr:`ControllerRun.torque_resolution_nm`): the
+smallest step between two of the run's torque values, what the controller
+writes (0.001 Nm for the CS351 runs at hand); a drop the signal cannot
+resolve is no stick-slip event (:mod:`shared.stickslip.extremum_tracker`).
 
 The controller's own result (each step's name, OK/NOK, nominal and actual
 values, the run's verdict, part and batch) is read too
@@ -26,16 +40,21 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from shared.contract import ControllerResult, ControllerStep, RunClock
+from shared.contract import ControllerResult, ControllerStep, RunClock, RunOperation
 from shared.errors import InputError
 from shared.offline.controller_import.controller_steps import (
     ControllerVerdict,
+    integer_expected,
+    integer_of,
+    read_speed,
     read_step,
     read_verdict,
+    run_operation,
     text,
     torque_function,
 )
 from shared.offline.controller_import.controller_timing import check_date, check_times
+from shared.stickslip import signal_resolution
 
 STEPS_KEY = "tightening steps"
 TIME_KEY, TORQUE_KEY, ANGLE_KEY = "time values", "torque values", "angle values"
@@ -45,6 +64,7 @@ LARGEST_ID = 2**63 - 1
 
 #: Header fields kept in the ``controller`` metadata record of an imported run.
 HEADER_FIELDS = (
+    "tool serial",
     "hardware",
     "sw version",
     "node id",
@@ -75,6 +95,7 @@ class ControllerRun:
     angle_deg: list[float]
     steps: list[ControllerStep]
     verdict: ControllerVerdict
+    operation: RunOperation = "tightening"
 
     def __len__(self) -> int:
         return len(self.time_s)
@@ -105,6 +126,11 @@ class ControllerRun:
         return [t - first for t in self.time_s]
 
     @property
+    def torque_resolution_nm(self) -> float:
+        """The smallest step between two of the run's torque values (0: none seen)."""
+        return signal_resolution(self.torque_nm)
+
+    @property
     def final_torque_nominal_nm(self) -> float | None:
         """The last step's ``TF Torque`` nominal: the torque the run was meant to end at."""
         function = torque_function(self.steps[-1])
@@ -131,6 +157,7 @@ class ControllerRun:
             torque_unit=verdict.torque_unit,
             torsion_release_samples=verdict.torsion_release_samples,
             steps=list(self.steps),
+            operation=self.operation,
             **verdict.batch,
         )
 
@@ -150,8 +177,10 @@ def read_controller_run(path: Path) -> ControllerRun:
     columns: tuple[list[float], list[float], list[float]] = ([], [], [])
     step_times: list[list[float]] = []
     step_records: list[ControllerStep] = []
+    speeds: list[float | None] = []
     for number, step in enumerate(steps):
         times, torques, angles = _step_columns(path, number, step)
+        speeds.append(read_speed(path, f"{STEPS_KEY}[{number}]", step))
         columns[0].extend(times)
         columns[1].extend(torques)
         columns[2].extend(angles)
@@ -176,6 +205,7 @@ def read_controller_run(path: Path) -> ControllerRun:
         angle_deg=columns[2],
         steps=step_records,
         verdict=verdict,
+        operation=run_operation(speeds),
     )
 
 
@@ -229,9 +259,10 @@ def _numbers(where: str, graph: dict[str, Any], key: str) -> list[float]:
 
 
 def _integer(path: Path, document: dict[str, Any], key: str) -> int:
-    value = document.get(key)
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise InputError(f"{path}: '{key}': expected an integer, got {_kind(value)} {value!r}")
+    written = document.get(key)
+    value = integer_of(written)
+    if value is None:
+        raise InputError(f"{path}: '{key}': {integer_expected(written)}")
     if value < 0:
         raise InputError(f"{path}: '{key}': expected a number from 0 up, got {value}")
     if value > LARGEST_ID:

@@ -57,9 +57,12 @@ class OverlayRun:
         return self.result.result if self.result is not None else "no result"
 
 
-def find_run_files(folder: Path, station: str, run_id: int) -> list[Path]:
-    """The MCAP files of run ``run_id`` of ``station`` under the recordings ``folder``."""
-    files = run_files(folder, station, run_id)
+def find_run_files(
+    folder: Path, station: str, run_id: int, loops: list[Path] | None = None
+) -> list[Path]:
+    """The MCAP files of run ``run_id`` of ``station`` under the recordings ``folder`` (symlink
+    loops met on the way: skipped, in ``loops``; ``folder`` one: InputError)."""
+    files = run_files(folder, station, run_id, loops)
     if not files:
         station_folder = folder / station_folder_name(station)
         raise InputError(

@@ -8,7 +8,8 @@ on ``results`` (``source`` ``controller`` or ``import``). What the run was
 aimed at is there: the windows of its final torque and angle (the
 controller's monitoring functions, ``MF TorqueMin`` ... ``MF AngleMax``) and
 its target (the last step's tightening function, ``TF Torque`` or ``TF
-Angle``, and its nominal value).
+Angle``, and its nominal value), and whether the run was a loosening (its
+torque is then drawn as the replay saw it: its magnitude).
 
 The station file's program of the same id is not: on a CAN station file it
 is the station's own program (the simulated joint's demo program, whose
@@ -37,6 +38,7 @@ class ControllerMarks:
     angle_window_deg: Window
     torque_target_nm: float | None
     angle_target_deg: float | None
+    loosening: bool = False  # the run turned the tool back
 
     @staticmethod
     def of(
@@ -60,6 +62,7 @@ class ControllerMarks:
             angle_window_deg=(result.final_angle_deg.min, result.final_angle_deg.max),
             torque_target_nm=nominal if function == "TF Torque" else None,
             angle_target_deg=nominal if function == "TF Angle" else None,
+            loosening=controller is not None and controller.operation == "loosening",
         )
 
     def describe(self) -> str:
@@ -74,6 +77,8 @@ class ControllerMarks:
             parts.append(f"target {self.angle_target_deg:g} deg")
         else:
             parts.append("no target")
+        if self.loosening:
+            parts.append("a loosening: torque drawn as its magnitude")
         return ", ".join(parts)
 
 

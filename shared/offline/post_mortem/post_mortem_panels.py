@@ -126,6 +126,10 @@ def _controller_torque(ax: Any, run: RecordedRun) -> None:
     if marks is None:
         return
     low, high = marks.torque_window_nm
+    if marks.loosening:  # drawn as magnitudes, as its torque
+        low, high = (None if v is None else abs(v) for v in (low, high))
+        if low is not None and high is not None and low > high:
+            low, high = high, low
     if low is not None and high is not None:
         ax.axhspan(low, high, color=WINDOW_COLOR, alpha=0.15,
                    label=f"controller's torque window {low:g} to {high:g} Nm")  # fmt: skip
@@ -135,8 +139,9 @@ def _controller_torque(ax: Any, run: RecordedRun) -> None:
                 ax.axhline(bound, color=WINDOW_COLOR, lw=1.2,
                            label=f"controller's torque {side} {bound:g} Nm")  # fmt: skip
     if marks.torque_target_nm is not None:
-        ax.axhline(marks.torque_target_nm, color="tab:purple", ls=":", lw=1.2,
-                   label=f"controller's target {marks.torque_target_nm:g} Nm")  # fmt: skip
+        target = abs(marks.torque_target_nm) if marks.loosening else marks.torque_target_nm
+        ax.axhline(target, color="tab:purple", ls=":", lw=1.2,
+                   label=f"controller's target {target:g} Nm")  # fmt: skip
 
 
 def _times(run: RecordedRun, events: Sequence[StickSlipEvent]) -> list[float]:
@@ -146,7 +151,12 @@ def _times(run: RecordedRun, events: Sequence[StickSlipEvent]) -> list[float]:
 def draw_torque(ax: Any, run: RecordedRun, bounds: Bounds) -> None:
     """Figure 10 (top): torque, peaks T_max,j, envelopes T_stick and T_slip, the stop."""
     times = [run.run_time_s(s.time_ns) for s in run.samples]
-    ax.plot(times, [s.torque_nm for s in run.samples], color="tab:blue", lw=0.8, label="torque T")
+    if run.controller is not None and run.controller.loosening:  # the load, as the replay saw it
+        torques = [abs(s.torque_nm) for s in run.samples]
+        ax.plot(times, torques, color="tab:blue", lw=0.8, label="torque |T| (a loosening)")
+    else:
+        torques = [s.torque_nm for s in run.samples]
+        ax.plot(times, torques, color="tab:blue", lw=0.8, label="torque T")
     if run.events:
         ax.plot(
             _times(run, run.events),

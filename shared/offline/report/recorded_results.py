@@ -6,7 +6,8 @@ Reads ``<recordings>/<station>/<YYYY-MM-DD>/*.mcap`` (the layout of
 range, every complete message of channels ``results`` and ``runs``, damaged
 files as far as they go (:class:`RecordingScan`, a warning each). A file
 that cannot be read at all (empty, cut inside its header, not MCAP, not a
-regular file) is named, skipped and counted; a payload that does not decode
+regular file, a symlink loop) is named, skipped and counted (a recordings
+folder that is a symlink loop: one line, InputError); a payload that does not decode
 (a Sample where a result belongs, ``{}``, binary) is refused and counted,
 the file's other messages still read. A result is kept when it ended
 (``time_ns``) inside the range, matches the program / tool asked for and
@@ -23,15 +24,15 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from datetime import UTC, date, datetime, timedelta
+from datetime import date, datetime, timedelta
 from pathlib import Path
 
 from shared.contract import RunSummary, TighteningResult, channels, decode
 from shared.errors import InputError
 from shared.quality import ProgramColumns, columns_of, implausible, refusal_line
-from shared.recordings import recording_files, station_days
+from shared.recordings import loop_lines, recording_files, station_days
 from shared.recordings.mcap import RecordingScan
-from shared.results import ResultsQuery, ResultsStore, program_columns
+from shared.results import ResultsQuery, ResultsStore, program_columns, time_ns_of
 
 #: progress is told every this many files (when there are more)
 PROGRESS_EVERY_FILES = 50
@@ -47,11 +48,21 @@ class ResultFilter:
     program_id: int | None = None
     tool_id: int | None = None
 
+    @property
+    def since_ns(self) -> int | None:
+        return None if self.since is None else time_ns_of(self.since)
+
+    @property
+    def until_ns(self) -> int | None:
+        return None if self.until is None else time_ns_of(self.until)
+
     def keeps(self, result: TighteningResult) -> bool:
-        ended = datetime.fromtimestamp(result.time_ns / 1e9, UTC)
+        """Whether ``result`` is in the range (to the nanosecond, as the store's query) and
+        of the program and tool asked for."""
+        since_ns, until_ns = self.since_ns, self.until_ns
         return (
-            (self.since is None or ended >= self.since)
-            and (self.until is None or ended < self.until)
+            (since_ns is None or result.time_ns >= since_ns)
+            and (until_ns is None or result.time_ns < until_ns)
             and (self.program_id is None or result.program_id == self.program_id)
             and (self.tool_id is None or result.tool_id == self.tool_id)
         )
@@ -73,16 +84,19 @@ class RecordedResults:
         return sum(program.runs for program in self.programs)
 
 
-def files_in_range(station: str, folder: Path, rule: ResultFilter) -> list[Path]:
+def files_in_range(
+    station: str, folder: Path, rule: ResultFilter, loops: list[Path] | None = None
+) -> list[Path]:
     """The MCAP files of ``station`` under ``folder`` whose day folder may hold the range
-    (a day either side: a file opened before midnight holds runs that ended after it)."""
+    (a day either side: a file opened before midnight holds runs that ended after it);
+    symlink loops met on the way: in ``loops`` (``folder`` one: InputError)."""
     first: date | None = rule.since.date() - timedelta(days=1) if rule.since else None
     last: date | None = rule.until.date() + timedelta(days=1) if rule.until else None
     files: list[Path] = []
-    for day_date, day in station_days(folder, station):
+    for day_date, day in station_days(folder, station, loops):
         if (first and day_date < first) or (last and day_date > last):
             continue
-        files.extend(recording_files(day))
+        files.extend(recording_files(day, loops=loops))
     return files
 
 
@@ -91,15 +105,16 @@ def read_results(
 ) -> RecordedResults:
     """Every result that ``rule`` keeps, in the order the runs ended; ``progress(done,
     total)`` is called every :data:`PROGRESS_EVERY_FILES` files and at the end."""
+    loops: list[Path] = []
     files = [
         (station, path)
         for station, folder in rule.stations
-        for path in files_in_range(station, folder, rule)
+        for path in files_in_range(station, folder, rule, loops)
     ]
     results: list[TighteningResult] = []
     #: (station, run id, tool id) -> its RunSummary (events per run when a result has none)
     summaries: dict[tuple[str, int, int], RunSummary] = {}
-    read = RecordedResults(files=len(files))
+    read = RecordedResults(files=len(files), skipped=loop_lines(loops))
     seen: set[tuple[str, int, int, int]] = set()
     for done, (station, path) in enumerate(files, start=1):
         try:
@@ -165,8 +180,8 @@ def read_stored(store: ResultsStore, rule: ResultFilter) -> RecordedResults:
         stations=[station for station, _ in rule.stations],
         program_id=rule.program_id,
         tool_id=rule.tool_id,
-        since_ns=None if rule.since is None else round(rule.since.timestamp() * 1e9),
-        until_ns=None if rule.until is None else round(rule.until.timestamp() * 1e9),
+        since_ns=rule.since_ns,
+        until_ns=rule.until_ns,
         limit=None,
         oldest_first=True,
     )

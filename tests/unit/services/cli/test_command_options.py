@@ -64,3 +64,10 @@ def test_damage_warning_is_one_line_on_stderr(capsys: pytest.CaptureFixture[str]
     assert captured.err == (
         "boltwatch export: warning: truncated after 3 chunks; exported what is readable\n"
     )
+
+
+def test_a_result_id_option_takes_every_id_the_contract_allows() -> None:
+    from services.cli.command_options import RESULT_ID_MAX
+    from shared.contract import INT64_MAX
+
+    assert RESULT_ID_MAX == INT64_MAX

@@ -200,7 +200,7 @@ def test_a_ledger_of_a_newer_version_or_a_wrong_tool_data_table_is_not_written(
     db.execute(f"PRAGMA user_version = {LEDGER_VERSION + 1}")
     db.commit()
     db.close()
-    with pytest.raises(BrokenLedgerError, match="a ledger of version 3, newer than this"):
+    with pytest.raises(BrokenLedgerError, match=f"a ledger of version {LEDGER_VERSION + 1}, newer"):
         WearLedger(path)
     other = ledger_path(tmp_path / "other")
     other.parent.mkdir()

@@ -200,3 +200,55 @@ def test_a_refused_results_payload_costs_no_result_of_its_file(tmp_path: Path) -
         (again,) = store.find(ResultsQuery(plant=PLACE.plant))
         assert (again.line, again.station_name) == (PLACE.line, PLACE.name)
         assert store.recording_read("box", path) is not None
+
+
+def test_a_result_that_cannot_be_a_measurement_is_kept_aside_live_and_at_catch_up(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Run 2's result says 1e308 Nm (a faulty controller): the recorder records it, and the
+    store keeps it aside, named in the log and counted, as ``results rebuild`` and ``report``
+    name it; runs 1 and 3 are results. The next start, its store gone, reads the recordings
+    again (the catch-up) and keeps the same aside."""
+    from shared.contract import JudgedFigure
+
+    station = _station(tmp_path)
+    absurd = factories.result(
+        2,
+        part_id="VIN0002",
+        time_ns=T0_NS + 2 * 10**10 + 10**6,
+        final_torque_nm=JudgedFigure(1e308, 180.0, 240.0, "high"),
+        result="NOK",
+    )
+    line = "station st1 run 2 (tool 7): final torque 1e+308 Nm, expected within ±1e+06 Nm"
+    recorder = RunningRecorder(station)
+    watch = recorder.service.results
+    assert watch is not None
+    session = zenoh.open(zenoh_config("peer", connect=station.config.zenoh.listen))
+    try:
+        publish(session, _run_with_result(1, "VIN0001"))
+        publish(session, [*run_messages(2, 50), ("results", absurd)])
+        publish(session, _run_with_result(3, "VIN0003"))
+        wait_until(lambda: len(_stored(station)) == 2 and watch.refused == 1, "stored", WAIT_S)
+    finally:
+        session.close()
+        recorder.finish()
+    assert [s.result.run_id for s in _stored(station)] == [1, 3]
+    assert any(line in record.getMessage() for record in caplog.records)
+    with ResultsStore(station_store(station), create=False) as store:
+        assert store.refused(ResultsQuery()) == [line]
+        assert ("st1", 2) in store.verdicts([("st1", 2)])  # its recording may be let go
+
+    (station.recordings_folder / "results.sqlite").unlink()
+    caplog.clear()
+    again = RunningRecorder(station)
+    catch_up = again.service.results
+    assert catch_up is not None
+    try:
+        wait_until(
+            lambda: len(_stored(station)) == 2 and catch_up.refused == 1, "caught up", WAIT_S
+        )
+    finally:
+        again.finish()
+    assert any(line in record.getMessage() for record in caplog.records)
+    with ResultsStore(station_store(station), create=False) as store:
+        assert store.refused(ResultsQuery()) == [line]

@@ -165,3 +165,32 @@ def test_nothing_is_deleted_while_the_store_cannot_be_asked(
     failing = [r for r in caplog.records if "nothing is deleted until" in r.getMessage()]
     assert [r.levelno for r in failing] == [logging.WARNING]
     assert any("answers again" in r.getMessage() for r in caplog.records)
+
+
+def test_a_symlink_loop_in_the_recordings_is_named_once_and_never_touched(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A day folder and a run file that are links to themselves, beside an old stored file:
+    the passes delete the old file, log each loop once (not every pass) and leave them."""
+    station = _station(tmp_path)
+    folder = station.recordings_folder
+    now_ns = time.time_ns()
+    old = write_run_file(folder, 1, now_ns - 40 * DAY_NS, [run_result(1)])
+    newest = write_run_file(folder, 2, now_ns - 2 * DAY_NS, [run_result(2)])
+    store(store_target(folder, None), [run_result(1), run_result(2)], old)
+    loops = [old.parent.with_name("2000-01-01"), old.with_name("st1_run9_000000.mcap")]
+    for loop in loops:
+        loop.symlink_to(loop.name)
+    (scope,) = retention_scopes([station])
+    caplog.set_level(logging.WARNING, logger="services.recorder.retention_watch")
+    watch = RetentionWatch(scope, interval_s=0.1)
+    try:
+        watch.open_files([])
+        wait_until(lambda: watch.deleted["st1"] == 1 and watch.passes >= 3, "three passes")
+    finally:
+        watch.close()
+    assert not old.exists() and newest.exists() and all(loop.is_symlink() for loop in loops)
+    named = [r.getMessage() for r in caplog.records if "is a symlink loop" in r.getMessage()]
+    assert sorted(named) == sorted(
+        f"retention: {loop}: is a symlink loop; skipped, never touched" for loop in loops
+    )

@@ -118,13 +118,45 @@ def test_results_rebuild_stores_every_readable_result(
     assert status == 0, error
     for path in unreadable:
         assert sum(str(path) in line and "skipped" in line for line in error.splitlines()) == 1
-    assert sum("refused" in line for line in error.splitlines()) == len(WRONG_PAYLOADS)
-    stored = GOOD_RUNS - len(unreadable) + 1 + len(ABSURD_NM)  # as the recorder stores them
-    assert re.search(rf"2 not readable, skipped; 4 refused\): {stored} results", printed), printed
+    refused = [line for line in error.splitlines() if "refused" in line]
+    assert len(refused) == len(WRONG_PAYLOADS) + len(ABSURD_NM)
+    assert sum("final torque 1e+308 Nm" in line or "-1e+308" in line for line in refused) == 2
+    stored = GOOD_RUNS - len(unreadable) + 1  # the absurd ones are no result
+    assert re.search(rf"2 not readable, skipped; 6 refused\): {stored} results", printed), printed
     with ResultsStore(store_target(folder, None), create=False) as opened:
         assert ("st1", 20) in opened.verdicts([("st1", 20)])  # beside the wrong payloads
     status, printed, _ = _run(capsys, "results", "rebuild", "--recordings", str(folder))
     assert "0 results" in printed  # the file with refused payloads was read whole: not again
+
+
+def test_rebuild_results_and_report_agree_on_what_is_a_result(
+    hostile: tuple[Path, Path, list[Path]], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """What ``results rebuild`` stores, ``results`` lists and ``report`` counts, from the store
+    and from the files: the same results, the same absurd ones refused in the same words."""
+    station, folder, unreadable = hostile
+    kept = GOOD_RUNS - len(unreadable) + 1
+    status, printed, error = _run(capsys, "results", "rebuild", "--recordings", str(folder))
+    assert status == 0, error
+    rebuilt = sorted(line.split("refused ", 1)[1] for line in error.splitlines() if "(tool" in line)
+    assert len(rebuilt) == len(ABSURD_NM) and f": {kept} results, {kept} new" in printed
+
+    status, printed, error = _run(capsys, "results", "--recordings", str(folder), "--csv")
+    assert status == 0 and len(printed.splitlines()) == 1 + kept  # the header, each result
+    listed = sorted(line.split("refused ", 1)[1] for line in error.splitlines() if "(tool" in line)
+    assert listed == rebuilt
+
+    reports = {}
+    for source in ([], ["--from-recordings"]):
+        out = tmp_path / f"report{len(source)}"
+        args = ["report", "--config", str(station), "--out", str(out), *source]
+        status, printed, error = _run(capsys, *args)
+        assert status == 0, error
+        assert printed.startswith(f"{kept} results (from ") and f": {kept} runs" in printed
+        reports[len(source)] = sorted(
+            line.split("refused ", 1)[1] for line in error.splitlines() if "(tool" in line
+        )
+    assert reports[0] == reports[1] == rebuilt
 
 
 def test_overlay_skips_a_part_that_cannot_be_read(
@@ -181,3 +213,32 @@ def test_figures_at_the_bounds_are_measurements() -> None:
     )
     assert implausible(edge) is None
     assert implausible(factories.result(1, events=None, process_intensity=None)) is None
+
+
+@pytest.mark.parametrize("source", [[], ["--from-recordings"]])
+def test_a_result_ending_a_nanosecond_from_a_bound_is_in_the_range_it_is_in(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], source: list[str]
+) -> None:
+    """``--since`` and ``--until`` hold to the nanosecond, from the store (integer
+    nanoseconds in SQL) and from the files alike (a float of seconds since 1970 holds about a
+    quarter of a microsecond): each run is its own program, so the report says which."""
+    folder = tmp_path / "recordings"
+    since_ns, until_ns = DAY_NS + 10**9, DAY_NS + 5 * 10**9  # 08:00:01 and 08:00:05
+    ended = {1: since_ns - 1, 2: since_ns, 3: until_ns - 1, 4: until_ns}
+    for run_id, time_ns in ended.items():
+        result = factories.result(
+            run_id, time_ns=time_ns, program_id=run_id, program_name=f"P{run_id}"
+        )
+        write_result_file(folder, result)
+    station = write_station_file(tmp_path / "station.toml", folder, connect=CONNECT)
+    assert main(["results", "rebuild", "--config", str(station)]) == 0
+    window = ["--since", "2026-03-02T08:00:01", "--until", "2026-03-02T08:00:05"]
+    capsys.readouterr()
+    status, printed, _ = _run(capsys, "results", "--config", str(station), *window, "--csv")
+    assert status == 0 and len(printed.splitlines()) == 3  # the header, runs 3 and 2
+    out = str(tmp_path / "out")
+    args = ["report", "--config", str(station), "--out", out, *window, *source]
+    status, printed, error = _run(capsys, *args)
+    assert status == 0, error
+    counted = sorted(int(n) for n in re.findall(r"^program (\d+) \(", printed, re.MULTILINE))
+    assert counted == [2, 3]

@@ -193,6 +193,30 @@ def test_report_filters_range_program_and_tool(
     assert status == 0 and "program 1 (" not in printed and "program 2 (P2): 12 runs" in printed
 
 
+@pytest.mark.parametrize("source", [[], ["--from-recordings"]])
+def test_the_program_and_tool_a_result_can_have_can_be_asked_for(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], source: list[str]
+) -> None:
+    """Ids are the contract's 64-bit ones (a controller's parameter set and tool serial,
+    imported): what the store holds and ``results --program`` finds, ``report`` finds too."""
+    recordings = tmp_path / "recordings"
+    program, tool = 2**40 + 3, 2**62
+    for n in range(1, 4):
+        values = (210.0 + n, 47.0, 56000.0, 1e6, 40.0)
+        _write_run(recordings, _result(n, DAY1_NS + n * 10**9, program, tool, values))
+    station = write_station_file(
+        tmp_path / "station.toml", recordings, connect=["tcp/127.0.0.1:7447"]
+    )
+    assert main(["results", "rebuild", "--config", str(station)]) == 0
+    assert main(["results", "--config", str(station), "--program", str(program)]) == 0
+    out = str(tmp_path / "out")
+    args = ["--config", str(station), "--out", out, "--program", str(program), "--tool", str(tool)]
+    capsys.readouterr()
+    status, printed, error = _report([*args, *source], capsys)
+    assert status == 0, error
+    assert f"program {program} (P{program}): 3 runs" in printed
+
+
 def test_no_result_in_range_is_one_line_and_status_2(
     recorded: tuple[Path, list[TighteningResult]],
     tmp_path: Path,

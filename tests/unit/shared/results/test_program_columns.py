@@ -1,7 +1,7 @@
 """A report's columns from the store are the columns of the results themselves: the same
 statistics from ``program_columns`` (a few statements) as from ``program_statistics`` over
-the results read one by one, on SQLite and PostgreSQL; a tightening whose figures cannot be
-a measurement is left out of them and named."""
+the results read one by one, on SQLite and PostgreSQL, whatever the program ids; a
+tightening whose figures cannot be a measurement is left out of them and named."""
 
 from __future__ import annotations
 
@@ -101,6 +101,23 @@ def test_the_stores_columns_give_the_statistics_of_the_results(target: StoreTarg
         if result.station in ("st1", "st2") and result.time_ns >= query.since_ns  # type: ignore[operator]
     ]
     for mine, theirs in zip(some, program_statistics(kept, 5), strict=True):
+        _same(mine, theirs)
+
+
+def test_programs_a_float_cannot_tell_apart_are_two_programs(target: StoreTarget) -> None:
+    """Program ids are the contract's 64-bit ids (a controller's, imported): 2**53 and
+    2**53 + 1 are one number as a float, and two programs with their own runs in the store
+    as in the results."""
+    results = [
+        factories.result(n, time_ns=factories.T0 + n * SECOND_NS, program_id=2**53 + n % 2)
+        for n in range(1, 7)
+    ]
+    with ResultsStore(target) as store:
+        store.add([stored_result(result, "A", None, None, 1) for result in results])
+        stored = [statistics_of(c, 5) for c in program_columns(store, ResultsQuery()).programs]
+    read = program_statistics(results, 5)
+    assert [(p.program_id, p.runs) for p in stored] == [(2**53, 3), (2**53 + 1, 3)]
+    for mine, theirs in zip(stored, read, strict=True):
         _same(mine, theirs)
 
 

@@ -1,6 +1,6 @@
 """The store's versions: a new store is made whole, an older one migrated with nothing
 lost (a store of version 1, before the plant model, of version 2, before the part's
-source, and of version 3, before a final stage's pulses, among them), a newer one refused, a
+source, and of version 4, before a final stage's pulses, among them), a newer one refused, a
 reader of a current one takes no lock, writers starting together migrate once, a damaged
 file is named and left as it is."""
 
@@ -26,7 +26,7 @@ from shared.results import (
 )
 from shared.results.results_table import format_csv, format_table
 from tests.support import factories
-from tests.support.old_results_store import version_1_store, version_2_store, version_3_store
+from tests.support.old_results_store import version_1_store, version_2_store, version_4_store
 
 #: a later version, as the next boltwatch would bring one: a column added
 NEXT_VERSION = (*MIGRATIONS, ("ALTER TABLE tightenings ADD COLUMN operator TEXT",))
@@ -180,18 +180,18 @@ def test_an_unreachable_server_is_one_line_without_its_password() -> None:
     assert text.startswith("results store postgresql://boltwatch:***@127.0.0.1:1/results")
 
 
-def test_a_version_3_store_is_migrated_at_start_and_keeps_a_final_stages_pulses(
+def test_a_version_4_store_is_migrated_at_start_and_keeps_a_final_stages_pulses(
     target: StoreTarget,
 ) -> None:
-    """Version 4 adds ``pulses`` (a final stage's pulses back to the target): the rows stored
+    """Version 5 adds ``pulses`` (a final stage's pulses back to the target): the rows stored
     before say nothing (None, as a run without a final stage); new rows keep theirs, found by
     the table and the CSV."""
     old = [
         stored_result(factories.result(run), "A", f"/rec/{run}.mcap", "box", run) for run in (1, 2)
     ]
-    version_3_store(target, old)
+    version_4_store(target, old)
     with ResultsStore(target) as store:
-        assert (store.migrated_from, store.version) == (3, SCHEMA_VERSION)
+        assert (store.migrated_from, store.version) == (4, SCHEMA_VERSION)
         kept = store.find(ResultsQuery(oldest_first=True))
         assert kept == old and {s.result.pulses for s in kept} == {None}
         staged = factories.result(3, pulses=1, stop_reason="target_reached")

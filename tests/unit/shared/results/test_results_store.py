@@ -152,3 +152,22 @@ def test_a_reader_where_no_store_is_is_told_how_one_comes(target: StoreTarget) -
         ResultsStore(target, create=False)
     if target.sqlite_path is not None:
         assert not target.sqlite_path.exists()
+
+
+def test_a_part_id_is_stored_as_the_part_a_search_asks_for(target: StoreTarget) -> None:
+    """A result's part id as another tool wrote it (a recording not ours, a bridge): spaces
+    at either end (a scanner's padding) or none at all (""). The part search (the line's
+    page, ``results --part``) asks for a part without them, as every writer of ours names
+    one: stored so, the part is found; "" is no part (null)."""
+    from services.dashboard.part_search import part_of
+
+    with ResultsStore(target) as store:
+        _store(store, _result(1, part_id=" VIN7  "), _result(2, part_id=""), _result(3))
+        (found,) = store.find(ResultsQuery(part_id=part_of(" VIN7 ")))
+        assert found.result.run_id == 1 and found.result.part_id == "VIN7"
+        assert store.count(ResultsQuery(part_id="")) == 0
+        assert [s.result.part_id for s in store.find(ResultsQuery(oldest_first=True))] == [
+            "VIN7",
+            None,
+            None,
+        ]

@@ -3,12 +3,20 @@ rows have doubled, and what they change: a month of a line read by the time inde
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import pytest
 
 from shared.errors import StoreError
-from shared.results import ResultsQuery, ResultsStore, StoreTarget, results_store, stored_result
+from shared.results import (
+    ResultsDatabase,
+    ResultsQuery,
+    ResultsStore,
+    StoreTarget,
+    results_store,
+    stored_result,
+)
 from shared.results.sqlite_statistics import FEWEST_ROWS, keep_statistics, statistics_rows
 from tests.support import factories
 
@@ -132,3 +140,40 @@ def test_statistics_that_cannot_be_written_do_not_keep_a_result_from_the_store(
         _add(store, 0, FEWEST_ROWS // 3 + 1)
         assert store.count(ResultsQuery()) == 3 * (FEWEST_ROWS // 3 + 1)
     assert "planner statistics not written: results store: database is locked" in caplog.text
+
+
+def _without_statistics(target: StoreTarget) -> None:
+    """The store as one no writer of this boltwatch has opened since it filled up: a
+    ``results rebuild`` of an older boltwatch, a copy of a line's store (no ``sqlite_stat1``)."""
+    with ResultsStore(target) as store, store.database.transaction():
+        store.database.execute("DELETE FROM sqlite_stat1")
+    with ResultsDatabase(target) as database:
+        assert statistics_rows(database) == 0
+
+
+def test_a_store_only_readers_open_gets_its_statistics_from_the_first(tmp_path: Path) -> None:
+    target = StoreTarget(sqlite_path=tmp_path / "results.sqlite")
+    with ResultsStore(target) as store:
+        _add(store, 0, 500)
+    _without_statistics(target)
+    assert "tightenings_by_time" in _month_plan(target)  # the reader's own plan, already
+    with ResultsDatabase(target) as database:
+        assert statistics_rows(database) == 1500  # and every reader's after it
+
+
+def test_a_reader_waits_for_no_writer_to_write_statistics(tmp_path: Path) -> None:
+    """A writer holds the store's lock (a recorder's transaction, a migration): the reader
+    answers at once, planning with SQLite's guesses; the next reader writes them."""
+    target = StoreTarget(sqlite_path=tmp_path / "results.sqlite")
+    with ResultsStore(target) as store:
+        _add(store, 0, 500)
+    _without_statistics(target)
+    plans: list[str] = []
+    with ResultsDatabase(target) as writer, writer.transaction(lock=True):
+        reader = threading.Thread(target=lambda: plans.append(_month_plan(target)), daemon=True)
+        reader.start()
+        reader.join(5.0)
+        assert len(plans) == 1 and "tightenings_by_station" in plans[0]
+    with ResultsDatabase(target) as database:
+        assert statistics_rows(database) == 0
+    assert "tightenings_by_time" in _month_plan(target)

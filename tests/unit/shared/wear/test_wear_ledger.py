@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import sqlite3
 import threading
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -10,8 +12,9 @@ import pytest
 from services.cli.main import main
 from shared.contract import RunSummary
 from shared.errors import InputError
+from shared.wear import APPLICATION_ID, LEDGER_VERSION, WearLedger, ledger_path
+from shared.wear import COLUMNS as LEDGER_COLUMNS
 from shared.wear import CONTRACT_LIMITS as LIMITS
-from shared.wear import WearLedger, ledger_path
 from tests.support import factories
 
 T0_NS = 1_700_000_000_000_000_000
@@ -44,6 +47,76 @@ def test_totals_follow_eq_69_and_worst_runs_lead(tmp_path: Path) -> None:
     assert worst == [(2, 2.0), (3, 1.0), (1, 0.5)]
     assert wear.last_service_ns is None
     assert (wear.runs_since_service, wear.intensity_since_service) == (4, 3.75)
+
+
+def test_a_loosening_adds_its_intensity_but_is_none_of_the_tools_tightenings(
+    tmp_path: Path,
+) -> None:
+    with WearLedger(tmp_path / "wear.sqlite") as ledger:
+        for run_id, intensity in enumerate([0.5, 2.0], start=1):
+            assert ledger.add_run(summary(run_id, intensity), T0_NS, LIMITS)
+        loosening = replace(summary(3, 1.5), operation="loosening")
+        assert ledger.add_run(loosening, T0_NS, LIMITS)
+        assert not ledger.add_run(loosening, T0_NS, LIMITS)  # once, as any run
+        wear = ledger.tool(7)
+        interval = ledger.since_service(7)
+    assert (wear.runs, wear.loosenings, wear.total_intensity) == (2, 1, 4.0)
+    assert wear.intensity_per_run == 4.0 / 3  # of every run
+    assert (wear.runs_since_service, wear.intensity_since_service) == (2, 4.0)
+    assert (interval.runs, interval.intensity) == (2, 4.0)
+    assert [r.run_id for r in wear.worst_runs] == [2, 3, 1]
+
+
+#: the runs table as boltwatch made it before a run's operation (ledger version 2)
+RUNS_OF_VERSION_2 = """
+CREATE TABLE runs (
+    station TEXT NOT NULL, run_id INTEGER NOT NULL, tool_id INTEGER NOT NULL,
+    program_id INTEGER NOT NULL, tool_state TEXT NOT NULL, stop_reason TEXT,
+    events INTEGER NOT NULL, process_intensity REAL NOT NULL, started_ns INTEGER NOT NULL,
+    ended_ns INTEGER NOT NULL, recorded_ns INTEGER NOT NULL, PRIMARY KEY (station, run_id)
+);
+CREATE TABLE services (
+    id INTEGER PRIMARY KEY AUTOINCREMENT, tool_id INTEGER NOT NULL,
+    serviced_ns INTEGER NOT NULL, note TEXT NOT NULL
+);
+"""
+
+
+def test_a_ledger_made_before_operations_is_read_as_tightenings_and_migrated(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "wear.sqlite"
+    db = sqlite3.connect(path)
+    db.execute(f"PRAGMA application_id = {APPLICATION_ID}")
+    db.execute("PRAGMA user_version = 2")
+    db.execute("PRAGMA journal_mode=WAL")
+    db.executescript(RUNS_OF_VERSION_2)
+    for run_id, intensity in ((1, 1.0), (2, 2.0)):
+        s = summary(run_id, intensity)
+        db.execute(
+            "INSERT INTO runs VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            (s.station, s.run_id, s.tool_id, s.program_id, s.tool_state, s.stop_reason,
+             s.events, s.process_intensity, s.started_ns, s.ended_ns, T0_NS),
+        )  # fmt: skip
+    db.commit()
+    db.close()
+    with WearLedger(path, read_only=True) as reader:  # `boltwatch wear` on the old ledger
+        seven = reader.tool(7)
+    assert (seven.runs, seven.loosenings, seven.total_intensity) == (2, 0, 3.0)
+
+    with WearLedger(path) as ledger:  # a writer opens it: the column is added, nothing lost
+        assert ledger.add_run(replace(summary(3, 4.0), operation="loosening"), T0_NS, LIMITS)
+        seven = ledger.tool(7)
+    assert (seven.runs, seven.loosenings, seven.total_intensity) == (2, 1, 7.0)
+    db = sqlite3.connect(path)
+    try:
+        assert db.execute("PRAGMA user_version").fetchone() == (LEDGER_VERSION,)
+        columns = tuple(row[1] for row in db.execute("PRAGMA table_info(runs)"))
+        assert columns == LEDGER_COLUMNS["runs"]
+        operations = db.execute("SELECT run_id, operation FROM runs ORDER BY run_id").fetchall()
+    finally:
+        db.close()
+    assert operations == [(1, "tightening"), (2, "tightening"), (3, "loosening")]
 
 
 def test_a_repeated_summary_or_a_restart_never_counts_twice(tmp_path: Path) -> None:

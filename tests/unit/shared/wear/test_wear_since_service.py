@@ -2,8 +2,8 @@
 
 Checked against the ledger's own whole-history figures (``WearLedger.tool``)
 after every step of a random sequence: runs of several tools (late ones too,
-ended before a service), services, a second writer on the same file, a
-redelivered run, the ledger reopened.
+ended before a service; loosenings among them), services, a second writer on
+the same file, a redelivered run, the ledger reopened.
 """
 
 from __future__ import annotations
@@ -24,8 +24,10 @@ S_NS = 1_000_000_000
 TOOLS = (7, 8, 9)
 
 
-def summary(run_id: int, tool_id: int, ended_ns: int, intensity: float) -> RunSummary:
-    """A half-second run of ``tool_id`` at its own station."""
+def summary(
+    run_id: int, tool_id: int, ended_ns: int, intensity: float, loosening: bool = False
+) -> RunSummary:
+    """A half-second run of ``tool_id`` at its own station (a tightening, or a loosening)."""
     return factories.summary(
         run_id,
         station=f"st{tool_id}",
@@ -35,6 +37,7 @@ def summary(run_id: int, tool_id: int, ended_ns: int, intensity: float) -> RunSu
         samples=500,
         started_ns=ended_ns - S_NS // 2,
         ended_ns=ended_ns,
+        operation="loosening" if loosening else "tightening",
     )
 
 
@@ -69,7 +72,10 @@ def test_the_kept_interval_always_agrees_with_the_whole_history(seed: int, tmp_p
             else:
                 run_ids[tool_id] += 1
                 late_ns = rng.choice((0, 0, 0, 5 * S_NS))  # ended before a recent service
-                run = summary(run_ids[tool_id], tool_id, now_ns - late_ns, rng.uniform(0, 9))
+                loosening = rng.random() < 0.2  # its intensity counts, not as a tightening
+                run = summary(
+                    run_ids[tool_id], tool_id, now_ns - late_ns, rng.uniform(0, 9), loosening
+                )
                 assert rng.choice((ledger, other)).add_run(run, now_ns, LIMITS)
             if action > 0.97:
                 ledger.close()
