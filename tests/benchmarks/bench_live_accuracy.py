@@ -258,8 +258,18 @@ def offline(
 
 def staged_offline(program: Program, joint: Joint, torque_only: bool) -> StagedEnd:
     """The joint staged offline with the station's program: the rig's controller and the
-    core, on the rig the live runs had (its defaults)."""
-    return run_staged(joint.constants, program, RigSection(), joint.seed, torque_only)
+    core, on the rig the live runs had (its defaults), obeying each command within the
+    deciding sample's period as the live rig does (the core assumes a reaction of one
+    sample, the station's default)."""
+    return run_staged(
+        joint.constants,
+        program,
+        RigSection(),
+        joint.seed,
+        torque_only,
+        latency_samples=0,
+        reaction_samples=1.0,
+    )
 
 
 def report(rows: dict[str, list[float]], title: str, oracle_name: str) -> None:

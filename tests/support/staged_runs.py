@@ -5,8 +5,9 @@ final stage's speed, the hold, the pulses, its filtered shutoff at the target
 and its hard limits) on the rig's physics, and the predictor's pure core with
 the program's final stage, as a staged station decides. Every command the
 core gives (final, rundown, stop, pulse, finish) reaches the controller
-``latency_samples`` after the sample that decided it, as a StopCommand does in
-the stop-only benchmark (``bench_torque_only.run``). The tool's own halts are
+``latency_samples`` after the sample that decided it (1: as a StopCommand does
+in the stop-only benchmark, ``bench_torque_only.run``; 0: as the live rig
+obeys one, within the period of the deciding sample). The tool's own halts are
 told to the core as the acquisition tells them (``ToolStage`` holding).
 
 Used by ``tests/benchmarks/bench_torque_only.py`` and the tests of the final stage.
@@ -77,8 +78,14 @@ def run_staged(
     torque_only: bool,
     latency_samples: int = 1,
     max_samples: int | None = None,
+    reaction_samples: float | None = None,
 ) -> StagedEnd:
-    """Tighten one joint with ``program`` (it has a final stage) to the controller's end."""
+    """Tighten one joint with ``program`` (it has a final stage) to the controller's end.
+
+    ``latency_samples``: samples the tool still runs after the deciding sample before a
+    command takes effect; ``reaction_samples``: what the core assumes of it (default: the
+    same; a station's default is 1, while the live rig obeys within the deciding sample's
+    period: ``bench_live_accuracy.py`` compares with latency 0, reaction 1)."""
     assert program.final_stage is not None
     physics = TighteningPhysics(constants, program, rig, seed=seed)
     controller = RunController(
@@ -91,7 +98,9 @@ def run_staged(
             has_force=not torque_only,
             motor_speed_rad_s=program.motor_speed_rad_s,
             constants=constants,
-            reaction_samples=float(latency_samples),
+            reaction_samples=float(
+                latency_samples if reaction_samples is None else reaction_samples
+            ),
             final_stage=program.final_stage,
         )
     )
@@ -103,11 +112,12 @@ def run_staged(
     reason, detail = "", ""
     controller.start()
     for n in range(limit):
-        m = controller.tick()
-        while due and due[0][0] <= n:
+        # a command decided at sample k takes effect before sample k + latency + 1
+        while due and due[0][0] < n:
             _apply(controller, due.popleft()[1])
         if controller.finished:
             break
+        m = controller.tick()
         if controller.stage is ToolStageCode.HOLDING and not told_halted:
             told_halted = True
             if core.decision is None:
