@@ -1,12 +1,18 @@
 """The MCAP files of one station: one file per run, named as :mod:`shared.recordings.layout` says.
 
 A run file is opened by the run's ``ToolState(state="running")`` and holds
-everything the station publishes until the next run starts, so the run's
-summary, its last bus statistics and the idle time after it stay with it.
-A file that reaches ``max_file_bytes`` or ``max_file_duration_s`` (a run that
-never ends) continues in ``..._part<N>.mcap``. After a rotation the previous
-run's file stays open for ``late_grace_s`` so late messages carrying its
-run id (a RunSummary racing the next run's start) still land in it.
+what the station publishes from then on: the run, its result and its
+summary. It is finished (complete, under its name) ``late_grace_s`` after the
+run's summary (its ``RunSummary``), or at the next run's start, whichever
+comes first: a station that stops tightening has its last run's file readable
+a moment after the run, not at its next run. What the station says after that
+(its counters between runs) goes into an idle file (``<station>_idle_...``),
+which the next run's start finishes. A message of a run whose file was
+finished never opens a file named for that run again: it goes to the idle
+file. A file that reaches ``max_file_bytes`` or ``max_file_duration_s`` (a run
+that never ends) continues in ``..._part<N>.mcap``. After a rotation the
+previous run's file stays open for ``late_grace_s`` so late messages carrying
+its run id (a RunSummary racing the next run's start) still land in it.
 
 With ``rerun`` options each run file (not the idle ones) has a companion
 :class:`RerunSink` writing ``<same stem>.rrd``; it receives what its MCAP
@@ -75,6 +81,8 @@ class OpenRun:
     started: tuple[int | None, int]
     tool_id: int | None
     program_id: int | None
+    #: when the file is to be finished: a grace after its run's summary (None: at the next run)
+    finish_at_ns: int | None = None
 
 
 class StationFiles:
@@ -113,6 +121,10 @@ class StationFiles:
         self._rerun_sinks: dict[McapSink, RerunSink] = {}
         self._run_started: tuple[int | None, int] = (None, 0)  # (run_id, ToolState time_ns)
         self._started_runs: deque[int | None] = deque(maxlen=STARTED_RUNS_KEPT)
+        #: when the current run's file is finished: a grace after its summary
+        self._finish_at_ns: int | None = None
+        #: runs whose file was finished after their summary: never a file of theirs again
+        self._finished_runs: deque[int | None] = deque(maxlen=STARTED_RUNS_KEPT)
 
     def write(self, received: Received) -> None:
         now_ns = received.log_time_ns
@@ -134,12 +146,11 @@ class StationFiles:
             target.write(received)
         self.written += 1
         self.last_path = sink.path
-        if (
-            sink is self.current
-            and received.schema_name == channels.TOOL.schema_name
-            and received.message
-        ):
-            self._run_ended = received.message.state in _ENDED_STATES  # a refused one is raw
+        if sink is self.current and received.message is not None:
+            if received.schema_name == channels.TOOL.schema_name:
+                self._run_ended = received.message.state in _ENDED_STATES  # a refused one is raw
+            elif received.schema_name == channels.RUNS.schema_name and run_id == sink.run_id:
+                self._finish_at_ns = now_ns + self._limits.late_grace_ns  # the run is over
         self._flush_if_due(now_ns)
 
     def write_samples(self, samples: Sequence[Received]) -> None:
@@ -172,7 +183,8 @@ class StationFiles:
         """A file to write a message of ``run_id`` into (not a run's start): opened when there
         is none (the resumed run's after a fault), continued in a next part past the limits."""
         if self.current is None:
-            resumed_run_id, part = self._resume or (run_id, 1)
+            finished = run_id in self._finished_runs  # its file is done: the idle file's
+            resumed_run_id, part = self._resume or (None if finished else run_id, 1)
             self._open(resumed_run_id, now_ns, part)
         elif self._over_limits(now_ns):
             self._continue(now_ns)
@@ -182,11 +194,26 @@ class StationFiles:
             self.flush(now_ns)
 
     def tick(self, now_ns: int) -> None:
-        """Flush when the flush interval has passed; close the previous file after its grace."""
+        """Flush when the flush interval has passed; close the previous file after its grace,
+        and the current run's file a grace after its summary."""
         self._flush_if_due(now_ns)
         if self.previous is not None and now_ns >= self._previous_until_ns:
             self._close(self.previous)
             self.previous = None
+        finish_at_ns = self._finish_at_ns
+        if self.current is not None and finish_at_ns is not None and now_ns >= finish_at_ns:
+            self._finish_current()
+
+    def _finish_current(self) -> None:
+        """The current run is over (a grace after its summary): its file is finished now; what
+        comes next opens an idle file (raising: the owner abandons it)."""
+        current = self.current
+        assert current is not None
+        self._finish_at_ns = None
+        self._finished_runs.append(current.run_id)
+        self._close(current)
+        self.current = None
+        LOG.debug("%s finished a grace after its run's summary", current.path)
 
     def flush(self, now_ns: int) -> None:
         for sink in (self.current, self.previous):
@@ -218,8 +245,11 @@ class StationFiles:
             companion = self._rerun_sinks.pop(sink, None)
             if companion is not None:
                 companion.close()  # never raises
-        if self._resume is None and self.current is not None:
-            self._resume = (self.current.run_id, self._part + 1)
+        current = self.current
+        if self._resume is None and current is not None:
+            finished = current.run_id in self._finished_runs  # failed while being finished
+            self._resume = (None if finished else current.run_id, self._part + 1)
+        self._finish_at_ns = None
         self.previous = self.current = None
         return lost
 
@@ -241,7 +271,9 @@ class StationFiles:
             self._run_started,
             self._tool_id,
             self._program_id,
+            self._finish_at_ns,
         )
+        self._finish_at_ns = None
         return handed
 
     def adopt(self, run: OpenRun | None) -> None:
@@ -257,6 +289,7 @@ class StationFiles:
         self._run_ended = run.ended
         self._run_started = run.started
         self._tool_id, self._program_id = run.tool_id, run.program_id
+        self._finish_at_ns = run.finish_at_ns
         self._started_runs.append(run.sink.run_id)
 
     @property
@@ -276,6 +309,7 @@ class StationFiles:
             self._close(self.previous)
         self.previous = self.current
         self._previous_until_ns = now_ns + self._limits.late_grace_ns
+        self._finish_at_ns = None  # the previous file's grace is its own now
         self._open(run_id, now_ns, part=1)
 
     def _continue(self, now_ns: int) -> None:
