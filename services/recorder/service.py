@@ -156,7 +156,10 @@ class RecorderService:
             None
             if view_only
             else SpoolFiling(
-                SpoolKeeper(first.recordings_folder), self.recorder, self._file_received
+                SpoolKeeper(first.recordings_folder),
+                self.recorder,
+                self._file_received,
+                self._deferred,
             )
         )
         if not view_only:
@@ -327,7 +330,7 @@ class RecorderService:
         if received.message is None:
             return
         if self.spooling is not None and received.schema_name == _SPOOL:
-            self.spooling.keeper.on_stats(received.message)
+            self.spooling.on_stats(received.message)
         self._feed(received, recording, now_ns)
 
     def _feed(self, received: Received, recording: Path | None, now_ns: int) -> None:
@@ -346,6 +349,15 @@ class RecorderService:
                 self.wear.on_summary(message, now_ns)
         elif schema == channels.TOOL_DATA.schema_name and self.wear is not None:
             self.wear.on_tool_data(message, now_ns)
+
+    def _deferred(self, received: Received) -> None:
+        """A live message a hole of its station's spool will file later: a run's summary is
+        counted in the wear ledger now (it counts a run once: again when filed, nothing)."""
+        if received.schema_name == channels.RUNS.schema_name and received.message is not None:
+            if self.results is not None:
+                self.results.on_summary(received.message)
+            if self.wear is not None:
+                self.wear.on_summary(received.message, received.log_time_ns)
 
     def _file_batch(self, batch: Received, filed_ns: int, hole: StationFiles | None) -> None:
         """Each sample of a batch, then its events and intensities, as if each had come alone

@@ -134,6 +134,8 @@ class StationFiles:
             self._run_started = (received.run_id, received.message.time_ns)
             self._resume = (received.run_id, 1)  # should the disk fail before the file opens
             self._start_run(received.run_id, now_ns)
+        elif received.schema_name == channels.SAMPLES.schema_name:
+            self._open_or_continue(received.run_id, now_ns, samples_of=received.run_id)
         else:
             self._open_or_continue(received.run_id, now_ns)
         assert self.current is not None
@@ -159,7 +161,8 @@ class StationFiles:
         if not samples:
             return
         now_ns = samples[-1].log_time_ns
-        self._open_or_continue(samples[0].run_id, now_ns)
+        run_id = samples[0].message.run_id
+        self._open_or_continue(run_id, now_ns, samples_of=run_id)
         assert self.current is not None
         groups: list[tuple[McapSink, Sequence[Received]]] = [(self.current, samples)]
         previous = self.previous
@@ -179,9 +182,25 @@ class StationFiles:
         companion = self._rerun_sinks.get(sink)
         return (sink,) if companion is None else (sink, companion)
 
-    def _open_or_continue(self, run_id: int | None, now_ns: int) -> None:
+    def _open_or_continue(
+        self, run_id: int | None, now_ns: int, samples_of: int | None = None
+    ) -> None:
         """A file to write a message of ``run_id`` into (not a run's start): opened when there
-        is none (the resumed run's after a fault), continued in a next part past the limits."""
+        is none (the resumed run's after a fault), continued in a next part past the limits.
+        ``samples_of``: samples of that run; a run never started here (its start was lost:
+        a disk fault, a spool that lost it) gets a file of its own, not the current run's."""
+        if samples_of and self._unseen(samples_of):
+            LOG.info(
+                "%s: samples of run %d, whose start never came: a file of its own",
+                self.station,
+                samples_of,
+            )
+            self._started_runs.append(samples_of)
+            self._tool_id = self._program_id = None  # not known without the run's start
+            self._run_started = (samples_of, now_ns)
+            self._resume = (samples_of, 1)
+            self._start_run(samples_of, now_ns)
+            return
         if self.current is None:
             finished = run_id in self._finished_runs  # its file is done: the idle file's
             resumed_run_id, part = self._resume or (None if finished else run_id, 1)
@@ -296,6 +315,18 @@ class StationFiles:
     def unflushed_messages(self) -> int:
         """Messages of the open files not yet on the disk."""
         return sum(s.unflushed_messages for s in (self.previous, self.current) if s is not None)
+
+    def _unseen(self, run_id: int) -> bool:
+        """Samples of ``run_id`` while another run's file is open, a run never started (nor
+        finished) here."""
+        current, previous = self.current, self.previous
+        return (
+            current is not None
+            and current.run_id != run_id
+            and (previous is None or previous.run_id != run_id)
+            and run_id not in self._started_runs
+            and run_id not in self._finished_runs
+        )
 
     def _is_new_run(self, run_id: int | None) -> bool:
         """A run id starts once: its ToolState flipping back to running opens no new file."""

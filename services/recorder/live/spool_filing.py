@@ -8,7 +8,10 @@ back when it catches up), a live message the hole is not ready for waits in
 memory (:mod:`.waiting_live`) and is filed as soon as the hole reaches it,
 and a hole filled to its end has its files finished. A station's messages
 that carry no number (its spool's own counters) go where its run in progress
-is: an open hole's files while there is one.
+is: an open hole's files while there is one. A deferred message's number is
+never taken as gone while it waits here (the hole files it); a deferred run
+summary goes to the wear ledger at once (``on_deferred``: the ledger counts a
+run once, and its row waits in memory while the ledger cannot be written).
 """
 
 from __future__ import annotations
@@ -18,22 +21,38 @@ from collections.abc import Callable
 from services.recorder.live.recorder import Recorder
 from services.recorder.live.run_files import StationFiles
 from services.recorder.live.spool_keeper import SpoolKeeper
-from services.recorder.live.spool_order import Fate
+from services.recorder.live.spool_order import Fate, Held, nothing_held
 from services.recorder.live.waiting_live import WaitingLive
-from shared.contract import SeqMark, SpoolAck
+from shared.contract import SeqMark, SpoolAck, SpoolStats, channels
 from shared.recordings import Received
 
 #: files one received message at a time: (message, filed at, a hole's files or None: live)
 FileReceived = Callable[[Received, int, "StationFiles | None"], None]
+#: a run's records: kept in memory past the bound of deferred messages
+_RECORDS = frozenset(
+    channel.schema_name for channel in (channels.RUNS, channels.RESULTS, channels.CONTROLLER)
+)
+
+
+def _no_early(_received: Received) -> None:
+    return None
 
 
 class SpoolFiling:
     """Numbered messages of every spool a recorder hears, into its files."""
 
-    def __init__(self, keeper: SpoolKeeper, recorder: Recorder, file: FileReceived) -> None:
+    def __init__(
+        self,
+        keeper: SpoolKeeper,
+        recorder: Recorder,
+        file: FileReceived,
+        on_deferred: Callable[[Received], None] = _no_early,
+    ) -> None:
+        """``on_deferred``: given each live message deferred (not filed now)."""
         self.keeper = keeper
         self._recorder = recorder
         self._file = file
+        self._on_deferred = on_deferred
         self._waiting: dict[tuple[str, str], WaitingLive[tuple[Received, SeqMark]]] = {}
         #: a hole filed something since the last acknowledgement (a station drains its spool)
         self.refiling = False
@@ -48,6 +67,14 @@ class SpoolFiling:
             if ready is None:
                 return
             self._file_numbered(*ready, filed_ns)
+
+    def on_stats(self, stats: SpoolStats) -> None:
+        """A station's spool counters (what it no longer has is gone, but what waits here)."""
+        self.keeper.on_stats(stats, self._held(stats.station, stats.source))
+
+    def _held(self, station: str, source: str) -> Held:
+        waiting = self._waiting.get((station, source))
+        return nothing_held if waiting is None else waiting.held
 
     def unnumbered_files(self, station: str) -> StationFiles | None:
         """Where a message of ``station`` without a number goes: the files of a hole holding
@@ -68,14 +95,18 @@ class SpoolFiling:
 
     def _file_numbered(self, received: Received, mark: SeqMark, filed_ns: int) -> None:
         station = received.station
-        routing = self.keeper.route(station, mark, received.run_started)
+        routing = self.keeper.route(
+            station, mark, received.run_started, self._held(station, mark.source)
+        )
         hole = routing.hole
         if hole is not None and hole.files is None:
             hole.files = self._recorder.hole_files(station, hand_over=routing.opened)
         if routing.fate is Fate.DEFER:
             if not mark.again:
                 waiting = self._waiting.setdefault((station, mark.source), WaitingLive())
-                waiting.keep(mark.seq, (received, mark), len(received.payload))
+                record = received.schema_name in _RECORDS
+                waiting.keep(mark.seq, (received, mark), len(received.payload), record)
+                self._on_deferred(received)
             return
         if routing.fate is Fate.SKIP:
             return

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Final
 
-from services.recorder.live.spool_order import Hole, Routing, SpoolOrder
+from services.recorder.live.spool_order import Held, Hole, Routing, SpoolOrder, nothing_held
 from shared.contract import SeqMark, SeqRange, SpoolAck, SpoolStats
 from shared.files import describe_os_error, write_json_atomically
 from shared.spool import SeqRanges
@@ -76,19 +76,22 @@ class SpoolKeeper:
         self.save_errors = 0
         self.last_error: str | None = None
 
-    def route(self, station: str, mark: SeqMark, run_started: bool) -> Routing:
-        """Where message ``mark.seq`` goes (:meth:`SpoolOrder.route`)."""
+    def route(
+        self, station: str, mark: SeqMark, run_started: bool, held: Held = nothing_held
+    ) -> Routing:
+        """Where message ``mark.seq`` goes (:meth:`SpoolOrder.route`; ``held``: the numbers
+        of its source kept in memory)."""
         order = self._source(station, mark.source, mark.spool_id).order
-        return order.route(mark.seq, run_started, mark.kept_before)
+        return order.route(mark.seq, run_started, mark.kept_before, held)
 
     def filed_as(self, station: str, mark: SeqMark, routing: Routing) -> None:
         self._source(station, mark.source, mark.spool_id).order.filed_as(mark.seq, routing)
 
-    def on_stats(self, stats: SpoolStats) -> None:
-        """A station's spool counters: what it no longer has is gone."""
+    def on_stats(self, stats: SpoolStats, held: Held = nothing_held) -> None:
+        """A station's spool counters: what it no longer has (nor is ``held``) is gone."""
         source = self._source(stats.station, stats.source, stats.spool_id)
         oldest = stats.oldest_seq if stats.messages else stats.head_seq + 1
-        gone = source.order.station_has_from(oldest)
+        gone = source.order.station_has_from(oldest, held)
         if gone:
             LOG.error(
                 "%s: %d messages of its %s spool are gone (dropped to keep its bound) "
