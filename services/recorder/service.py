@@ -458,7 +458,9 @@ def _serve(
             skeleton.on_stop(Stop.DEVICE, foxglove.close)
         session = skeleton.open_session(loaded[0].config.zenoh)
         if not view_only:
-            refuse_stations_recorded_elsewhere(session, [s.station_id for s in loaded])
+            refuse_stations_recorded_elsewhere(
+                session, [s.station_id for s in loaded], loaded[0].config.zenoh.lease_s
+            )
             finish_unfinished(folder)  # what a crash left, before the results' catch-up reads
         live = start_rerun_live(args)
         if live is not None:
