@@ -142,6 +142,22 @@ class Recorder:
             return
         self._maybe_recovered(files, now_ns)
 
+    def live_files(self, station: str) -> StationFiles:
+        """The live files of ``station`` (where its messages go outside a spool's hole)."""
+        return self._files(station)
+
+    def end_message(
+        self, files: StationFiles, mark: tuple[str, int, int] | None, now_ns: int
+    ) -> None:
+        """``files`` filed a numbered message received at ``now_ns``
+        (:meth:`StationFiles.end_message`: its mark, then the flush held back meanwhile)."""
+        try:
+            files.end_message(mark)
+        except OSError as err:
+            self._fault(files, err, now_ns, unwritten=0)
+        else:
+            self._maybe_recovered(files, now_ns)
+
     def hole_files(self, station: str, hand_over: bool) -> StationFiles:
         """Files for a hole of ``station``'s spool (``hand_over``: they go on with the run the
         live files were recording, and the live files start afresh)."""

@@ -26,6 +26,12 @@ Below the free-space reserve (:mod:`.free_space`) no file is opened: the
 files open are finished and :class:`~.free_space.LowFreeSpaceError` (an
 ``OSError``) is raised, which the owner takes as a failing disk.
 
+A spooling station's numbered message (:mod:`.spool_filing`) is marked in the
+file it went into (:meth:`StationFiles.end_message`; a message split between
+two files is marked in neither: sent again after a kill, it may be filed
+twice, never lost), which writes the numbers it holds last in each of its
+chunks (:mod:`shared.recordings.mcap.spool_marks`).
+
 When the disk fails under a file (an :class:`OSError` out of any method),
 the owner (:class:`~services.recorder.live.recorder.Recorder`) calls
 :meth:`StationFiles.abandon`; the next write opens a new part of the same run.
@@ -43,7 +49,7 @@ from typing import TYPE_CHECKING
 from services.recorder.live.free_space import FreeSpace
 from shared.contract import channels
 from shared.recordings import FileMetadata, Received, Sink, file_path
-from shared.recordings.mcap import McapSink
+from shared.recordings.mcap import FileMarks, McapSink
 
 if TYPE_CHECKING:  # rerun is imported only when .rrd files are wanted
     from shared.recordings.rerun import RerunOptions, RerunSink
@@ -125,6 +131,10 @@ class StationFiles:
         self._finish_at_ns: int | None = None
         #: runs whose file was finished after their summary: never a file of theirs again
         self._finished_runs: deque[int | None] = deque(maxlen=STARTED_RUNS_KEPT)
+        #: the files written since :meth:`start_message` (a numbered message's)
+        self._touched: set[McapSink] = set()
+        self._in_message = False  # between start_message and end_message: no flush
+        self._last_now_ns = 0  # the log time of the last message written
 
     def write(self, received: Received) -> None:
         now_ns = received.log_time_ns
@@ -146,6 +156,7 @@ class StationFiles:
             sink = previous
         for target in self._sinks_of(sink):
             target.write(received)
+        self._touched.add(sink)
         self.written += 1
         self.last_path = sink.path
         if sink is self.current and received.message is not None:
@@ -174,8 +185,35 @@ class StationFiles:
         for sink, group in groups:
             for target in self._sinks_of(sink):
                 target.write_samples(group)
+            self._touched.add(sink)
             self.written += len(group)
         self._flush_if_due(now_ns)
+
+    def start_message(self) -> None:
+        """A numbered message is about to be filed, perhaps in several parts (a batch: its
+        samples, events, intensities): no flush, no chunk ends until :meth:`end_message`."""
+        self._touched.clear()
+        self._in_message = True
+        for sink in (self.current, self.previous):
+            if sink is not None:
+                sink.hold = True
+
+    def end_message(self, mark: tuple[str, int, int] | None) -> None:
+        """The message since :meth:`start_message` is filed: ``mark`` (source, spool id,
+        seq; None: not filed whole) is said by the file it went into (by none when it went
+        into two, or none); then what was held back: a full chunk ends, a due flush."""
+        if mark is not None and len(self._touched) == 1:
+            (filed_into,) = self._touched
+            if filed_into.marks is None:
+                filed_into.marks = FileMarks(self.station)
+            filed_into.marks.add(*mark)
+        self._touched.clear()
+        self._in_message = False
+        for sink in (self.current, self.previous):
+            if sink is not None:
+                sink.hold = False
+                sink.end_chunk_if_full()
+        self._flush_if_due(self._last_now_ns)
 
     def _sinks_of(self, sink: McapSink) -> tuple[Sink, ...]:
         """The run file's MCAP sink, then its companions (its ``.rrd``)."""
@@ -209,6 +247,9 @@ class StationFiles:
             self._continue(now_ns)
 
     def _flush_if_due(self, now_ns: int) -> None:
+        self._last_now_ns = max(self._last_now_ns, now_ns)
+        if self._in_message:
+            return  # after the message (end_message): its marks go with it
         if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
             self.flush(now_ns)
 
@@ -389,6 +430,7 @@ class StationFiles:
             fsync=self._limits.fsync,
             rename_when_complete=True,
         )
+        self.current.hold = self._in_message
         self._resume = None
         LOG.debug("opened %s", path)
         if self._rerun is not None and run_id is not None:

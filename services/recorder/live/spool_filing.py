@@ -8,7 +8,9 @@ back when it catches up), a live message the hole is not ready for waits in
 memory (:mod:`.waiting_live`) and is filed as soon as the hole reaches it,
 and a hole filled to its end has its files finished. A station's messages
 that carry no number (its spool's own counters) go where its run in progress
-is: an open hole's files while there is one. A deferred message's number is
+is: an open hole's files while there is one. Each numbered message filed is
+marked in its file (:meth:`StationFiles.end_message`), for a recorder that
+starts after this one is killed. A deferred message's number is
 never taken as gone while it waits here (the hole files it); a deferred run
 summary goes to the wear ledger at once (``on_deferred``: the ledger counts a
 run once, and its row waits in memory while the ledger cannot be written).
@@ -114,7 +116,15 @@ class SpoolFiling:
             self._recorder.hand_back(hole.files)
         files = hole.files if routing.fate is Fate.HOLE and hole is not None else None
         self.refiling = self.refiling or files is not None
-        self._file(received, filed_ns, files)
+        target = files if files is not None else self._recorder.live_files(station)
+        target.start_message()
+        filed = False
+        try:
+            self._file(received, filed_ns, files)
+            filed = True
+        finally:  # said in the file it went into
+            numbered = (mark.source, mark.spool_id, mark.seq) if filed else None
+            self._recorder.end_message(target, numbered, received.log_time_ns)
         self.keeper.filed_as(station, mark, routing)
         self._close_holes()
 
