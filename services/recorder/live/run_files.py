@@ -225,9 +225,12 @@ class StationFiles:
     ) -> None:
         """A file to write a message of ``run_id`` into (not a run's start): opened when there
         is none (the resumed run's after a fault), continued in a next part past the limits.
-        ``samples_of``: samples of that run; a run never started here (its start was lost:
-        a disk fault, a spool that lost it) gets a file of its own, not the current run's."""
-        if samples_of and self._unseen(samples_of):
+        ``samples_of``: samples of that run; in a hole's files (what a spool sends again, in
+        order), a run never started there (its start was lost: a disk fault, a spool that
+        lost it) gets a file of its own, not the current run's. Live, such samples go into
+        the current file (a recorder that joined mid-run; a station whose run ids flip must
+        not make a file per sample)."""
+        if samples_of and self.sent_again and self._unseen(samples_of):
             LOG.info(
                 "%s: samples of run %d, whose start never came: a file of its own",
                 self.station,
