@@ -5,8 +5,10 @@ the :class:`~services.recorder.live.spool_keeper.SpoolKeeper`) to the files of
 the :class:`~services.recorder.live.recorder.Recorder`: a hole gets files of
 its own (handed the run the live files were recording when it opened, handed
 back when it catches up), a live message the hole is not ready for waits in
-memory (:mod:`.waiting_live`) and is filed as soon as the hole reaches it,
-and a hole filled to its end has its files finished. A station's messages
+memory (:mod:`.waiting_live`) and is filed as soon as the hole reaches it
+(logged then: what was sent again before it came later than it did, and a
+file's log times follow its order), and a hole filled to its end has its
+files finished. A station's messages
 that carry no number (its spool's own counters) go where its run in progress
 is: an open hole's files while there is one. Each numbered message filed is
 marked in its file (:meth:`StationFiles.end_message`), for a recorder that
@@ -68,7 +70,11 @@ class SpoolFiling:
             ready = waiting.take(order.next_expected)
             if ready is None:
                 return
-            self._file_numbered(*ready, filed_ns)
+            kept, kept_mark = ready
+            # logged as filed now, after what was sent again before it: a file's log times
+            # follow its order (a reader playing it by log time meets its samples in order)
+            kept = kept._replace(log_time_ns=max(kept.log_time_ns, filed_ns))
+            self._file_numbered(kept, kept_mark, filed_ns)
 
     def on_stats(self, stats: SpoolStats) -> None:
         """A station's spool counters (what it no longer has is gone, but what waits here)."""
