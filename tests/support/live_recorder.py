@@ -102,12 +102,13 @@ def write_station_file(
     quality: Mapping[str, Any] | None = None,
     retention: Mapping[str, Any] | None = None,
     station: Mapping[str, Any] | None = None,
+    zenoh: Mapping[str, Any] | None = None,
 ) -> Path:
     """A copy of config/station.toml as a zenoh peer on the given endpoints.
 
     ``can.dbc`` and ``station.joint`` point at the repository's files;
     ``recorder.folder`` is ``recordings``; ``recorder`` overrides recorder keys,
-    ``station`` station keys;
+    ``station`` station keys, ``zenoh`` zenoh keys (``mode``, ``lease_s``);
     ``quality``: the ``[quality]`` section; ``retention``: the ``[retention]`` section.
     """
     with STATION_FILE.open("rb") as handle:
@@ -116,7 +117,12 @@ def write_station_file(
     data["station"] = {**data["station"], **(station or {})}
     data["station"]["joint"] = str((base / data["station"]["joint"]).resolve())
     data["can"]["dbc"] = str((base / data["can"]["dbc"]).resolve())
-    data["zenoh"] = {"mode": "peer", "connect": list(connect), "listen": list(listen)}
+    data["zenoh"] = {
+        "mode": "peer",
+        "connect": list(connect),
+        "listen": list(listen),
+        **(zenoh or {}),
+    }
     data["recorder"] = {**data["recorder"], "folder": str(recordings), **(recorder or {})}
     if quality is not None:
         data["quality"] = dict(quality)
