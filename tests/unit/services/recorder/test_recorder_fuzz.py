@@ -9,7 +9,8 @@ byte and in order, on its key's raw channel of the MCAP files; the log holds
 no traceback and no line per payload: the first refusal at once, then at most
 one line per ``INTERVAL_S`` (10 s) saying how many it stands for (one line when
 the fuzz is quick, one every 10 s of it on a loaded machine, where it takes a
-minute and more); afterwards a good run is recorded and the wear query answers. The long run: ``tests/benchmarks/fuzz_services.py``.
+minute and more); afterwards a good run is recorded and the wear query answers.
+The long run: ``tests/benchmarks/fuzz_services.py``.
 """
 
 from __future__ import annotations
