@@ -38,7 +38,7 @@ import zenoh
 from services.cli.station_supervisor import stop_process
 from shared.config import load_station
 from shared.contract import RunSummary, Sample, channels, decode
-from shared.recordings.mcap import RecordingScan
+from shared.recordings.mcap import RAW_ENCODING, RecordingScan
 from shared.runtime import zenoh_config
 from tests.support.listener import Listener
 from tests.support.station_files import free_tcp_port, serve, write_station
@@ -83,6 +83,8 @@ def recorded(folder: Path) -> tuple[dict[int, list[int]], dict[int, RunSummary]]
     for path in sorted(folder.rglob("*.mcap")):
         scan = RecordingScan(path)
         for _, channel, message in scan.messages():
+            # a raw channel holds what the recorder refused, byte for byte: none is sent here
+            assert channel.message_encoding != RAW_ENCODING, (path, channel, message.data)
             if channel.topic.endswith("/samples"):
                 sample = decode(Sample, message.data)
                 sequences.setdefault(sample.run_id, []).append(sample.sequence)
