@@ -247,6 +247,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.full:
         args.runs = -(-FULL_SAMPLES // (args.stations * args.run_samples))
+    # SIGTERM stops the children too (the line's processes are stopped in a finally)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(f"{parser.prog}: stopped by SIGTERM"))
     if args.netns and (why := unavailable_reason()) is not None:
         raise SystemExit(f"--netns: {why}")
     with tempfile.TemporaryDirectory(prefix="bench-stress-") as tmp:

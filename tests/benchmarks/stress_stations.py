@@ -175,8 +175,6 @@ def main(argv: list[str] | None = None) -> int:
     depths = [station.spool_depth() for station in stations]
     while any(d for d in depths) and time.monotonic() < deadline and not stopped.is_set():
         time.sleep(1.0)
-        for station in stations:
-            station.bus()  # the recorder's loss count sees the last samples
         depths = [station.spool_depth() for station in stations]
     drained_s = time.monotonic() - started
     manifest = {station.station: station.close() for station in stations}
