@@ -55,7 +55,9 @@ RECONNECT_PERIOD_MAX_S = 0.5
 START_TIMEOUT_S = 30.0
 RUN_TIMEOUT_S = 30.0
 RIG_RUN = re.compile(r"run (\d+): (\w+) by (\w+), force (\d+) N, .* (\d+) samples, ")
-LINK_EVENT_SAMPLES = 20  # 20 ms at 1 kHz: how far the link flag may lag the link
+#: how far the acquisition's link flag may lag the link, in samples at 1 kHz: zenoh's event
+#: callback waits for the GIL, a few ms on a quiet machine, 47 ms seen at load 17
+LINK_EVENT_SAMPLES = 100
 
 
 #: what the test hears of the station on zenoh
@@ -238,11 +240,15 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
         assert run.stop_source == "shutoff_force", run
         assert abs(run.force_n - TARGET_FORCE_N) / TARGET_FORCE_N < 0.05, run
     # After the outage every run is recorded whole and the predictor decides again; its
-    # StopCommand reaches the tool (a target_reached decision may tie with the rig's shutoff).
+    # StopCommand reaches the tool (a target_reached decision may tie with the rig's shutoff,
+    # and on a loaded machine the line's predictor may decide after the tool stopped by
+    # itself: a late decision, seen at load 15; the awaited run was stopped early by it).
     after = [r for r in runs if r > max(outage_runs)]
     assert after, f"no run after the outage: {runs}"
     for run_id in after:
         assert missing[run_id] <= stats.missed_samples, (run_id, missing)
-        assert run_id in summaries and summaries[run_id].stop_reason is not None, run_id
+        summary = summaries.get(run_id)
+        assert summary is not None, run_id
+        assert summary.stop_reason is not None or summary.late_decision is not None, summary
     early = [r for r in after if summaries[r].stop_reason == "plateau_closest"]
     assert early and all(runs[r].stop_source == "stop_command" for r in early), runs
