@@ -14,7 +14,8 @@ batches, its spool on, or off for every ``--no-spool-every``-th; every
 is on the line does) split over ``--generators`` processes, and ``--real`` real
 stations (rig and acquisition with its edge predictor on a ``udp_multicast`` CAN
 bus, spool on). Every ``--restart-every-s`` the router is killed (SIGKILL) and
-started again ``--outage-s`` later. With ``--netns`` the line server and each
+started again ``--outage-s`` later, while the stations publish (not while their spools
+drain afterwards). With ``--netns`` the line server and each
 generator and real station are hosts of their own
 (:class:`tests.support.netns_line.Line`) and every ``--cut-every-s`` one
 generator's cable is pulled for ``--cut-s``.
@@ -103,6 +104,38 @@ class StressLine:
         for name in reversed(list(self.processes)):
             self.stop(name)
 
+    def chaos(self, args: argparse.Namespace, endpoint: str) -> tuple[int, int]:
+        """Kill and restart the router, pull cables (with a line), while the generators
+        publish; then wait for them to drain their spools and end. (restarts, cuts)"""
+        generators = [f"generator{g}" for g in range(args.generators)]
+        published = [self.folder / f"manifest{g}.published" for g in range(args.generators)]
+        next_restart = time.monotonic() + args.restart_every_s
+        next_cut = time.monotonic() + args.cut_every_s
+        restarts = cuts = 0
+        while any(self.processes[g].poll() is None for g in generators):
+            time.sleep(0.2)
+            if all(path.exists() for path in published):
+                continue  # every run published: the spools drain in peace
+            now = time.monotonic()
+            if args.restart_every_s and now >= next_restart:
+                self.processes["router"].send_signal(signal.SIGKILL)
+                self.processes["router"].wait(10)
+                time.sleep(args.outage_s)
+                self.serve("router", None, ["router", "--listen", endpoint])
+                restarts += 1
+                # the next outage is counted from the router's start: on a loaded machine a
+                # Python process takes seconds to listen
+                self.wait_log("router", "router listening", START_TIMEOUT_S, restarts + 1)
+                next_restart = time.monotonic() + args.restart_every_s
+            if self.line is not None and args.cut_every_s and now >= next_cut:
+                host = cuts % args.generators + 1
+                self.line.cut(host)
+                time.sleep(args.cut_s)
+                self.line.reconnect(host)
+                cuts += 1
+                next_cut = time.monotonic() + args.cut_every_s
+        return restarts, cuts
+
 
 def every(paths: Sequence[Path], step: int, offset: int) -> list[str]:
     """The ids of every ``step``-th station file from the ``offset``-th (none: step 0)."""
@@ -129,7 +162,6 @@ def _run(args: argparse.Namespace, folder: Path, line: Line | None) -> dict[str,
     no_spool = every(synthetic, args.no_spool_every, args.no_spool_every - 1)
     per_sample = every(synthetic, args.per_sample_every, 0)
     stress = StressLine(folder, line)
-    restarts = cuts = 0
     started = time.monotonic()
     try:
         stress.serve("router", None, ["router", "--listen", endpoint])
@@ -150,31 +182,7 @@ def _run(args: argparse.Namespace, folder: Path, line: Line | None) -> dict[str,
                        *mine, "--runs", str(args.runs), "--run-samples", str(args.run_samples),
                        "--no-spool", *no_spool, "--per-sample", *per_sample]  # fmt: skip
             stress.start(f"generator{g}", g + 1, command)
-        generators = [f"generator{g}" for g in range(args.generators)]
-        next_restart = time.monotonic() + args.restart_every_s
-        next_cut = time.monotonic() + args.cut_every_s
-        cut_host = 0
-        while any(stress.processes[g].poll() is None for g in generators):
-            now = time.monotonic()
-            if args.restart_every_s and now >= next_restart:
-                stress.processes["router"].send_signal(signal.SIGKILL)
-                stress.processes["router"].wait(10)
-                time.sleep(args.outage_s)
-                stress.serve("router", None, ["router", "--listen", endpoint])
-                restarts += 1
-                # the next outage is counted from the router's start: on a loaded machine a
-                # Python process takes seconds to listen
-                stress.wait_log("router", "router listening", START_TIMEOUT_S, restarts + 1)
-                next_restart = time.monotonic() + args.restart_every_s
-            if line is not None and args.cut_every_s and now >= next_cut:
-                host = cut_host % args.generators + 1
-                line.cut(host)
-                time.sleep(args.cut_s)
-                line.reconnect(host)
-                cuts += 1
-                cut_host += 1
-                next_cut = time.monotonic() + args.cut_every_s
-            time.sleep(0.2)
+        restarts, cuts = stress.chaos(args, endpoint)
         for path in real:
             stress.processes[f"{path.stem}-rig"].wait(timeout=args.real_runs * 30)
         time.sleep(args.settle_s)  # real stations' spools drained, last batches filed

@@ -19,7 +19,9 @@ for its publisher's thread to catch up every :data:`CATCH_UP_SAMPLES` samples
 (:meth:`QueuedPublisher.call`), so its queue never nears its bound and no sample
 is dropped for want of room. At the end every spool is drained (the recorder
 has acknowledged all it holds) before the process exits, and the manifest
-(JSON) says, per station, each run's id and sample count and whether it spooled.
+(JSON) says, per station, each run's id and sample count and whether it spooled
+(``MANIFEST`` with the suffix ``.published`` is written once every run is
+handed to the publishers, before the drain).
 """
 
 from __future__ import annotations
@@ -171,6 +173,7 @@ def main(argv: list[str] | None = None) -> int:
         for station in stations:
             station.run(rows)
     published_s = time.monotonic() - started
+    args.manifest.with_suffix(".published").write_text(f"{published_s:.1f}\n")
     deadline = time.monotonic() + DRAIN_TIMEOUT_S
     depths = [station.spool_depth() for station in stations]
     while any(d for d in depths) and time.monotonic() < deadline and not stopped.is_set():
