@@ -11,14 +11,14 @@ One router and one ``serve recorder`` (MCAP only; ``--rerun``: and Rerun) for
 each a real :class:`~shared.runtime.queued_publisher.QueuedPublisher` with
 batches, its spool on, or off for every ``--no-spool-every``-th; every
 ``--per-sample-every``-th puts each sample alone, as a station whose predictor
-is on the line does) split over ``--generators`` processes, and ``--real`` real
-stations (rig and acquisition with its edge predictor on a ``udp_multicast`` CAN
-bus, spool on). Every ``--restart-every-s`` the router is killed (SIGKILL) and
-started again ``--outage-s`` later, while the stations publish (not while their spools
-drain afterwards). With ``--netns`` the line server and each
-generator and real station are hosts of their own
-(:class:`tests.support.netns_line.Line`) and every ``--cut-every-s`` one
-generator's cable is pulled for ``--cut-s``.
+is on the line does) split over ``--generators`` processes and publishing
+``--rate`` samples a second in all, and ``--real`` real stations (rig and
+acquisition with its edge predictor on a ``udp_multicast`` CAN bus, spool on).
+Every ``--restart-every-s`` the router is killed (SIGKILL) and started again
+``--outage-s`` later, while the stations publish (not while their spools drain
+afterwards). With ``--netns`` the line server and each generator and real
+station are hosts of their own (:class:`tests.support.netns_line.Line`) and
+every ``--cut-every-s`` one generator's cable is pulled for ``--cut-s``.
 
 Afterwards every message of every MCAP file is read back and checked
 (:mod:`tests.benchmarks.recording_check`): each decodes with its channel's
@@ -180,6 +180,7 @@ def _run(args: argparse.Namespace, folder: Path, line: Line | None) -> dict[str,
             mine = [str(p) for p in synthetic[g :: args.generators]]
             command = ["-m", "tests.benchmarks.stress_stations", str(folder / f"manifest{g}.json"),
                        *mine, "--runs", str(args.runs), "--run-samples", str(args.run_samples),
+                       "--rate", str(args.rate / args.generators),
                        "--no-spool", *no_spool, "--per-sample", *per_sample]  # fmt: skip
             stress.start(f"generator{g}", g + 1, command)
         restarts, cuts = stress.chaos(args, endpoint)
@@ -239,6 +240,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=10, help="runs per synthetic station")
     parser.add_argument("--run-samples", type=int, default=1000, help="samples a run")
     parser.add_argument("--full", action="store_true", help=f"{FULL_SAMPLES:,} samples in all")
+    parser.add_argument(
+        "--rate", type=float, default=10_000.0, help="samples a second, all synthetic stations"
+    )
     parser.add_argument("--generators", type=int, default=2, help="processes of the stations")
     parser.add_argument("--no-spool-every", type=int, default=5, help="0: every one spools")
     parser.add_argument("--per-sample-every", type=int, default=5, help="0: every one puts batches")

@@ -14,8 +14,10 @@ in the batch in progress), ``ToolState`` running and done around each run and
 :class:`BusStats` with the count of samples published. Only the CAN bus and
 the predictor are left out: what reaches zenoh is what an acquisition puts.
 
-The stations run as fast as the machine lets them, not at 1 kHz: each waits
-for its publisher's thread to catch up every :data:`CATCH_UP_SAMPLES` samples
+The stations publish side by side, sample by sample, at ``--rate`` samples a
+second in all (not 1 kHz each: 50 stations of real acquisitions do not fit on
+two cores; 0: as fast as the machine lets them), and each waits for its
+publisher's thread to catch up every :data:`CATCH_UP_SAMPLES` samples
 (:meth:`QueuedPublisher.call`), so its queue never nears its bound and no sample
 is dropped for want of room. At the end every spool is drained (the recorder
 has acknowledged all it holds) before the process exits, and the manifest
@@ -50,6 +52,8 @@ from tests.support.synthetic_runs import staircase
 #: a station waits for its publisher's thread at most this many samples behind
 CATCH_UP_SAMPLES = 2_000
 EVENT_EVERY_SAMPLES = 25
+#: the pace is kept every this many samples of each station
+PACE_SAMPLES = 50
 DRAIN_TIMEOUT_S = 600.0
 
 
@@ -82,24 +86,35 @@ class StressStation:
         self._event: StickSlipEvent = template("events", self.station, now_ns, first_run_id)
         self._intensity: Intensity = template("intensity", self.station, now_ns, first_run_id)
 
-    def run(self, rows: list[tuple[float, float, float]]) -> None:
-        """Publish one whole run."""
+    def start_run(self) -> int:
+        """Tool running: a new run; its id."""
         run_id = self.next_run_id
         self.next_run_id += 1
+        self.publisher.publish(
+            ToolState(self.station, run_id, self.tool_id, 1, "running", time.time_ns())
+        )
+        return run_id
+
+    def sample(self, run_id: int, sequence: int, row: tuple[float, float, float]) -> None:
+        """One sample of the run; an event and its intensity every 25 (in its batch)."""
         publish = self.publisher.publish
-        station = self.station
-        publish(ToolState(station, run_id, self.tool_id, 1, "running", time.time_ns()))
-        for sequence, (torque, angle, force) in enumerate(rows):
-            now_ns = time.time_ns()
-            publish(Sample(station, run_id, sequence, now_ns, torque, angle, force, sequence / 1e3))
-            if sequence % EVENT_EVERY_SAMPLES == EVENT_EVERY_SAMPLES - 1:
-                publish(dataclasses.replace(self._event, run_id=run_id, time_ns=now_ns))
-                publish(dataclasses.replace(self._intensity, run_id=run_id, time_ns=now_ns))
-            if sequence % CATCH_UP_SAMPLES == CATCH_UP_SAMPLES - 1:
-                self.catch_up()
-        self.published += len(rows)
-        self.runs[run_id] = len(rows)
-        publish(ToolState(station, run_id, self.tool_id, 1, "done", time.time_ns()))
+        now_ns = time.time_ns()
+        torque, angle, force = row
+        time_s = sequence / 1e3
+        publish(Sample(self.station, run_id, sequence, now_ns, torque, angle, force, time_s))
+        if sequence % EVENT_EVERY_SAMPLES == EVENT_EVERY_SAMPLES - 1:
+            publish(dataclasses.replace(self._event, run_id=run_id, time_ns=now_ns))
+            publish(dataclasses.replace(self._intensity, run_id=run_id, time_ns=now_ns))
+        if sequence % CATCH_UP_SAMPLES == CATCH_UP_SAMPLES - 1:
+            self.catch_up()
+
+    def end_run(self, run_id: int, samples: int) -> None:
+        """Tool done, and the bus counters with the run's samples."""
+        self.published += samples
+        self.runs[run_id] = samples
+        self.publisher.publish(
+            ToolState(self.station, run_id, self.tool_id, 1, "done", time.time_ns())
+        )
         self.bus()
 
     def catch_up(self) -> None:
@@ -150,6 +165,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("files", nargs="+", type=Path)
     parser.add_argument("--runs", type=int, required=True, help="runs per station")
     parser.add_argument("--run-samples", type=int, default=1000)
+    parser.add_argument(
+        "--rate", type=float, default=0.0, help="samples a second, all its stations (0: at once)"
+    )
     parser.add_argument("--no-spool", nargs="*", default=[], help="station ids without spool")
     parser.add_argument(
         "--per-sample", nargs="*", default=[], help="station ids that put each sample alone"
@@ -167,11 +185,19 @@ def main(argv: list[str] | None = None) -> int:
         stations.append(StressStation(loaded, spool, batches, first_run_id))
     time.sleep(2.0)  # the router learns the subscribers
     started = time.monotonic()
+    per_s = args.rate / len(stations) if args.rate else 0.0  # samples a second, each station
     for _ in range(args.runs):
         if stopped.is_set():
             break
-        for station in stations:
-            station.run(rows)
+        run_ids = [station.start_run() for station in stations]
+        run_started = time.monotonic()
+        for sequence, row in enumerate(rows):  # the stations side by side, sample by sample
+            for station, run_id in zip(stations, run_ids, strict=True):
+                station.sample(run_id, sequence, row)
+            if per_s and sequence % PACE_SAMPLES == 0:
+                time.sleep(max(0.0, run_started + sequence / per_s - time.monotonic()))
+        for station, run_id in zip(stations, run_ids, strict=True):
+            station.end_run(run_id, len(rows))
     published_s = time.monotonic() - started
     args.manifest.with_suffix(".published").write_text(f"{published_s:.1f}\n")
     deadline = time.monotonic() + DRAIN_TIMEOUT_S
