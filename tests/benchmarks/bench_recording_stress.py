@@ -202,10 +202,12 @@ def _run(args: argparse.Namespace, folder: Path, line: Line | None) -> dict[str,
     check = check_recordings(base.parent / "recordings", published)
     result = check.summary()
     spooled_missing = {s: n for s, n in check.missing.items() if s not in no_spool and n}
-    real_lost = {}
+    real_lost: dict[str, int | None] = {}
+    real_recorded: dict[str, int] = {}
     for path in real:
         bus = check.last_bus.get(path.stem)
         recorded = sum(m.count(1) for (s, _), m in check.seen.items() if s == path.stem)
+        real_recorded[path.stem] = recorded
         real_lost[path.stem] = None if bus is None else bus.samples - recorded
     recorder_log = (folder / "recorder.log").read_text(errors="replace")
     refused_line = re.findall(r"refused payloads per station, recorded raw: (.*)", recorder_log)
@@ -221,6 +223,7 @@ def _run(args: argparse.Namespace, folder: Path, line: Line | None) -> dict[str,
             int(str(m["dropped"])) + int(str(m["failed"])) for m in manifest.values()
         ),
         "missing_spooled": spooled_missing,
+        "real_stations_recorded": real_recorded,
         "real_stations_lost": real_lost,
         "elapsed_s": round(elapsed_s, 1),
         "samples_per_s": round(check.samples / elapsed_s),
