@@ -7,7 +7,6 @@ benchmarks; no product code imports it.
 
 from __future__ import annotations
 
-import socket
 import threading
 import time
 import tomllib
@@ -21,6 +20,7 @@ from services.recorder.service import RecorderService
 from shared.config import AnyStation, ControllerStation, LoadedStation, toml_writer
 from shared.contract import encode, keys
 from shared.runtime import ServiceSkeleton
+from tests.support.free_ports import free_tcp_port
 from tests.support.paths import STATION_FILE
 
 WAIT_S = 10.0  # upper bound on waits for zenoh; tests never assert on time
@@ -87,10 +87,9 @@ class RunningRecorder:
 
 
 def free_port() -> int:
-    """A TCP port on 127.0.0.1 that nothing listens on right now."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
+    """A TCP port on 127.0.0.1 that nothing listens on right now, and that the kernel hands to
+    no other process meanwhile (:mod:`tests.support.free_ports`)."""
+    return free_tcp_port()
 
 
 def write_station_file(
