@@ -162,7 +162,10 @@ class RecorderService:
             None
             if view_only
             else SpoolFiling(
-                SpoolKeeper(first.recordings_folder), self.recorder, self._file_received
+                SpoolKeeper(first.recordings_folder),
+                self.recorder,
+                self._file_received,
+                self._deferred,
             )
         )
         if not view_only:
@@ -345,7 +348,7 @@ class RecorderService:
         if received.message is None:
             return
         if self.spooling is not None and received.schema_name == _SPOOL:
-            self.spooling.keeper.on_stats(received.message)
+            self.spooling.on_stats(received.message)
         self._feed(received, recording, now_ns)
 
     def _feed(self, received: Received, recording: Path | None, now_ns: int) -> None:
@@ -366,6 +369,15 @@ class RecorderService:
             self.wear.on_tool_data(message, now_ns)
         elif schema == _PART and self.last_parts is not None:
             self.last_parts.on_scan(message, received.station)
+
+    def _deferred(self, received: Received) -> None:
+        """A live message a hole of its station's spool will file later: a run's summary is
+        counted in the wear ledger now (it counts a run once: again when filed, nothing)."""
+        if received.schema_name == channels.RUNS.schema_name and received.message is not None:
+            if self.results is not None:
+                self.results.on_summary(received.message)
+            if self.wear is not None:
+                self.wear.on_summary(received.message, received.log_time_ns)
 
     def _file_batch(self, batch: Received, filed_ns: int, hole: StationFiles | None) -> None:
         """Each sample of a batch, then its events and intensities, as if each had come alone
@@ -466,7 +478,9 @@ def _serve(
             skeleton.on_stop(Stop.DEVICE, foxglove.close)
         session = skeleton.open_session(loaded[0].config.zenoh)
         if not view_only:
-            refuse_stations_recorded_elsewhere(session, [s.station_id for s in loaded])
+            refuse_stations_recorded_elsewhere(
+                session, [s.station_id for s in loaded], loaded[0].config.zenoh.lease_s
+            )
             finish_unfinished(folder)  # what a crash left, before the results' catch-up reads
         live = start_rerun_live(args)
         if live is not None:

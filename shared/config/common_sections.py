@@ -112,6 +112,14 @@ class ZenohSection(StrictModel):
         le=60,
         description="longest pause between two attempts to reach a lost router (never gives up)",
     )
+    lease_s: float = Field(
+        default=10.0,
+        ge=1,
+        le=600,
+        description="how long the line keeps the session of a service that went silent (its "
+        "host lost power, its cable was cut) and with it its liveliness tokens: zenoh's "
+        "transport/link/tx/lease",
+    )
     tls_root_ca: Path | None = Field(
         default=None, description="CA certificate (PEM) of the line, relative to this station file"
     )

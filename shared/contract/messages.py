@@ -45,6 +45,7 @@ from shared.contract.part_messages import (  # noqa: F401  (re-exported: one imp
 from shared.contract.spool_messages import (  # noqa: F401  (re-exported: one import for every message)
     SeqRange,
     SpoolAck,
+    SpoolFiled,
     SpoolStats,
 )
 from shared.contract.stage_messages import (  # noqa: F401  (re-exported: one import for every message)

@@ -15,7 +15,11 @@ spool holds before it, so the recorder knows every number between is gone
   per spooling source): what it has written to disk and flushed; the station
   deletes it from its spool and sends again what is not acknowledged;
 - :class:`SpoolStats` (the station, ``boltwatch/<st>/spool``, once a second):
-  the spool's depth, what it sends again, what it had to drop.
+  the spool's depth, what it sends again, what it had to drop;
+- :class:`SpoolFiled` (never put on the line: the recorder writes it into its
+  own files, last in each chunk): the numbers of one spool a file holds, which a
+  restarted recorder reads so that what the station sends again of it is not
+  filed twice.
 """
 
 from __future__ import annotations
@@ -125,3 +129,17 @@ class SpoolStats:
     dropped_samples: Count  # samples dropped to keep the bound (the oldest first)
     dropped_messages: Count  # messages dropped to keep the bound
     acknowledged_ns: TimeNs | None  # when the last acknowledgement came (None: never)
+
+
+@dataclass(frozen=True, slots=True)
+class SpoolFiled:
+    """The numbers of one spooling source a recording file holds (so far, in its chunks up
+    to this one): written by the recorder into its files, never put on the line."""
+
+    __pydantic_config__ = WIRE_CONFIG
+
+    station: StationId
+    source: SpoolSource
+    spool_id: Count
+    time_ns: TimeNs
+    ranges: list[SeqRange] = field(default_factory=list)

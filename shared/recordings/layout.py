@@ -3,7 +3,7 @@
 Layout (UTC)::
 
     <recordings>/<station>/<YYYY-MM-DD>/<station>_run<run_id>_<HHMMSS>[_part<N>][_<copy>].mcap
-    <recordings>/<station>/<YYYY-MM-DD>/<station>_idle_<HHMMSS>.mcap   before a station's first run
+    <recordings>/<station>/<YYYY-MM-DD>/<station>_idle_<HHMMSS>.mcap   between runs, before the first
     ... and beside a run's .mcap its Rerun recording, the same stem with .rrd
 
 While the recorder writes a run's file it is named ``.<name>.writing`` (hidden,
@@ -175,7 +175,7 @@ def _note_loop(path: Path, loops: list[Path] | None) -> None:
 class FileName:
     """What a recording's name says: :func:`file_path` read back."""
 
-    run_id: int | None  # None: an idle file (before the station's first run)
+    run_id: int | None  # None: an idle file (between runs, before the station's first)
     opened: datetime  # UTC, to the second: its day folder and ``HHMMSS``
     part: int  # 1, or N of ``_part<N>``
     copy: int  # 1, or N of ``_<N>`` (a name taken already)

@@ -220,6 +220,10 @@ class QueuedPublisher:
                 self._spool_due_s = now_s + SPOOL_TICK_S
                 for spooled in spool.tick():
                     self._resend(spooled)
+        except (sqlite3.Error, OSError, zenoh.ZError) as err:
+            self.spool_errors += 1
+            self._log_spool("spool of %s: %s", self._station_id, err)
+        try:  # also when the work failed: the recorder learns what the spool no longer has
             if now_s >= self._stats_due_s:
                 self._stats_due_s = now_s + SPOOL_STATS_S
                 self._publisher(channels.SPOOL).put(encode(spool.stats()))

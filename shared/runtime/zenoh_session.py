@@ -62,11 +62,14 @@ def zenoh_config(
     reconnect_period_max_ms: int = RECONNECT_PERIOD_MAX_MS,
     tls: TlsFiles | None = None,
     connect_only: bool = False,
+    lease_ms: int | None = None,
 ) -> zenoh.Config:
     """A zenoh.Config with ``mode``, endpoints, and multicast scouting off.
 
     ``connect_only``: a peer that reaches the line only through ``connect``
-    (gossip off: it learns of no other peer to connect to).
+    (gossip off: it learns of no other peer to connect to). ``lease_ms``: how
+    long the others keep this session once it goes silent (zenoh's
+    ``transport/link/tx/lease``; None: zenoh's default, 10 s).
 
     A client waits ``connect_timeout_ms`` for its router at open (-1: for ever,
     so services may start before the router and survive its late start), and
@@ -87,6 +90,8 @@ def zenoh_config(
         config.insert_json5("connect/timeout_ms", json.dumps(connect_timeout_ms))
     if connect_only:
         config.insert_json5("scouting/gossip/enabled", "false")
+    if lease_ms is not None:
+        config.insert_json5("transport/link/tx/lease", json.dumps(lease_ms))
     if tls is not None:
         _insert_tls(config, tls)
     return config
@@ -145,6 +150,7 @@ def section_config(section: ZenohSection, wait_for_router: bool = True) -> zenoh
         reconnect_period_max_ms=round(section.reconnect_period_max_s * 1e3),
         tls=_tls_files(section),
         connect_only=alone,
+        lease_ms=round(section.lease_s * 1e3),
     )
 
 

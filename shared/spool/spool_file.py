@@ -19,7 +19,11 @@ recorder may have some of them already; and their numbers must never be
 given again, or the recorder would take new messages for ones it has. A file
 not closed cleanly therefore skips :data:`COMMIT_ROWS` numbers when it is
 opened again (:attr:`SpoolFile.skipped_at_open`): the recorder counts the
-numbers it never got as gone.
+numbers it never got as gone. A group that fails to be written (a full disk:
+SQLite rolls it back) is lost from the spool the same way: its numbers are
+never given again (the next group starts past the highest given), the counts
+are taken again from the file, and the spool works again as soon as the disk
+takes writes.
 
 Kinds: samples (a batch or a sample), records (a run's result, summary,
 controller result: never dropped), others (tool states, events, decisions,
@@ -105,8 +109,10 @@ class SpoolFile:
         self._db.execute(f"PRAGMA user_version={SCHEMA_VERSION}")
         self._compress = zstandard.ZstdCompressor(level=1).compress
         self._decompress = zstandard.ZstdDecompressor().decompress
-        self._in_transaction = False
         self.uncommitted = 0
+        #: the highest seq given: a group rolled back must not make SQLite give its again
+        self._given_seq = 0
+        self._failed = False  # a write failed: the next group starts past ``_given_seq``
         # what is kept, counted as it changes (one scan at the start, none after)
         self.messages = self.samples = self.stored_bytes = 0
         self._runs: Counter[int] = Counter()
@@ -119,9 +125,12 @@ class SpoolFile:
     def close(self) -> None:
         """Commit what is pending and close (cleanly: no number skipped at the next open);
         safe to call twice."""
-        with contextlib.suppress(sqlite3.ProgrammingError):
-            self.commit()
-            self._db.execute("UPDATE counters SET value = 0 WHERE name = 'open'")
+        with contextlib.suppress(sqlite3.ProgrammingError):  # closed already
+            # a disk that takes no write: the group is lost, the file left as not closed
+            # cleanly (the next open skips numbers)
+            with contextlib.suppress(sqlite3.OperationalError):
+                self.commit()
+                self._db.execute("UPDATE counters SET value = 0 WHERE name = 'open'")
             self._db.close()
 
     def _skip_if_unclean(self) -> int:
@@ -144,16 +153,23 @@ class SpoolFile:
     def append(
         self, topic: str, payload: bytes, kind: int, run_id: int | None, samples: int, put_ns: int
     ) -> int:
-        """Keep one message; its seq. Durable after the next :meth:`commit`."""
-        if not self._in_transaction:
-            self._db.execute("BEGIN")
-            self._in_transaction = True
+        """Keep one message; its seq. Durable after the next :meth:`commit`. A write that
+        fails (sqlite3.Error: a full disk) loses the group in progress, whose seqs are
+        never given again."""
         stored = self._compress(payload)
-        cursor = self._db.execute(
-            "INSERT INTO spooled (topic, kind, run_id, samples, put_ns, payload) "
-            "VALUES (?, ?, ?, ?, ?, ?)",
-            (topic, kind, run_id, samples, put_ns, stored),
-        )
+        try:
+            if not self._db.in_transaction:
+                self._db.execute("BEGIN")
+                if self._failed:
+                    self._skip_given()
+            cursor = self._db.execute(
+                "INSERT INTO spooled (topic, kind, run_id, samples, put_ns, payload) "
+                "VALUES (?, ?, ?, ?, ?, ?)",
+                (topic, kind, run_id, samples, put_ns, stored),
+            )
+        except sqlite3.Error:
+            self._group_lost()
+            raise
         self.uncommitted += 1
         self.messages += 1
         self.samples += samples
@@ -162,14 +178,44 @@ class SpoolFile:
             self._runs[run_id] += 1
         seq = cursor.lastrowid
         assert seq is not None
+        self._given_seq = max(self._given_seq, seq)
         return seq
 
     def commit(self) -> None:
-        """What was appended reaches the disk (fsync)."""
-        if self._in_transaction:
-            self._db.execute("COMMIT")
-            self._in_transaction = False
-            self.uncommitted = 0
+        """What was appended reaches the disk (fsync); sqlite3.Error when it cannot (the group
+        is lost, :meth:`append` starts the next one)."""
+        if self._db.in_transaction:
+            try:
+                self._db.execute("COMMIT")
+            except sqlite3.Error:
+                self._group_lost()
+                raise
+        self.uncommitted = 0
+
+    def _group_lost(self) -> None:
+        """A write failed: the group in progress is rolled back (SQLite may have done it),
+        what is kept counted again from the file, its seqs skipped by the next group."""
+        with contextlib.suppress(sqlite3.Error):
+            if self._db.in_transaction:
+                self._db.execute("ROLLBACK")
+        self._failed = True
+        self.uncommitted = 0
+        self.messages = self.samples = self.stored_bytes = 0
+        self._runs.clear()
+        with contextlib.suppress(sqlite3.Error):
+            self._count("1 = 1", (), sign=+1)
+
+    def _skip_given(self) -> None:
+        """In the group being begun: SQLite gives seqs past every one given before."""
+        if self._given_seq > self.head_seq:
+            if not self._db.execute(
+                "SELECT 1 FROM sqlite_sequence WHERE name = 'spooled'"
+            ).fetchone():
+                self._db.execute("INSERT INTO sqlite_sequence (name, seq) VALUES ('spooled', 0)")
+            self._db.execute(
+                "UPDATE sqlite_sequence SET seq = ? WHERE name = 'spooled'", (self._given_seq,)
+            )
+        self._failed = False
 
     def delete(self, ranges: Iterable[tuple[int, int]]) -> int:
         """Forget the messages of ``ranges`` (the recorder has them); how many."""

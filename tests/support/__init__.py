@@ -17,7 +17,9 @@ with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
   (the core over a simulated joint)
 - stations and files: :mod:`.paths` (the repository's files), :mod:`.config_files`
   (station files written from the shipped one), :mod:`.station_files` (isolated
-  station files for system tests), :mod:`.rig_fixtures` (rigs and programs)
+  station files for system tests), :mod:`.free_ports` (their routers' and CAN
+  buses' ports, never the kernel's to hand out), :mod:`.rig_fixtures` (rigs and
+  programs)
 - on zenoh: :mod:`.listener` (a station's messages as a test hears them, decoded
   by channel)
 - services in a test: :mod:`.live_recorder`, :mod:`.recorder_driver`,

@@ -7,7 +7,6 @@ benchmarks; no product code imports it.
 
 from __future__ import annotations
 
-import socket
 import threading
 import time
 import tomllib
@@ -21,6 +20,7 @@ from services.recorder.service import RecorderService
 from shared.config import AnyStation, ControllerStation, LoadedStation, toml_writer
 from shared.contract import encode, keys
 from shared.runtime import ServiceSkeleton
+from tests.support.free_ports import free_tcp_port
 from tests.support.paths import STATION_FILE
 
 WAIT_S = 10.0  # upper bound on waits for zenoh; tests never assert on time
@@ -87,10 +87,9 @@ class RunningRecorder:
 
 
 def free_port() -> int:
-    """A TCP port on 127.0.0.1 that nothing listens on right now."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
+    """A TCP port on 127.0.0.1 that nothing listens on right now, and that the kernel hands to
+    no other process meanwhile (:mod:`tests.support.free_ports`)."""
+    return free_tcp_port()
 
 
 def write_station_file(
@@ -102,12 +101,13 @@ def write_station_file(
     quality: Mapping[str, Any] | None = None,
     retention: Mapping[str, Any] | None = None,
     station: Mapping[str, Any] | None = None,
+    zenoh: Mapping[str, Any] | None = None,
 ) -> Path:
     """A copy of config/station.toml as a zenoh peer on the given endpoints.
 
     ``can.dbc`` and ``station.joint`` point at the repository's files;
     ``recorder.folder`` is ``recordings``; ``recorder`` overrides recorder keys,
-    ``station`` station keys;
+    ``station`` station keys, ``zenoh`` zenoh keys (``mode``, ``lease_s``);
     ``quality``: the ``[quality]`` section; ``retention``: the ``[retention]`` section.
     """
     with STATION_FILE.open("rb") as handle:
@@ -116,7 +116,12 @@ def write_station_file(
     data["station"] = {**data["station"], **(station or {})}
     data["station"]["joint"] = str((base / data["station"]["joint"]).resolve())
     data["can"]["dbc"] = str((base / data["can"]["dbc"]).resolve())
-    data["zenoh"] = {"mode": "peer", "connect": list(connect), "listen": list(listen)}
+    data["zenoh"] = {
+        "mode": "peer",
+        "connect": list(connect),
+        "listen": list(listen),
+        **(zenoh or {}),
+    }
     data["recorder"] = {**data["recorder"], "folder": str(recordings), **(recorder or {})}
     if quality is not None:
         data["quality"] = dict(quality)

@@ -178,8 +178,10 @@ class LiveStation:
         what: str,
         timeout_s: float = 30.0,
         poll_s: float = 0.05,
+        details: Callable[[], str] | None = None,
     ) -> None:
-        wait_supervised(self.supervisor, condition, what, timeout_s, poll_s)
+        """Poll ``condition`` (:func:`wait_supervised`; ``details()`` said when it gives up)."""
+        wait_supervised(self.supervisor, condition, what, timeout_s, poll_s, details=details)
 
     def summaries(self) -> list[RunSummary]:
         return self.heard.of(channels.RUNS.topic)

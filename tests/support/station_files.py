@@ -7,19 +7,12 @@ import contextlib
 import os
 import re
 import signal
-import socket
 import subprocess
 import sys
 from pathlib import Path
 
-from tests.support.live_recorder import free_port as free_tcp_port
+from tests.support.free_ports import free_tcp_port, free_udp_port
 from tests.support.paths import CONFIG, REPO, STATION_FILE
-
-
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        probe.bind(("", 0))
-        return int(probe.getsockname()[1])
 
 
 def write_station(

@@ -25,17 +25,20 @@ from services.recorder.live.recorder import RETRY_INTERVAL_NS
 from shared.contract import RunSummary
 from shared.recordings import run_files, unfinished_files
 from shared.recordings.mcap import RecordingScan
-from shared.wear import CONTRACT_LIMITS, WearLedger
+from shared.wear import CONTRACT_LIMITS, WearLedger, ledger_path
 from tests.support import factories
 from tests.support.disk_faults import fill_up, read_only, tmpfs
-from tests.support.live_station import check_next_run_normal, live_station
+from tests.support.live_station import check_next_run_normal, live_station, recorded_sequences
 from tests.support.paths import REPO
 from tests.support.recorder_driver import RecorderDriver, recorded_messages
 
 pytestmark = pytest.mark.system
 
 RECORDER_LOG = "services.recorder.live.recorder"
-NO_RESERVE = {"flush_interval_s = 1.0": "flush_interval_s = 1.0\nfree_space_reserve_bytes = 0"}
+#: the free-space reserve scaled to a 16 MB disk (by default the largest run file, 256 MB)
+SCALED_RESERVE = {
+    "flush_interval_s = 1.0": "flush_interval_s = 1.0\nfree_space_reserve_bytes = 2000000"
+}
 
 
 def errors_logged(caplog: pytest.LogCaptureFixture, level: int) -> list[str]:
@@ -252,27 +255,71 @@ def test_a_full_disk_does_not_corrupt_the_wear_ledger(tmp_path: Path) -> None:
         assert tool.runs >= 2
 
 
+def ledger_runs(recordings: Path) -> set[int]:
+    """The runs the wear ledger counts (none while it is not made)."""
+    try:
+        with sqlite3.connect(ledger_path(recordings)) as ledger:
+            return {row[0] for row in ledger.execute("SELECT run_id FROM runs")}
+    except sqlite3.Error:
+        return set()
+
+
+def runs_of_each_file(recordings: Path) -> dict[str, set[int]]:
+    """The runs whose samples each MCAP file holds (files under their names)."""
+    return {
+        path.name: {json.loads(message.data)["run_id"] for _, _, message in scan}
+        for path in sorted(recordings.rglob("*.mcap"))
+        for scan in [RecordingScan(path).messages("/samples")]
+    }
+
+
 def test_the_station_goes_on_while_the_recordings_disk_is_full(tmp_path: Path) -> None:
-    """Real processes; the station's recordings folder is a 4 MB tmpfs filled mid-run
-    (the wear ledger, one level up, stays on the real disk); no free-space reserve, so the
-    disk is met full."""
+    """Real processes, an edge station as `boltwatch up` runs it: the whole recordings
+    folder (run files, wear ledger, results store, the station's spool) is a 16 MB tmpfs with
+    a reserve scaled to it, filled after the third run and freed three runs later. Runs go on
+    and are decided meanwhile; the run in progress when room comes back is recorded from
+    there on (or whole, what the spool or the recorder's memory still had) and every run is
+    counted in the wear ledger, those made while nothing could be written too; no file holds
+    another run's samples."""
     with (
-        tmpfs(tmp_path / "recordings" / "st1", 4 << 20) as station_folder,
-        live_station(tmp_path, replacements=NO_RESERVE) as station,
+        tmpfs(tmp_path / "recordings", 16 << 20) as recordings,
+        live_station(tmp_path, placement="edge", replacements=SCALED_RESERVE) as station,
     ):
-        station.wait_runs_summarised(1)
-        filler = fill_up(station_folder)
+        station.wait_runs_summarised(3)
+        filler = fill_up(recordings)
         station.wait_for(
             lambda: "No space left on device (ENOSPC)" in station.log("recorder"),
             "the recorder to log the full disk",
         )
         during = len(station.summaries())
-        summaries = station.wait_runs_summarised(during + 1)  # tightening goes on
+        summaries = station.wait_runs_summarised(during + 3)  # tightening goes on
         assert all(station.decided(s.run_id) for s in summaries[during:])
-        filler.unlink()
+        station.wait_for(lambda: station.running_run() is not None, "a run in progress")
+        in_progress = station.running_run()
+        filler.unlink()  # room again, mid-run
         station.wait_for(
             lambda: "recording works again" in station.log("recorder"), "the recorder to recover"
         )
-        check_next_run_normal(station)
+        after = check_next_run_normal(station)
+        assert in_progress is not None and in_progress < after
+        summary = next(s for s in station.summaries() if s.run_id == in_progress)
+
+        def recorded_from_room_on() -> bool:  # from some sample to its last, each once
+            recorded = recorded_sequences(station.recordings, in_progress)
+            return bool(recorded) and recorded == list(range(recorded[0], summary.samples))
+
+        station.wait_for(
+            recorded_from_room_on,
+            f"run {in_progress}, in progress when room came back, recorded from there on",
+            details=lambda: str(recorded_sequences(station.recordings, in_progress)[:3]),
+        )
+        summarised = {s.run_id for s in station.summaries() if s.run_id <= after}
+        station.wait_for(
+            lambda: summarised <= ledger_runs(recordings),
+            "every run in the wear ledger",
+            details=lambda: f"{sorted(summarised - ledger_runs(recordings))} not counted",
+        )
         assert station.process("recorder").exit_code() is None
         assert "recording failed" in station.log("recorder")
+    mixed = {name: runs for name, runs in runs_of_each_file(recordings).items() if len(runs) > 1}
+    assert not mixed, mixed

@@ -27,6 +27,7 @@ import pytest
 from mcap.reader import make_reader
 
 from services.cli.station_supervisor import stop_process
+from shared.recordings.mcap import RAW_ENCODING, RAW_REASON
 from tests.support.netns_line import (
     LINE_ENDPOINT,
     Line,
@@ -68,11 +69,19 @@ class StationRecord:
         return sum(len(s) for s in self.samples_by_run.values())
 
 
-def read_recordings(folder: Path) -> dict[str, StationRecord]:
+def read_recordings(folder: Path) -> tuple[dict[str, StationRecord], list[str]]:
+    """What each station's channels hold, and each message the recorder refused (its raw
+    channels: a payload that arrived and does not decode, kept byte for byte, never a
+    sample), named with its topic, why and its bytes."""
     records: dict[str, StationRecord] = defaultdict(StationRecord)
+    refused: list[str] = []
     for path in sorted(folder.rglob("*.mcap")):
         with path.open("rb") as handle:
             for _schema, channel, message in make_reader(handle).iter_messages():
+                if channel.message_encoding == RAW_ENCODING:
+                    why = channel.metadata.get(RAW_REASON)
+                    refused.append(f"{path.name} {channel.topic} ({why}): {message.data!r}")
+                    continue
                 station, topic = channel.topic.split("/")[1:3]
                 record = records[station]
                 body = json.loads(message.data)
@@ -82,7 +91,7 @@ def read_recordings(folder: Path) -> dict[str, StationRecord]:
                     record.summaries.append(body)
                 elif topic == "bus" and body["time_ns"] >= record.last_bus.get("time_ns", 0):
                     record.last_bus = body
-    return records
+    return records, refused
 
 
 def station_files(tmp_path: Path) -> list[Path]:
@@ -174,7 +183,8 @@ def test_three_hosts_one_cut_off_for_twelve_seconds(tmp_path: Path) -> None:
         finally:
             for _name, process in reversed(processes):
                 stop_process(process)
-    records = read_recordings(tmp_path / "recordings")
+    records, refused = read_recordings(tmp_path / "recordings")
+    assert not refused, refused[:5]  # nothing on the line sends a payload that does not decode
 
     for index in range(1, STATIONS + 1):
         if index == CUT_STATION:

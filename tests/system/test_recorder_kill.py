@@ -9,11 +9,13 @@ a free loopback port); this test publishes a run at ~1 kHz into it.
 
 from __future__ import annotations
 
+import json
 import signal
 import subprocess
 import sys
 import threading
 import time
+from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -21,12 +23,24 @@ import pytest
 import zenoh
 from mcap.reader import make_reader
 
-from shared.contract import Sample, TighteningResult, ToolState, channels, decode, encode
+from shared.contract import (
+    Sample,
+    SpoolAck,
+    SpoolStats,
+    TighteningResult,
+    ToolState,
+    channels,
+    decode,
+    encode,
+    keys,
+)
 from shared.recordings import final_path_of, unfinished_files
 from shared.recordings.mcap import RecordingScan, recover
 from shared.results import ResultsQuery, ResultsStore, StoreTarget
-from shared.runtime import zenoh_config
+from shared.runtime import QueuedPublisher, zenoh_config
+from shared.spool import SpoolFile, StationSpool
 from tests.support import factories
+from tests.support.listener import Listener
 from tests.support.live_recorder import (
     free_port,
     has_subscribers,
@@ -34,6 +48,7 @@ from tests.support.live_recorder import (
     write_station_file,
 )
 from tests.support.paths import REPO
+from tests.support.recorded_runs import run_messages
 
 pytestmark = pytest.mark.system
 
@@ -43,14 +58,20 @@ FLUSH_INTERVAL_S = 1.0
 
 
 class RecorderProcess:
-    def __init__(self, tmp_path: Path, log_name: str = "recorder.log") -> None:
-        self.endpoint = f"tcp/127.0.0.1:{free_port()}"
+    def __init__(
+        self,
+        tmp_path: Path,
+        log_name: str = "recorder.log",
+        flush_interval_s: float = FLUSH_INTERVAL_S,
+        endpoint: str | None = None,
+    ) -> None:
+        self.endpoint = endpoint or f"tcp/127.0.0.1:{free_port()}"
         self.recordings = tmp_path / "recordings"
         station_file = write_station_file(
             tmp_path / "station.toml",
             self.recordings,
             listen=[self.endpoint],
-            recorder={"flush_interval_s": FLUSH_INTERVAL_S},
+            recorder={"flush_interval_s": flush_interval_s},
         )
         self.log = (tmp_path / log_name).open("w")
         self.process = subprocess.Popen(
@@ -249,3 +270,92 @@ def scan_complete(path: Path) -> bool:
     for _ in scan.records():
         pass
     return scan.complete
+
+
+def test_kill_9_while_a_spooling_station_publishes_files_every_sample_exactly_once(
+    tmp_path: Path,
+) -> None:
+    """A station spooling what it puts (an edge station's batches) publishes runs while the
+    line's recorder is killed with SIGKILL and started again. The killed recorder had
+    flushed more than it had acknowledged (it flushes every 0.2 s here, acknowledges once a
+    second): the station sends that again, and the restarted recorder, which finished the
+    killed one's files, recognises it. Every sample of every run is in exactly one file."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    recorder = RecorderProcess(tmp_path, flush_interval_s=0.2, endpoint=endpoint)
+    session = zenoh.open(zenoh_config("peer", connect=[endpoint]))
+    spool = StationSpool(
+        "st1",
+        "acquisition",
+        SpoolFile(tmp_path / "edge" / "st1-acquisition.sqlite"),
+        1 << 30,
+        drain_messages_per_s=500.0,
+        resend_after_s=0.5,
+    )
+    publisher = QueuedPublisher(session, "st1", batch_samples=True, spool=spool)
+    heard = Listener(session, topics=[channels.SPOOL.topic, channels.SPOOL_ACK.topic])
+    published: list[tuple[int, int]] = []
+    stop = threading.Event()
+
+    def tighten() -> None:
+        run_id = 0
+        while not stop.is_set():
+            run_id += 1
+            for topic, message in run_messages(run_id, 400):
+                publisher.publish(message)
+                if topic == "samples":
+                    published.append((run_id, message.sequence))
+                    if message.sequence % 10 == 0:
+                        time.sleep(0.01)  # about 1 kHz
+
+    station = threading.Thread(target=tighten)
+    try:
+        wait_until(lambda: recorder_alive(session), "the recorder", timeout_s=30)
+        station.start()
+        wait_until(lambda: len(published) > 2500, "runs published")
+
+        def between_acknowledgements() -> bool:  # flushed twice since the last one
+            acks: list[SpoolAck] = heard.of(channels.SPOOL_ACK.topic)
+            return bool(acks) and 0.5e9 <= time.time_ns() - acks[-1].time_ns <= 0.8e9
+
+        wait_until(between_acknowledgements, "0.5 s after an acknowledgement")
+        recorder.process.send_signal(signal.SIGKILL)  # mid-run
+        recorder.process.wait(10)
+        wait_until(lambda: len(published) > 3500, "runs published with no recorder")
+        recorder = RecorderProcess(
+            tmp_path, flush_interval_s=0.2, endpoint=endpoint, log_name="restarted.log"
+        )
+        wait_until(lambda: len(published) > 6000, "runs published to the restarted recorder")
+        stop.set()
+        station.join()
+        done = threading.Event()
+        publisher.call(done.set)
+        wait_until(done.is_set, "the station's puts")
+        head_seq = spool.stats().head_seq
+
+        def emptied() -> bool:
+            spools: list[SpoolStats] = heard.of(channels.SPOOL.topic)
+            return bool(spools) and spools[-1].head_seq >= head_seq and spools[-1].messages == 0
+
+        wait_until(emptied, "the spool emptied", timeout_s=60)
+        recorder.process.send_signal(signal.SIGTERM)
+        assert recorder.process.wait(10) == 0
+    finally:
+        stop.set()
+        if station.is_alive():
+            station.join()
+        recorder.stop()
+        publisher.close()
+        heard.close()
+        session.close()
+    times: Counter[tuple[int, int]] = Counter()
+    for path in recorder.files():
+        for _, _, message in RecordingScan(path).messages("/samples"):
+            times[(json.loads(message.data)["run_id"], message.sequence)] += 1
+    twice = sorted(key for key, count in times.items() if count > 1)
+    assert not twice, f"{len(twice)} samples in two files, e.g. {twice[:5]}"
+    assert set(times) == set(published), "a sample lost"
+
+
+def recorder_alive(session: zenoh.Session) -> bool:
+    replies = session.liveliness().get(keys.health_key("st1", "recorder"), timeout=1)
+    return any(reply.ok is not None for reply in replies)

@@ -12,13 +12,20 @@ what an outage costs is counted: with it nothing is lost,
 - those samples are missing from the recording (the rig's log says how many
   samples each run had), and nothing else is; the recorder's own end-to-end
   count (``RecorderStats.missing_samples``) is exactly what the recording lacks;
+- the runs that lost samples follow one another and are no more than the
+  outage overlaps: its length as the acquisition measured it (the sleep, the new
+  router's start, which takes seconds on a loaded machine, and the reconnect)
+  over the shortest run and its pause, plus one;
 - the run(s) the predictor could not stop ended at the rig's conventional
   shutoff, at the target: the tool never tightens blind;
-- a run after the outage is recorded whole and stopped by the predictor.
+- a run after the outage (one started once the recorder was heard again: the
+  recorder may reconnect after the acquisition, and a run started in between
+  loses its first samples) is recorded whole and stopped by the predictor.
 """
 
 from __future__ import annotations
 
+import math
 import re
 import signal
 import subprocess
@@ -31,8 +38,9 @@ import pytest
 import zenoh
 
 from services.cli.station_supervisor import stop_process
+from shared.config import load_station
 from shared.contract import RunSummary, Sample, channels, decode
-from shared.recordings.mcap import RecordingScan
+from shared.recordings.mcap import RAW_ENCODING, RecordingScan
 from shared.runtime import zenoh_config
 from tests.support.listener import Listener
 from tests.support.station_files import free_tcp_port, serve, write_station
@@ -47,7 +55,9 @@ RECONNECT_PERIOD_MAX_S = 0.5
 START_TIMEOUT_S = 30.0
 RUN_TIMEOUT_S = 30.0
 RIG_RUN = re.compile(r"run (\d+): (\w+) by (\w+), force (\d+) N, .* (\d+) samples, ")
-LINK_EVENT_SAMPLES = 20  # 20 ms at 1 kHz: how far the link flag may lag the link
+#: how far the acquisition's link flag may lag the link, in samples at 1 kHz: zenoh's event
+#: callback waits for the GIL, a few ms on a quiet machine, 47 ms seen at load 17
+LINK_EVENT_SAMPLES = 100
 
 
 #: what the test hears of the station on zenoh
@@ -77,6 +87,8 @@ def recorded(folder: Path) -> tuple[dict[int, list[int]], dict[int, RunSummary]]
     for path in sorted(folder.rglob("*.mcap")):
         scan = RecordingScan(path)
         for _, channel, message in scan.messages():
+            # a raw channel holds what the recorder refused, byte for byte: none is sent here
+            assert channel.message_encoding != RAW_ENCODING, (path, channel, message.data)
             if channel.topic.endswith("/samples"):
                 sample = decode(Sample, message.data)
                 sequences.setdefault(sample.run_id, []).append(sample.sequence)
@@ -100,6 +112,7 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
     # the spool off: what the outage costs a station without store and forward is counted
     # exactly (with it, nothing is lost: tests/system/test_store_and_forward.py)
     path.write_text(path.read_text() + "\n[spool]\nenabled = false\n")
+    pause_s = load_station(path).config.rig.pause_between_runs_s
     logs = {n: tmp_path / f"{n}.log" for n in ("router", "recorder", "predictor", "acq", "rig")}
     router = serve(["router", "--listen", endpoint], logs["router"])
     services = [
@@ -133,13 +146,23 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
                 router.send_signal(signal.SIGKILL)
                 router.wait(10)
                 time.sleep(OUTAGE_S)  # the fault itself: the line has no router this long
+                stats_before = len(heard.of("recorder"))  # none can come while no router is
                 router = serve(["router", "--listen", endpoint], logs["router"])
-                before = len(heard.of("runs"))
+                # the recorder reconnects on its own schedule, after the acquisition at times
+                # (a run that started just then loses its first samples: seen, 4): the run
+                # awaited is one that started once the recorder was heard again
+                heard.wait(
+                    lambda: len(heard.of("recorder")) > stats_before,
+                    "the recorder back on the line",
+                    RUN_TIMEOUT_S,
+                )
+                back_ns = heard.of("recorder")[stats_before].time_ns
                 heard.wait(
                     lambda: any(
-                        s.stop_reason == "plateau_closest" for s in heard.of("runs")[before:]
+                        s.stop_reason == "plateau_closest" and s.started_ns > back_ns
+                        for s in heard.of("runs")
                     ),
-                    "a run after the restart stopped early by the predictor (plateau_closest)",
+                    "a run started after the restart stopped early by the predictor",
                     RUN_TIMEOUT_S * 2,
                 )
                 stop_process(rig, grace_s=10.0)
@@ -196,7 +219,16 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
     lost_in_recording = sum(missing.values())
     assert stats.unsent_samples <= lost_in_recording + stats.missed_samples + LINK_EVENT_SAMPLES
     assert lost_in_recording <= stats.unsent_samples + 1000 * RECONNECT_PERIOD_MAX_S * 2
-    assert 1 <= len(outage_runs) <= 3, missing
+    # The runs that lost samples are the ones the outage overlapped, one after the other: as
+    # many as fit in it, plus one it started in. The outage is the sleep plus the new router's
+    # start (a Python process: under a second on a quiet machine, 5 s at load 15 to 18, where
+    # outages of 7.9 and 8.3 s touched 4 and 5 runs) plus the reconnect, so it is taken as
+    # measured, with the recorder's later reconnect.
+    outage_s = float(outage_lines[0][0]) + 2 * RECONNECT_PERIOD_MAX_S
+    period_s = min(run.samples for run in runs.values()) / 1e3 + pause_s
+    most = math.ceil(outage_s / period_s) + 1
+    assert 1 <= len(outage_runs) <= most, (missing, outage_s, period_s)
+    assert outage_runs == list(range(outage_runs[0], outage_runs[-1] + 1)), missing
     assert all(lost >= 0 for lost in missing.values()), missing
     # The recorder counted the loss itself, to the sample, whatever the runs it fell in.
     recorded_samples = sum(len(set(run_sequences)) for run_sequences in sequences.values())
@@ -209,11 +241,15 @@ def test_services_reconnect_after_the_router_is_killed(tmp_path: Path) -> None:
         assert run.stop_source == "shutoff_force", run
         assert abs(run.force_n - TARGET_FORCE_N) / TARGET_FORCE_N < 0.05, run
     # After the outage every run is recorded whole and the predictor decides again; its
-    # StopCommand reaches the tool (a target_reached decision may tie with the rig's shutoff).
+    # StopCommand reaches the tool (a target_reached decision may tie with the rig's shutoff,
+    # and on a loaded machine the line's predictor may decide after the tool stopped by
+    # itself: a late decision, seen at load 15; the awaited run was stopped early by it).
     after = [r for r in runs if r > max(outage_runs)]
     assert after, f"no run after the outage: {runs}"
     for run_id in after:
         assert missing[run_id] <= stats.missed_samples, (run_id, missing)
-        assert run_id in summaries and summaries[run_id].stop_reason is not None, run_id
+        summary = summaries.get(run_id)
+        assert summary is not None, run_id
+        assert summary.stop_reason is not None or summary.late_decision is not None, summary
     early = [r for r in after if summaries[r].stop_reason == "plateau_closest"]
     assert early and all(runs[r].stop_source == "stop_command" for r in early), runs

@@ -13,7 +13,11 @@ never stops the recorder. The station's open files are abandoned (what was
 flushed stays under the file's writing name; :meth:`Recorder.close`, or the
 next start if it cannot, makes it the run file), messages are dropped
 and counted, and writing is tried again at the next run's start or every
-:data:`RETRY_INTERVAL_NS`. It logs one ERROR when the fault starts (file and
+:data:`RETRY_INTERVAL_NS`; a disk that was full (``ENOSPC``, ``EDQUOT``, below
+the reserve) is tried again as soon as it has room (its free space, one
+``statvfs`` at most every :data:`ROOM_CHECK_INTERVAL_NS`, back above the
+reserve, or :data:`ROOM_BYTES` without one), so the run in progress is
+recorded from where room came back. It logs one ERROR when the fault starts (file and
 errno text), a reminder with the count of dropped messages at most every
 :data:`REMINDER_INTERVAL_NS`, and one INFO when writing works again (a flush
 reached the disk). ``write_errors``, ``last_write_error`` and
@@ -29,12 +33,14 @@ station's own for such messages, a file per run, finished once nothing came for
 
 from __future__ import annotations
 
+import errno
 import logging
 from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from services.recorder.live.free_space import FreeSpace
 from services.recorder.live.run_files import FileLimits, StationFiles
 from shared.files import describe_os_error
 from shared.recordings import FileMetadata, Received, writing_path
@@ -50,6 +56,11 @@ RETRY_INTERVAL_NS = 3_000_000_000
 REMINDER_INTERVAL_NS = 10_000_000_000
 #: a station's files of late messages are finished when nothing came for them this long
 LATE_FILES_IDLE_NS = 10_000_000_000
+#: a full disk's free space is looked at this often while it is full
+ROOM_CHECK_INTERVAL_NS = 100_000_000
+#: free space that is room again when there is no reserve
+ROOM_BYTES = 256 * 1024
+_FULL = (errno.ENOSPC, errno.EDQUOT)
 
 
 class Recorder:
@@ -85,6 +96,9 @@ class Recorder:
         self._fault_dropped = 0
         self._retry_at_ns = 0
         self._remind_at_ns = 0
+        self._full = False  # the fault is a full disk: tried again once it has room
+        self._room = FreeSpace(folder, max(limits.free_space_reserve_bytes, ROOM_BYTES))
+        self._room_checked_ns = 0
 
     def write(self, received: Received, files: StationFiles | None = None) -> Path | None:
         """File one received message into its station's live files (or ``files``: the
@@ -137,6 +151,22 @@ class Recorder:
             self._fault(files, err, now_ns, unwritten=unwritten)
             return
         self._maybe_recovered(files, now_ns)
+
+    def live_files(self, station: str) -> StationFiles:
+        """The live files of ``station`` (where its messages go outside a spool's hole)."""
+        return self._files(station)
+
+    def end_message(
+        self, files: StationFiles, mark: tuple[str, int, int] | None, now_ns: int
+    ) -> None:
+        """``files`` filed a numbered message received at ``now_ns``
+        (:meth:`StationFiles.end_message`: its mark, then the flush held back meanwhile)."""
+        try:
+            files.end_message(mark)
+        except OSError as err:
+            self._fault(files, err, now_ns, unwritten=0)
+        else:
+            self._maybe_recovered(files, now_ns)
 
     def hole_files(self, station: str, hand_over: bool) -> StationFiles:
         """Files for a hole of ``station``'s spool (``hand_over``: they go on with the run the
@@ -201,6 +231,8 @@ class Recorder:
             except OSError as err:
                 self._fault(files, err, now_ns, unwritten=0)
                 ok = False
+            else:  # a file written after a fault is on the disk now: writing works again
+                self._maybe_recovered(files, now_ns)
         return ok and self.recording_ok
 
     def tick(self, now_ns: int) -> None:
@@ -264,8 +296,20 @@ class Recorder:
 
     def _waits_for_retry(self, files: StationFiles, now_ns: int) -> bool:
         """Writing failed and the station's files were abandoned, not tried again yet: what
-        arrives is dropped (a run's start tries at once)."""
-        return not self.recording_ok and files.current is None and now_ns < self._retry_at_ns
+        arrives is dropped (a run's start tries at once, and so does a full disk that has
+        room again)."""
+        waits = not self.recording_ok and files.current is None and now_ns < self._retry_at_ns
+        return waits and not self._room_again(now_ns)
+
+    def _room_again(self, now_ns: int) -> bool:
+        """A full disk has room again (its free space looked at now and then)."""
+        if not self._full or now_ns - self._room_checked_ns < ROOM_CHECK_INTERVAL_NS:
+            return False
+        self._room_checked_ns = now_ns
+        try:
+            return self._room.free_bytes() >= self._room.reserve_bytes
+        except OSError:
+            return False
 
     def _files(self, station: str) -> StationFiles:
         files = self._stations.get(station)
@@ -281,6 +325,8 @@ class Recorder:
         self.last_write_error = describe_os_error(err, path)
         lost = files.abandon() + unwritten
         self._retry_at_ns = now_ns + RETRY_INTERVAL_NS
+        self._full = err.errno in _FULL
+        self._room_checked_ns = now_ns
         if self.recording_ok:
             self.recording_ok = False
             self._fault_started_ns = now_ns

@@ -1,12 +1,18 @@
 """The MCAP files of one station: one file per run, named as :mod:`shared.recordings.layout` says.
 
 A run file is opened by the run's ``ToolState(state="running")`` and holds
-everything the station publishes until the next run starts, so the run's
-summary, its last bus statistics and the idle time after it stay with it.
-A file that reaches ``max_file_bytes`` or ``max_file_duration_s`` (a run that
-never ends) continues in ``..._part<N>.mcap``. After a rotation the previous
-run's file stays open for ``late_grace_s`` so late messages carrying its
-run id (a RunSummary racing the next run's start) still land in it.
+what the station publishes from then on: the run, its result and its
+summary. It is finished (complete, under its name) ``late_grace_s`` after the
+run's summary (its ``RunSummary``), or at the next run's start, whichever
+comes first: a station that stops tightening has its last run's file readable
+a moment after the run, not at its next run. What the station says after that
+(its counters between runs) goes into an idle file (``<station>_idle_...``),
+which the next run's start finishes. A message of a run whose file was
+finished never opens a file named for that run again: it goes to the idle
+file. A file that reaches ``max_file_bytes`` or ``max_file_duration_s`` (a run
+that never ends) continues in ``..._part<N>.mcap``. After a rotation the
+previous run's file stays open for ``late_grace_s`` so late messages carrying
+its run id (a RunSummary racing the next run's start) still land in it.
 
 Files that hear no run's start (``runs_by_id``: what a line predictor's spool
 sends again, events to summaries of runs whose files are closed) open a run's
@@ -23,6 +29,12 @@ reader of the folder never meets a run file being written or left broken.
 Below the free-space reserve (:mod:`.free_space`) no file is opened: the
 files open are finished and :class:`~.free_space.LowFreeSpaceError` (an
 ``OSError``) is raised, which the owner takes as a failing disk.
+
+A spooling station's numbered message (:mod:`.spool_filing`) is marked in the
+file it went into (:meth:`StationFiles.end_message`; a message split between
+two files is marked in neither: sent again after a kill, it may be filed
+twice, never lost), which writes the numbers it holds last in each of its
+chunks (:mod:`shared.recordings.mcap.spool_marks`).
 
 When the disk fails under a file (an :class:`OSError` out of any method),
 the owner (:class:`~services.recorder.live.recorder.Recorder`) calls
@@ -41,7 +53,7 @@ from typing import TYPE_CHECKING
 from services.recorder.live.free_space import FreeSpace
 from shared.contract import channels
 from shared.recordings import FileMetadata, Received, Sink, file_path
-from shared.recordings.mcap import McapSink
+from shared.recordings.mcap import FileMarks, McapSink
 
 if TYPE_CHECKING:  # rerun is imported only when .rrd files are wanted
     from shared.recordings.rerun import RerunOptions, RerunSink
@@ -79,6 +91,8 @@ class OpenRun:
     started: tuple[int | None, int]
     tool_id: int | None
     program_id: int | None
+    #: when the file is to be finished: a grace after its run's summary (None: at the next run)
+    finish_at_ns: int | None = None
 
 
 class StationFiles:
@@ -120,6 +134,14 @@ class StationFiles:
         self._rerun_sinks: dict[McapSink, RerunSink] = {}
         self._run_started: tuple[int | None, int] = (None, 0)  # (run_id, ToolState time_ns)
         self._started_runs: deque[int | None] = deque(maxlen=STARTED_RUNS_KEPT)
+        #: when the current run's file is finished: a grace after its summary
+        self._finish_at_ns: int | None = None
+        #: runs whose file was finished after their summary: never a file of theirs again
+        self._finished_runs: deque[int | None] = deque(maxlen=STARTED_RUNS_KEPT)
+        #: the files written since :meth:`start_message` (a numbered message's)
+        self._touched: set[McapSink] = set()
+        self._in_message = False  # between start_message and end_message: no flush
+        self._last_now_ns = 0  # the log time of the last message written
 
     def write(self, received: Received) -> None:
         now_ns = received.log_time_ns
@@ -133,6 +155,8 @@ class StationFiles:
             assert received.run_id is not None
             self._run_started = (received.run_id, _run_time_ns(received, now_ns))
             self._start_run(received.run_id, now_ns)
+        elif received.schema_name == channels.SAMPLES.schema_name:
+            self._open_or_continue(received.run_id, now_ns, samples_of=received.run_id)
         else:
             self._open_or_continue(received.run_id, now_ns)
         assert self.current is not None
@@ -143,14 +167,14 @@ class StationFiles:
             sink = previous
         for target in self._sinks_of(sink):
             target.write(received)
+        self._touched.add(sink)
         self.written += 1
         self.last_path = sink.path
-        if (
-            sink is self.current
-            and received.schema_name == channels.TOOL.schema_name
-            and received.message
-        ):
-            self._run_ended = received.message.state in _ENDED_STATES  # a refused one is raw
+        if sink is self.current and received.message is not None:
+            if received.schema_name == channels.TOOL.schema_name:
+                self._run_ended = received.message.state in _ENDED_STATES  # a refused one is raw
+            elif received.schema_name == channels.RUNS.schema_name and run_id == sink.run_id:
+                self._finish_at_ns = now_ns + self._limits.late_grace_ns  # the run is over
         self._flush_if_due(now_ns)
 
     def write_samples(self, samples: Sequence[Received]) -> None:
@@ -159,7 +183,8 @@ class StationFiles:
         if not samples:
             return
         now_ns = samples[-1].log_time_ns
-        self._open_or_continue(samples[0].run_id, now_ns)
+        run_id = samples[0].message.run_id
+        self._open_or_continue(run_id, now_ns, samples_of=run_id)
         assert self.current is not None
         groups: list[tuple[McapSink, Sequence[Received]]] = [(self.current, samples)]
         previous = self.previous
@@ -171,33 +196,98 @@ class StationFiles:
         for sink, group in groups:
             for target in self._sinks_of(sink):
                 target.write_samples(group)
+            self._touched.add(sink)
             self.written += len(group)
         self._flush_if_due(now_ns)
+
+    def start_message(self) -> None:
+        """A numbered message is about to be filed, perhaps in several parts (a batch: its
+        samples, events, intensities): no flush, no chunk ends until :meth:`end_message`."""
+        self._touched.clear()
+        self._in_message = True
+        for sink in (self.current, self.previous):
+            if sink is not None:
+                sink.hold = True
+
+    def end_message(self, mark: tuple[str, int, int] | None) -> None:
+        """The message since :meth:`start_message` is filed: ``mark`` (source, spool id,
+        seq; None: not filed whole) is said by the file it went into (by none when it went
+        into two, or none); then what was held back: a full chunk ends, a due flush."""
+        if mark is not None and len(self._touched) == 1:
+            (filed_into,) = self._touched
+            if filed_into.marks is None:
+                filed_into.marks = FileMarks(self.station)
+            filed_into.marks.add(*mark)
+        self._touched.clear()
+        self._in_message = False
+        for sink in (self.current, self.previous):
+            if sink is not None:
+                sink.hold = False
+                sink.end_chunk_if_full()
+        self._flush_if_due(self._last_now_ns)
 
     def _sinks_of(self, sink: McapSink) -> tuple[Sink, ...]:
         """The run file's MCAP sink, then its companions (its ``.rrd``)."""
         companion = self._rerun_sinks.get(sink)
         return (sink,) if companion is None else (sink, companion)
 
-    def _open_or_continue(self, run_id: int | None, now_ns: int) -> None:
+    def _open_or_continue(
+        self, run_id: int | None, now_ns: int, samples_of: int | None = None
+    ) -> None:
         """A file to write a message of ``run_id`` into (not a run's start): opened when there
-        is none (the resumed run's after a fault), continued in a next part past the limits."""
+        is none (the resumed run's after a fault), continued in a next part past the limits.
+        ``samples_of``: samples of that run; in a hole's files (what a spool sends again, in
+        order), a run never started there (its start was lost: a disk fault, a spool that
+        lost it) gets a file of its own, not the current run's. Live, such samples go into
+        the current file (a recorder that joined mid-run; a station whose run ids flip must
+        not make a file per sample)."""
+        if samples_of and self.sent_again and self._unseen(samples_of):
+            LOG.info(
+                "%s: samples of run %d, whose start never came: a file of its own",
+                self.station,
+                samples_of,
+            )
+            self._started_runs.append(samples_of)
+            self._tool_id = self._program_id = None  # not known without the run's start
+            self._run_started = (samples_of, now_ns)
+            self._resume = (samples_of, 1)
+            self._start_run(samples_of, now_ns)
+            return
         if self.current is None:
-            resumed_run_id, part = self._resume or (run_id, 1)
+            finished = run_id in self._finished_runs  # its file is done: the idle file's
+            resumed_run_id, part = self._resume or (None if finished else run_id, 1)
             self._open(resumed_run_id, now_ns, part)
         elif self._over_limits(now_ns):
             self._continue(now_ns)
 
     def _flush_if_due(self, now_ns: int) -> None:
+        self._last_now_ns = max(self._last_now_ns, now_ns)
+        if self._in_message:
+            return  # after the message (end_message): its marks go with it
         if now_ns - self._last_flush_ns >= self._limits.flush_interval_ns:
             self.flush(now_ns)
 
     def tick(self, now_ns: int) -> None:
-        """Flush when the flush interval has passed; close the previous file after its grace."""
+        """Flush when the flush interval has passed; close the previous file after its grace,
+        and the current run's file a grace after its summary."""
         self._flush_if_due(now_ns)
         if self.previous is not None and now_ns >= self._previous_until_ns:
             self._close(self.previous)
             self.previous = None
+        finish_at_ns = self._finish_at_ns
+        if self.current is not None and finish_at_ns is not None and now_ns >= finish_at_ns:
+            self._finish_current()
+
+    def _finish_current(self) -> None:
+        """The current run is over (a grace after its summary): its file is finished now; what
+        comes next opens an idle file (raising: the owner abandons it)."""
+        current = self.current
+        assert current is not None
+        self._finish_at_ns = None
+        self._finished_runs.append(current.run_id)
+        self._close(current)
+        self.current = None
+        LOG.debug("%s finished a grace after its run's summary", current.path)
 
     def flush(self, now_ns: int) -> None:
         for sink in (self.current, self.previous):
@@ -229,8 +319,11 @@ class StationFiles:
             companion = self._rerun_sinks.pop(sink, None)
             if companion is not None:
                 companion.close()  # never raises
-        if self._resume is None and self.current is not None:
-            self._resume = (self.current.run_id, self._part + 1)
+        current = self.current
+        if self._resume is None and current is not None:
+            finished = current.run_id in self._finished_runs  # failed while being finished
+            self._resume = (None if finished else current.run_id, self._part + 1)
+        self._finish_at_ns = None
         self.previous = self.current = None
         return lost
 
@@ -252,7 +345,9 @@ class StationFiles:
             self._run_started,
             self._tool_id,
             self._program_id,
+            self._finish_at_ns,
         )
+        self._finish_at_ns = None
         return handed
 
     def adopt(self, run: OpenRun | None) -> None:
@@ -268,6 +363,7 @@ class StationFiles:
         self._run_ended = run.ended
         self._run_started = run.started
         self._tool_id, self._program_id = run.tool_id, run.program_id
+        self._finish_at_ns = run.finish_at_ns
         self._started_runs.append(run.sink.run_id)
 
     def _opens_its_run(self, run_id: int | None) -> bool:
@@ -285,6 +381,18 @@ class StationFiles:
         """Messages of the open files not yet on the disk."""
         return sum(s.unflushed_messages for s in (self.previous, self.current) if s is not None)
 
+    def _unseen(self, run_id: int) -> bool:
+        """Samples of ``run_id`` while another run's file is open, a run never started (nor
+        finished) here."""
+        current, previous = self.current, self.previous
+        return (
+            current is not None
+            and current.run_id != run_id
+            and (previous is None or previous.run_id != run_id)
+            and run_id not in self._started_runs
+            and run_id not in self._finished_runs
+        )
+
     def _is_new_run(self, run_id: int | None) -> bool:
         """A run id starts once: its ToolState flipping back to running opens no new file."""
         if run_id in self._started_runs:
@@ -297,6 +405,7 @@ class StationFiles:
             self._close(self.previous)
         self.previous = self.current
         self._previous_until_ns = now_ns + self._limits.late_grace_ns
+        self._finish_at_ns = None  # the previous file's grace is its own now
         self._open(run_id, now_ns, part=1)
 
     def _continue(self, now_ns: int) -> None:
@@ -345,6 +454,7 @@ class StationFiles:
             fsync=self._limits.fsync,
             rename_when_complete=True,
         )
+        self.current.hold = self._in_message
         self._resume = None
         LOG.debug("opened %s", path)
         if self._rerun is not None and run_id is not None:

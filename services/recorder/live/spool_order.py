@@ -27,10 +27,13 @@ becomes of each numbered message (pure: no file, no zenoh):
   the station's next pass sends it once more);
 - a number sent again past everything known (the tail of a cut with nothing
   live after it): the next one goes to the live files, one past it opens a hole;
-- numbers the station no longer has (dropped to keep its spool's bound) are
-  **gone**: counted, and the holes pass them. A message sent again names the
-  number its spool holds before it (every number between is gone), and the
-  station's counters name its oldest (:meth:`SpoolOrder.station_has_from`).
+- numbers the station no longer has (dropped to keep its spool's bound, or
+  lost with its disk) are **gone**: counted, and the holes pass them. A message
+  sent again names the number its spool holds before it (every number between
+  is gone), and the station's counters name its oldest
+  (:meth:`SpoolOrder.station_has_from`). A number the recorder holds itself,
+  deferred in memory (``held``), is never gone: the hole files it when it
+  gets there (the station's copy was lost, the recorder's was not).
 
 A source that starts no runs (a line predictor: its events, decisions, results
 and summaries belong to the runs the station's acquisition starts) is not
@@ -45,10 +48,18 @@ acknowledges once its files are flushed, and keeps across its restarts.
 from __future__ import annotations
 
 import enum
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 from shared.spool import SeqRanges
+
+#: the numbers from ``first`` to ``last`` held in memory, in order (deferred live messages)
+Held = Callable[[int, int], Sequence[int]]
+
+
+def nothing_held(_first: int, _last: int) -> Sequence[int]:
+    return ()
 
 
 class Fate(enum.Enum):
@@ -126,15 +137,21 @@ class SpoolOrder:
         ends = [hole.last if hole.last is not None else hole.next - 1 for hole in self.holes]
         return max([self.filed.highest, *ends])
 
-    def route(self, seq: int, run_started: bool, kept_before: int | None = None) -> Routing:
+    def route(
+        self,
+        seq: int,
+        run_started: bool,
+        kept_before: int | None = None,
+        held: Held = nothing_held,
+    ) -> Routing:
         """What becomes of message ``seq`` (``run_started``: a run's start, a ToolState
         running; ``kept_before``: sent again, and the number the station's spool holds
-        before it; None: live)."""
+        before it; None: live; ``held``: the numbers kept in memory, never gone)."""
         self.seen = max(self.seen, seq)
         if seq in self.filed:
             return self._skip()
         if kept_before is not None and kept_before <= self.top:
-            self._gone(kept_before + 1, seq - 1)  # not in the spool, not filed: gone
+            self._gone(kept_before + 1, seq - 1, held)  # not in the spool, not filed: gone
             if seq in self.filed:
                 return self._skip()
         if not self.in_order:
@@ -167,10 +184,11 @@ class SpoolOrder:
         for hole in self.holes:
             self._pass_filed(hole)
 
-    def station_has_from(self, oldest_seq: int) -> int:
+    def station_has_from(self, oldest_seq: int, held: Held = nothing_held) -> int:
         """The station's spool holds nothing below ``oldest_seq`` (its oldest message, or one
-        past its newest when it is empty): what is not filed below it is gone; how many."""
-        return self._gone(1, oldest_seq - 1)
+        past its newest when it is empty): what is not filed below it, nor ``held``, is
+        gone; how many."""
+        return self._gone(1, oldest_seq - 1, held)
 
     def completed(self) -> list[Hole]:
         """The holes filled to their end: removed (their files are the caller's to close)."""
@@ -190,17 +208,18 @@ class SpoolOrder:
         self.deferred += 1
         return Routing(Fate.DEFER, hole, opened=True)
 
-    def _gone(self, first: int, last: int) -> int:
-        """Numbers ``first`` to ``last`` that are not filed are gone: passed (the holes go past
-        them), counted; how many. Never past :attr:`seen` (a number that never came may
-        still come)."""
+    def _gone(self, first: int, last: int, held: Held = nothing_held) -> int:
+        """Numbers ``first`` to ``last`` that are not filed, nor ``held``, are gone: passed
+        (the holes go past them), counted; how many. Never past :attr:`seen` (a number that
+        never came may still come)."""
         last = min(last, self.seen)
         passed = 0
         for missing_first, missing_last in list(self.filed.missing(last)):
             if missing_last >= first:
                 start = max(missing_first, first)
-                passed += missing_last - start + 1
-                self.filed.add_range(start, missing_last)
+                for gone_first, gone_last in _without(start, missing_last, held):
+                    passed += gone_last - gone_first + 1
+                    self.filed.add_range(gone_first, gone_last)
         if passed:
             self.gone += passed
             for hole in self.holes:
@@ -221,3 +240,16 @@ class SpoolOrder:
     def _skip(self) -> Routing:
         self.skipped += 1
         return Routing(Fate.SKIP)
+
+
+def _without(first: int, last: int, held: Held) -> list[tuple[int, int]]:
+    """The ranges of ``first`` to ``last`` between the numbers ``held``."""
+    ranges = []
+    start = first
+    for number in held(first, last):
+        if number > start:
+            ranges.append((start, number - 1))
+        start = number + 1
+    if start <= last:
+        ranges.append((start, last))
+    return ranges

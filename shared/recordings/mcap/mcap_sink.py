@@ -22,6 +22,12 @@ any method; the owner then calls :meth:`McapSink.abandon`, which lets go of
 the file without writing more (what was flushed stays readable with
 ``boltwatch recover``) and says how many messages were lost with it.
 
+A chunk ends at every flush, at the file's end and past :data:`_CHUNK_BYTES`;
+with :attr:`McapSink.marks` (a spooling station's file) the numbers of the
+stations' spools the file holds so far are written last in each chunk
+(:mod:`.spool_marks`), so a marker that can be read names only messages on the
+disk.
+
 ``rename_when_complete=True`` (the recorder's run files): the file is written
 under its writing name (:func:`~shared.recordings.layout.writing_path`) and
 takes ``path`` only in :meth:`McapSink.close`, once finished and on the disk
@@ -49,7 +55,8 @@ from shared.recordings.layout import writing_path
 from shared.recordings.received import Received
 from shared.recordings.mcap.mcap_messages import MessageAppender, MessageRow
 from shared.recordings.mcap.recording_reader import RAW_ENCODING, RecordingScan
-from shared.contract import channels
+from shared.recordings.mcap.spool_marks import MARKS_TOPIC, FileMarks, marks_channel_metadata
+from shared.contract import SpoolFiled, channels, encode, keys
 from shared.contract import json_schema
 from shared.errors import InputError
 
@@ -59,6 +66,8 @@ LOG = logging.getLogger(__name__)
 RAW_REASON = "boltwatch.raw"
 
 _CHUNK_BYTES = 1024 * 1024  # upper bound; flushes close chunks far earlier
+#: the writer's own chunk bound, never met: the sink ends each chunk itself (its marks last)
+_WRITER_CHUNK_BYTES = 1 << 62
 
 
 class McapSink:
@@ -88,7 +97,15 @@ class McapSink:
         self._channels: dict[tuple[str, str], int] = {}
         self._counters: dict[int, int] = {}
         self._unflushed_bytes = 0
+        self._chunk_bytes = 0  # written into the chunk in progress
         self._flushed_bytes = 0  # the file's length at the last flush
+        #: the spool numbers this file holds (a spooling station's), written last in each chunk
+        self.marks: FileMarks | None = None
+        self._marks_channels: dict[tuple[str, int], int] = {}
+        self._marks_ns = 0
+        #: a message of several parts is being written: a full chunk ends after it
+        #: (:meth:`end_chunk_if_full`), so that its marks end the chunk that holds it
+        self.hold = False
         self._closed = False
         self._abandoned = False
         self._name_synced = not fsync  # the folder's entry for the file, on the disk
@@ -96,7 +113,7 @@ class McapSink:
         self._file: BinaryIO = self.writing_path.open("xb")
         try:
             self._writer = Writer(
-                self._file, chunk_size=_CHUNK_BYTES, compression=CompressionType.ZSTD
+                self._file, chunk_size=_WRITER_CHUNK_BYTES, compression=CompressionType.ZSTD
             )
             self._writer.start(profile="", library=library)
             self._messages = MessageAppender(self._writer)
@@ -148,10 +165,39 @@ class McapSink:
         self.run_ids.update({s.message.run_id for s in samples})
 
     def _append(self, channel_id: int, rows: list[MessageRow]) -> None:
-        """Write ``rows`` on the channel and count them (messages, bytes not yet flushed)."""
-        self._unflushed_bytes += self._messages.add(channel_id, rows)
+        """Write ``rows`` on the channel and count them (messages, bytes not yet flushed); a
+        chunk grown past :data:`_CHUNK_BYTES` ends (to the operating system, not synced)."""
+        written = self._messages.add(channel_id, rows)
+        self._unflushed_bytes += written
+        self._chunk_bytes += written
         self.messages += len(rows)
         self.last_write_ns = rows[-1][1]
+        if not self.hold:
+            self.end_chunk_if_full()
+
+    def end_chunk_if_full(self) -> None:
+        """End the chunk in progress past :data:`_CHUNK_BYTES`: its marks last, then to the
+        operating system (not synced)."""
+        if self._chunk_bytes >= _CHUNK_BYTES and not self._closed:
+            self._write_marks()
+            self._writer.flush()
+            self._chunk_bytes = 0
+
+    def _write_marks(self) -> None:
+        """The spool numbers the file holds, last in the chunk about to end (those changed
+        since the last chunk; not counted as messages)."""
+        marks = self.marks
+        if marks is None or not marks.changed:
+            return
+        time_ns = self._marks_ns = max(self.last_write_ns, self._marks_ns + 1)  # newest last
+        for mark in marks.take(time_ns):
+            channel_id = self._marks_channel(mark)
+            sequence = self._counters.get(channel_id, 0)
+            self._counters[channel_id] = sequence + 1
+            row = (sequence & 0xFFFFFFFF, time_ns, time_ns, encode(mark))
+            written = self._messages.add(channel_id, [row])
+            self._unflushed_bytes += written
+            self._chunk_bytes += written
 
     @property
     def unflushed_messages(self) -> int:
@@ -162,7 +208,9 @@ class McapSink:
         """Close the chunk in progress, write it through to the OS and (fsync) to the disk."""
         if self._closed or not self.dirty:
             return
+        self._write_marks()
         self._writer.flush()
+        self._chunk_bytes = 0
         self._sync()
         self._flushed_bytes = self._file.tell()
         self._unflushed_bytes = 0
@@ -175,6 +223,7 @@ class McapSink:
             return
         self._closed = True
         try:
+            self._write_marks()
             self._writer.finish()
             self._sync()
         finally:
@@ -252,10 +301,23 @@ class McapSink:
             self._channels[(key, reason)] = channel_id
         return channel_id
 
-    def _schema_id(self, schema_name: str) -> int:
+    def _marks_channel(self, mark: SpoolFiled) -> int:
+        """The channel of one spool's marks (its metadata names them: never a raw one)."""
+        channel_id = self._marks_channels.get((mark.source, mark.spool_id))
+        if channel_id is None:
+            channel_id = self._writer.register_channel(
+                topic=keys.station_key(mark.station, MARKS_TOPIC),
+                message_encoding=MessageEncoding.JSON,
+                schema_id=self._schema_id("boltwatch.SpoolFiled", SpoolFiled),
+                metadata=marks_channel_metadata(mark.source, mark.spool_id),
+            )
+            self._marks_channels[(mark.source, mark.spool_id)] = channel_id
+        return channel_id
+
+    def _schema_id(self, schema_name: str, message_type: type | None = None) -> int:
         schema_id = self._schemas.get(schema_name)
         if schema_id is None:
-            schema = json_schema(channels.SCHEMA_TYPES[schema_name])
+            schema = json_schema(message_type or channels.SCHEMA_TYPES[schema_name])
             schema_id = self._writer.register_schema(
                 name=schema_name,
                 encoding=SchemaEncoding.JSONSchema,

@@ -358,7 +358,8 @@ class RecorderTarget(_Target):
         self.running.finish()
         raw: list[tuple[str, bytes]] = []
         typed: dict[str, list[Any]] = {}
-        for path in sorted(self.loaded.recordings_folder.glob("st1/*/*.mcap")):
+        files = self.loaded.recordings_folder.glob("st1/*/*.mcap")
+        for path in sorted(files, key=_first_log_time_ns):  # in the order they were written
             with path.open("rb") as handle:
                 for _, channel, message in make_reader(handle).iter_messages(log_time_order=False):
                     if channel.message_encoding == RAW_ENCODING:
@@ -372,3 +373,12 @@ class RecorderTarget(_Target):
         for publisher in self._publishers.values():
             publisher.undeclare()
         self.feeding.close()
+
+
+def _first_log_time_ns(path: Path) -> int:
+    """When the first message of a complete file was received (an idle file between two runs
+    sorts between them, whatever its name)."""
+    with path.open("rb") as handle:
+        summary = make_reader(handle).get_summary()
+    statistics = None if summary is None else summary.statistics
+    return 0 if statistics is None else statistics.message_start_time

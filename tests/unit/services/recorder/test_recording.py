@@ -29,7 +29,7 @@ from shared.contract import (
     json_schema,
     keys,
 )
-from shared.recordings.mcap import RAW_ENCODING, RAW_REASON
+from shared.recordings.mcap import RAW_ENCODING, RAW_REASON, RecordingScan
 from shared.runtime import ServiceSkeleton, zenoh_config
 from tests.support.live_recorder import (
     RunningRecorder,
@@ -250,3 +250,40 @@ def test_a_view_only_recorder_takes_none_of_the_line_recorders_duties(
         watcher.undeclare()
     assert list(recordings.glob("st1/*/st1_run5_*.mcap"))
     assert not (recordings / "wear.sqlite").exists()
+
+
+def test_the_newest_runs_file_is_final_a_grace_after_its_summary(
+    tmp_path: Path,
+    station: LoadedStation,
+    recorder: RunningRecorder,
+    publisher_session: zenoh.Session,
+) -> None:
+    """One run, then nothing: its file (and its .rrd) take their names a short grace after
+    the run's summary, readable, with no next run and the recorder still recording."""
+    publish(publisher_session, run_messages(1, SAMPLES))
+    wait_until(lambda: recorded_files(station) != [], "run 1's file under its name")
+    assert recorder.thread.is_alive()
+    (path,) = recorded_files(station)
+    assert path.name.startswith("st1_run1_")
+    scan = RecordingScan(path)
+    assert [message.sequence for _, _, message in scan.messages("/samples")] == list(range(SAMPLES))
+    assert scan.complete
+    rerun_verify = [str(Path(sys.executable).parent / "rerun"), "rrd", "verify"]
+    assert (
+        subprocess.run([*rerun_verify, str(path.with_suffix(".rrd"))], check=False).returncode == 0
+    )
+    inspected = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "services.cli",
+            "inspect",
+            str(path),
+            "--out",
+            str(tmp_path / "run1.png"),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert inspected.returncode == 0, inspected.stderr

@@ -168,3 +168,45 @@ def test_a_batch_with_samples_of_the_run_before_splits_between_their_files(
             sequences[path.name] = [m.sequence for _, c, m in found if c.topic.endswith("samples")]
     assert sequences == {"st1_run1_221320.mcap": [0, 1, 4], "st1_run2_221320.mcap": [2, 3]}
     assert files.written == 2 + 5
+
+
+def test_a_runs_file_is_final_a_grace_after_its_summary_and_the_idle_time_goes_elsewhere(
+    tmp_path: Path, station: LoadedStation
+) -> None:
+    """The station stops tightening: its last run's file is finished (under its name) a
+    grace after the run's summary, with no next run; what the station says afterwards (its
+    counters) goes into an idle file, which the next run's start finishes."""
+    files = StationFiles("st1", tmp_path, LIMITS, FileMetadata(station))
+    t = T0_NS
+    feed(
+        files,
+        [
+            ("tool", tool(1, "running", t), t),
+            ("samples", sample(1, 0, t + 1), t + 1),
+            ("tool", tool(1, "done", t + 2), t + 2),
+            ("runs", summary(1, t + 2), t + 3),
+            ("bus", bus(t + 4), t + 4),  # within the grace: still the run's
+        ],
+    )
+    files.tick(t + LIMITS.late_grace_ns)  # the grace is not over
+    assert files.closed_paths == []
+    files.tick(t + 3 + LIMITS.late_grace_ns)
+    (run1,) = files.closed_paths
+    assert run1.name == "st1_run1_221320.mcap" and run1.is_file()
+    assert counts(run1) == {"tool": 2, "samples": 1, "runs": 1, "bus": 1}
+    later = t + 5 * SECOND_NS
+    feed(
+        files,
+        [
+            ("tool", tool(1, "idle", later), later),  # the ended run's id: not a file of its
+            ("bus", bus(later + 1), later + 1),
+            ("bus", bus(later + SECOND_NS), later + SECOND_NS),
+            ("tool", tool(2, "running", later + 2 * SECOND_NS), later + 2 * SECOND_NS),
+        ],
+    )
+    files.tick(later + 10 * SECOND_NS)  # the idle file's grace after run 2's start
+    files.close()
+    names = [p.name for p in files.closed_paths]
+    assert names == ["st1_run1_221320.mcap", "st1_idle_221325.mcap", "st1_run2_221327.mcap"]
+    assert counts(files.closed_paths[1]) == {"bus": 2, "tool": 1}
+    assert counts(files.closed_paths[2]) == {"tool": 1}

@@ -247,3 +247,16 @@ def test_a_recorder_that_restarts_fills_what_it_had_not_saved() -> None:
     assert order.gone == 1
     assert [h.last for h in order.completed()] == [13]
     assert order.route(21, False, None).fate is Fate.LIVE
+
+
+def test_a_number_the_recorder_holds_is_never_gone() -> None:
+    """Live 4 and 5 were deferred (kept in the recorder's memory) while the hole from 3 waits;
+    the station lost 3 to 5 (its disk was full): its counters say its oldest is 6. 3 is gone;
+    4 and 5 are not: the hole stops at 4, where the recorder files what it holds."""
+    order = SpoolOrder()
+    file(order, 1, True, None)
+    file(order, 2, False, None)
+    assert [order.route(seq, False, None).fate for seq in (4, 5)] == [Fate.DEFER] * 2
+    held = [4, 5]
+    assert order.station_has_from(6, lambda first, last: [n for n in held if first <= n <= last])
+    assert order.gone == 1 and order.next_expected == 4

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import threading
+import time
 from collections import defaultdict
 from collections.abc import Iterator
 from pathlib import Path
@@ -22,11 +23,20 @@ import zenoh
 from mcap.reader import make_reader
 
 from shared.config import LoadedStation
-from shared.contract import SpoolStats, channels, to_dict
+from shared.contract import (
+    SpoolStats,
+    ToolState,
+    channels,
+    encode,
+    keys,
+    seq_attachment,
+    to_dict,
+)
 from shared.runtime import QueuedPublisher, zenoh_config
 from shared.spool import SpoolFile, StationSpool
+from tests.support import factories
 from tests.support.listener import Listener
-from tests.support.live_recorder import RunningRecorder, wait_until
+from tests.support.live_recorder import RunningRecorder, has_subscribers, wait_until
 from tests.support.recorded_runs import run_messages
 
 SAMPLES = 400  # per run: eight batches of samples
@@ -125,3 +135,40 @@ def test_a_run_put_while_the_recorder_was_down_is_recorded_whole_once_it_is_back
         assert [m for t, m in recorded if t == "samples"] == published_samples
     # what went while the recorder was down came again (run 2 alone is 8 batches and 6 more)
     assert spool.resent >= 14
+
+
+def test_a_run_whose_start_is_sent_again_is_in_order_by_log_time(
+    station: LoadedStation, station_session: zenoh.Session
+) -> None:
+    """A recorder that came back mid-run missed the run's start (its ToolState and first
+    samples): the rest, live, waits in its memory until the station sends the start again.
+    The run's one file is in order whichever way it is read, by log time too: what waited
+    is logged when it is filed, after what was sent again before it."""
+    recorder = RunningRecorder(station)
+    numbered = [("tool", ToolState("st1", 4, 7, 1, "running", 1))] + [
+        ("samples", factories.sample(4, n, time_ns=10 + n)) for n in range(10)
+    ]
+    try:
+        puts = {
+            topic: station_session.declare_publisher(
+                keys.station_key("st1", topic), congestion_control=zenoh.CongestionControl.BLOCK
+            )
+            for topic in ("tool", "samples")
+        }
+        wait_until(lambda: all(has_subscribers(p) for p in puts.values()), "the recorder")
+        for seq, (topic, message) in enumerate(numbered, start=1):
+            if seq > 3:  # 1 to 3 (the run's start) were lost on the way
+                puts[topic].put(encode(message), attachment=seq_attachment("acquisition", 9, seq))
+        time.sleep(0.2)  # the live ones arrived first
+        for seq, (topic, message) in enumerate(numbered[:3], start=1):
+            station_session.put(
+                keys.again_key("st1", topic),
+                encode(message),
+                attachment=seq_attachment("acquisition", 9, seq, seq - 1),
+            )
+        wait_until(lambda: recorder.service.recorder.messages == len(numbered), "all filed")
+    finally:
+        recorder.finish()
+    ((path, messages),) = read_back(station).items()
+    samples = [m["sequence"] for topic, m in messages if topic == "samples"]
+    assert samples == list(range(10)), path  # read back by log time

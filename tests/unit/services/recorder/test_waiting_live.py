@@ -23,3 +23,14 @@ def test_past_its_bound_a_message_is_not_kept_and_counted() -> None:
     waiting.keep(2, "b", 10)
     waiting.keep(3, "c", 10)
     assert waiting.full == 1 and len(waiting) == 2
+
+
+def test_a_runs_records_are_kept_past_the_bound_up_to_their_own() -> None:
+    """A summary or result is small and all a full disk leaves of its run: kept past the bytes,
+    up to a count of its own."""
+    waiting: WaitingLive[str] = WaitingLive(max_bytes=15, max_records=2)
+    waiting.keep(1, "batch", 10)
+    waiting.keep(2, "batch", 10)  # past the bytes: not kept
+    for seq in (3, 4, 5):
+        waiting.keep(seq, "summary", 10, record=True)
+    assert waiting.full == 2 and waiting.held(1, 10) == [1, 3, 4]

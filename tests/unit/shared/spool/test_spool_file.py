@@ -3,13 +3,18 @@ process, what waits is counted."""
 
 from __future__ import annotations
 
+import os
+import sqlite3
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
+import pytest
+
 from shared.spool import SeqRanges, SpoolFile
 from shared.spool.spool_file import COMMIT_ROWS, KIND_OTHER, KIND_RECORDS, KIND_SAMPLES
+from tests.support.disk_faults import fill_up, tmpfs
 from tests.support.paths import REPO
 
 
@@ -110,3 +115,33 @@ def test_a_killed_process_loses_only_what_it_had_not_committed(tmp_path: Path) -
     assert spool.append("tool", b"next", 2, 1, 0, 9) == 5 + COMMIT_ROWS + 1
     spool.close()
     assert SpoolFile(path).skipped_at_open == 0  # closed cleanly: nothing skipped
+
+
+def test_a_full_disk_loses_the_group_in_progress_and_the_spool_works_again_with_room(
+    tmp_path: Path,
+) -> None:
+    """A real full disk (a tmpfs filled up) fails the group being written: SQLite rolls it
+    back. Its numbers (already put toward the line) are never given again, what is kept is
+    counted again from the file, and once there is room the spool keeps messages again."""
+    with tmpfs(tmp_path / "edge", 1 << 20) as edge:
+        spool = SpoolFile(edge / "st1-acquisition.sqlite")
+        kept = fill(spool, "sr", run_id=1)
+        assert kept == [1, 2]
+        filler = fill_up(edge)
+        given: list[int] = []
+        with pytest.raises(sqlite3.OperationalError):
+            for n in range(5000):  # the group's pages spill to the full disk, or its commit
+                given.append(spool.append("samples", os.urandom(300), KIND_SAMPLES, 2, 10, n))
+            spool.commit()
+        assert given  # put toward the line with these numbers: lost with the group
+        assert (spool.messages, spool.samples, spool.depth().runs) == (2, 10, 1)
+        spool.commit()  # nothing in progress: no error
+        filler.unlink()
+        after = fill(spool, "so", run_id=3)
+        assert after[0] > max(given)  # never a number given before
+        assert spool.messages == 4 and spool.head_seq == after[-1]
+        spool.close()
+        reopened = SpoolFile(edge / "st1-acquisition.sqlite")
+        assert reopened.skipped_at_open == 0  # closed cleanly
+        assert [m.seq for m in reopened.after(0, 10, 10**18, SeqRanges())] == [*kept, *after]
+        reopened.close()
