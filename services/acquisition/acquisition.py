@@ -29,7 +29,6 @@ good decision after it still stops the tool.
 from __future__ import annotations
 
 import logging
-import threading
 import time
 from collections import Counter, deque
 from collections.abc import Callable
@@ -42,20 +41,24 @@ from services.acquisition.frame_decoder import (
     FrameDecoder,
     JointSensorsFrame,
     Rejected,
+    StageCommandFrame,
     StopCommandFrame,
     ToolSensorsFrame,
+    ToolStageFrame,
     ToolStatusFrame,
 )
 from services.acquisition.pairing import AssembledSample, SampleAssembler
+from services.acquisition.tool_commands import ToolCommands
 from shared.contract import (
     SAMPLE_RATE_HZ,
     BusStats,
     Sample,
+    StageDecision,
     StationDatabase,
     StopDecision,
-    StopReason,
-    StopReasonName,
     ToolRunState,
+    ToolStageCode,
+    ToolStageName,
     ToolState,
     can_id_bounds,
     codec,
@@ -91,9 +94,12 @@ class Acquisition:
         clock_ns: Callable[[], int] = time.time_ns,
         unsent_samples: Callable[[], int] = lambda: 0,
         decider: Decider | None = None,
+        stage_commands: bool = True,
     ) -> None:
         """``unsent_samples``: how many samples the outlet could not deliver (no router);
-        ``decider``: decides on each sample on this thread (the edge predictor), or None."""
+        ``decider``: decides on each sample on this thread (the edge predictor), or None;
+        ``stage_commands``: the station file lets it command a final stage (when the DBC
+        and the tool controller do too: :mod:`.tool_commands`)."""
         self._decider = decider
         self.station_id = station_id
         self._unsent_samples = unsent_samples
@@ -107,18 +113,16 @@ class Acquisition:
         self._rejected: Counter[str] = Counter()
         self._frames = 0
         self._receive_errors = 0
-        self._stop_commands = 0
-        self._late_decisions = 0
         self._bad_decisions = 0
-        self._decode_decision = codec.decoder(
-            StopDecision, {"run_id": can_id_bounds(database)["run_id"]}
-        )
+        run_bounds = {"run_id": can_id_bounds(database)["run_id"]}
+        self._decode_decision = codec.decoder(StopDecision, run_bounds)
+        self._decode_stage = codec.decoder(StageDecision, run_bounds)
+        self._commands = ToolCommands(database, bus, stage_commands, clock_ns)
+        self._run_commands = self._commands.mode
+        self._stage: tuple[ToolStageName, int] | None = None  # the running run's (stage, pulses)
         self._log_bad_decision = RateLimitedLog(LOG, logging.ERROR)
         self._log_late_decision = RateLimitedLog(LOG, logging.WARNING)
-        self._send_lock = threading.Lock()
         self._tool: ToolStatusFrame | None = None
-        self._stopped_run: int | None = None
-        self._stopped_reason: StopReasonName | None = None
         self._started_runs: deque[int] = deque(maxlen=STARTED_RUNS_KEPT)
         self._repeated_runs = 0
         self._decider_errors = 0
@@ -159,12 +163,14 @@ class Acquisition:
             self._emit(self._assembler.joint_frame(frame.counter, frame.force_n, time_ns))
         elif isinstance(frame, ToolStatusFrame):
             self._tool_status(frame, time_ns)
+        elif isinstance(frame, ToolStageFrame):
+            self._tool_stage(frame, time_ns)
         elif isinstance(frame, Rejected):
             self._rejected[frame.reason] += 1
             if LOG.isEnabledFor(logging.DEBUG):
                 LOG.debug("rejected frame 0x%x: %s", message.arbitration_id, frame.reason)
-        elif isinstance(frame, StopCommandFrame):
-            LOG.debug("StopCommand from another node for run %d", frame.run_id)
+        elif isinstance(frame, StopCommandFrame | StageCommandFrame):
+            LOG.debug("%s from another node for run %d", type(frame).__name__, frame.run_id)
 
     def _emit(self, samples: list[AssembledSample]) -> None:
         run_id = self._tool.run_id if self._tool is not None else 0
@@ -187,7 +193,7 @@ class Acquisition:
                     self._decider_failed()
                 else:
                     if decision is not None:
-                        self.send_stop(decision)  # before anything else: the stop path
+                        self.send(decision)  # before anything else: the stop path
             self._outlet.sample(sample)
 
     def _tool_status(self, frame: ToolStatusFrame, time_ns: int) -> None:
@@ -219,8 +225,13 @@ class Acquisition:
         if starts_run:
             self._started_runs.append(frame.run_id)
             self._assembler.start_run()
+            self._run_commands = self._commands.run_commands()
+            # a staged tool starts each run in its rundown (its ToolStage said so before)
+            self._stage = ("rundown", 0) if self._run_commands == "staged" else None
         self._tool = frame
         ended = frame.state in (ToolRunState.DONE, ToolRunState.ABORTED)
+        commands = self._commands
+        stage, pulses = self._stage if self._stage is not None else (None, 0)
         state = ToolState(
             self.station_id,
             frame.run_id,
@@ -229,16 +240,53 @@ class Acquisition:
             state_name,  # type: ignore[arg-type]
             time_ns,
             stop_command=(
-                self._stopped_reason if ended and self._stopped_run == frame.run_id else None
+                commands.stopped_reason if ended and commands.stopped_run == frame.run_id else None
             ),
+            commands=self._run_commands,
+            stage=stage if frame.state == ToolRunState.RUNNING else None,
+            pulses=pulses,
         )
+        self._tell(state)
+        LOG.info("run %d: %s (program %d)", frame.run_id, state_name, frame.program_id)
+
+    def _tool_stage(self, frame: ToolStageFrame, time_ns: int) -> None:
+        """A staged tool's ToolStage: its features; a new stage of the running run is a new
+        ToolState (running, with the stage), told to the predictor and the line."""
+        self._commands.heard(frame)
+        tool = self._tool
+        if tool is None or tool.state != ToolRunState.RUNNING or frame.run_id != tool.run_id:
+            return  # a run's features come before its start; stale ones are no news
+        try:
+            stage_name: ToolStageName = ToolStageCode(frame.stage).name.lower()  # type: ignore[assignment]
+        except ValueError:
+            self._rejected["bad_state"] += 1
+            return
+        if (stage_name, frame.pulses) == self._stage:
+            return
+        self._stage = (stage_name, frame.pulses)
+        self._tell(
+            ToolState(
+                self.station_id,
+                tool.run_id,
+                tool.tool_id,
+                tool.program_id,
+                "running",
+                time_ns,
+                commands=self._run_commands,
+                stage=stage_name,
+                pulses=frame.pulses,
+            )
+        )
+        LOG.info("run %d: %s (pulses %d)", tool.run_id, stage_name, frame.pulses)
+
+    def _tell(self, state: ToolState) -> None:
+        """A run state to the station's predictor (edge) and to the line."""
         if self._decider is not None:
             try:
                 self._decider.on_tool_state(state)
             except Exception:
                 self._decider_failed()
         self._outlet.tool_state(state)
-        LOG.info("run %d: %s (program %d)", frame.run_id, state_name, frame.program_id)
 
     def _decider_failed(self) -> None:
         """The predictor raised: logged (rate-limited), counted; samples still flow."""
@@ -253,65 +301,50 @@ class Acquisition:
 
     def decision(self, payload: bytes, key: str = "decision") -> bool:
         """A decision payload received on ``key``: a StopCommand if it is a valid decision for
-        the running run (see :meth:`send_stop`); a bad payload is counted, never raised."""
+        the running run (see :meth:`send`); a bad payload is counted, never raised."""
         try:
             decision = self._decode_decision(payload)
-            if decision.station != self.station_id:
-                raise InputError(f"a decision of station {decision.station!r}, not of this one")
             if decision.advisory:  # decided after the fact (import, a controller's bridge)
                 raise InputError("an advisory decision (decided after the fact) stops no tool")
         except InputError as err:
-            self._bad_decisions += 1
-            self._log_bad_decision(
-                "bad decision payload on %s ignored (#%d): %s", key, self._bad_decisions, err
-            )
-            return False
-        return self.send_stop(decision)
+            return self._bad_decision(key, err)
+        return self.send(decision, key)
+
+    def stage(self, payload: bytes, key: str = "stage") -> bool:
+        """A final stage's command received on ``key`` (a line predictor's): a StageCommand
+        or a pulse's StopCommand for the running run; a bad payload is counted."""
+        try:
+            decision = self._decode_stage(payload)
+        except InputError as err:
+            return self._bad_decision(key, err)
+        return self.send(decision, key)
+
+    def _bad_decision(self, key: str, err: InputError) -> bool:
+        self._bad_decisions += 1
+        self._log_bad_decision(
+            "bad decision payload on %s ignored (#%d): %s", key, self._bad_decisions, err
+        )
+        return False
+
+    def send(self, decision: StopDecision | StageDecision, key: str = "") -> bool:
+        """The CAN command for ``decision`` if it is for the running run: the run's first
+        halt once (StopCommand), a staged tool's commands (:mod:`.tool_commands`)."""
+        if decision.station != self.station_id:
+            error = InputError(f"a decision of station {decision.station!r}, not of this one")
+            return self._bad_decision(key or "the station's predictor", error)
+        if isinstance(decision, StopDecision):
+            return self._commands.stop(decision, self._tool)
+        return self._commands.stage(decision, self._tool)
 
     def send_stop(self, decision: StopDecision) -> bool:
         """Send StopCommand for ``decision`` if it is for the running run; once per run."""
-        tool = self._tool
-        if tool is None or tool.state != ToolRunState.RUNNING or decision.run_id != tool.run_id:
-            self._late_decisions += 1
-            self._log_late_decision(
-                "decision for run %d ignored: the tool is not running it (#%d)",
-                decision.run_id,
-                self._late_decisions,
-            )
-            return False
-        with self._send_lock:
-            if self._stopped_run == decision.run_id:
-                return False
-            reason = StopReason[decision.reason.upper()]
-            data = self._database.encode(
-                "StopCommand", {"RunId": decision.run_id, "Reason": int(reason)}
-            )
-            message = can.Message(
-                arbitration_id=self._database.stop_command_id,
-                data=data,
-                is_extended_id=self._database.is_extended("StopCommand"),
-            )
-            try:
-                self._bus.send(message)
-            except can.CanError as err:
-                LOG.error("StopCommand for run %d could not be sent: %s", decision.run_id, err)
-                return False
-            self._stopped_run = decision.run_id
-            self._stopped_reason = decision.reason
-            self._stop_commands += 1
-        lag_ms = (self._clock_ns() - decision.time_ns) / 1e6
-        LOG.info(
-            "run %d: StopCommand sent (%s), %.2f ms after the deciding sample",
-            decision.run_id,
-            decision.reason,
-            lag_ms,
-        )
-        return True
+        return self.send(decision)
 
     # -- counters ------------------------------------------------------------------------
 
     def stats(self) -> BusStats:
         pairing = self._assembler.counters
+        commands = self._commands
         rejected = self._rejected
         return BusStats(
             station=self.station_id,
@@ -328,10 +361,14 @@ class Acquisition:
             counter_faults=pairing.repeated + pairing.backwards + pairing.implausible,
             unpaired=pairing.unpaired,
             orphans=pairing.orphans,
-            stop_commands=self._stop_commands,
+            stop_commands=commands.stop_commands,
             unsent_samples=self._unsent_samples(),
-            late_decisions=self._late_decisions,
+            late_decisions=commands.late_decisions,
             bad_decisions=self._bad_decisions,
             started_ns=self._started_ns,
             repeated_runs=self._repeated_runs,
+            tool_commands=commands.mode,
+            tool_commands_note=commands.note,
+            stage_commands=commands.stage_commands,
+            refused_stages=commands.refused_stages,
         )

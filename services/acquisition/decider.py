@@ -20,7 +20,7 @@ from collections.abc import Callable
 from typing import Protocol
 
 from shared.config import LoadedStation
-from shared.contract import Sample, StopDecision, ToolState
+from shared.contract import Sample, StageDecision, StopDecision, ToolState
 from shared.runtime import ServiceSkeleton
 
 
@@ -30,8 +30,9 @@ class Decider(Protocol):
     def on_tool_state(self, state: ToolState) -> None:
         """The tool's run state changed (``done`` / ``aborted`` say what stopped it)."""
 
-    def on_sample(self, sample: Sample) -> StopDecision | None:
-        """A complete sample of the running run; a decision to stop the tool now, or None."""
+    def on_sample(self, sample: Sample) -> StopDecision | StageDecision | None:
+        """A complete sample of the running run; a decision to stop the tool now, a final
+        stage's command (a tool that runs one), or None."""
 
 
 class StationDecider(Decider, Protocol):

@@ -42,11 +42,38 @@ class StopCommandFrame:
 
 
 @dataclass(frozen=True, slots=True)
+class ToolStageFrame:
+    """What a tool controller that runs a final stage is doing (ToolStage)."""
+
+    run_id: int
+    stage: int
+    pulses: int
+    features: int
+    max_pulses: int
+
+
+@dataclass(frozen=True, slots=True)
+class StageCommandFrame:
+    """A StageCommand on the bus (another node's: the station sends its own)."""
+
+    run_id: int
+    command: int
+
+
+@dataclass(frozen=True, slots=True)
 class Rejected:
     reason: RejectReason
 
 
-DecodedFrame = ToolSensorsFrame | JointSensorsFrame | ToolStatusFrame | StopCommandFrame | Rejected
+DecodedFrame = (
+    ToolSensorsFrame
+    | JointSensorsFrame
+    | ToolStatusFrame
+    | ToolStageFrame
+    | StopCommandFrame
+    | StageCommandFrame
+    | Rejected
+)
 
 
 class FrameDecoder:
@@ -90,4 +117,14 @@ class FrameDecoder:
                 int(signals["ProgramId"]),
                 int(signals["State"]),
             )
+        if name == "ToolStage":
+            return ToolStageFrame(
+                int(signals["RunId"]),
+                int(signals["Stage"]),
+                int(signals["Pulses"]),
+                int(signals["Features"]),
+                int(signals["MaxPulses"]),
+            )
+        if name == "StageCommand":
+            return StageCommandFrame(int(signals["RunId"]), int(signals["Command"]))
         return StopCommandFrame(int(signals["RunId"]), int(signals["Reason"]))

@@ -9,10 +9,10 @@ Where the decision runs is the station file's ``[predictor] placement``:
   process's own, published for the line; none is taken from zenoh (so a node
   on the network cannot stop this station's tool);
 - ``line``: a ``boltwatch serve predictor`` elsewhere decides; this process
-  subscribes ``boltwatch/<station>/decision`` and turns each decision for
-  the running run into a ``StopCommand`` straight from the zenoh callback (a
-  bad payload is counted in ``BusStats.bad_decisions``, never raised into
-  zenoh).
+  subscribes ``boltwatch/<station>/decision`` (and ``/stage``, a final stage's
+  commands) and turns each decision for the running run into a ``StopCommand``
+  (a ``StageCommand``) straight from the zenoh callback (a bad payload is
+  counted in ``BusStats.bad_decisions``, never raised into zenoh).
 
 The CAN thread runs under ``SCHED_FIFO`` where allowed (:mod:`shared.runtime.realtime`)
 and never waits on zenoh: samples, run states, bus counters and the
@@ -61,6 +61,17 @@ def decision_handler(acquisition: Acquisition) -> Callable[[zenoh.Sample], None]
     return on_decision
 
 
+def stage_handler(acquisition: Acquisition) -> Callable[[zenoh.Sample], None]:
+    """The zenoh callback of ``boltwatch/<st>/stage``: into :meth:`Acquisition.stage`
+    (placement line: a final stage's command on the line becomes a CAN command)."""
+    key = channels.STAGE.key(acquisition.station_id)
+
+    def on_stage(sample: zenoh.Sample) -> None:
+        acquisition.stage(sample.payload.to_bytes(), key)
+
+    return on_stage
+
+
 def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None) -> int:
     station = load_station(args.config)
     edge = station.config.predictor.placement == "edge"
@@ -94,9 +105,11 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
             outlet,
             unsent_samples=lambda: outlet.unsent_samples,
             decider=decider,
+            stage_commands=station.config.can.tool_commands == "auto",
         )
         if not edge:
             skeleton.subscriber(channels.DECISION.key(station_id), decision_handler(acquisition))
+            skeleton.subscriber(channels.STAGE.key(station_id), stage_handler(acquisition))
         skeleton.health_token(station_id, "acquisition")
         LOG.info(
             "acquisition of %s on %s:%s, decisions %s",

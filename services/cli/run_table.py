@@ -5,7 +5,9 @@ The ``result`` column is the run's verdict (its ``TighteningResult`` on
 ``boltwatch/<st>/results``: OK, or NOK against the program's windows); ``-``
 when no result arrived for the run. The last column, ``part``, is the part
 the result names (the id the line scanned before the run, a controller's
-VIN), left-aligned as ids are read; ``-`` when it names none.
+VIN), left-aligned as ids are read; ``-`` when it names none. A run whose
+final stage gave pulses back to the target says so after its stop reason
+(``target_reached+pulse``, ``+2pulses``).
 """
 
 from __future__ import annotations
@@ -49,6 +51,8 @@ def row(
         reached = f"{summary.reached_torque_nm:.1f} Nm"
     error = "-" if summary.error_pct is None else f"{summary.error_pct:+.2f}"
     reason = summary.stop_reason or f"tool ({summary.tool_state})"
+    if summary.pulses:  # a final stage's pulses back to the target
+        reason += "+pulse" if summary.pulses == 1 else f"+{summary.pulses}pulses"
     cells = (
         str(summary.run_id),
         str(summary.program_id),
@@ -85,6 +89,10 @@ def totals(summaries: list[RunSummary], results: list[TighteningResult] | None =
         parts = {result.part_id for result in results if result.part_id}
         if parts:
             line += f", {len(parts)} part{'s' if len(parts) != 1 else ''}"
+    staged = [s for s in summaries if s.commands == "staged"]
+    if staged:
+        pulsed = sum(1 for s in staged if s.pulses)
+        line += f", {len(staged)} in a final stage ({pulsed} took a pulse)"
     return line
 
 

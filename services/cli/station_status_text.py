@@ -105,8 +105,16 @@ def _bus_text(bus: BusHealth | None) -> str:
         f"{bus.bad_frames} bad frames, {bus.receive_errors} receive errors, "
         f"{bus.unsent_samples} unsent samples, {bus.late_decisions} late decisions, "
         f"{bus.bad_decisions} bad decisions "
-        f"({bus.frames} frames since start, {bus.age_s:.1f} s ago)"
+        f"({bus.frames} frames since start, {bus.age_s:.1f} s ago); {_commands_text(bus)}"
     )
+
+
+def _commands_text(bus: BusHealth) -> str:
+    """What the station commands its tool: a final stage, or stop only and why."""
+    if bus.tool_commands == "staged":
+        return f"tool commands: final stage and pulses ({bus.stage_commands} stage commands sent)"
+    why = f": {bus.tool_commands_note}" if bus.tool_commands_note else ""
+    return f"tool commands: stop only{why}"
 
 
 def _predictor_text(predictor: PredictorHealth | None) -> str:

@@ -291,6 +291,9 @@ def _stop_view(summary: RunSummary, now_ns: int) -> dict[str, Any]:
         "tool_id": summary.tool_id,
         "stop_reason": summary.stop_reason or f"tool ({summary.tool_state})",
         "late_decision": summary.late_decision,
+        # a final stage (None: the run had none), and its pulses back to the target
+        "final_stage_s": summary.final_stage_s,
+        "pulses": summary.pulses,
         "error_pct": summary.error_pct,
         "events": summary.events,
         "age_s": round((now_ns - summary.ended_ns) / _NS, 3),

@@ -1,8 +1,8 @@
 """One tightening run as the live service sees it: a core plus the run's bookkeeping.
 
 Turns the core's plain outputs into :mod:`shared.contract.messages` (events,
-intensity, decision: :mod:`shared.stickslip.run_messages`) and, at the
-end, the run's :class:`RunSummary`.
+intensity, decision, a final stage's commands: :mod:`shared.stickslip.run_messages`)
+and, at the end, the run's :class:`RunSummary`.
 Pure: the wall-clock time of a decision is passed in by the caller.
 """
 
@@ -17,20 +17,23 @@ from shared.contract import (
     RunClock,
     RunSummary,
     Sample,
+    StageDecision,
     StickSlipEvent,
     StopDecision,
     ToolState,
 )
 from shared.stickslip import (
+    CoreCommand,
     CoreDecision,
     EventFigures,
     PredictorCore,
     PredictorSettings,
     decision_message,
     event_messages,
+    stage_message,
 )
 
-Outgoing = StickSlipEvent | Intensity | StopDecision
+Outgoing = StickSlipEvent | Intensity | StopDecision | StageDecision
 
 
 class ActiveRun:
@@ -57,6 +60,7 @@ class ActiveRun:
         self.samples = 0
         self.last: Sample | None = None  # the last sample whose torque was a measurement
         self.decision: StopDecision | None = None
+        self.tool_pulses = 0  # the pulses the tool said it ran (ToolStage)
         self._torque_low, self._torque_high = settings.sensor_range.torque_nm
 
     def _time_s(self, sample: Sample) -> float:
@@ -78,9 +82,23 @@ class ActiveRun:
         for output in outputs:
             if isinstance(output, EventFigures):
                 messages.extend(self._event_messages(output, sample))
-            else:
+            elif isinstance(output, CoreDecision):
                 messages.append(self._decision_message(output, sample, wall_ns))
+            else:
+                messages.append(self._stage_message(output, sample, wall_ns))
         return messages
+
+    def on_tool_stage(self, state: ToolState) -> None:
+        """A staged tool's new stage: halted by itself (``holding``) before any decision."""
+        if state.stage == "holding":
+            self.core.on_tool_halted()
+        self.tool_pulses = max(self.tool_pulses, state.pulses)
+
+    def _stage_message(self, command: CoreCommand, sample: Sample, wall_ns: int) -> StageDecision:
+        state = self.state
+        return stage_message(
+            state.station, state.run_id, command, sample.time_ns, sample.torque_nm, wall_ns
+        )
 
     def _event_messages(self, event: EventFigures, sample: Sample) -> list[Outgoing]:
         state = self.state
@@ -107,6 +125,7 @@ class ActiveRun:
         too late, or never reached the tool, is reported as ``late_decision``.
         """
         last = self.last
+        final = self.core.final_stage
         reached_force = last.force_n if last is not None and self.settings.has_force else None
         force_low, force_high = self.settings.sensor_range.force_n
         if reached_force is not None and not force_low <= reached_force <= force_high:
@@ -121,7 +140,8 @@ class ActiveRun:
         target_torque = self.program.target_torque_nm
         if reached_force is not None and target_force:
             error_pct = 100.0 * (reached_force - target_force) / target_force
-        elif last is not None and not self.settings.has_force and target_torque:
+        elif last is not None and target_torque and not self.settings.force_mode:
+            # a torque target: on a torque-only station, or a program without a force target
             error_pct = 100.0 * (reached_torque - target_torque) / target_torque
         return RunSummary(
             station=self.state.station,
@@ -146,4 +166,7 @@ class ActiveRun:
             samples=self.samples,
             started_ns=self.started_ns,
             ended_ns=end.time_ns,
+            commands=self.state.commands,
+            final_stage_s=final.switched_at_s if final is not None else None,
+            pulses=max(self.tool_pulses, end.pulses),
         )

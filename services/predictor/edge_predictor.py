@@ -47,7 +47,7 @@ from services.predictor.served_station import ServedStation
 from services.predictor.station_refusal import refuse_stations_served_elsewhere
 from services.predictor.station_runs import StationRuns
 from shared.config import LoadedStation
-from shared.contract import Sample, StopDecision, ToolState, channels
+from shared.contract import Sample, StageDecision, StopDecision, ToolState, channels
 from shared.errors import InputError
 from shared.runtime import RateLimitedLog, ServiceSkeleton
 
@@ -87,10 +87,10 @@ class EdgePredictor:
         for message in self._runs.on_tool(state):  # a run's result and summary when it ended
             self._publish(message)
 
-    def on_sample(self, sample: Sample) -> StopDecision | None:
-        decision = None
+    def on_sample(self, sample: Sample) -> StopDecision | StageDecision | None:
+        decision: StopDecision | StageDecision | None = None
         for message in self._runs.on_sample(sample, time.time_ns()):
-            if isinstance(message, StopDecision):  # the acquisition sends and logs the stop
+            if isinstance(message, StopDecision | StageDecision):  # the acquisition sends it
                 decision = message
             self._publish(message)
         return decision

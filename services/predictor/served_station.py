@@ -13,7 +13,15 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from shared.config import LoadedStation, Program
-from shared.contract import PartScan, Sample, StationDatabase, ToolState, can_id_bounds, codec
+from shared.contract import (
+    PartScan,
+    Sample,
+    StationDatabase,
+    ToolCommandsName,
+    ToolState,
+    can_id_bounds,
+    codec,
+)
 from shared.model import JointConstants
 from shared.stickslip import PredictorSettings
 
@@ -36,8 +44,9 @@ class ServedStation:
         """The station's program; KeyError names the station and its known ids."""
         return self.station.config.program(program_id)
 
-    def settings(self, program: Program) -> PredictorSettings:
-        """The core's settings for one run of ``program`` at this station."""
+    def settings(self, program: Program, commands: ToolCommandsName = "stop") -> PredictorSettings:
+        """The core's settings for one run of ``program`` at this station (``commands``:
+        what its tool takes for this run; "staged" runs the program's final stage)."""
         config = self.station.config
         constants = self._constants.get(program.id)
         if constants is None:
@@ -49,4 +58,5 @@ class ServedStation:
             config.station.has_force_sensor,
             constants,
             self.station.sensor_range,
+            commands,
         )

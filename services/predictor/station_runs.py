@@ -5,8 +5,10 @@ predictor (:mod:`.service`, fed from zenoh) and the edge predictor
 (:mod:`.edge_predictor`, fed on the acquisition's CAN thread). Rules:
 
 - ``running`` starts a run (an :class:`ActiveRun` with the station's
-  settings for its program); a run id starts once, however its state flips
-  (counted in :attr:`repeated_runs`);
+  settings for its program, staged when the tool takes a final stage's
+  commands: ``ToolState.commands``); a run id starts once, however its state
+  flips (counted in :attr:`repeated_runs`); a ``running`` of a run under way
+  is a staged tool's new stage (it halted: ``holding``);
 - a new run of the station ends its older ones, unheard (their ``done`` was
   lost in an outage: counted in :attr:`unfinished_runs`, no summary);
 - ``done`` / ``aborted`` ends a run: its :class:`TighteningResult` (the summary
@@ -74,7 +76,11 @@ class StationRuns:
         """A run state of the station; when it ended a run, the run's result and summary
         (in the order to publish them: a summary's reader finds the result already there)."""
         if state.state == "running":
-            self._start(state)
+            run = self._runs.get(state.run_id)
+            if run is not None:  # a staged tool's new stage (ToolStage), in the same run
+                run.on_tool_stage(state)
+            else:
+                self._start(state)
             return []
         if state.state not in ("done", "aborted"):
             return []
@@ -159,7 +165,7 @@ class StationRuns:
             return
         part_id, part_source = self._part  # read once: an edge predictor's scans come on
         # another thread
-        settings = self.served.settings(program)
+        settings = self.served.settings(program, state.commands or "stop")
         self._runs[state.run_id] = ActiveRun(state, program, settings, part_id, part_source)
         LOG.debug(
             "%s run %s started (program %s, part %s)",

@@ -12,6 +12,22 @@ What every tool controller does by itself, boltwatch or not:
 * after the motor stops, keep sampling for ``settle_time_s`` (and until a slip
   under way has finished), then end.
 
+A program with a final stage, on a controller that takes stage commands
+(``accepts_stages``; the CAN side: ``docs/reference/can-and-trace.md``):
+
+* rundown at the program's speed; the final stage's speed on a
+  ``StageCommand`` final (back to the rundown speed on one saying rundown),
+  or by itself at ``switch_torque_nm`` (``switch = "torque"``);
+* a halt (a StopCommand, its own shutoff) leaves the run HOLDING, open for a
+  pulse (the final speed again, until the next halt; at most ``max_pulses``)
+  or a finish (the run ends DONE); after ``hold_s`` without either, and once
+  a slip under way has finished, it ends the run by itself: a station that
+  went quiet never holds the tool;
+* its own shutoff at the target watches the torque (the preload) averaged
+  over :data:`FINAL_SHUTOFF_SAMPLES` samples in the final stage and a pulse,
+  as a controller filters its transducer on a slow final step (one noisy
+  sample would halt it short of the target).
+
 ``tick()`` advances one sample period and returns that sample; the caller
 sends it and asks ``finished`` whether the run is over.
 """
@@ -20,10 +36,12 @@ from __future__ import annotations
 
 import enum
 import logging
+import statistics
+from collections import deque
 
 from services.rig.physics import Measurement, TighteningPhysics
 from shared.config import Program
-from shared.contract import ToolRunState
+from shared.contract import StageCommandCode, ToolRunState, ToolStageCode
 
 LOG = logging.getLogger(__name__)
 
@@ -40,6 +58,9 @@ class StopSource(enum.StrEnum):
     LIMIT_TIME = "limit_time"
     SERVICE_STOP = "service_stop"
 
+
+#: samples of the torque its own shutoff averages in the final stage and a pulse
+FINAL_SHUTOFF_SAMPLES = 8
 
 LIMITS = frozenset(
     {StopSource.LIMIT_TORQUE, StopSource.LIMIT_FORCE, StopSource.LIMIT_ANGLE, StopSource.LIMIT_TIME}
@@ -58,6 +79,7 @@ class RunController:
         settle_time_s: float,
         has_force_sensor: bool = True,
         shutoff: bool = True,
+        accepts_stages: bool = True,
     ) -> None:
         self.physics = physics
         self.program = program
@@ -70,6 +92,20 @@ class RunController:
         self.halt_time_s: float | None = None
         self.samples = 0
         self.last: Measurement | None = None
+        #: the program's final stage, when this controller runs it (None: stop only)
+        self.final_stage = program.final_stage if accepts_stages else None
+        self.accepts_stages = accepts_stages
+        self.stage = ToolStageCode.RUNDOWN
+        self.pulses = 0
+        self._held_since_s: float | None = None  # HOLDING since (run seconds)
+        self._finish_asked = False
+        self._recent_torque: deque[float] = deque(maxlen=FINAL_SHUTOFF_SAMPLES)
+        self._recent_force: deque[float] = deque(maxlen=FINAL_SHUTOFF_SAMPLES)
+
+    @property
+    def staged(self) -> bool:
+        """This run runs a final stage (the program has one and the controller takes it)."""
+        return self.final_stage is not None
 
     @property
     def finished(self) -> bool:
@@ -84,10 +120,45 @@ class RunController:
         """A StopCommand: obeyed (True) only for this run while its motor turns."""
         if run_id != self.run_id or self.state is not ToolRunState.RUNNING:
             return False
-        if self.stop_source is not None:
+        if not self.physics.motor_running or self.stage is ToolStageCode.HOLDING:
+            return False
+        if self.stop_source is not None and self.stage is not ToolStageCode.PULSE:
             return False
         self._halt(StopSource.STOP_COMMAND)
         return True
+
+    def request_stage(self, run_id: int, command: StageCommandCode) -> bool:
+        """A StageCommand: obeyed (True) only for this run, by a staged run, in a stage where
+        it applies (final, rundown: while the motor turns in the rundown or final stage;
+        pulse, finish: while holding; a pulse while pulses are left)."""
+        stage = self.final_stage
+        if stage is None or run_id != self.run_id or self.state is not ToolRunState.RUNNING:
+            return False
+        if command is StageCommandCode.FINAL and self.stage is ToolStageCode.RUNDOWN:
+            self._run_at(ToolStageCode.FINAL, stage.speed_rad_s)
+        elif command is StageCommandCode.RUNDOWN and self.stage is ToolStageCode.FINAL:
+            self._run_at(ToolStageCode.RUNDOWN, self.program.motor_speed_rad_s)
+        elif (
+            command is StageCommandCode.PULSE
+            and self.stage is ToolStageCode.HOLDING
+            and self.pulses < stage.max_pulses
+            and self.stop_source not in LIMITS
+        ):
+            self.pulses += 1
+            self._held_since_s = None
+            self._run_at(ToolStageCode.PULSE, stage.speed_rad_s)
+        elif command is StageCommandCode.FINISH and self.stage is ToolStageCode.HOLDING:
+            self._finish_asked = True
+        else:
+            return False
+        return True
+
+    def _run_at(self, stage: ToolStageCode, speed_rad_s: float) -> None:
+        self.stage = stage
+        self._recent_torque.clear()
+        self._recent_force.clear()
+        self.physics.set_motor_speed(speed_rad_s)
+        LOG.debug("run %d: %s at %.4g rad/s", self.run_id, stage.name.lower(), speed_rad_s)
 
     def interrupt(self) -> None:
         """The service is shutting down: halt now and end the run ABORTED."""
@@ -104,13 +175,29 @@ class RunController:
         measurement = self.physics.advance()
         self.samples += 1
         self.last = measurement
-        if self.stop_source is None:
+        self._recent_torque.append(measurement.torque_nm)
+        self._recent_force.append(measurement.force_n)
+        if self.physics.motor_running:
             source = self._limit_reached(measurement) or self._shutoff_reached(measurement)
             if source is not None:
                 self._halt(source)
-        elif self._settled(measurement):
+            else:
+                self._switch_by_torque(measurement)
+        elif self._ended(measurement):
             self.state = ToolRunState.ABORTED if self.stop_source in LIMITS else ToolRunState.DONE
         return measurement
+
+    def _switch_by_torque(self, measurement: Measurement) -> None:
+        """``switch = "torque"``: the final stage at the controller's own switch point."""
+        stage = self.final_stage
+        if (
+            stage is not None
+            and stage.switch == "torque"
+            and self.stage is ToolStageCode.RUNDOWN
+            and stage.switch_torque_nm is not None
+            and measurement.torque_nm >= stage.switch_torque_nm
+        ):
+            self._run_at(ToolStageCode.FINAL, stage.speed_rad_s)
 
     def _limit_reached(self, measurement: Measurement) -> StopSource | None:
         program = self.program
@@ -132,24 +219,39 @@ class RunController:
         if not self._shutoff:
             return None
         program = self.program
+        torque_nm, force_n = measurement.torque_nm, measurement.force_n
+        if self.stage in (ToolStageCode.FINAL, ToolStageCode.PULSE):
+            # a slow step: the filtered values (module docstring)
+            torque_nm = statistics.fmean(self._recent_torque)
+            force_n = statistics.fmean(self._recent_force)
         if self.has_force_sensor and program.target_force_n is not None:
-            if measurement.force_n >= program.target_force_n:
+            if force_n >= program.target_force_n:
                 return StopSource.SHUTOFF_FORCE
             return None
-        if (
-            program.target_torque_nm is not None
-            and measurement.torque_nm >= program.target_torque_nm
-        ):
+        if program.target_torque_nm is not None and torque_nm >= program.target_torque_nm:
             return StopSource.SHUTOFF_TORQUE
         return None
 
     def _halt(self, source: StopSource) -> None:
         self.physics.halt_motor()
-        self.stop_source = source
+        if self.stop_source is None or source in LIMITS:  # the run's first halt, or a limit
+            self.stop_source = source
         self.halt_time_s = self.physics.time_s
+        if self.staged:
+            self.stage = ToolStageCode.HOLDING
+            self._held_since_s = self.halt_time_s
         LOG.debug("run %d: motor halted at %.3f s (%s)", self.run_id, self.halt_time_s, source)
 
-    def _settled(self, measurement: Measurement) -> bool:
+    def _ended(self, measurement: Measurement) -> bool:
+        """The motor stands: is the run over? (its settle time, or a staged run's hold)"""
+        if not self.physics.settled:
+            return False
+        if self.staged and self.stop_source not in LIMITS:
+            if self._finish_asked:
+                return True
+            assert self.final_stage is not None and self._held_since_s is not None
+            held_s = measurement.time_s - self._held_since_s
+            return held_s >= self.final_stage.hold_s - 1e-9
         assert self.halt_time_s is not None
         waited_s = measurement.time_s - self.halt_time_s
-        return waited_s >= self._settle_time_s - 1e-9 and self.physics.settled
+        return waited_s >= self._settle_time_s - 1e-9

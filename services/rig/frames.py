@@ -1,7 +1,8 @@
 """The rig's CAN frames, encoded through the station's DBC (contract names only).
 
-The tool controller sends ToolSensors and ToolStatus, the force sensor node
-JointSensors; both listen for StopCommand. Ids, layout and scaling come from
+The tool controller sends ToolSensors and ToolStatus (and, when it runs a
+final stage, ToolStage), the force sensor node JointSensors; both listen for
+StopCommand (the controller for StageCommand too). Ids, layout and scaling come from
 :class:`~shared.contract.can_database.StationDatabase`, never from this file. A
 reading beyond what its signal can carry is sent at the end of the range, as
 a real transducer saturates at full scale (the predictor counts it as
@@ -13,7 +14,15 @@ from __future__ import annotations
 
 import can
 
-from shared.contract import COUNTER_MODULO, SensorRange, StationDatabase, ToolRunState
+from shared.contract import (
+    COUNTER_MODULO,
+    FEATURE_STAGES,
+    SensorRange,
+    StageCommandCode,
+    StationDatabase,
+    ToolRunState,
+    ToolStageCode,
+)
 
 
 class RigFrames:
@@ -25,10 +34,12 @@ class RigFrames:
         self._torque_nm = sensor_range.torque_nm
         self._angle_deg = sensor_range.angle_deg
         self._force_n = sensor_range.force_n
-        self._extended = {
-            name: database.is_extended(name)
-            for name in ("ToolSensors", "JointSensors", "ToolStatus")
-        }
+        names = ["ToolSensors", "JointSensors", "ToolStatus"]
+        if database.has_stages:
+            names.append("ToolStage")
+        self._extended = {name: database.is_extended(name) for name in names}
+        #: the DBC has the final stage's messages (the rig may run one)
+        self.has_stages = database.has_stages
 
     def _message(self, name: str, frame_id: int, signals: dict[str, float | int]) -> can.Message:
         return can.Message(
@@ -63,6 +74,36 @@ class RigFrames:
             self._database.tool_status_id,
             {"RunId": run_id, "ToolId": tool_id, "ProgramId": program_id, "State": int(state)},
         )
+
+    def tool_stage(
+        self, run_id: int, stage: ToolStageCode, pulses: int, max_pulses: int
+    ) -> can.Message:
+        """ToolStage of a controller that takes StageCommand (Features bit 0 set)."""
+        tool_stage_id = self._database.tool_stage_id
+        assert tool_stage_id is not None  # only with a DBC that has it (has_stages)
+        return self._message(
+            "ToolStage",
+            tool_stage_id,
+            {
+                "RunId": run_id,
+                "Stage": int(stage),
+                "Pulses": pulses,
+                "Features": FEATURE_STAGES,
+                "MaxPulses": max_pulses,
+            },
+        )
+
+    def stage_command(self, message: can.Message) -> tuple[int, StageCommandCode] | None:
+        """(RunId, Command) of a StageCommand frame; None for any other or malformed frame,
+        and for a command this controller does not know."""
+        frame_id = self._database.stage_command_id
+        if frame_id is None or message.arbitration_id != frame_id or message.is_error_frame:
+            return None
+        try:
+            signals = self._database.decode(message.arbitration_id, message.data)
+            return int(signals["RunId"]), StageCommandCode(int(signals["Command"]))
+        except Exception:  # cantools raises several kinds; ValueError for an unknown command
+            return None
 
     def stop_command_run_id(self, message: can.Message) -> int | None:
         """The RunId of a StopCommand frame; None for any other (or malformed) frame."""

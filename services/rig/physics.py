@@ -151,9 +151,26 @@ class TighteningPhysics:
 
     # --- commands -------------------------------------------------------------
 
+    @property
+    def motor_speed_rad_s(self) -> float:
+        """φ̇_m now: the program's speed, a final stage's, or 0 once halted."""
+        return self._motor_speed
+
     def halt_motor(self) -> None:
         """The motor stops now; a slip under way finishes by itself."""
         self._motor_speed = 0.0
+
+    def set_motor_speed(self, speed_rad_s: float) -> None:
+        """The motor turns at ``speed_rad_s`` from now on (a final stage, a pulse; 0 halts).
+
+        The state stays exact across the change: a stick phase goes on standing
+        with the torque now rising at k_e · speed (its break instant is solved
+        again at the next :meth:`advance`), a slip under way goes on with the
+        motor's new speed in its closed form.
+        """
+        if not speed_rad_s >= 0.0 or math.isinf(speed_rad_s):
+            raise ValueError(f"speed_rad_s must be finite and ≥ 0 (got {speed_rad_s})")
+        self._motor_speed = speed_rad_s
 
     def advance(self) -> Measurement:
         """One sample period forward; the (noisy) sensors at its end."""

@@ -3,7 +3,11 @@
 Per run: ToolStatus(running), then every sample period a ToolSensors frame
 and (with a force sensor) a JointSensors frame carrying the same 16-bit
 rolling Counter (0 at the start of each run); ToolStatus every 100 ms and on
-each change (done or aborted, then idle). Pacing uses absolute deadlines on
+each change (done or aborted, then idle). A controller that takes StageCommand
+(``[rig] stage_commands``, and a DBC that has it) sends ToolStage before the
+run's first ToolStatus, on every change of its stage or pulses, and with each
+ToolStatus; a StageCommand for the running run is obeyed within the tick, as
+a StopCommand is. Pacing uses absolute deadlines on
 ``time.perf_counter``; the wait for the next deadline is ``bus.recv`` itself,
 so a StopCommand for the running run halts the motor within the current tick.
 More than 50 ms late: a warning, a count, and the schedule restarts from now.
@@ -33,7 +37,7 @@ from services.rig.controller import RunController, StopSource
 from services.rig.frames import RigFrames
 from services.rig.physics import TighteningPhysics
 from shared.config import Program, RigSection
-from shared.contract import ToolRunState
+from shared.contract import ToolRunState, ToolStageCode
 from shared.errors import TransportError
 from shared.model import JointConstants
 
@@ -57,6 +61,7 @@ class RunSummary:
     slips: int
     samples: int
     late_resyncs: int
+    pulses: int = 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -119,7 +124,8 @@ class RealtimeRig:
             summary = self.run_one(program, first_run_id + index, seed + index, stop)
             summaries.append(summary)
             LOG.info(
-                "run %d: %s by %s, force %.0f N, torque %.1f Nm, %d slips, %d samples, %d late",
+                "run %d: %s by %s, force %.0f N, torque %.1f Nm, %d slips, %d samples, %d late, "
+                "%d pulses",
                 summary.run_id,
                 summary.state.name.lower(),
                 summary.stop_source,
@@ -128,6 +134,7 @@ class RealtimeRig:
                 summary.slips,
                 summary.samples,
                 summary.late_resyncs,
+                summary.pulses,
             )
             index += 1
         return summaries
@@ -137,13 +144,18 @@ class RealtimeRig:
     ) -> RunSummary:
         """One tightening in real time; returns after the final ToolStatus(idle)."""
         physics = TighteningPhysics(self._constants, program, self._rig, seed, SAMPLE_PERIOD_S)
+        stages = self._rig.stage_commands and self._frames.has_stages
         controller = RunController(
             physics,
             program,
             run_id,
             settle_time_s=self._rig.settle_time_s,
             has_force_sensor=self._tool.has_force_sensor,
+            accepts_stages=stages,
         )
+        reported: tuple[ToolStageCode, int] | None = None
+        if stages:  # what it takes, before the run starts (the station fixes it per run)
+            reported = self._send_stage(controller)
         controller.start()
         self._send_status(controller)
         late = 0
@@ -153,6 +165,8 @@ class RealtimeRig:
         next_status = start + STATUS_PERIOD_S
         while True:
             measurement = controller.tick()
+            if stages and reported != (controller.stage, controller.pulses):
+                reported = self._send_stage(controller)
             self._send(
                 self._frames.tool_sensors(measurement.torque_nm, measurement.angle_deg, counter)
             )
@@ -167,6 +181,8 @@ class RealtimeRig:
             now = self._clock()
             if now >= next_status:
                 self._send_status(controller)
+                if stages:
+                    reported = self._send_stage(controller)
                 next_status = now + STATUS_PERIOD_S
             deadline += SAMPLE_PERIOD_S
             lateness_s = now - deadline
@@ -190,6 +206,7 @@ class RealtimeRig:
             slips=physics.slip_count,
             samples=controller.samples,
             late_resyncs=late,
+            pulses=controller.pulses,
         )
 
     def _wait_until(self, deadline: float, controller: RunController) -> None:
@@ -201,6 +218,9 @@ class RealtimeRig:
                 run_id = self._frames.stop_command_run_id(message)
                 if run_id is not None and controller.request_stop(run_id):
                     LOG.info("run %d: StopCommand obeyed", run_id)
+                stage = self._frames.stage_command(message)
+                if stage is not None and controller.request_stage(*stage):
+                    LOG.info("run %d: StageCommand %s obeyed", stage[0], stage[1].name.lower())
             if self._clock() >= deadline:
                 return
 
@@ -221,6 +241,19 @@ class RealtimeRig:
             wait_end = min(end, now + STATUS_PERIOD_S)
             while not stop.is_set() and self._clock() < wait_end:
                 self._bus.recv(timeout=min(0.01, max(0.0, wait_end - self._clock())))
+
+    def _send_stage(self, controller: RunController) -> tuple[ToolStageCode, int]:
+        """ToolStage now; the (stage, pulses) it reported."""
+        stage = controller.final_stage
+        self._send(
+            self._frames.tool_stage(
+                controller.run_id,
+                controller.stage,
+                controller.pulses,
+                stage.max_pulses if stage is not None else 0,
+            )
+        )
+        return controller.stage, controller.pulses
 
     def _send_status(self, controller: RunController) -> None:
         self._send(

@@ -7,7 +7,8 @@ names), :func:`load_any_station` (a CAN or a controller station) or
 - :mod:`.station` (the CAN station file), :mod:`.controller_station` (a station
   whose tool an Open Protocol controller drives), :mod:`.station_kinds` (either
   kind), :mod:`.common_sections` (what both have), :mod:`.program_windows` (a program's
-  windows: where a run must end to be OK), :mod:`.openprotocol` (a controller that
+  windows: where a run must end to be OK), :mod:`.final_stage` (a program's final stage
+  at a lower speed, and its pulses), :mod:`.openprotocol` (a controller that
   speaks Open Protocol, and the simulated one's side), :mod:`.quality` (when the
   recorder raises a quality alert), :mod:`.retention` (how long the recorder keeps the
   recordings), :mod:`.rig_parts` (the simulated line's parts: bolts
@@ -23,6 +24,7 @@ from shared.config.controller_station import (
     ControllerStation,
     ControllerStationConfig,
 )
+from shared.config.final_stage import FinalStage
 from shared.config.joint import JointConfig, load_joint
 from shared.config.line import (
     check_derivable,
@@ -56,6 +58,7 @@ __all__ = [
     "ControllerProgram",
     "ControllerStation",
     "ControllerStationConfig",
+    "FinalStage",
     "JointConfig",
     "LoadedStation",
     "OpenProtocolSection",

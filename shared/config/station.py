@@ -30,6 +30,7 @@ from shared.config.common_sections import (
     spool_folder,
 )
 from shared.config.controller_station import is_controller_station
+from shared.config.final_stage import FinalStage
 from shared.config.joint import JointConfig, load_joint
 from shared.config.loading import StrictModel, read_toml, resolve_relative, validate
 from shared.config.openprotocol import OpenProtocolSection, RigOpenProtocolSection
@@ -55,6 +56,11 @@ class CanSection(StrictModel):
     channel: str = Field(min_length=1, description="multicast group, can0, or a virtual bus name")
     port: int | None = Field(default=None, ge=1, le=65535, description="udp_multicast only")
     dbc: Path = Field(description="CAN database, relative to this station file")
+    tool_commands: Literal["auto", "stop"] = Field(
+        default="auto",
+        description="'auto': command a program's final stage when the DBC has StageCommand "
+        "and the tool controller says it takes it (ToolStage); 'stop': stop commands only",
+    )
 
     @model_validator(mode="after")
     def _port_only_for_multicast(self) -> CanSection:
@@ -84,6 +90,11 @@ class Program(ProgramWindows):
         description="the joint this program tightens, relative to the station file "
         "(default: the station's station.joint)",
     )
+    final_stage: FinalStage | None = Field(
+        default=None,
+        description="a final stage at a lower speed, and pulses back to the target "
+        "(shared/config/final_stage.py); none: the tool runs at one speed and is stopped",
+    )
 
     @model_validator(mode="after")
     def _has_a_target(self) -> Program:
@@ -112,6 +123,29 @@ class Program(ProgramWindows):
         past = self.windows_past_limits()
         if past is not None:
             raise ValueError(past)
+        return self
+
+    @model_validator(mode="after")
+    def _final_stage_fits(self) -> Program:
+        """A final stage slower than the rundown, switching below the target."""
+        stage = self.final_stage
+        if stage is None:
+            return self
+        if stage.speed_rad_s >= self.motor_speed_rad_s:
+            raise ValueError(
+                f"final_stage.speed_rad_s {stage.speed_rad_s:g} rad/s is not below "
+                f"motor_speed_rad_s {self.motor_speed_rad_s:g} rad/s: a final stage is slower"
+            )
+        switch_nm = stage.switch_torque_nm
+        if switch_nm is not None:
+            which, below = ("max_torque_nm", self.max_torque_nm)
+            if self.target_torque_nm is not None:
+                which, below = ("target_torque_nm", self.target_torque_nm)
+            if switch_nm >= below:
+                raise ValueError(
+                    f"final_stage.switch_torque_nm {switch_nm:g} Nm is not below {which} "
+                    f"{below:g} Nm: the tool would never run its final stage"
+                )
         return self
 
     def limits_beyond(self, sensor_range: SensorRange) -> str | None:
@@ -159,6 +193,11 @@ class RigSection(StrictModel):
     force_noise_n: float = Field(default=30.0, ge=0)
     angle_noise_deg: float = Field(default=0.01, ge=0)
     settle_time_s: float = Field(default=0.03, gt=0, description="samples sent after the stop")
+    stage_commands: bool = Field(
+        default=True,
+        description="the simulated controller takes StageCommand (a program's final stage, "
+        "pulses) and says so in ToolStage; false: it only stops, as an older controller",
+    )
     pause_between_runs_s: float = Field(default=0.5, ge=0)
     seed: int | None = Field(default=None, description="none: a fresh seed per process")
     bolts_per_part: int = Field(

@@ -12,9 +12,16 @@
 - :mod:`.trace` (the offline trace CSV), :mod:`.run_clock` (a run's clock: ns <-> s)
 - :mod:`.spool_messages` (what a station's spool and the recorder say to each other)
 - :mod:`.part_messages` (what the line says of the part at a station: its id)
+- :mod:`.stage_messages` (what a station commands a tool that runs a final stage)
 """
 
-from shared.contract.can_database import CONTRACT, COUNTER_MODULO, SAMPLE_RATE_HZ, StationDatabase
+from shared.contract.can_database import (
+    CONTRACT,
+    COUNTER_MODULO,
+    SAMPLE_RATE_HZ,
+    STAGE_MESSAGES,
+    StationDatabase,
+)
 from shared.contract.channels import CHANNELS, SCHEMA_TYPES, Channel
 from shared.contract.codec import MAX_PAYLOAD_BYTES, decode, decoder, encode, json_schema, to_dict
 from shared.contract.message_fields import (
@@ -32,6 +39,7 @@ from shared.contract.message_fields import (
     can_id_bounds,
 )
 from shared.contract.messages import (
+    FEATURE_STAGES,
     BridgeStats,
     BusStats,
     ControllerAlarm,
@@ -55,14 +63,22 @@ from shared.contract.messages import (
     RunSummary,
     Sample,
     SampleBatch,
+    StageCommandCode,
+    StageCommandName,
+    StageDecision,
+    StageReason,
+    StageReasonName,
     StepStatus,
     StickSlipEvent,
     StopDecision,
     StopReason,
     StopReasonName,
     TighteningResult,
+    ToolCommandsName,
     ToolData,
     ToolRunState,
+    ToolStageCode,
+    ToolStageName,
     ToolState,
     Verdict,
     WearAlert,
@@ -88,6 +104,7 @@ __all__ = [
     "DEFAULT_FLOAT",
     "DEFAULT_INT",
     "DEFAULT_TEXT",
+    "FEATURE_STAGES",
     "FLOAT_MAX",
     "INT64_MAX",
     "MAX_PAYLOAD_BYTES",
@@ -96,6 +113,7 @@ __all__ = [
     "PART_ID_CHARS",
     "SAMPLE_RATE_HZ",
     "SCHEMA_TYPES",
+    "STAGE_MESSAGES",
     "STATION_ID",
     "BridgeStats",
     "BusStats",
@@ -129,6 +147,11 @@ __all__ = [
     "SpoolAck",
     "SpoolFiled",
     "SpoolStats",
+    "StageCommandCode",
+    "StageCommandName",
+    "StageDecision",
+    "StageReason",
+    "StageReasonName",
     "StationDatabase",
     "StepStatus",
     "StickSlipEvent",
@@ -137,8 +160,11 @@ __all__ = [
     "StopReasonName",
     "TextRange",
     "TighteningResult",
+    "ToolCommandsName",
     "ToolData",
     "ToolRunState",
+    "ToolStageCode",
+    "ToolStageName",
     "ToolState",
     "Trace",
     "Verdict",

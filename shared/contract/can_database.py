@@ -3,7 +3,9 @@
 Message and signal names are the contract of docs/design.md; ids, layout and
 scaling live in the DBC. :class:`StationDatabase` looks every contract message
 up once, so a DBC that lacks one fails at start-up with its file named,
-and the hot path encodes and decodes through prepared cantools messages.
+and the hot path encodes and decodes through prepared cantools messages. The
+final stage's two messages (:data:`STAGE_MESSAGES`) are optional: a DBC
+without them is a stop-only station's (``has_stages`` False).
 """
 
 from __future__ import annotations
@@ -22,6 +24,14 @@ CONTRACT: dict[str, tuple[str, ...]] = {
     "JointSensors": ("Force", "Counter"),
     "ToolStatus": ("RunId", "ToolId", "ProgramId", "State"),
     "StopCommand": ("RunId", "Reason"),
+}
+
+#: Messages a tool controller that runs a final stage needs (``StageCommand`` from the
+#: station, ``ToolStage`` from the controller): a DBC without them is a stop-only station's,
+#: one with them must carry these signals.
+STAGE_MESSAGES: dict[str, tuple[str, ...]] = {
+    "StageCommand": ("RunId", "Command", "Pulse", "Reason"),
+    "ToolStage": ("RunId", "Stage", "Pulses", "Features", "MaxPulses"),
 }
 
 COUNTER_MODULO = 1 << 16
@@ -49,14 +59,31 @@ class StationDatabase:
                 message = database.get_message_by_name(name)
             except KeyError as err:
                 raise CanDatabaseError(f"{path}: message {name} missing (contract)") from err
-            missing = [s for s in signals if s not in {sig.name for sig in message.signals}]
-            if missing:
-                raise CanDatabaseError(f"{path}: {name} lacks signals {', '.join(missing)}")
-            self._messages[name] = message
+            self._messages[name] = _with_signals(path, message, signals)
+        present = {m.name for m in database.messages}
+        for name, signals in STAGE_MESSAGES.items():
+            if name in present:
+                message = database.get_message_by_name(name)
+                self._messages[name] = _with_signals(path, message, signals)
+        stage_names = [name for name in STAGE_MESSAGES if name in self._messages]
+        if 0 < len(stage_names) < len(STAGE_MESSAGES):
+            lacking = ", ".join(name for name in STAGE_MESSAGES if name not in self._messages)
+            raise CanDatabaseError(
+                f"{path}: has {', '.join(stage_names)} but not {lacking}: a final stage "
+                "needs both (or neither, for a tool that only stops)"
+            )
+        #: the DBC has the final stage's messages (a tool controller may take StageCommand)
+        self.has_stages = bool(stage_names)
         self.tool_sensors_id: int = self._messages["ToolSensors"].frame_id
         self.joint_sensors_id: int = self._messages["JointSensors"].frame_id
         self.tool_status_id: int = self._messages["ToolStatus"].frame_id
         self.stop_command_id: int = self._messages["StopCommand"].frame_id
+        self.stage_command_id: int | None = (
+            self._messages["StageCommand"].frame_id if self.has_stages else None
+        )
+        self.tool_stage_id: int | None = (
+            self._messages["ToolStage"].frame_id if self.has_stages else None
+        )
         #: frame id -> (message name, expected data length)
         self.by_id: dict[int, tuple[str, int]] = {
             m.frame_id: (name, m.length) for name, m in self._messages.items()
@@ -93,3 +120,11 @@ class StationDatabase:
         low = ends[0] if found.minimum is None else max(ends[0], float(found.minimum))
         high = ends[1] if found.maximum is None else min(ends[1], float(found.maximum))
         return float(low), float(high)
+
+
+def _with_signals(path: Path, message: Any, signals: tuple[str, ...]) -> Any:
+    """``message``, once it carries every one of ``signals`` (else one line naming them)."""
+    missing = [s for s in signals if s not in {sig.name for sig in message.signals}]
+    if missing:
+        raise CanDatabaseError(f"{path}: {message.name} lacks signals {', '.join(missing)}")
+    return message

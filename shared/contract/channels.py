@@ -29,6 +29,8 @@ topic              publisher             message, when
                    (openprotocol)
 ``decision``       predictor             :class:`StopDecision`, at most one per run
                    (openprotocol)        (a bridge's: advisory, the controller stopped)
+``stage``          predictor             :class:`StageDecision`, each command to a tool
+                                         that runs a final stage (switch, pulse, finish)
 ``runs``           predictor             :class:`RunSummary`, one per run
                    (openprotocol)
 ``results``        predictor (import,    :class:`TighteningResult`, one per run, just
@@ -72,9 +74,10 @@ recorder's queryable of the wear ledger), in :mod:`shared.contract.keys`.
 Every channel is put with congestion control BLOCK: zenoh's default (DROP)
 lost events under load, silently, and loss is counted end to end. Samples
 and tool states share one priority, so a run's ``done`` never overtakes its
-samples; a decision is REAL_TIME. Samples, tool states, decisions and part
-scans are express (no batching in zenoh: latency counts; a part must reach
-the predictor before its first run starts). Sample batches are not: they
+samples; a decision and a final stage's command are REAL_TIME. Samples, tool
+states, decisions, a final stage's commands and part scans are express (no
+batching in zenoh: latency counts; a part must reach the predictor before its
+first run starts). Sample batches are not: they
 are recorded, not decided on, and zenoh packs the batches of many stations
 into one frame toward the line's recorder (``bench_line.py`` at 50 stations:
 0.6 to 1.0 µs less of the recorder's CPU per sample, lag no worse).
@@ -101,6 +104,7 @@ from shared.contract.messages import (
     SampleBatch,
     SpoolAck,
     SpoolStats,
+    StageDecision,
     StickSlipEvent,
     StopDecision,
     TighteningResult,
@@ -172,6 +176,7 @@ DECISION = Channel(
     Qos(real_time=True, express=True),
     _BRIDGE,
 )
+STAGE = Channel("stage", StageDecision, "predictor", Qos(real_time=True, express=True))
 RUNS = Channel("runs", RunSummary, "predictor", also_by=_BRIDGE)
 RESULTS = Channel("results", TighteningResult, "predictor", also_by=("import", *_BRIDGE))
 PREDICTOR = Channel("predictor", PredictorStats, "predictor")
@@ -197,6 +202,7 @@ CHANNELS: tuple[Channel[Any], ...] = (
     EVENTS,
     INTENSITY,
     DECISION,
+    STAGE,
     RUNS,
     RESULTS,
     PREDICTOR,

@@ -16,7 +16,9 @@ What tool controllers say (a controller's result, its tool data and alarms, a
 controller bridge's counters) is in :mod:`shared.contract.controller_messages` and
 imported from here as every other message.
 What the line says of the part at a station (:class:`PartScan`) is in
-:mod:`shared.contract.part_messages`, imported from here too.
+:mod:`shared.contract.part_messages`, imported from here too; what a station
+commands a tool that runs a final stage (:class:`StageDecision`), in
+:mod:`shared.contract.stage_messages`.
 """
 
 from __future__ import annotations
@@ -45,6 +47,17 @@ from shared.contract.spool_messages import (  # noqa: F401  (re-exported: one im
     SpoolAck,
     SpoolFiled,
     SpoolStats,
+)
+from shared.contract.stage_messages import (  # noqa: F401  (re-exported: one import for every message)
+    FEATURE_STAGES,
+    StageCommandCode,
+    StageCommandName,
+    StageDecision,
+    StageReason,
+    StageReasonName,
+    ToolCommandsName,
+    ToolStageCode,
+    ToolStageName,
 )
 
 ToolStateName = Literal["idle", "running", "done", "aborted"]
@@ -145,6 +158,13 @@ class ToolState:
     # done / aborted: the StopCommand boltwatch sent the tool in this run (its reason);
     # None: none went out, the tool stopped by itself (its own shutoff or limits)
     stop_command: StopReasonName | None = None
+    # what the station may command the tool in this run: "stop", or "staged" (a final
+    # stage and pulses: its controller said it takes StageCommand); None: not said (a
+    # controller bridge, a recording made before stages existed): stop
+    commands: ToolCommandsName | None = None
+    # running, on a staged tool: the stage it runs (ToolStage); a change is a new ToolState
+    stage: ToolStageName | None = None
+    pulses: Count = 0  # pulses the tool has run in this run
 
 
 @dataclass(frozen=True, slots=True)
@@ -173,6 +193,12 @@ class BusStats:
     repeated_runs: Count = 0  # ToolStatus starting a run id that had started already: ignored
     started_ns: TimeNs = 0  # when this acquisition process started: a new value, a new process
     bad_decisions: Count = 0  # decision payloads refused (not a valid StopDecision): no stop
+    # what the station may command its tool in the next run: stop, or staged (a final
+    # stage: the DBC, the station file and the tool controller all allow it); why not
+    tool_commands: ToolCommandsName = "stop"
+    tool_commands_note: str = ""
+    stage_commands: Count = 0  # StageCommands sent
+    refused_stages: Count = 0  # a final stage's commands for a run whose tool runs stop only
 
 
 @dataclass(frozen=True, slots=True)
@@ -280,6 +306,12 @@ class RunSummary:
     # a loosening (an imported controller run turning the tool back) is no tightening: the
     # wear ledger counts its intensity, not the run among the tool's tightenings
     operation: RunOperation = "tightening"
+    # what the station could command the tool in this run ("staged": a final stage and
+    # pulses; None: not said, stop only); a final stage: when it began, seconds since the
+    # run's start (None: none ran), and the pulses back to the target the run took
+    commands: ToolCommandsName | None = None
+    final_stage_s: float | None = None
+    pulses: Count = 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -465,3 +497,6 @@ class TighteningResult:
     # restored from the line when the predictor started, unknown); None: not said (a result
     # of a controller, which names its own VIN, or one made before this field)
     part_source: PartSource | None = None
+    # a final stage (a staged tool): the pulses back to the target the run took (a pulse
+    # won back a slip drop lost during the halt); None: the run had no final stage
+    pulses: Count | None = None

@@ -33,6 +33,10 @@ class BusHealth:
     unsent_samples: int  # published with no router reachable
     late_decisions: int  # decisions for a run the tool was no longer running
     bad_decisions: int = 0  # decision payloads refused (not a valid StopDecision)
+    # what the station commands its tool: "stop" (and why, tool_commands_note) or "staged"
+    tool_commands: str = "stop"
+    tool_commands_note: str = ""
+    stage_commands: int = 0  # a final stage's StageCommands sent
 
 
 def bus_rate(first: BusStats | None, latest: BusStats | None) -> float | None:
@@ -65,4 +69,7 @@ def bus_health(stats: BusStats | None, received_ns: int, now_ns: int) -> BusHeal
         unsent_samples=stats.unsent_samples,
         late_decisions=stats.late_decisions,
         bad_decisions=stats.bad_decisions,
+        tool_commands=stats.tool_commands,
+        tool_commands_note=stats.tool_commands_note,
+        stage_commands=stats.stage_commands,
     )

@@ -52,6 +52,9 @@ class ProgramColumns:
     events_per_run: list[int]
     stations: list[str]
     tools: list[int]
+    #: runs that ran a final stage, and of them the ones that needed a pulse back to the target
+    staged_runs: int = 0
+    pulsed_runs: int = 0
 
 
 def reason_kinds(reasons: str) -> set[str]:
@@ -119,6 +122,8 @@ def _program_columns(
         window_counts=window_counts,
         nok_reasons=nok_reasons,
         stop_reasons=Counter(run.stop_reason or TOOL_STOPPED for run in runs),
+        staged_runs=sum(1 for run in runs if run.pulses is not None),
+        pulsed_runs=sum(1 for run in runs if run.pulses),
         events_per_run=events,
         stations=sorted({run.station for run in runs}),
         tools=sorted({run.tool_id for run in runs}),

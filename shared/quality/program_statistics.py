@@ -66,6 +66,10 @@ class ProgramStatistics:
     window_changes: list[str] = field(default_factory=list)
     stations: list[str] = field(default_factory=list)
     tools: list[int] = field(default_factory=list)
+    #: runs that ran a final stage, and of them those that needed a pulse (a quality signal:
+    #: a slip during the halt, won back)
+    staged_runs: int = 0
+    pulsed_runs: int = 0
 
     @property
     def nok_rate(self) -> float:
@@ -117,4 +121,6 @@ def statistics_of(columns: ProgramColumns, subgroup_size: int) -> ProgramStatist
         window_changes=changes,
         stations=columns.stations,
         tools=columns.tools,
+        staged_runs=columns.staged_runs,
+        pulsed_runs=columns.pulsed_runs,
     )

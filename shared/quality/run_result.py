@@ -70,4 +70,5 @@ def tightening_result(
         process_intensity=summary.process_intensity,
         source="predictor",
         part_source=part_source,
+        pulses=summary.pulses if summary.commands == "staged" else None,
     )

@@ -39,8 +39,9 @@ from shared.results.results_query import ResultsQuery
 from shared.results.results_store import ResultsStore
 
 _WINDOWS = ", ".join(column for _value, *window in JUDGED_COLUMNS for column in window)
-#: what is counted: of each program, its runs by station, tool, stop reason and windows
-_GROUPS = f"program_id, station, tool_id, stop_reason, {_WINDOWS}"
+#: what is counted: of each program, its runs by station, tool, stop reason, a final
+#: stage's pulses (NULL: no final stage) and windows
+_GROUPS = f"program_id, station, tool_id, stop_reason, pulses, {_WINDOWS}"
 #: what each run gives, in the order the runs ended: the figures' arrays, NOK reasons, and
 #: what it is counted by
 _RUN_COLUMNS = (
@@ -95,8 +96,11 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
         of_program = figures[program_ids == program_id]
         groups = grouped[program_id]
         stop_reasons: Counter[str] = Counter()
-        for _station, _tool, reason, *_windows, runs in groups:
+        staged = pulsed = 0
+        for _station, _tool, reason, pulses, *_windows, runs in groups:
             stop_reasons[reason or TOOL_STOPPED] += runs
+            staged += runs if pulses is not None else 0
+            pulsed += runs if pulses else 0
         reasons: Counter[str] = Counter()
         for text in nok_reasons[program_id]:
             reasons.update(reason_kinds(text))
@@ -115,11 +119,13 @@ def program_columns(store: ResultsStore, query: ResultsQuery) -> StoredColumns:
                     for index, key in enumerate(JUDGED_FIGURES)
                 },
                 window_counts={
-                    key: len({group[3 + 2 * index : 5 + 2 * index] for group in groups})
+                    key: len({group[4 + 2 * index : 6 + 2 * index] for group in groups})
                     for index, key in enumerate(JUDGED_FIGURES)
                 },
                 nok_reasons=reasons,
                 stop_reasons=stop_reasons,
+                staged_runs=staged,
+                pulsed_runs=pulsed,
                 events_per_run=[int(events) for events in _measured(of_program[:, 4])],
                 stations=sorted({group[0] for group in groups}),
                 tools=sorted({int(group[1]) for group in groups}),

@@ -32,7 +32,7 @@ from shared.results.refused_results import IMPLAUSIBLE_SQL
 from shared.results.results_database import ResultsDatabase, StoreError
 
 #: the version this boltwatch writes; MIGRATIONS[v - 1] makes version v
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
 
 TIGHTENING_COLUMNS = (
     "station", "run_id", "plant", "line", "station_name", "tightening_id", "tool_id",
@@ -41,7 +41,7 @@ TIGHTENING_COLUMNS = (
     "angle_deg", "angle_min_deg", "angle_max_deg", "angle_status",
     "force_n", "force_min_n", "force_max_n", "force_status",
     "stop_reason", "events", "process_intensity", "source",
-    "recording", "recording_host", "stored_ns", "part_source",
+    "recording", "recording_host", "stored_ns", "part_source", "pulses",
 )  # fmt: skip
 STEP_COLUMNS = (
     "station", "run_id", "step_index", "name", "function", "nominal", "actual", "status",
@@ -164,8 +164,22 @@ _VERSION_4 = (
     f"DELETE FROM tightenings WHERE {IMPLAUSIBLE_SQL}",
 )
 
+# a final stage's pulses back to the target (TighteningResult.pulses): NULL for a run without
+# a final stage, and for a row made before (nothing rewritten, as in version 3), in both
+# tables of tightenings
+_VERSION_5 = (
+    "ALTER TABLE tightenings ADD COLUMN pulses BIGINT",
+    "ALTER TABLE refused_tightenings ADD COLUMN pulses BIGINT",
+)
+
 #: the statements that bring a store from version v - 1 to v, for v = 1, 2, ...
-MIGRATIONS: tuple[tuple[str, ...], ...] = (_VERSION_1, _VERSION_2, _VERSION_3, _VERSION_4)
+MIGRATIONS: tuple[tuple[str, ...], ...] = (
+    _VERSION_1,
+    _VERSION_2,
+    _VERSION_3,
+    _VERSION_4,
+    _VERSION_5,
+)
 
 
 def migrate(database: ResultsDatabase, migrations: tuple[tuple[str, ...], ...] = MIGRATIONS) -> int:

@@ -31,6 +31,7 @@ CSV_HEADER = (
     "angle_deg", "angle_min_deg", "angle_max_deg", "angle_status",
     "force_n", "force_min_n", "force_max_n", "force_status",
     "stop_reason", "events", "process_intensity", "source", "recording", "recording_host",
+    "pulses",
 )  # fmt: skip
 
 
@@ -53,6 +54,14 @@ def _part(part_id: str | None, source: str | None) -> str:
     return f"{part_id} ({source})" if source == "restored" else part_id
 
 
+def _stopped_on(reason: str | None, pulses: int | None) -> str:
+    """What stopped the tool, and a final stage's pulses after it (``target_reached+pulse``)."""
+    text = reason or "-"
+    if pulses:
+        text += "+pulse" if pulses == 1 else f"+{pulses}pulses"
+    return text
+
+
 def row(stored: StoredResult) -> tuple[str, ...]:
     r = stored.result
     return (
@@ -68,7 +77,7 @@ def row(stored: StoredResult) -> tuple[str, ...]:
         _figure(r.final_torque_nm),
         _figure(r.final_angle_deg),
         _figure(r.final_force_n, 1000.0),
-        r.stop_reason or "-",
+        _stopped_on(r.stop_reason, r.pulses),
         "-" if r.events is None else str(r.events),
         r.nok_reasons or "-",
         stored.recording or "-",
@@ -95,7 +104,7 @@ def csv_row(stored: StoredResult) -> list[Any]:
         r.tool_id,
         r.batch_counter, r.result, r.nok_reasons,
         *figures, r.stop_reason, r.events, r.process_intensity, r.source, stored.recording,
-        stored.recording_host,
+        stored.recording_host, r.pulses,
     ]  # fmt: skip
 
 

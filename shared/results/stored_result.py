@@ -69,7 +69,7 @@ def to_row(stored: StoredResult) -> tuple[Any, ...]:
         angle.value, angle.min, angle.max, angle.status,
         force.value, force.min, force.max, force.status,
         r.stop_reason, r.events, r.process_intensity, r.source,
-        stored.recording, stored.recording_host, stored.stored_ns, r.part_source,
+        stored.recording, stored.recording_host, stored.stored_ns, r.part_source, r.pulses,
     )  # fmt: skip
 
 
@@ -90,7 +90,7 @@ def from_row(row: Sequence[Any], steps: Sequence[ResultStep] = ()) -> StoredResu
         angle, angle_min, angle_max, angle_status,
         force, force_min, force_max, force_status,
         stop_reason, events, intensity, source, recording, recording_host, stored_ns,
-        part_source,
+        part_source, pulses,
     ) = row  # fmt: skip
     result = TighteningResult(
         station=station,
@@ -113,6 +113,7 @@ def from_row(row: Sequence[Any], steps: Sequence[ResultStep] = ()) -> StoredResu
         source=source,
         steps=list(steps),
         part_source=part_source,
+        pulses=None if pulses is None else int(pulses),
     )
     return StoredResult(
         result, line, recording, recording_host, int(stored_ns), plant, station_name

@@ -24,7 +24,9 @@ the Open Protocol bridge and the tests. Files, one concept each:
 - :mod:`.stop_policy`        when to stop and why: the rules of :mod:`.stop_rules`, in order
 - :mod:`.stop_rules`         one class per rule: hard limits, target and halt plan,
                              plateau (eqs. 64/65), intensity (eq. 70), constant bands (eq. 71)
-- :mod:`.outputs`            the stop decision: CoreDecision
+- :mod:`.final_stage_run`    a final stage: when to slow down, halt, pulse, finish
+- :mod:`.sliding_line`       a least-squares line through the newest samples, O(1)
+- :mod:`.outputs`            the stop decision (CoreDecision), a final stage's CoreCommand
 - :mod:`.predictor_core`     the facade that joins them
 - :mod:`.run_messages`       the core's outputs as the messages a station publishes
 - :mod:`.trace_replay`       the core over an offline trace (``boltwatch predict``)
@@ -47,11 +49,16 @@ from shared.stickslip.inclination_window import MAX_PASSED, MIN_PASSED, NO_FLIP,
 from shared.stickslip.input_guard import InputReport
 from shared.stickslip.model_bands import MIN_STICK_SHARE, MODEL_SLACK, ModelBandCheck
 from shared.stickslip.motor_motion import MotorMotion
-from shared.stickslip.outputs import CoreDecision
+from shared.stickslip.outputs import CoreCommand, CoreDecision
 from shared.stickslip.predictor_core import PredictorCore
 from shared.stickslip.ramp_estimator import SPAN, RampEstimator
 from shared.stickslip.regression import fit_line, fit_parabola, predict_periods, predict_plateaus
-from shared.stickslip.run_messages import decision_message, event_messages, stick_slip_event
+from shared.stickslip.run_messages import (
+    decision_message,
+    event_messages,
+    stage_message,
+    stick_slip_event,
+)
 from shared.stickslip.scoring import PredictionScores
 from shared.stickslip.second_difference import SEED_SAMPLES
 from shared.stickslip.settings import DEFAULT_WINDOW_SAMPLES, PlateauMethod, PredictorSettings
@@ -72,6 +79,7 @@ __all__ = [
     "NO_FLIP",
     "SEED_SAMPLES",
     "SPAN",
+    "CoreCommand",
     "CoreDecision",
     "EventFigures",
     "EventHistory",
@@ -105,6 +113,7 @@ __all__ = [
     "replay",
     "replay_run",
     "signal_resolution",
+    "stage_message",
     "stick_slip_event",
     "torque_mean_nm",
 ]

@@ -40,6 +40,7 @@ from typing import Any
 
 from shared.contract import RunClock, RunSummary, channels
 from shared.stickslip.event_figures import EventFigures
+from shared.stickslip.outputs import CoreDecision
 from shared.stickslip.predictor_core import PredictorCore
 from shared.stickslip.run_messages import decision_message, event_messages
 from shared.stickslip.settings import PredictorSettings
@@ -88,7 +89,7 @@ def replay_run(run: StoppedRun) -> PredictorReplay:
                     (index, channels.EVENTS.topic, event),
                     (index, channels.INTENSITY.topic, intensity),
                 ]
-            else:
+            elif isinstance(output, CoreDecision):
                 decision = decision_message(
                     station, run_id, output, time_ns, torque_nm, time_ns, advisory=True
                 )

@@ -5,7 +5,7 @@
     core = PredictorCore(settings)
     for t, torque, force, angle in samples:          # force NaN when there is none
         for output in core.update(t, torque, force, angle):
-            ...                                     # EventFigures or CoreDecision
+            ...                       # EventFigures, CoreDecision, or a final stage's CoreCommand
 
 Per sample the work is O(1): the input guard, the window's running
 inclination sum (eqs. 46, 47), a noise estimate, a running force sum and the
@@ -24,6 +24,7 @@ from shared.contract import Prediction
 from shared.stickslip.event_figures import EventFigures, compute_figures, event_period_s
 from shared.stickslip.event_history import EventHistory
 from shared.stickslip.extremum_tracker import ExtremumTracker, Slip
+from shared.stickslip.final_stage_run import D2_PER_SIGMA, FinalStageRun
 from shared.stickslip.force_history import ForceHistory
 from shared.stickslip.halt_planner import HaltPlanner
 from shared.stickslip.inclination_window import NO_FLIP, InclinationWindow
@@ -38,7 +39,7 @@ from shared.stickslip.input_guard import (
 )
 from shared.stickslip.model_bands import BandVerdict, ModelBandCheck
 from shared.stickslip.motor_motion import MotorMotion
-from shared.stickslip.outputs import CoreDecision
+from shared.stickslip.outputs import CoreCommand, CoreDecision
 from shared.stickslip.regression import predict_events
 from shared.stickslip.scoring import PredictionScores
 from shared.stickslip.screw_plateaus import ScrewPlateaus
@@ -57,7 +58,7 @@ STAIRCASE_EVENTS = 3
 PLAN_PERIODS = 1.5  # a torque halt plan holds this many predicted periods after its peak
 MAX_STEP_FRACTION = 0.25  # a predicted step larger than this share of the value: no decision
 
-CoreOutput = EventFigures | CoreDecision
+CoreOutput = EventFigures | CoreDecision | CoreCommand
 
 
 class PredictorCore:
@@ -85,6 +86,20 @@ class PredictorCore:
             if not settings.force_mode and target_torque is not None and target_torque > 0.0
             else None
         )
+        stage = settings.final_stage
+        self.final_stage = (
+            FinalStageRun(
+                stage,
+                None if settings.force_mode else target_torque,
+                settings.target_force_n if settings.force_mode else None,
+                settings.reaction_samples,
+            )
+            if stage is not None
+            else None
+        )
+        self._model_step_nm = math.nan  # k_e · φ̇_m · Δt: the model's stick-ramp step
+        if settings.constants is not None and settings.motor_speed_rad_s is not None:
+            self._model_step_nm = settings.constants.k_e_nm_per_rad * settings.motor_speed_rad_s
         self._count = 0
         self._start_time_s = math.nan
         self._start_angle_deg = math.nan
@@ -106,6 +121,12 @@ class PredictorCore:
     def decision(self) -> CoreDecision | None:
         """The run's latched stop decision, if any."""
         return self.policy.decision
+
+    def on_tool_halted(self) -> None:
+        """The tool reports it halted by itself (its own shutoff): a final stage then waits
+        for the torque to settle and judges it as after its own halt."""
+        if self.final_stage is not None:
+            self.final_stage.on_tool_halted()
 
     def update(
         self, time_s: float, torque_nm: float, force_n: float, angle_deg: float
@@ -155,7 +176,34 @@ class PredictorCore:
         )
         if decision is not None:
             out.append(decision)
+        final = self.final_stage
+        if final is not None:
+            if decision is not None:
+                final.on_decided(decision.reason)
+            else:
+                out.extend(self._final_stage(final, time_s, torque_nm, force))
         return out
+
+    def _final_stage(
+        self, final: FinalStageRun, time_s: float, torque_nm: float, force: float | None
+    ) -> list[CoreOutput]:
+        """The final stage's command for this sample, or its first halt (a decision)."""
+        planner = self._halt_planner
+        drop_nm = planner.drop_nm if planner is not None else math.nan
+        step_nm = planner.rate_nm_per_sample if planner is not None else math.nan
+        if not step_nm > 0.0:
+            step_nm = self._model_step_nm * self._guard.nominal_dt_s
+        sigma_nm = self._tracker.noise_d2_nm / D2_PER_SIGMA
+        said = final.on_sample(time_s, torque_nm, step_nm, sigma_nm, drop_nm)
+        if said is None:
+            return []
+        if isinstance(said, CoreCommand):
+            return [said]
+        decision = self.policy.on_final_stage(time_s, said, torque_nm, force)
+        if decision is None:
+            return []
+        final.on_decided(decision.reason)
+        return [decision]
 
     def _on_slip(self, slip: Slip, now_s: float, torque_nm: float) -> list[CoreOutput]:
         settings = self.settings
@@ -234,7 +282,8 @@ class PredictorCore:
             if predictions and self._guard.nominal_dt_s > 0.0:
                 period_s = predictions[0].time_s - peak.time_s
                 valid = int(PLAN_PERIODS * period_s / self._guard.nominal_dt_s) + 1
-            self.policy.plan_halt(halt, planner.rate_nm_per_sample, planner.drop_nm, valid)
+            if self.final_stage is None:  # a final stage halts on its own line
+                self.policy.plan_halt(halt, planner.rate_nm_per_sample, planner.drop_nm, valid)
         verdict = None
         if self.model_bands is not None:
             verdict = self.model_bands.on_event(
@@ -263,6 +312,8 @@ class PredictorCore:
         )
         if decision is not None:
             out.append(decision)
+            if self.final_stage is not None:
+                self.final_stage.on_decided(decision.reason)
         return out
 
     def _decide_on_event(

@@ -1,4 +1,5 @@
-"""The core's plain outputs as the messages a station publishes (events, intensity, decision).
+"""The core's plain outputs as the messages a station publishes (events, intensity, decision,
+a final stage's commands).
 
 One place for the conversion, so a live run (:class:`~services.predictor.active_run.ActiveRun`)
 and a replayed one (``boltwatch import``) publish the same fields the same way.
@@ -11,9 +12,9 @@ from __future__ import annotations
 
 import math
 
-from shared.contract import Intensity, RunClock, StickSlipEvent, StopDecision
+from shared.contract import Intensity, RunClock, StageDecision, StickSlipEvent, StopDecision
 from shared.stickslip.event_figures import EventFigures
-from shared.stickslip.outputs import CoreDecision
+from shared.stickslip.outputs import CoreCommand, CoreDecision
 
 
 def stick_slip_event(
@@ -83,4 +84,28 @@ def decision_message(
         predicted_torque_nm=decision.predicted_torque_nm,
         decided_ns=decided_ns,
         advisory=advisory,
+    )
+
+
+def stage_message(
+    station: str,
+    run_id: int,
+    command: CoreCommand,
+    sample_time_ns: int,
+    sample_torque_nm: float,
+    decided_ns: int,
+) -> StageDecision:
+    """A final stage's command, given at the sample of ``sample_time_ns``."""
+    torque = command.torque_nm if math.isfinite(command.torque_nm) else sample_torque_nm
+    return StageDecision(
+        station=station,
+        run_id=run_id,
+        time_ns=sample_time_ns,
+        time_s=command.time_s,
+        command=command.command,
+        reason=command.reason,
+        detail=command.detail,
+        torque_nm=torque,
+        pulse=command.pulse,
+        decided_ns=decided_ns,
     )

@@ -14,8 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from shared.config import PredictorSection, Program
-from shared.contract import CONTRACT_RANGE, SensorRange
+from shared.config import FinalStage, PredictorSection, Program
+from shared.contract import CONTRACT_RANGE, SensorRange, ToolCommandsName
 from shared.model import JointConstants
 
 DEFAULT_WINDOW_SAMPLES = 5
@@ -53,6 +53,9 @@ class PredictorSettings:
     # the step the recorded torque is written to (Nm; 0: not known): a drop of no more than
     # a few steps is no slip (see signal_resolution)
     torque_resolution_nm: float = 0.0
+    # the program's final stage, when the tool runs it (its controller takes StageCommand):
+    # the core then also commands the switch, the pulses and the finish (final_stage_run)
+    final_stage: FinalStage | None = None
 
     @property
     def force_mode(self) -> bool:
@@ -67,8 +70,10 @@ class PredictorSettings:
         has_force: bool,
         constants: JointConstants | None = None,
         sensor_range: SensorRange = CONTRACT_RANGE,
+        commands: ToolCommandsName = "stop",
     ) -> PredictorSettings:
-        """Settings for a run of ``program`` on a station with (or without) a force sensor."""
+        """Settings for a run of ``program`` on a station with (or without) a force sensor;
+        ``commands="staged"``: its tool runs the program's final stage, if it has one."""
         return cls(
             target_force_n=program.target_force_n,
             target_torque_nm=program.target_torque_nm,
@@ -83,4 +88,5 @@ class PredictorSettings:
             motor_speed_rad_s=program.motor_speed_rad_s,
             constants=constants,
             sensor_range=sensor_range,
+            final_stage=program.final_stage if commands == "staged" else None,
         )

@@ -111,6 +111,15 @@ class StopPolicy:
         )
         return None if stop is None else self._decide(time_s, stop, torque_nm, force_now_n)
 
+    def on_final_stage(
+        self, time_s: float, stop: Stop, torque_nm: float, force_n: float | None
+    ) -> CoreDecision | None:
+        """The final stage's halt on the target (:mod:`.final_stage_run`), if nothing
+        decided before it."""
+        if self.decision is not None:
+            return None
+        return self._decide(time_s, stop, torque_nm, force_n)
+
     def on_input_fault(self, time_s: float, bad_samples: int) -> CoreDecision | None:
         """The input guard saw ``bad_samples`` unusable samples in a row."""
         if self.decision is not None:

@@ -15,10 +15,10 @@ from typing import Any
 from shared.contract import Trace
 from shared.stickslip.event_figures import EventFigures
 from shared.stickslip.outputs import CoreDecision
-from shared.stickslip.predictor_core import PredictorCore
+from shared.stickslip.predictor_core import CoreOutput, PredictorCore
 
 
-def replay(core: PredictorCore, trace: Trace) -> Iterator[EventFigures | CoreDecision]:
+def replay(core: PredictorCore, trace: Trace) -> Iterator[CoreOutput]:
     """Feed every sample of ``trace`` to ``core``; yield the outputs in order."""
     columns = zip(
         trace.time_s.tolist(),
@@ -34,13 +34,16 @@ def replay(core: PredictorCore, trace: Trace) -> Iterator[EventFigures | CoreDec
             yield from outputs
 
 
-def output_record(output: EventFigures | CoreDecision) -> dict[str, Any]:
-    """The JSON Lines object of one output: ``{"type": "event"|"stop", "time_s": ..., ...}``."""
+def output_record(output: CoreOutput) -> dict[str, Any]:
+    """The JSON Lines object of one output: ``{"type": "event"|"stop"|"stage", "time_s": ...}``
+    (``stage``: a final stage's command, only from a core whose settings have one)."""
     fields = dataclasses.asdict(output)
     if isinstance(output, EventFigures):
         record: dict[str, Any] = {"type": "event"}
-    else:
+    elif isinstance(output, CoreDecision):
         record = {"type": "stop"}
+    else:
+        record = {"type": "stage"}
     record.update(fields)
     return json_safe(record)
 

@@ -187,7 +187,7 @@ class Station(StationPayloads):
         self.put[channels.TOOL.topic](self.tool(run_id, state, now_ns))
 
     def bus(self, now_ns: int) -> None:
-        stats = BusStats(self.station, now_ns, 0, self.published, *[0] * 11)
+        stats = BusStats(self.station, now_ns, 0, self.published, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0)
         self.put[channels.BUS.topic](encode(dataclasses.replace(stats, started_ns=self.started_ns)))
 
 

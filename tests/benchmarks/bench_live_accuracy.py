@@ -3,7 +3,7 @@
 Run on demand (not a test)::
 
     .venv/bin/python tests/benchmarks/bench_live_accuracy.py [--joints 100] [--torque-only]
-        [--placement edge|line]
+        [--placement edge|line] [--final-share 0.1]
 
 The joints are those of ``bench_predictor_accuracy.py`` (same draw, same
 seed, same physics): k_e 200-2000 Nm/rad, k_s 30-180 kN/rad, μ_stick
@@ -34,6 +34,11 @@ Per joint, |F_reached - F_target| / F_target of:
 
 Also printed: live = offline, the share of runs whose live decision was the
 offline one (same reason at the same sample), and what stopped each run.
+``--final-share S``: every program has a final stage at S of its speed, the
+rig runs it (StageCommand over CAN: switch, pulses, finish) and the station
+commands it; besides the rows above, **offline staged** is the same joint
+tightened offline by the rig's controller and the core with that program
+(``tests/support/staged_runs.py``), the figure the live one is held to.
 ``--torque-only``: the station has no force sensor and the programs target
 the torque (the preload figures are then information, as in the offline
 benchmark, and the torque figures are printed beside them).
@@ -64,6 +69,7 @@ from services.cli.station_supervisor import stop_process
 from services.rig.frames import RigFrames
 from services.rig.realtime import RealtimeRig, ToolIdentity
 from shared.config import (
+    Program,
     RigSection,
     load_station,
 )
@@ -102,6 +108,7 @@ from tests.benchmarks.bench_predictor_accuracy import (
 from tests.benchmarks.bench_stop_path import wait_alive
 from tests.benchmarks.joint_files import joint_toml
 from tests.support.listener import Listener
+from tests.support.staged_runs import StagedEnd, run_staged
 from tests.support.station_files import serve, write_station
 
 STATION = "st1"
@@ -119,7 +126,7 @@ class LiveRun:
     decision: StopDecision | None
 
 
-def program_text(number: int, joint: Joint, torque_only: bool) -> str:
+def program_text(number: int, joint: Joint, torque_only: bool, final_share: float | None) -> str:
     program = joint.program
     target = (
         f"target_torque_nm = {joint.target_torque_nm!r}"
@@ -138,10 +145,23 @@ max_force_n = {program.max_force_n!r}
 max_angle_deg = {MAX_ANGLE_DEG}
 max_time_s = {program.max_time_s!r}
 joint = "joints/joint{number}.toml"
+""" + (
+        ""
+        if final_share is None
+        else f"""
+[programs.final_stage]
+speed_rad_s = {final_share * program.motor_speed_rad_s!r}
 """
+    )
 
 
-def write_files(folder: Path, joints: list[Joint], placement: str, torque_only: bool) -> Path:
+def write_files(
+    folder: Path,
+    joints: list[Joint],
+    placement: str,
+    torque_only: bool,
+    final_share: float | None = None,
+) -> Path:
     """The station file with one program (and one joint file) per joint."""
     (folder / "joints").mkdir(parents=True)
     for number, joint in enumerate(joints, 1):
@@ -153,7 +173,7 @@ def write_files(folder: Path, joints: list[Joint], placement: str, torque_only: 
     )
     text = station.read_text()
     programs = text[text.index("[[programs]]") : text.index("[predictor]")]
-    body = "".join(program_text(n, j, torque_only) for n, j in enumerate(joints, 1))
+    body = "".join(program_text(n, j, torque_only, final_share) for n, j in enumerate(joints, 1))
     text = text.replace(programs, body + "\n")
     if torque_only:
         text = text.replace("has_force_sensor = true", "has_force_sensor = false")
@@ -236,6 +256,22 @@ def offline(
     return reached_n, reached_torque_nm, decided
 
 
+def staged_offline(program: Program, joint: Joint, torque_only: bool) -> StagedEnd:
+    """The joint staged offline with the station's program: the rig's controller and the
+    core, on the rig the live runs had (its defaults), obeying each command within the
+    deciding sample's period as the live rig does (the core assumes a reaction of one
+    sample, the station's default)."""
+    return run_staged(
+        joint.constants,
+        program,
+        RigSection(),
+        joint.seed,
+        torque_only,
+        latency_samples=0,
+        reaction_samples=1.0,
+    )
+
+
 def report(rows: dict[str, list[float]], title: str, oracle_name: str) -> None:
     print(f"\n{title}")
     print(f"{'policy':24s} {'mean%':>7s} {'median%':>7s} {'p95%':>7s}  /oracle   /conv")
@@ -255,6 +291,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=2018)
     parser.add_argument("--placement", choices=("edge", "line"), default="edge")
     parser.add_argument("--torque-only", action="store_true")
+    parser.add_argument(
+        "--final-share",
+        type=float,
+        default=None,
+        help="each program gets a final stage at this share of its speed (a staged station: "
+        "the live runs are compared with the same joints staged offline)",
+    )
     parser.add_argument("--keep", type=Path, default=None, help="keep files and logs here")
     args = parser.parse_args(argv)
     if not 1 <= args.joints <= 255:
@@ -271,7 +314,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def measure(args: argparse.Namespace, joints: list[Joint], folder: Path) -> int:
-    station_file = write_files(folder, joints, args.placement, args.torque_only)
+    station_file = write_files(folder, joints, args.placement, args.torque_only, args.final_share)
     station = load_station(station_file)
     endpoint = station.config.zenoh.connect[0]
     processes = [serve(["router", "--listen", endpoint], folder / "router.log", REPO)]
@@ -317,6 +360,20 @@ def measure(args: argparse.Namespace, joints: list[Joint], folder: Path) -> int:
             rows[name].append(error(joint, force))
             torque_rows[name].append(torque_error(joint, torque))
     mode = "torque-only" if args.torque_only else "force"
+    if args.final_share is not None:
+        mode += f", a final stage at {args.final_share:g} of the speed"
+        staged = [
+            staged_offline(station.config.program(n), joint, args.torque_only)
+            for n, joint in enumerate(joints, 1)
+        ]
+        rows["offline staged"] = [
+            error(j, end.force_n) for j, end in zip(joints, staged, strict=True)
+        ]
+        torque_rows["offline staged"] = [
+            torque_error(j, end.torque_nm) for j, end in zip(joints, staged, strict=True)
+        ]
+        pulsed = sum(end.pulses > 0 for end in staged)
+        print(f"offline staged: {pulsed} of {len(staged)} runs took a pulse")
     print(
         f"{len(joints)} joints, {mode}, placement {args.placement}, live through the real "
         f"processes in {live_s:.0f} s"

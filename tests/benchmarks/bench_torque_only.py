@@ -38,13 +38,12 @@ from __future__ import annotations
 
 import argparse
 import copy
+import functools
 import math
-import statistics
 import sys
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
@@ -54,33 +53,15 @@ if str(REPO) not in sys.path:  # run as a script from anywhere
 from services.rig.physics import Measurement, TighteningPhysics
 from shared.stickslip import PredictorCore, PredictorSettings
 from tests.benchmarks.torque_only_joints import FAMILIES, Joint, family_joints
+from tests.benchmarks.torque_only_report import End, JointResult, json_lines, print_family
+from tests.support.staged_runs import SETTLE_TIME_S, run_staged, staged_program
 
 SETTLE_SAMPLES = 300
 LATENCY_SAMPLES = 1
 TORQUE_BAND = 0.05  # oracle halts at every sample with |T - T*| ≤ this · T*
 FORCE_BAND = 0.03  # ... and with |F - F*| ≤ this · F*
 STICK_BAND = 0.3  # ... and at every new stick phase with |F - F*| ≤ this · F*
-WORSE_THAN_CONVENTIONAL = 0.01
-
-
-@dataclass(frozen=True)
-class End:
-    """Where a stop left the joint: settled true torque and preload, and why it stopped."""
-
-    torque_nm: float
-    force_n: float
-    reason: str = ""
-    detail: str = ""
-    decided_nm: float = math.nan  # measured torque at the deciding sample
-
-
-@dataclass(frozen=True)
-class JointResult:
-    joint: Joint
-    oracle_torque: End
-    oracle_force: End
-    stops: dict[str, End]
-    drops_pct: list[float]  # true slip drops near the target, % of T* (unstopped run)
+FINAL_SHARE = 0.1  # a staged program's final speed, as a share of its rundown speed
 
 
 def physics(joint: Joint) -> TighteningPhysics:
@@ -95,6 +76,18 @@ def settle(sim: TighteningPhysics) -> tuple[float, float]:
             break
         sim.advance()
     return sim.true_torque_nm, sim.true_force_n
+
+
+def settled_end(sim: TighteningPhysics, halted_at: int, **said: str | float) -> End:
+    """The End of a run halted after ``halted_at`` samples; its cycle as a controller ends it
+    (the slip finished and its settle time passed)."""
+    sim.halt_motor()
+    waited = 0
+    while waited < SETTLE_SAMPLES and not sim.settled:
+        sim.advance()
+        waited += 1
+    cycle = halted_at + max(waited, round(SETTLE_TIME_S * 1000))
+    return End(sim.true_torque_nm, sim.true_force_n, cycle_samples=cycle, **said)  # type: ignore[arg-type]
 
 
 def samples(joint: Joint) -> int:
@@ -137,14 +130,15 @@ def oracle(joint: Joint) -> tuple[End, End, list[float]]:
 def run(joint: Joint, decide: Callable[[Measurement], tuple[str, str] | None]) -> End:
     """Tighten until ``decide`` gives (reason, detail); the motor halts LATENCY_SAMPLES later."""
     sim = physics(joint)
-    for _ in range(samples(joint)):
+    for n in range(1, samples(joint) + 1):
         m = sim.advance()
         said = decide(m)
         if said is not None:
             for _ in range(LATENCY_SAMPLES):
                 sim.advance()
-            return End(*settle(sim), reason=said[0], detail=said[1], decided_nm=m.torque_nm)
-    return End(*settle(sim), reason="none")
+            halted = n + LATENCY_SAMPLES
+            return settled_end(sim, halted, reason=said[0], detail=said[1], decided_nm=m.torque_nm)
+    return settled_end(sim, samples(joint), reason="none")
 
 
 def conventional(joint: Joint, torque_only: bool) -> End:
@@ -174,106 +168,36 @@ def boltwatch(joint: Joint, torque_only: bool) -> End:
     return run(joint, decide)
 
 
-def measure(joint: Joint) -> JointResult:
+def staged(joint: Joint, torque_only: bool, final_share: float) -> End:
+    """boltwatch with the program's final stage (``staged_runs.run_staged``)."""
+    program = staged_program(
+        joint.program,
+        final_share,
+        joint.target_torque_nm,
+        None if torque_only else joint.target_force_n,
+    )
+    end = run_staged(joint.constants, program, joint.rig, joint.seed, torque_only, LATENCY_SAMPLES)
+    return End(
+        end.torque_nm,
+        end.force_n,
+        reason=end.reason,
+        detail=f"{' '.join(end.commands)}: {end.detail}",
+        cycle_samples=end.cycle_samples,
+        pulses=end.pulses,
+    )
+
+
+def measure(joint: Joint, final_share: float = FINAL_SHARE) -> JointResult:
     best_t, best_f, drops = oracle(joint)
     stops = {
         "conventional torque": conventional(joint, torque_only=True),
         "boltwatch torque-only": boltwatch(joint, torque_only=True),
+        "boltwatch torque-only staged": staged(joint, True, final_share),
         "conventional force": conventional(joint, torque_only=False),
         "boltwatch force": boltwatch(joint, torque_only=False),
+        "boltwatch force staged": staged(joint, False, final_share),
     }
     return JointResult(joint, best_t, best_f, stops, drops)
-
-
-def torque_error(r: JointResult, end: End) -> float:
-    """Signed (T_reached − T*) / T*."""
-    return (end.torque_nm - r.joint.target_torque_nm) / r.joint.target_torque_nm
-
-
-def force_error(r: JointResult, end: End) -> float:
-    """Signed (F_reached − F*) / F*."""
-    return (end.force_n - r.joint.target_force_n) / r.joint.target_force_n
-
-
-def lost_drop(r: JointResult, end: End) -> bool:
-    """The stop ended a slip drop low: more than half a drop (and 1 %) under T*."""
-    drop = statistics.median(r.drops_pct) / 100.0 if r.drops_pct else r.joint.drop_share
-    return torque_error(r, end) < -max(WORSE_THAN_CONVENTIONAL, 0.5 * drop)
-
-
-def summary(errors: list[float]) -> str:
-    """mean / p95 of |e| and the signed worst, in %."""
-    magnitudes = sorted(abs(e) for e in errors)
-    p95 = magnitudes[min(len(magnitudes) - 1, math.ceil(0.95 * len(magnitudes)) - 1)]
-    worst = max(errors, key=abs)
-    return f"{100 * statistics.fmean(magnitudes):6.2f} {100 * p95:6.2f} {100 * worst:+7.2f}"
-
-
-def print_family(family: str, results: list[JointResult], worst: int) -> None:
-    role = FAMILIES[family][0]
-    print(f"\n{family} ({role}, {len(results)} joints)   mean% / p95% / worst% (signed)")
-    header = f"{'stop':24s} {'torque |T-T*|/T*':>22s}   {'preload |F-F*|/F*':>22s}"
-    print(header)
-    rows: list[tuple[str, Callable[[JointResult], End]]] = [
-        ("oracle", lambda r: r.oracle_torque),
-        ("conventional torque", lambda r: r.stops["conventional torque"]),
-        ("boltwatch torque-only", lambda r: r.stops["boltwatch torque-only"]),
-    ]
-    for name, pick in rows:
-        torque = summary([torque_error(r, pick(r)) for r in results])
-        preload = summary([force_error(r, pick(r)) for r in results])
-        print(f"{name:24s} {torque:>22s}   {preload:>22s}")
-    for name, pick in (
-        ("oracle (preload)", lambda r: r.oracle_force),
-        ("conventional force", lambda r: r.stops["conventional force"]),
-        ("boltwatch force", lambda r: r.stops["boltwatch force"]),
-    ):
-        print(f"{name:24s} {'':>22s}   {summary([force_error(r, pick(r)) for r in results]):>22s}")
-    oracle_mean = statistics.fmean(abs(torque_error(r, r.oracle_torque)) for r in results)
-    bw = [abs(torque_error(r, r.stops["boltwatch torque-only"])) for r in results]
-    conv = [abs(torque_error(r, r.stops["conventional torque"])) for r in results]
-    worse = sum(b - c > WORSE_THAN_CONVENTIONAL for b, c in zip(bw, conv, strict=True))
-    worse_preload = sum(
-        abs(force_error(r, r.stops["boltwatch torque-only"]))
-        - abs(force_error(r, r.stops["conventional torque"]))
-        > WORSE_THAN_CONVENTIONAL
-        for r in results
-    )
-    print(
-        f"torque-only: {statistics.fmean(bw) / max(oracle_mean, 1e-12):.1f}x oracle, "
-        f"{statistics.fmean(bw) / statistics.fmean(conv):.2f}x conventional; "
-        f"joints > 1 % of T* worse than conventional: {worse}; "
-        f"preload > 1 % of F* worse: {worse_preload}"
-    )
-    stick = [r for r in results if r.drops_pct]
-    smooth = [r for r in results if not r.drops_pct]
-    for name in ("conventional torque", "boltwatch torque-only"):
-        lost = sum(lost_drop(r, r.stops[name]) for r in results)
-        by_class = " / ".join(
-            f"{statistics.fmean(abs(torque_error(r, r.stops[name])) for r in rs) * 100:.2f}"
-            if rs
-            else "-"
-            for rs in (stick, smooth)
-        )
-        print(f"  {name}: mean % stick-slip / smooth near T* {by_class}; drops lost {lost}")
-    print(f"  ({len(stick)} joints stick and slip near T*, {len(smooth)} slide smoothly there)")
-    ranked = sorted(results, key=lambda r: -abs(torque_error(r, r.stops["boltwatch torque-only"])))
-    for r in ranked[:worst]:
-        print_joint(r)
-
-
-def print_joint(r: JointResult) -> None:
-    j = r.joint
-    bw = r.stops["boltwatch torque-only"]
-    conv = r.stops["conventional torque"]
-    drops = f"{statistics.median(r.drops_pct):.1f}" if r.drops_pct else "-"
-    print(
-        f"  #{j.number:<3d} drop {100 * j.drop_share:4.1f}% (true {drops}%) "
-        f"scatter {100 * j.rig.mu_stick_scatter:3.1f}% ramp {j.ramp_samples_per_pct:4.1f} "
-        f"smp/% | oracle {100 * torque_error(r, r.oracle_torque):+6.2f} "
-        f"conv {100 * torque_error(r, conv):+6.2f} bw {100 * torque_error(r, bw):+6.2f} "
-        f"[{bw.reason}: {bw.detail}]"
-    )
 
 
 def main() -> None:
@@ -282,18 +206,30 @@ def main() -> None:
     parser.add_argument("--families", default=",".join(FAMILIES))
     parser.add_argument("--jobs", type=int, default=1, help="worker processes")
     parser.add_argument("--worst", type=int, default=3, help="worst joints listed per family")
+    parser.add_argument(
+        "--final-share",
+        type=float,
+        default=FINAL_SHARE,
+        help="a staged program's final speed as a share of its rundown speed",
+    )
     args = parser.parse_args()
     families = args.families.split(",")
     joints = [j for f in families for j in family_joints(f, args.joints)]
     wall = time.perf_counter()
+    work = functools.partial(measure, final_share=args.final_share)
     if args.jobs > 1:
         with ProcessPoolExecutor(args.jobs) as pool:
-            results = list(pool.map(measure, joints, chunksize=2))
+            results = list(pool.map(work, joints, chunksize=2))
     else:
-        results = [measure(j) for j in joints]
+        results = [work(j) for j in joints]
     print(f"{len(joints)} joints in {time.perf_counter() - wall:.0f} s wall, {args.jobs} job(s)")
     for family in families:
-        print_family(family, [r for r in results if r.joint.family == family], args.worst)
+        of_family = [r for r in results if r.joint.family == family]
+        print_family(family, FAMILIES[family][0], of_family, args.worst)
+    print()
+    for family in families:
+        for line in json_lines(family, [r for r in results if r.joint.family == family]):
+            print(line)
 
 
 if __name__ == "__main__":

@@ -125,7 +125,9 @@ class StressStation:
         self.publisher.call(self._caught_up.set)
 
     def bus(self) -> None:
-        stats = BusStats(self.station, time.time_ns(), 0, self.published, *[0] * 11)
+        stats = BusStats(
+            self.station, time.time_ns(), 0, self.published, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0
+        )
         self.publisher.publish(dataclasses.replace(stats, started_ns=self.started_ns))
 
     def spool_depth(self) -> int | None:

@@ -87,10 +87,18 @@ function stops(station) {
   return table(["run", "stop reason", "error", "events", "when"],
     station.stops.map((s) => el("tr", { class: "stop" },
       el("td", { class: "num" }, s.run_id),
-      el("td", {}, s.stop_reason + (s.late_decision ? ` (late: ${s.late_decision})` : "")),
+      el("td", {}, s.stop_reason + (s.late_decision ? ` (late: ${s.late_decision})` : "") +
+        stageText(s)),
       el("td", { class: "num" }, fixed(s.error_pct, 2, " %")),
       el("td", { class: "num" }, s.events),
       el("td", {}, ago(s.age_s)))));
+}
+
+// a final stage: where it began, and the pulses back to the target (a quality signal)
+function stageText(s) {
+  if (s.final_stage_s === null || s.final_stage_s === undefined) return "";
+  const pulses = s.pulses === 0 ? "" : s.pulses === 1 ? ", 1 pulse" : `, ${s.pulses} pulses`;
+  return ` (final stage at ${fixed(s.final_stage_s, 2, " s")}${pulses})`;
 }
 
 function wear(station) {

@@ -84,6 +84,30 @@ def _decisions(ax: Any, run: RecordedRun) -> None:
         )
 
 
+#: how each command of a final stage is drawn: (line style, its legend's words)
+_STAGE_LINES = {
+    "final": (":", "final stage from here"),
+    "rundown": (":", "back to the rundown speed"),
+    "pulse": ("-.", "pulse back to the target"),
+}
+
+
+def _stages(ax: Any, run: RecordedRun) -> None:
+    """A final stage's switch, a return to the rundown, each pulse: a teal vertical line."""
+    labelled: set[str] = set()
+    for stage in run.stages:
+        style = _STAGE_LINES.get(stage.command)
+        if style is None:  # a pulse's halt and the finish: the decision's line says enough
+            continue
+        ls, words = style
+        label = None
+        if stage.command not in labelled:
+            labelled.add(stage.command)
+            label = words if stage.command != "pulse" else f"{words} ({stage.reason})"
+        at_s = run.run_time_s(stage.time_ns)
+        ax.axvline(at_s, color="tab:cyan", ls=ls, lw=1.2, label=label)
+
+
 def _target(ax: Any, run: RecordedRun, key: str, scale: float = 1.0) -> None:
     """The program's target from the file's ``program`` record; a controller's run: none
     (that record is the station file's, not the controller's pset)."""
@@ -151,6 +175,7 @@ def draw_torque(ax: Any, run: RecordedRun, bounds: Bounds) -> None:
     _target(ax, run, "target_torque_nm")
     _controller_torque(ax, run)
     _decisions(ax, run)
+    _stages(ax, run)
     extra = "" if bounds.model is not None else " (no analytical envelopes)"
     ax.set(title=f"Fig. 10 (top): torque with detected peaks{extra}", ylabel="torque T / Nm")
     ax.set_xlabel("run time / s")

@@ -35,6 +35,7 @@ from shared.contract import (
     ControllerResult,
     RunClock,
     Sample,
+    StageDecision,
     StickSlipEvent,
     StopDecision,
     TighteningResult,
@@ -50,6 +51,7 @@ LOG = logging.getLogger(__name__)
 
 EVENT_SCHEMA = channels.EVENTS.schema_name
 DECISION_SCHEMA = channels.DECISION.schema_name
+STAGE_SCHEMA = channels.STAGE.schema_name
 RESULT_SCHEMA = channels.RESULTS.schema_name
 CONTROLLER_SCHEMA = channels.CONTROLLER.schema_name
 #: why a controller's run has no model (the caption says it)
@@ -87,6 +89,7 @@ class RecordedRun:
     state: str = ""  # RecordingScan.describe() of the source: complete, or what was lost
     runs_in_file: list[int] = field(default_factory=list)  # every run with samples in the file
     controller: ControllerMarks | None = None  # the controller's windows and target, if its run
+    stages: list[StageDecision] = field(default_factory=list)  # a final stage's commands
 
     @property
     def t0_ns(self) -> int:
@@ -131,12 +134,14 @@ def read_run(source: Path, run_id: int | None = None) -> RecordedRun:
     samples: list[Sample] = []
     events: list[StickSlipEvent] = []
     decisions: list[StopDecision] = []
+    stages: list[StageDecision] = []
     results: list[TighteningResult] = []
     controllers: list[ControllerResult] = []
     kept: dict[str, tuple[type, list[Any]]] = {
         SAMPLE_SCHEMA: (Sample, samples),
         EVENT_SCHEMA: (StickSlipEvent, events),
         DECISION_SCHEMA: (StopDecision, decisions),
+        STAGE_SCHEMA: (StageDecision, stages),
         RESULT_SCHEMA: (TighteningResult, results),
         CONTROLLER_SCHEMA: (ControllerResult, controllers),
     }
@@ -174,6 +179,7 @@ def read_run(source: Path, run_id: int | None = None) -> RecordedRun:
         scan.complete,
         state=scan.describe(),
         runs_in_file=sorted(counts),
+        stages=[d for d in stages if d.run_id == run_id],
     )
     run.joint, run.motor_speed_rad_s, run.model_missing = _model_inputs(metadata)
     run.controller = ControllerMarks.of(

@@ -67,6 +67,8 @@ def _program_section(program: ProgramStatistics) -> str:
         for name, count in program.stop_reasons
     )
     notes = "".join(f"<p>{html.escape(change)}</p>" for change in program.window_changes)
+    if program.staged_runs:
+        notes += f"<p>{html.escape(pulses_text(program))}</p>"
     return (
         f"<h2>Program {program.program_id}: {html.escape(program.program_name or 'unnamed')}</h2>"
         f"<p>stations {html.escape(', '.join(program.stations))}; tools "
@@ -120,4 +122,16 @@ def terminal_lines(programs: Sequence[ProgramStatistics]) -> list[str]:
             lines.append(f"  NOK reasons: {top}")
         stops = ", ".join(f"{name} ({count})" for name, count in program.stop_reasons)
         lines.append(f"  stop reasons: {stops}")
+        if program.staged_runs:
+            lines.append(f"  final stage: {pulses_text(program)}")
     return lines
+
+
+def pulses_text(program: ProgramStatistics) -> str:
+    """How often a program's final stage needed a pulse back to the target (a slip during
+    the halt, won back): a quality signal."""
+    share = 100.0 * program.pulsed_runs / program.staged_runs
+    return (
+        f"{program.staged_runs} runs in a final stage, {program.pulsed_runs} needed a pulse "
+        f"({share:.1f} %)"
+    )

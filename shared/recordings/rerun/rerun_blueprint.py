@@ -36,6 +36,7 @@ TORQUE = "torque/torque_nm"
 PEAKS = "torque/peaks"
 PREDICTED_PEAKS = "torque/predicted_peaks"
 TORQUE_STOP = "torque/stop"
+TORQUE_STAGE = "torque/stage"  # a final stage's commands: switch, pulse, halt, finish
 FORCE = "force/force_n"
 PLATEAUS = "force/plateaus"
 PREDICTED_PLATEAUS = "force/predicted_plateaus"
@@ -62,6 +63,7 @@ _POINTS: dict[str, tuple[str, tuple[int, int, int], rr.components.MarkerShape, f
     PEAKS: ("peak", (214, 39, 40), rr.components.MarkerShape.Down, 6.0),
     PREDICTED_PEAKS: ("predicted peak", (255, 127, 14), rr.components.MarkerShape.Cross, 5.0),
     TORQUE_STOP: ("stop", (200, 0, 200), rr.components.MarkerShape.Asterisk, 10.0),
+    TORQUE_STAGE: ("final stage", (0, 150, 136), rr.components.MarkerShape.Diamond, 8.0),
     PLATEAUS: ("plateau", (214, 39, 40), rr.components.MarkerShape.Square, 5.0),
     PREDICTED_PLATEAUS: ("predicted plateau", (255, 127, 14), rr.components.MarkerShape.Cross, 5.0),
     FORCE_STOP: ("stop", (200, 0, 200), rr.components.MarkerShape.Asterisk, 10.0),

@@ -137,7 +137,8 @@ class RerunSink:
         self._texts: list[str] = []
         self._levels: list[str] = []
         names = [bp.TORQUE, bp.ANGLE, bp.FORCE, bp.PEAKS, bp.PLATEAUS, bp.PREDICTED_PEAKS]
-        names += [bp.PREDICTED_PLATEAUS, bp.TORQUE_STOP, bp.FORCE_STOP, bp.F_SS, *bp.K_PATHS]
+        names += [bp.PREDICTED_PLATEAUS, bp.TORQUE_STOP, bp.TORQUE_STAGE, bp.FORCE_STOP, bp.F_SS]
+        names += list(bp.K_PATHS)
         names += [bp.EVENT_INTENSITY, bp.PROCESS_INTENSITY]
         self._series = {name: _Series(name) for name in names}
         self._torque = self._series[bp.TORQUE]
@@ -173,6 +174,8 @@ class RerunSink:
                 self._event(message)
             elif received.schema_name == channels.DECISION.schema_name:
                 self._decision(message)
+            elif received.schema_name == channels.STAGE.schema_name:
+                self._stage(message)
             elif received.schema_name == channels.RUNS.schema_name:
                 self._summary(message)
             elif received.schema_name == channels.CONTROLLER.schema_name:
@@ -265,6 +268,16 @@ class RerunSink:
             )
         )
         self._text(t_ns, text + (f" ({decision.detail})" if decision.detail else ""), "WARN")
+
+    def _stage(self, stage: Any) -> None:
+        t_ns = self._clock.ns(stage.time_s)
+        self._series[bp.TORQUE_STAGE].add(t_ns, stage.torque_nm)
+        pulse = f" {stage.pulse}" if stage.command in ("pulse", "stop") else ""
+        text = (
+            f"final stage: {stage.command}{pulse} ({stage.reason}) at {stage.time_s:.3f} s, "
+            f"torque {stage.torque_nm:.1f} N·m"
+        )
+        self._text(t_ns, text + (f" ({stage.detail})" if stage.detail else ""), "INFO")
 
     def _summary(self, summary: Any) -> None:
         text = (

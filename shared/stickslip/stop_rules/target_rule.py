@@ -85,6 +85,7 @@ class TargetRule:
         "_lead_samples",
         "_over_target",
         "_previous_value",
+        "_project",
         "_ramp",
         "halt",
         "target_force_n",
@@ -98,6 +99,9 @@ class TargetRule:
         self.halt = HaltPlan()
         self._ramp = RampEstimator()
         self._lead_samples = s.reaction_samples + 0.5
+        # a torque target reached in a final stage is decided on the stage's line
+        # (final_stage_run): the projection of a noisy slow ramp would halt early
+        self._project = s.final_stage is None or self.target_torque_nm is None
         self._over_target = 0
         self._previous_value = math.nan
 
@@ -132,7 +136,7 @@ class TargetRule:
             return Stop(
                 "target_reached", f"{quantity} {value:.5g} {unit} ≥ target {target:g} {unit}"
             )
-        projected = self._ramp.projected(self._lead_samples)
+        projected = self._ramp.projected(self._lead_samples) if self._project else math.nan
         if projected >= target:
             return Stop(
                 "target_reached",

@@ -59,6 +59,7 @@ from shared.contract import (
     SeqRange,
     SpoolAck,
     SpoolStats,
+    StageDecision,
     StickSlipEvent,
     StopDecision,
     TextRange,
@@ -109,6 +110,9 @@ def template(topic: str, station: str, now_ns: int, run_id: int = 1) -> Any:
         "intensity": lambda: Intensity(station, run_id, now_ns, 0.5, 0.5),
         "decision": lambda: StopDecision(
             station, run_id, now_ns, 0.1, "plateau_closest", "", 50.0, 2e4, 2.1e4, now_ns
+        ),
+        "stage": lambda: StageDecision(
+            station, run_id, now_ns, 1.2, "final", "near_target", "", 190.0, 0, now_ns
         ),
         "runs": lambda: RunSummary(
             station,

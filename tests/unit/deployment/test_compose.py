@@ -182,6 +182,7 @@ PREDICTOR_PUTS = {
     channels.EVENTS.topic,
     channels.INTENSITY.topic,
     channels.DECISION.topic,
+    channels.STAGE.topic,  # a final stage's commands to the tool
     channels.RUNS.topic,
     channels.RESULTS.topic,  # a run's TighteningResult
     channels.PREDICTOR.topic,

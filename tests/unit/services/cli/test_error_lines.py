@@ -158,7 +158,7 @@ def test_up_refuses_an_unknown_program_and_numbers_past_its_ranges(
     """``--program 99`` was a KeyError; ``--stations 10**17`` built ids for ever and
     ``--runs 10**17`` started the whole station before the rig refused it."""
     line = fails_with(["up", "--config", "station.toml", "--program", "99"], capsys)
-    assert line == "boltwatch up: station.toml: no program 99 (--program; the file has 1, 2)"
+    assert line == "boltwatch up: station.toml: no program 99 (--program; the file has 1, 2, 3)"
     line = fails_with(["up", "--config", "station.toml", "--stations", str(10**17)], capsys)
     assert re.fullmatch(
         r"boltwatch up: station.toml: can.port: \d+ \+ \d+ stations exceeds 65535", line

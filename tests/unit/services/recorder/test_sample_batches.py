@@ -194,7 +194,7 @@ def test_batches_are_recorded_exactly_as_samples_that_came_alone(
 
 
 def bus(station: str, published: int, started_ns: int) -> BusStats:
-    stats = BusStats(station, time.time_ns(), 0, published, *[0] * 11)
+    stats = BusStats(station, time.time_ns(), 0, published, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0)
     return dataclasses.replace(stats, started_ns=started_ns)
 
 

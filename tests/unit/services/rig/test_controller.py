@@ -1,13 +1,13 @@
-"""The tool controller: conventional shutoff, hard limits, StopCommand, settling."""
+"""The tool controller: conventional shutoff, hard limits, StopCommand, settling, a final stage."""
 
 from __future__ import annotations
 
 import pytest
 
-from services.rig.controller import RunController, StopSource
+from services.rig.controller import FINAL_SHUTOFF_SAMPLES, RunController, StopSource
 from services.rig.physics import TighteningPhysics
-from shared.config import Program
-from shared.contract import ToolRunState
+from shared.config import FinalStage, Program
+from shared.contract import StageCommandCode, ToolRunState, ToolStageCode
 from tests.support.rig_fixtures import constants, paper_program, paper_rig
 
 SETTLE_S = 0.03
@@ -115,3 +115,110 @@ def test_tick_needs_a_started_run() -> None:
     with pytest.raises(RuntimeError, match="not running"):
         run.tick()
     assert not run.request_stop(1)
+
+
+# -- a final stage ------------------------------------------------------------------------
+
+
+def staged_controller(accepts_stages: bool = True, **stage: object) -> RunController:
+    program = paper_program(
+        target_force_n=None,
+        target_torque_nm=200.0,
+        final_stage=FinalStage.model_validate({"speed_rad_s": 0.05, **stage}),
+    )
+    physics = TighteningPhysics(constants(), program, paper_rig(), seed=8)
+    run = RunController(
+        physics,
+        program,
+        run_id=42,
+        settle_time_s=SETTLE_S,
+        has_force_sensor=False,
+        accepts_stages=accepts_stages,
+    )
+    run.start()
+    return run
+
+
+def ticks_until(run: RunController, torque_nm: float) -> None:
+    for _ in range(20_000):
+        if run.tick().torque_nm >= torque_nm:
+            return
+    raise AssertionError(f"torque never reached {torque_nm} Nm")
+
+
+def test_a_staged_run_turns_slower_holds_after_the_halt_pulses_and_finishes() -> None:
+    run = staged_controller()
+    ticks_until(run, 180.0)
+    assert run.request_stage(42, StageCommandCode.FINAL)
+    assert run.stage is ToolStageCode.FINAL and run.physics.motor_speed_rad_s == 0.05
+    assert not run.request_stage(42, StageCommandCode.PULSE)  # no pulse while it turns
+    assert run.request_stop(42)
+    for _ in range(100):  # it holds the run open well past its settle time
+        run.tick()
+    assert run.stage is ToolStageCode.HOLDING and run.state is ToolRunState.RUNNING
+    assert run.request_stage(42, StageCommandCode.PULSE)
+    assert (run.stage, run.pulses, run.physics.motor_speed_rad_s) == (
+        ToolStageCode.PULSE,
+        1,
+        0.05,
+    )
+    run.tick()
+    assert run.request_stop(42)  # the pulse's own halt
+    run.tick()
+    assert run.stage is ToolStageCode.HOLDING
+    assert not run.request_stage(41, StageCommandCode.FINISH)  # another run's
+    assert run.request_stage(42, StageCommandCode.FINISH)
+    run_to_end(run)
+    assert run.state is ToolRunState.DONE and run.stop_source is StopSource.STOP_COMMAND
+
+
+def test_pulses_stop_at_max_pulses_and_an_unattended_hold_ends_by_itself() -> None:
+    run = staged_controller(max_pulses=1, hold_s=0.2)
+    ticks_until(run, 180.0)
+    run.request_stage(42, StageCommandCode.FINAL)
+    run.request_stop(42)
+    run.tick()
+    assert run.request_stage(42, StageCommandCode.PULSE)
+    run.tick()
+    run.request_stop(42)
+    run.tick()
+    assert not run.request_stage(42, StageCommandCode.PULSE)  # no pulse left
+    held = 0
+    while not run.finished:  # nobody finishes it: it ends hold_s after the halt
+        run.tick()
+        held += 1
+    assert run.state is ToolRunState.DONE and 199 <= held <= 260
+
+
+def test_back_to_the_rundown_speed_and_its_own_switch_at_a_torque() -> None:
+    run = staged_controller()
+    ticks_until(run, 150.0)
+    run.request_stage(42, StageCommandCode.FINAL)
+    assert run.request_stage(42, StageCommandCode.RUNDOWN)
+    assert run.stage is ToolStageCode.RUNDOWN and run.physics.motor_speed_rad_s == 0.5
+    by_itself = staged_controller(switch="torque", switch_torque_nm=190.0)
+    ticks_until(by_itself, 190.0)
+    assert by_itself.stage is ToolStageCode.FINAL
+    assert by_itself.physics.motor_speed_rad_s == 0.05
+
+
+def test_its_own_shutoff_in_the_final_stage_watches_the_filtered_torque() -> None:
+    run = staged_controller()
+    ticks_until(run, 195.0)
+    run.request_stage(42, StageCommandCode.FINAL)
+    torques = []
+    while run.physics.motor_running:
+        torques.append(run.tick().torque_nm)
+    assert run.stop_source is StopSource.SHUTOFF_TORQUE and run.stage is ToolStageCode.HOLDING
+    assert sum(torques[-FINAL_SHUTOFF_SAMPLES:]) / FINAL_SHUTOFF_SAMPLES >= 200.0
+
+
+def test_a_controller_that_only_stops_ignores_stage_commands() -> None:
+    run = staged_controller(accepts_stages=False)
+    assert not run.staged
+    ticks_until(run, 180.0)
+    assert not run.request_stage(42, StageCommandCode.FINAL)
+    assert run.physics.motor_speed_rad_s == 0.5
+    run.request_stop(42)
+    run_to_end(run)  # ends after its settle time, as every stop-only run
+    assert run.state is ToolRunState.DONE and run.pulses == 0

@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 
 from shared.config import StationPlace, load_joint, load_station
-from shared.errors import ConfigError
+from shared.contract import StationDatabase
+from shared.errors import CanDatabaseError, ConfigError
 from tests.support.config_files import write_station
 from tests.support.paths import CONFIG, STATION_FILE
 
@@ -174,3 +175,51 @@ def test_a_program_may_tighten_a_joint_of_its_own(tmp_path: Path) -> None:
     path.write_text(text.replace("paper-section-3-4.toml", "missing.toml"))
     with pytest.raises(ConfigError, match=r"programs\[1\]\.joint: file not found"):
         load_station(path)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "expected"),
+    [
+        (
+            "speed_rad_s = 0.05",
+            "speed_rad_s = 0.5",
+            "programs[2]: final_stage.speed_rad_s 0.5 rad/s is not below motor_speed_rad_s "
+            "0.5 rad/s",
+        ),
+        (
+            'switch = "predicted"',
+            'switch = "torque"',
+            "programs[2].final_stage: switch = 'torque' needs switch_torque_nm",
+        ),
+        (
+            'switch = "predicted"',
+            'switch = "torque"\nswitch_torque_nm = 200.0',
+            "programs[2]: final_stage.switch_torque_nm 200 Nm is not below target_torque_nm",
+        ),
+        (
+            'switch = "predicted"',
+            'switch = "predicted"\nswitch_torque_nm = 150.0',
+            "programs[2].final_stage: switch_torque_nm applies only to switch = 'torque'",
+        ),
+        ("max_pulses = 2", "max_pulses = 16", "programs[2].final_stage.max_pulses: "),
+        ("max_pulses = 2", "max_pulse = 2", "programs[2].final_stage.max_pulse: unknown key"),
+    ],
+)
+def test_a_final_stage_that_cannot_work_is_refused_naming_its_key(
+    tmp_path: Path, old: str, new: str, expected: str
+) -> None:
+    path = write_station(tmp_path, "")
+    text = path.read_text()
+    assert old in text
+    path.write_text(text.replace(old, new, 1))
+    with pytest.raises(ConfigError, match=r"^" + re.escape(f"{path}: {expected}")):
+        load_station(path)
+
+
+def test_a_dbc_with_one_of_the_final_stage_messages_is_refused(tmp_path: Path) -> None:
+    text = (CONFIG / "can" / "station.dbc").read_text()
+    half = tmp_path / "half.dbc"
+    half.write_text(text.replace("BO_ 129 ToolStage", "BO_ 129 ToolStagez"))
+    with pytest.raises(CanDatabaseError, match="has StageCommand but not ToolStage"):
+        StationDatabase(half)
+    assert StationDatabase(CONFIG / "can" / "station.dbc").has_stages

@@ -27,7 +27,8 @@ RUNS = 120
 def _results() -> list[TighteningResult]:
     """Two programs on three stations and four tools, in the order the runs ended: values
     missing now and then, NOKs with several reasons, every stop reason and none, a torque
-    window and a program name changed halfway, runs ending at the same time."""
+    window and a program name changed halfway, runs ending at the same time, program 2's
+    second half run in a final stage, now and then with a pulse."""
     rng = np.random.default_rng(5)
     results = []
     for n in range(RUNS):
@@ -57,6 +58,7 @@ def _results() -> list[TighteningResult]:
                 stop_reason=(None, "plateau_closest", "target_reached")[n % 3],
                 events=None if n % 13 == 0 else int(rng.integers(30, 45)),
                 process_intensity=None if n % 7 == 0 else float(rng.normal(1e6, 4e4)),
+                pulses=(n % 5 == 0) + (n % 15 == 0) if changed and program == 2 else None,
             )
         )
     results.sort(key=lambda result: (result.time_ns, result.station, result.run_id))
@@ -70,6 +72,7 @@ def _same(stored: ProgramStatistics, read: ProgramStatistics) -> None:
     assert stored.events_per_run == read.events_per_run
     assert stored.window_changes == read.window_changes
     assert (stored.stations, stored.tools) == (read.stations, read.tools)
+    assert (stored.staged_runs, stored.pulsed_runs) == (read.staged_runs, read.pulsed_runs)
     for mine, theirs in zip(stored.figures, read.figures, strict=True):
         assert mine.key == theirs.key
         np.testing.assert_array_equal(mine.values, theirs.values)
@@ -93,6 +96,7 @@ def test_the_stores_columns_give_the_statistics_of_the_results(target: StoreTarg
     assert [program.runs for program in stored] == [RUNS // 2, RUNS // 2]
     assert any(program.window_changes for program in stored), "the torque window changed"
     assert all(program.nok_reasons for program in stored), "some runs must be NOK"
+    assert [(p.staged_runs, p.pulsed_runs) for p in stored] == [(0, 0), (RUNS // 4, 6)]
     for mine, theirs in zip(stored, read, strict=True):
         _same(mine, theirs)
     kept = [

@@ -1,6 +1,6 @@
 """The store's versions: a new store is made whole, an older one migrated with nothing
-lost (a store of version 1, before the plant model, and of version 2, before the part's
-source, among them), a newer one refused, a
+lost (a store of version 1, before the plant model, of version 2, before the part's
+source, and of version 4, before a final stage's pulses, among them), a newer one refused, a
 reader of a current one takes no lock, writers starting together migrate once, a damaged
 file is named and left as it is."""
 
@@ -24,8 +24,9 @@ from shared.results import (
     stored_result,
     version_of,
 )
+from shared.results.results_table import format_csv, format_table
 from tests.support import factories
-from tests.support.old_results_store import version_1_store, version_2_store
+from tests.support.old_results_store import version_1_store, version_2_store, version_4_store
 
 #: a later version, as the next boltwatch would bring one: a column added
 NEXT_VERSION = (*MIGRATIONS, ("ALTER TABLE tightenings ADD COLUMN operator TEXT",))
@@ -177,3 +178,25 @@ def test_an_unreachable_server_is_one_line_without_its_password() -> None:
     text = str(raised.value)
     assert "secret" not in text and "\n" not in text
     assert text.startswith("results store postgresql://boltwatch:***@127.0.0.1:1/results")
+
+
+def test_a_version_4_store_is_migrated_at_start_and_keeps_a_final_stages_pulses(
+    target: StoreTarget,
+) -> None:
+    """Version 5 adds ``pulses`` (a final stage's pulses back to the target): the rows stored
+    before say nothing (None, as a run without a final stage); new rows keep theirs, found by
+    the table and the CSV."""
+    old = [
+        stored_result(factories.result(run), "A", f"/rec/{run}.mcap", "box", run) for run in (1, 2)
+    ]
+    version_4_store(target, old)
+    with ResultsStore(target) as store:
+        assert (store.migrated_from, store.version) == (4, SCHEMA_VERSION)
+        kept = store.find(ResultsQuery(oldest_first=True))
+        assert kept == old and {s.result.pulses for s in kept} == {None}
+        staged = factories.result(3, pulses=1, stop_reason="target_reached")
+        store.add([stored_result(staged, "A", None, None, 3)])
+        newest = store.find(ResultsQuery(oldest_first=False))[0]
+        assert newest.result == staged
+    assert "target_reached+pulse" in format_table([newest])
+    assert format_csv([newest]).splitlines()[1].endswith(",1")
