@@ -105,12 +105,14 @@ def _staged_run(samples: int = 200) -> list[tuple[str, Any]]:
                                          force_n=force, time_s=5.0 + n / 1000))
         )  # fmt: skip
     messages.append(("events", factories.event(1, 1, time_ns=T0_NS + 40 * MS_NS, time_s=0.04)))
-    for command, reason, at in (("final", "below_switch_point", 120), ("pulse", "lost_drop", 180)):
-        stage = StageDecision(
-            "st1", 1, T0_NS + at * MS_NS, at / 1000, command, reason, "", at * 1.0,
-            1 if command == "pulse" else 0, T0_NS + at * MS_NS,
-        )  # fmt: skip
-        messages.append(("stage", stage))
+    final = StageDecision(
+        "st1", 1, T0_NS + 120 * MS_NS, 0.12, "final", "below_switch_point", "", 120.0, 0,
+        T0_NS + 120 * MS_NS,
+    )  # fmt: skip
+    pulse = StageDecision(
+        "st1", 1, T0_NS + 180 * MS_NS, 0.18, "pulse", "lost_drop", "", 180.0, 1, T0_NS + 180 * MS_NS
+    )
+    messages += [("stage", final), ("stage", pulse)]
     decision = StopDecision(
         "st1", 1, T0_NS + 190 * MS_NS, 0.19, "input_fault", "torque not finite", math.nan,
         None, None, T0_NS + 190 * MS_NS,
