@@ -13,21 +13,25 @@ written by the real recorder (:func:`~tests.benchmarks.run_recordings.record_run
 stored as ``results rebuild`` stores them. The load is ``bench_line.py``'s generator:
 what N edge stations publish toward the line, at their rates (a ``SampleBatch`` every
 50 ms, 1000 samples a second a station, events, tool states, decisions, summaries), which
-the recorder files meanwhile. Debian's chromium (playwright, on the same box: a worse case
-than a browser on the engineer's own PC) opens runs by the address (``#run=st1/N``, the
+the recorder files meanwhile. Debian's chromium (playwright) runs on the same box at nice
+19 (``--browser-nice``: a browser on the engineer's PC takes no CPU from the line server;
+0 puts it beside the line's services) and opens runs by the address (``#run=st1/N``, the
 handler a click on a result row runs), one after the other per browser, each run opened
-once (cold: the page has not read it) unless said:
+once (cold: the page has not read it) unless said; each browser's first open (its
+scripts compiled) is not counted:
 
 1. ``quiet``: the line's services idle, one browser, cold; then ``quiet warm``: the same
    runs again (kept by the page);
 2. ``load``: the generator on, one browser, cold; ``load, B browsers``: B browsers at
    once, each its own runs, cold; ``load warm``: one browser, runs opened before.
 
-Per open, the page's own figure (``window.boltwatchRun.readyMs``): from the click's
-handler to the run's four charts drawn and the frame that shows them begun. Meanwhile a
+Per open, the page's own figures: from the click's handler to the run's four charts
+drawn and the frame that shows them begun (``window.boltwatchRun.readyMs``), and the part
+of it that was the page's answer (asked, received, parsed: ``fetchMs``). Meanwhile a
 thread asks ``/board.json`` every 100 ms (the page stays responsive: its answer's time),
 and the recorder's ``RecorderStats`` give its lag and the samples missing (the live path
-does not wait on the page), side by side with a stretch at load with nobody browsing.
+does not wait on the page), side by side with a stretch at load with nobody browsing;
+the CPU of the recorder and of the page's process, by phase.
 Exit status 1 when the goal is missed: at load, one browser, cold, p95 <= 300 ms.
 """
 
@@ -94,8 +98,9 @@ class BoardProbe:
             self.times_ms.setdefault(self.phase, []).append(elapsed)
 
 
-async def open_runs(page: Page, runs: list[int]) -> list[float]:
-    """Open each run by the address, one after the other; each one's time to ready (ms)."""
+async def open_runs(page: Page, runs: list[int], fetches: list[float]) -> list[float]:
+    """Open each run by the address, one after the other; each one's time to ready (ms), and
+    in ``fetches`` the part of it that was the page's answer (asked, received, parsed)."""
     times = []
     for run in runs:
         key = f"st1/{run}"
@@ -106,7 +111,11 @@ async def open_runs(page: Page, runs: list[int]) -> list[float]:
             f" && document.getElementById('run').dataset.key === '{key}'",
             timeout=OPEN_TIMEOUT_MS,
         )
-        times.append(float(await page.evaluate("window.boltwatchRun.readyMs")))
+        ready, fetch = await page.evaluate(
+            "[window.boltwatchRun.readyMs, window.boltwatchRun.fetchMs]"
+        )
+        times.append(float(ready))
+        fetches.append(float(fetch))
     return times
 
 
@@ -118,14 +127,16 @@ def summary(times: list[float]) -> str:
 
 
 async def browse(
-    url: str, runs: list[int], per_phase: int, browsers: int, line: Line
-) -> dict[str, list[float]]:
+    url: str, runs: list[int], per_phase: int, browsers: int, line: Line, browser_nice: int
+) -> dict[str, tuple[list[float], list[float]]]:
+    """The phases (see the module docstring): per phase, each open's time to ready and the
+    part of it that was the page's answer."""
     from playwright.async_api import async_playwright
 
-    results: dict[str, list[float]] = {}
+    results: dict[str, tuple[list[float], list[float]]] = {}
     async with async_playwright() as playwright:
         browser = await playwright.chromium.launch(
-            executable_path=str(CHROMIUM), args=CHROMIUM_ARGS
+            executable_path=str(_niced_chromium(line.folder, browser_nice)), args=CHROMIUM_ARGS
         )
         pages = []
         for _ in range(browsers):
@@ -139,28 +150,41 @@ async def browse(
         def take(count: int) -> list[int]:
             return [next(fresh) for _ in range(count)]
 
+        async def phase(name: str, shares: list[list[int]]) -> None:
+            line.phase(name)
+            fetches: list[float] = []
+            browsing = zip(pages[: len(shares)], shares, strict=True)  # the first ones
+            together = await asyncio.gather(
+                *(open_runs(page, share, fetches) for page, share in browsing)
+            )
+            results[name] = ([t for times in together for t in times], fetches)
+
+        for page in pages:  # each browser's first open (its scripts compiled): not counted
+            await open_runs(page, take(1), [])
         quiet = take(per_phase)
-        line.phase("quiet")
-        results["quiet"] = await open_runs(pages[0], quiet)
-        line.phase("quiet warm")
-        results["quiet warm"] = await open_runs(pages[0], quiet)
+        await phase("quiet", [quiet])
+        await phase("quiet warm", [quiet])
         line.start_load()
         line.phase("load, nobody browsing")
         await asyncio.sleep(QUIET_LOAD_S)
-        line.phase("load")
         loaded = take(per_phase)
-        results["load"] = await open_runs(pages[0], loaded)
-        line.phase(f"load, {browsers} browsers")
-        shares = [take(per_phase) for _ in pages]
-        together = await asyncio.gather(
-            *(open_runs(p, s) for p, s in zip(pages, shares, strict=True))
-        )
-        results[f"load, {browsers} browsers"] = [t for times in together for t in times]
-        line.phase("load warm")
-        results["load warm"] = await open_runs(pages[0], loaded)
+        await phase("load", [loaded])
+        await phase(f"load, {browsers} browsers", [take(per_phase) for _ in pages])
+        await phase("load warm", [loaded])
         line.phase("end")
         await browser.close()
     return results
+
+
+def _niced_chromium(folder: Path, nice: int) -> Path:
+    """Debian's chromium at ``nice`` (a browser on another machine takes no CPU from the
+    line server's services; 0: as it is)."""
+    if nice == 0:
+        return CHROMIUM
+    wrapper = folder / "chromium-niced"
+    wrapper.write_text(f'#!/bin/sh\nexec nice -n {nice} {CHROMIUM} "$@"\n')
+    wrapper.chmod(0o755)
+    return wrapper
 
 
 class Line:
@@ -268,9 +292,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--samples", type=int, default=3000, help="samples a run opened")
     parser.add_argument("--per-phase", type=int, default=10, help="runs opened a phase a browser")
     parser.add_argument("--browsers", type=int, default=4, help="browsers at once at load")
+    parser.add_argument(
+        "--browser-nice",
+        type=int,
+        default=19,
+        help="chromium's nice value (default 19: as if on another machine; 0: beside the line)",
+    )
     parser.add_argument("--keep", type=Path, default=None, help="keep files and logs here")
     args = parser.parse_args(argv)
-    runs = args.per_phase * (2 + args.browsers)
+    runs = args.per_phase * (2 + args.browsers) + args.browsers
     with tempfile.TemporaryDirectory(prefix="bench-run-view-") as tmp:
         folder = args.keep or Path(tmp)
         folder.mkdir(parents=True, exist_ok=True)
@@ -278,16 +308,18 @@ def main(argv: list[str] | None = None) -> int:
         try:
             line.start()
             url = f"http://127.0.0.1:{line.page_port}/"
+            runs_ = list(range(1, runs + 1))
             results = asyncio.run(
-                browse(url, list(range(1, runs + 1)), args.per_phase, args.browsers, line)
+                browse(url, runs_, args.per_phase, args.browsers, line, args.browser_nice)
             )
         finally:
             line.stop()
         generator = (folder / "generator.log").read_text().strip()
     print(f"N={args.stations} synthetic stations (+ st1), runs of {args.samples} samples")
-    print("time to ready in the browser (click -> charts drawn, frame begun):")
-    for phase, times in results.items():
-        print(f"  {phase}: {summary(times)}")
+    print("time to ready in the browser (click -> charts drawn, frame begun) [of it the page's")
+    print("answer: asked -> received and parsed]:")
+    for phase, (times, fetches) in results.items():
+        print(f"  {phase}: {summary(times)} [{summary(fetches)}]")
     print("/board.json answer while browsing:")
     for phase, times in line.board.times_ms.items():
         print(f"  {phase}: {summary(times)}")
@@ -299,7 +331,7 @@ def main(argv: list[str] | None = None) -> int:
         cores = f", CPU recorder {cpu[0]:.2f} page {cpu[1]:.2f}" if cpu else ""
         print(f"  {phase}: lag {worst}, missing {line.missing.get(phase, 0)}{cores}")
     print(f"  generator: {generator}")
-    load = results["load"]
+    load = results["load"][0]
     p95 = float(np.percentile(load, 95))
     met = p95 <= GOAL_P95_MS
     verdict = "met" if met else "MISSED"

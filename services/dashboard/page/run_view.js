@@ -216,7 +216,7 @@ function sideBySide(view, charts, note) {
   return el("div", { class: "modes" }, ...Object.values(buttons), align);
 }
 
-function drawRun(view, started) {
+function drawRun(view, started, fetched) {
   const chartBox = el("div", { class: "charts" });
   const note = el("div", { class: "side-note" });
   runPanel.replaceChildren(heading(view.station, view.run_id, view), subtitle(view), ...stateLine(view),
@@ -226,7 +226,7 @@ function drawRun(view, started) {
   drawAll(charts, (name) => runSpec(view, name));
   runPanel.dataset.mode = runPanel.dataset.modeReady = "run";
   window.boltwatchRun = { key: view.key, samples: view.samples, drawn: view.drawn, view, charts,
-    readyMs: null };
+    fetchMs: fetched - started, readyMs: null };
   // ready: drawn, and the frame that shows it begun (what the benchmark times from the click)
   const open = runOpens;
   requestAnimationFrame(() => {
@@ -254,7 +254,7 @@ async function showRun(station, run) {
       body = { errors: [err instanceof TypeError ? "the page's server does not answer" : err.message] };
     }
     if (open !== runOpens) return;
-    if (response && response.ok) { drawRun(body, started); return; }
+    if (response && response.ok) { drawRun(body, started, performance.now()); return; }
     const waiting = body.pending || (response && response.status === 503);
     if (waiting && performance.now() - started < RETRY_FOR_MS) {
       runPanel.replaceChildren(heading(station, run, null), none(`${body.errors.join("; ")}: asking again…`));
