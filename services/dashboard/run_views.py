@@ -17,7 +17,9 @@ The jobs, each in one worker:
 
 - :meth:`RunViews.view`: the run's view (its files located by :mod:`.run_locator`,
   read by :func:`~shared.offline.post_mortem.read_run_files`, drawn as data by
-  :func:`~shared.offline.post_mortem.run_document`), gzipped JSON;
+  :func:`~shared.offline.post_mortem.run_document`), gzipped JSON; a run just ended
+  whose file the recorder has not flushed yet (under its writing name, its result not
+  stored) is ``pending``: the page asks again;
 - :meth:`RunViews.part`: every tightening of the run's part overlaid (at most
   :data:`PART_RUNS`);
 - :meth:`RunViews.band`: the run against its program's last OK runs at its station;
@@ -202,6 +204,13 @@ class RunViews:
         try:
             run = self._read(located.files, run_id)
         except (InputError, OSError) as err:
+            if located.writing and located.stored is None:  # its samples not flushed yet
+                raise RunRequestError(
+                    404,
+                    f"run {run_id} of {station}: the recorder is still writing its file, which "
+                    f"holds none of its samples yet ({_text(err)})",
+                    pending=True,
+                ) from err
             raise RunRequestError(422, f"run {run_id} of {station}: {_text(err)}") from err
         document = run_document(run) | self._found(located)
         read = ReadRun(

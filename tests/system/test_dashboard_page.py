@@ -11,13 +11,14 @@ tightening of that part the results store holds (the recorder's
 ``results.sqlite``), newest first, with the verdicts heard on zenoh and their
 recordings, a hostile part id as text (never run), and the page stay live
 meanwhile. Program 2 gets a preload window at its target, so about half its runs are NOK:
-a click on a NOK result of the station's last results must draw that run's curve as its
-recording holds it (the file the results store names, read here with mcap's own reader:
-its sample count in every chart, its last sample, its final values and verdict, the
-preload window), the run's part's runs overlaid one more click away, every one the store
-holds; the NOK list must hold it. The page loads nothing but from its own server.
-Screenshots go to the test's folder (``BOLTWATCH_DOCS_IMAGES=1``: also to docs/images/,
-dashboard.png, run-view.png and run-part.png, the pictures of docs/how-to/line-page.md).
+a click on a NOK result in the NOK list (NOK results only) must draw that run's curve as
+its recording holds it (the file the results store names, read here with mcap's own
+reader: its sample count in every chart, its last sample, its final values and verdict,
+the preload window), the run's part's runs overlaid one more click away, every one the
+store holds; a click on the newest of the station's last results opens its run too. The
+page loads nothing but from its own server. Screenshots go to the test's folder
+(``BOLTWATCH_DOCS_IMAGES=1``: also to docs/images/, dashboard.png, run-view.png and
+run-part.png, the pictures of docs/how-to/line-page.md).
 
 Chromium comes from Debian's package (.ci/run installs it as root when
 missing); never ``playwright install``. Where it
@@ -133,7 +134,8 @@ def _search_a_part(
     # markup in a part id is text: no element made, no script run
     page.fill("#part", HOSTILE_PART)
     page.press("#part", "Enter")
-    page.wait_for_selector("#found p.none", timeout=PAGE_TIMEOUT_MS)
+    # the answer, not the "searching…" line before it (a p.none too)
+    page.wait_for_selector("#found p.none:has-text('no tightening')", timeout=PAGE_TIMEOUT_MS)
     assert page.locator("#found h2").inner_text() == f"Tightenings of part {HOSTILE_PART}"
     shown = page.locator("#found p.none").inner_text()
     assert shown == f"no tightening of part {HOSTILE_PART} in {target}"
@@ -188,8 +190,8 @@ DRAWN = """(() => { const run = window.boltwatchRun, charts = run.charts;
 def _a_nok_run_one_click_away(
     page: Any, station: LiveStation, heard: Callable[[], list[TighteningResult]], shots: Path
 ) -> None:
-    """A click on a NOK result draws its curve as its recording holds it; one more overlays
-    its part's runs; the NOK list holds it."""
+    """A click on a NOK result (in the NOK list) draws its curve as its recording holds it;
+    one more overlays its part's runs; a row of the last results opens its run too."""
     station.wait_for(
         lambda: any(
             r.result == "NOK"
@@ -213,14 +215,18 @@ def _a_nok_run_one_click_away(
     (row,) = _stored(station, ResultsQuery(stations=[STATION], run_id=nok.run_id))
     assert row.recording is not None
     samples, result = _recorded(row.recording, nok.run_id)
-    # one click: on the NOK row of the station's last results (or the NOK list's)
-    selector = f"#station-st1 tr.result[data-run='{nok.run_id}']"
-    if page.locator(selector).count() == 0:  # rolled off the ten newest: the NOK list has it
-        page.click("#nok-list")
-        selector = f"#found tr.found[data-run='{nok.run_id}']"
-        page.wait_for_selector(selector, timeout=PAGE_TIMEOUT_MS)
-    page.click(selector)
-    page.wait_for_selector("#run[data-ready='1']", timeout=PAGE_TIMEOUT_MS)
+    # one click: on its row in the NOK list (which live updates never redraw under the click)
+    page.click("#nok-list")
+    row = f"#found tr.found[data-run='{nok.run_id}']"
+    page.wait_for_selector(row, timeout=PAGE_TIMEOUT_MS)
+    verdicts = page.evaluate(
+        "[...document.querySelectorAll('#found tr.found .verdict')].map((v) => v.textContent)"
+    )
+    assert verdicts and set(verdicts) == {"NOK"}
+    page.click(row)
+    page.wait_for_selector(
+        f"#run[data-key='{STATION}/{nok.run_id}'][data-ready='1']", timeout=PAGE_TIMEOUT_MS
+    )
     drawn = page.evaluate(DRAWN)
     assert drawn["key"] == f"{STATION}/{nok.run_id}"
     assert drawn["samples"] == drawn["drawn"] == len(samples) > 100
@@ -243,15 +249,18 @@ def _a_nok_run_one_click_away(
     assert overlaid == [[f"{STATION}/{s.result.run_id}" for s in stored], len(stored)]
     assert len(stored) == len(bolts) >= 2
     page.locator("#run").screenshot(path=str(shots / "run-part.png"))
-    # the NOK list holds it
-    page.click("#nok-list")
-    page.wait_for_selector(f"#found tr.found[data-run='{nok.run_id}']", timeout=PAGE_TIMEOUT_MS)
-    verdicts = page.evaluate(
-        "[...document.querySelectorAll('#found tr.found .verdict')].map((v) => v.textContent)"
-    )
-    assert verdicts and set(verdicts) == {"NOK"}
     page.click("#run button.close")
     page.click("#found button.close")
+    # a row of the station's last results opens its run as well (the newest, live)
+    newest = page.locator("#station-st1 tr.result").first.get_attribute("data-run")
+    its = ResultsQuery(stations=[STATION], run_id=int(newest or "0"))
+    station.wait_for(lambda: bool(_stored(station, its)), f"run {newest} stored")  # flushed
+    page.click(f"#station-st1 tr.result[data-run='{newest}']")
+    page.wait_for_selector(
+        f"#run[data-key='{STATION}/{newest}'][data-ready='1']", timeout=PAGE_TIMEOUT_MS
+    )
+    assert page.evaluate("window.boltwatchRun.samples") > 100
+    page.click("#run button.close")
 
 
 def test_the_line_page_shows_results_live_in_a_real_browser(tmp_path: Path) -> None:

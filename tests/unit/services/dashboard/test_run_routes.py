@@ -156,6 +156,10 @@ def test_a_file_being_written_and_a_run_not_stored_yet_are_found_by_the_folder(
     newest = _file(station, 6)
     newest.rename(writing_path(newest))  # the recorder still writes it
     _store_says(station, "DELETE FROM tightenings WHERE run_id = 5")  # not stored yet
+    ended = _file(station, 4)  # just ended: its samples still in the recorder's open chunk
+    ended.rename(writing_path(ended))
+    writing_path(ended).write_bytes(writing_path(ended).read_bytes()[:1200])
+    _store_says(station, "DELETE FROM tightenings WHERE run_id = 4")
 
     async def ask() -> None:
         async with _served(station) as (client, url, _):
@@ -166,6 +170,12 @@ def test_a_file_being_written_and_a_run_not_stored_yet_are_found_by_the_folder(
             assert status == 200 and view["stored"] is None
             assert view["found"]["note"] == "not in the results store yet: found by the folder"
             assert view["result"]["run_id"] == 5  # the recording's own result
+            status, body, _ = await _get(client, f"{url}/api/runs/st1/4")
+            assert status == 404 and body["pending"] is True  # the page asks again
+            assert body["errors"][0].startswith(
+                "run 4 of st1: the recorder is still writing its file, which holds none of its "
+                "samples yet"
+            )
             status, body, _ = await _get(client, f"{url}/api/runs/st1/99")
             assert status == 404 and body["pending"] is True
             assert body["errors"] == [
