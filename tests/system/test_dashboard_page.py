@@ -212,9 +212,9 @@ def _a_nok_run_one_click_away(
     station.wait_for(
         lambda: bolts <= {s.result.run_id for s in _stored(station, part)}, "its part stored"
     )
-    (row,) = _stored(station, ResultsQuery(stations=[STATION], run_id=nok.run_id))
-    assert row.recording is not None
-    samples, result = _recorded(row.recording, nok.run_id)
+    (stored_nok,) = _stored(station, ResultsQuery(stations=[STATION], run_id=nok.run_id))
+    assert stored_nok.recording is not None
+    samples, result = _recorded(stored_nok.recording, nok.run_id)
     # one click: on its row in the NOK list (which live updates never redraw under the click)
     page.click("#nok-list")
     row = f"#found tr.found[data-run='{nok.run_id}']"
