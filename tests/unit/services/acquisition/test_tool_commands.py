@@ -12,8 +12,8 @@ import pytest
 
 from services.acquisition.acquisition import Acquisition
 from shared.contract import StageDecision, StationDatabase, StopDecision
+from tests.support.acquisition_bus import ListOutlet, drain, frame, status
 from tests.support.paths import DBC_FILE
-from tests.unit.services.acquisition.test_acquisition import ListOutlet, drain, frame, status
 
 DATABASE = StationDatabase(DBC_FILE)
 _channels = itertools.count()

@@ -20,7 +20,7 @@ from shared.line_status import LastRun, StatusCollector, to_json
 from tests.support.factories import T0, S, sample, summary
 
 
-def bus(time_ns: int, samples: int, **counters: int) -> BusStats:
+def bus(time_ns: int, samples: int, **counters: Any) -> BusStats:
     fields: dict[str, Any] = {
         "frames": 2 * samples,
         "unknown_ids": 0,
