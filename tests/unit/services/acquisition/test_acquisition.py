@@ -3,11 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
-import itertools
-from collections.abc import Iterator
 
 import can
-import pytest
 
 from services.acquisition.acquisition import Acquisition
 from shared.contract import (
@@ -22,18 +19,7 @@ from tests.support.acquisition_bus import ListOutlet, drain, frame, status
 from tests.support.paths import DBC_FILE
 
 DATABASE = StationDatabase(DBC_FILE)
-_channels = itertools.count()
 FRAME_IDS = {name: frame_id for frame_id, (name, _) in DATABASE.by_id.items()}
-
-
-@pytest.fixture
-def buses() -> Iterator[tuple[can.BusABC, can.BusABC]]:
-    channel = f"acq-test-{next(_channels)}"
-    with (
-        can.Bus(interface="virtual", channel=channel) as tool,
-        can.Bus(interface="virtual", channel=channel) as station,
-    ):
-        yield tool, station
 
 
 def decision(run_id: int) -> StopDecision:
