@@ -63,6 +63,8 @@ EVENT_CONTENT = "JoiningSystemEventContent"
 MACHINES_FOLDER = 1001
 RESULT_DATA_TYPE = 3008
 MACHINERY = "http://opcfoundation.org/UA/Machinery/"
+#: the joining system's folder of Machinery's building blocks
+BUILDING_BLOCKS = "MachineryBuildingBlocks"
 
 
 def result_browse_name(run_id: int) -> str:
@@ -101,6 +103,7 @@ class JoiningSystem:
             objecttype=node_id(JOINING_SYSTEM_TYPE, ijt),
         )
         await drop_placeholders(node)
+        await share_building_blocks(node)
         results = await node.get_child([f"{result_ns}:ResultManagement", f"{result_ns}:Results"])
         events = await server.get_event_generator(
             node_id(RESULT_READY_EVENT_TYPE, ijt), emitting_node=node.nodeid
@@ -198,6 +201,32 @@ async def drop_placeholders(node: Node) -> None:
             await remove_child(node, Node(node.session, child.NodeId), child.ReferenceTypeId)
         elif child.NodeClass == ua.NodeClass.Object:  # where the placeholders are
             await drop_placeholders(Node(node.session, child.NodeId))
+
+
+async def share_building_blocks(node: Node) -> None:
+    """``MachineryBuildingBlocks`` referring to the joining system's own ``Identification`` and
+    ``ResultManagement``, not to copies of them.
+
+    In the type the folder's ``HasAddIn`` references lead to the same instance declarations
+    as the type's own (one object, referenced twice); asyncua instantiates each reference
+    as a node of its own, so the folder held a second ResultManagement without its methods'
+    implementations and a second Identification without values. Each such copy (a child of
+    the folder with the browse name of a child of the joining system) is deleted and the
+    folder refers to the joining system's own object, with the reference type it had."""
+    own = {
+        (child.BrowseName.NamespaceIndex, child.BrowseName.Name): child.NodeId
+        for child in await node.get_children_descriptions(refs=ua.ObjectIds.HierarchicalReferences)
+    }
+    blocks_name = next((name for name in own if name[1] == BUILDING_BLOCKS), None)
+    if blocks_name is None:
+        return
+    blocks = Node(node.session, own[blocks_name])
+    for child in await blocks.get_children_descriptions(refs=ua.ObjectIds.HierarchicalReferences):
+        target = own.get((child.BrowseName.NamespaceIndex, child.BrowseName.Name))
+        if target is None or target == child.NodeId:
+            continue
+        await remove_child(blocks, Node(node.session, child.NodeId), child.ReferenceTypeId)
+        await blocks.add_reference(target, child.ReferenceTypeId, forward=True, bidirectional=False)
 
 
 async def remove_child(parent: Node, child: Node, reference_type: ua.NodeId) -> None:
