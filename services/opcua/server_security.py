@@ -43,7 +43,9 @@ from asyncua.server.user_managers import UserManager
 from cryptography import x509
 from cryptography.hazmat.primitives.asymmetric import rsa
 
+from services.opcua.client_sessions import use_client_sessions
 from services.opcua.password_hashes import unknown_user_hash, verify, verify_unknown
+from services.opcua.refusal_log import LoggedValidator, quiet_refusals
 from services.opcua.users_file import OpcuaUser, others_may_read, read_users
 from shared.errors import ConfigError
 
@@ -171,8 +173,12 @@ class PasswordUsers(UserManager):
 
 
 async def apply(server: Server, settings: SecuritySettings) -> None:
-    """Endpoints, user tokens and users, certificate and client validation of ``server``."""
+    """Endpoints, user tokens and users, certificate and client validation of ``server``; its
+    sessions :class:`~.client_sessions.ClientSession`, one line per refusal
+    (:mod:`.refusal_log`)."""
     settings.check()
+    quiet_refusals()
+    use_client_sessions(server)
     policies: list[ua.SecurityPolicyType] = []
     tokens: list[type] = []
     if settings.anonymous_read_only:
@@ -202,13 +208,12 @@ async def apply(server: Server, settings: SecuritySettings) -> None:
         if settings.trusted_clients is not None:
             store = TrustStore([settings.trusted_clients], [])
             await store.load()
-            server.set_certificate_validator(
-                CertificateValidator(
-                    CertificateValidatorOptions.TRUSTED_VALIDATION
-                    | CertificateValidatorOptions.PEER_CLIENT,
-                    store,
-                )
+            validator = CertificateValidator(
+                CertificateValidatorOptions.TRUSTED_VALIDATION
+                | CertificateValidatorOptions.PEER_CLIENT,
+                store,
             )
+            server.set_certificate_validator(LoggedValidator(validator, settings.trusted_clients))
     if settings.anonymous_read_only:
         policies.append(ua.SecurityPolicyType.NoSecurity)
     server.set_security_policy(policies)

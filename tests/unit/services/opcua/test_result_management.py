@@ -28,7 +28,7 @@ from services.opcua.joining_systems import (
     JoiningSystem,
 )
 from services.opcua.nodeset_files import missing_files, nodeset_folder
-from services.opcua.nodeset_loading import MACHINERY_RESULT, load_models
+from services.opcua.nodeset_loading import MACHINERY_RESULT, load_models, node_id
 from services.opcua.result_requests import (
     ERROR_STORE,
     ERROR_TOO_MANY,
@@ -390,7 +390,7 @@ def test_the_building_blocks_result_management_is_the_joining_system_s(served: S
         client = served.client
         ours = await client.get_namespace_index(BOLTWATCH_NAMESPACE)
         di = await client.get_namespace_index("http://opcfoundation.org/UA/DI/")
-        system = client.get_node(ua.NodeId("st1", ours))
+        system = client.get_node(node_id("st1", ours))
         machinery = await client.get_namespace_index(MACHINERY)
         blocks = f"{machinery}:{BUILDING_BLOCKS}"
         pairs = [
