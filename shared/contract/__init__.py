@@ -12,6 +12,7 @@
 - :mod:`.trace` (the offline trace CSV), :mod:`.run_clock` (a run's clock: ns <-> s)
 - :mod:`.spool_messages` (what a station's spool and the recorder say to each other)
 - :mod:`.part_messages` (what the line says of the part at a station: its id)
+- :mod:`.alert_messages` (who acknowledged, confirmed or commented on an alert)
 """
 
 from shared.contract.can_database import CONTRACT, COUNTER_MODULO, SAMPLE_RATE_HZ, StationDatabase
@@ -32,6 +33,9 @@ from shared.contract.message_fields import (
     can_id_bounds,
 )
 from shared.contract.messages import (
+    AlertAck,
+    AlertAction,
+    AlertSource,
     BridgeStats,
     BusStats,
     ControllerAlarm,
@@ -96,6 +100,9 @@ __all__ = [
     "SAMPLE_RATE_HZ",
     "SCHEMA_TYPES",
     "STATION_ID",
+    "AlertAck",
+    "AlertAction",
+    "AlertSource",
     "BridgeStats",
     "BusStats",
     "Channel",

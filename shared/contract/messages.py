@@ -16,7 +16,8 @@ What tool controllers say (a controller's result, its tool data and alarms, a
 controller bridge's counters) is in :mod:`shared.contract.controller_messages` and
 imported from here as every other message.
 What the line says of the part at a station (:class:`PartScan`) is in
-:mod:`shared.contract.part_messages`, imported from here too.
+:mod:`shared.contract.part_messages`, and who acknowledged an alert (:class:`AlertAck`)
+in :mod:`shared.contract.alert_messages`, imported from here too.
 """
 
 from __future__ import annotations
@@ -25,6 +26,11 @@ from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import Literal
 
+from shared.contract.alert_messages import (  # noqa: F401  (re-exported: one import for every message)
+    AlertAck,
+    AlertAction,
+    AlertSource,
+)
 from shared.contract.controller_messages import (  # noqa: F401  (re-exported: one import for every message)
     AlarmKind,
     BridgeStats,

@@ -21,14 +21,14 @@ import pytest
 from asyncua import Client, Server, ua
 from asyncua.ua.ua_binary import struct_to_binary
 
+from services.opcua.event_delivery import EventDelivery
 from services.opcua.joining_systems import (
     BOLTWATCH_NAMESPACE,
     BUILDING_BLOCKS,
-    MACHINERY,
     JoiningSystem,
 )
 from services.opcua.nodeset_files import missing_files, nodeset_folder
-from services.opcua.nodeset_loading import MACHINERY_RESULT, load_models, node_id
+from services.opcua.nodeset_loading import MACHINERY, MACHINERY_RESULT, load_models, node_id
 from services.opcua.result_requests import (
     ERROR_STORE,
     ERROR_TOO_MANY,
@@ -130,7 +130,7 @@ async def _start(target: StoreTarget, endpoint: str) -> tuple[Server, Served]:
     server.set_endpoint(endpoint)
     await load_models(server, nodeset_folder())
     result_ns = await server.get_namespace_index(MACHINERY_RESULT)
-    system = await JoiningSystem.create(server, "st1")
+    system = await JoiningSystem.create(server, "st1", await EventDelivery.create(server))
     nodes = {}
     for name, callback in result_management_methods(target, "st1", result_ns).items():
         nodes[name] = await system.result_management_method(name)
