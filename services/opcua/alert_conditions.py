@@ -25,6 +25,7 @@ from OPC UA (the line's page and ``boltwatch status`` show every alert).
 
 from __future__ import annotations
 
+import asyncio
 import logging
 from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import dataclass, field
@@ -101,6 +102,8 @@ class StationConditions:
         self._ours, self._ijt = namespaces
         self._conditions: dict[str, _Condition] = {}
         self._by_node: dict[ua.NodeId, _Condition] = {}
+        #: one change at a time: its notification goes out before the next change's
+        self._changing = asyncio.Lock()
 
     @classmethod
     async def create(
@@ -128,6 +131,10 @@ class StationConditions:
     async def report(self, alert: AlertEvent) -> None:
         """The alert into its condition (made at its first alert); an event when its state
         changed (an alert that goes off while off changes nothing)."""
+        async with self._changing:
+            await self._report(alert)
+
+    async def _report(self, alert: AlertEvent) -> None:
         held = self._conditions.get(alert.key)
         if held is None:
             if not alert.active:
@@ -148,11 +155,12 @@ class StationConditions:
         """Acknowledge, Confirm or AddComment of ``who`` (a session); its record.
         :class:`~.condition_states.ConditionMethodError` when refused."""
         held = self._by_node[condition_id]
-        before = (held.state.acked, held.state.confirmed)
         user = str(getattr(who, "user_name", "") or "")
-        held.state.act(action, event_id, comment, user)
-        self._transitions(held, before)
-        await self._notify(held)
+        async with self._changing:
+            before = (held.state.acked, held.state.confirmed)
+            held.state.act(action, event_id, comment, user)
+            self._transitions(held, before)
+            await self._notify(held)
         now_ns = int(datetime.now(UTC).timestamp() * 1e9)
         return AlertAck(
             station=self.station,

@@ -32,6 +32,7 @@ clause it passes, a ``RefreshEndEvent``. A subscription of another session is re
 
 from __future__ import annotations
 
+import asyncio
 import logging
 from datetime import UTC, datetime
 from typing import Any
@@ -88,6 +89,10 @@ class EventDelivery:
         #: each retained condition's last event, by ConditionId
         self.retained: dict[ua.NodeId, ServedEvent] = {}
         self._said: set[tuple[int, int]] = set()  # monitored items whose filter was refused
+        #: one delivery at a time: putting an event into a queue may let the loop run on
+        #: (and a client act on it: acknowledge), and every subscription must see an event
+        #: before it sees the next one
+        self._one_at_a_time = asyncio.Lock()
 
     @classmethod
     async def create(cls, server: Server) -> EventDelivery:
@@ -114,7 +119,12 @@ class EventDelivery:
 
     async def deliver(self, event: ServedEvent) -> None:
         """``event`` to every event monitored item on one of its notifiers whose where clause
-        it passes; a condition's kept while retained."""
+        it passes; a condition's kept while retained. Events reach every subscription in the
+        order they are delivered in."""
+        async with self._one_at_a_time:
+            await self._deliver(event)
+
+    async def _deliver(self, event: ServedEvent) -> None:
         if event.condition_id is not None:
             retain = event.fields.get(((0, "Retain"),))
             if retain is not None and retain.Value:
@@ -147,6 +157,11 @@ class EventDelivery:
             items = {values[1]: items[values[1]]}
         if not items:
             return _status(ua.StatusCodes.BadNothingToDo)
+        async with self._one_at_a_time:
+            await self._refresh(subscription, items)
+        return []
+
+    async def _refresh(self, subscription: Any, items: dict[int, Any]) -> None:
         for bracket in (self._refresh_start, None, self._refresh_end):
             if bracket is None:
                 for event in list(self.retained.values()):
@@ -157,7 +172,6 @@ class EventDelivery:
             marker = _refresh_event(bracket)  # one EventId for every copy
             for mid, item in items.items():
                 await self._to_item(subscription, mid, item, marker, filtered=False)
-        return []
 
     async def _to_item(
         self, subscription: Any, mid: int, item: Any, event: ServedEvent, filtered: bool
