@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import time
 from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -113,7 +114,8 @@ class StationConditions:
         delivery: EventDelivery,
         methods: ConditionMethods,
     ) -> StationConditions:
-        """The station's conditions (none until its first alert), their methods ``methods``'."""
+        """The station's conditions (none until its first alert), whose methods ``methods``
+        answers."""
         ijt = await server.get_namespace_index(IJT_BASE)
         types = await type_chain(server, node_id(JOINING_SYSTEM_CONDITION_TYPE, ijt))
         ours = system.node.nodeid.NamespaceIndex
@@ -161,10 +163,9 @@ class StationConditions:
             held.state.act(action, event_id, comment, user)
             self._transitions(held, before)
             await self._notify(held)
-        now_ns = int(datetime.now(UTC).timestamp() * 1e9)
         return AlertAck(
             station=self.station,
-            time_ns=now_ns,
+            time_ns=time.time_ns(),
             action=action,
             source=held.state.source,
             condition=held.state.key,
