@@ -53,8 +53,6 @@ MACHINES_FOLDER = 1001  # Machinery's Machines folder
 REFRESH_START = node_id(ua.ObjectIds.RefreshStartEventType)
 REFRESH_END = node_id(ua.ObjectIds.RefreshEndEventType)
 EVENT_NOTIFIER = ua.AttributeIds.EventNotifier
-
-
 HAS_NOTIFIER = node_id(ua.ObjectIds.HasNotifier)
 
 
