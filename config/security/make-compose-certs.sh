@@ -13,6 +13,7 @@
 #   router                                   the router (server certificate, names "router")
 #                                            + acl.json5, the access control for STATION...
 #   line-recorder, line-viewer, line-monitor the line's recorder, the live viewer, the operator
+#   line-opcua                               the line's OPC UA server (its zenoh identity)
 #   <st>-acquisition, <st>-rig               for each station (the acquisition holds the
 #                                            station's predictor: placement "edge")
 # EXTRA_IDENTITIES="st1-predictor ..." makes more, e.g. for a line predictor
@@ -48,7 +49,7 @@ here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 repo=$(cd "$here/../.." && pwd)
 owner_uid=${BOLTWATCH_UID:-10001}
 
-names=(line-recorder line-viewer line-monitor)
+names=(line-recorder line-viewer line-monitor line-opcua)
 for station in "${stations[@]}"; do
     names+=("$station-acquisition" "$station-rig")
 done

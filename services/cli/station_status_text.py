@@ -63,6 +63,7 @@ def _station_lines(status: StationStatus) -> list[str]:
         line("services", services),
         line("samples/s", rate),
         *_unless_bridge(status, status.bus, line("bus", _bus_text(status.bus))),
+        line("tool commands", _commands_text(status)),
         line("last run", _run_text(status.last_run)),
         line("last decision", _decision_text(status.last_decision)),
         line("last summary", _summary_text(status.last_summary)),
@@ -105,16 +106,21 @@ def _bus_text(bus: BusHealth | None) -> str:
         f"{bus.bad_frames} bad frames, {bus.receive_errors} receive errors, "
         f"{bus.unsent_samples} unsent samples, {bus.late_decisions} late decisions, "
         f"{bus.bad_decisions} bad decisions "
-        f"({bus.frames} frames since start, {bus.age_s:.1f} s ago); {_commands_text(bus)}"
+        f"({bus.frames} frames since start, {bus.age_s:.1f} s ago)"
     )
 
 
-def _commands_text(bus: BusHealth) -> str:
+def _commands_text(status: StationStatus) -> str:
     """What the station commands its tool: a final stage, or stop only and why."""
+    bus = status.bus
+    if bus is None:
+        if status.kind == "bridge":
+            return "none: an Open Protocol controller runs its program and stops by itself"
+        return "- (no BusStats in the window)"
     if bus.tool_commands == "staged":
-        return f"tool commands: final stage and pulses ({bus.stage_commands} stage commands sent)"
+        return f"final stage and pulses ({bus.stage_commands} stage commands sent)"
     why = f": {bus.tool_commands_note}" if bus.tool_commands_note else ""
-    return f"tool commands: stop only{why}"
+    return f"stop only{why}"
 
 
 def _predictor_text(predictor: PredictorHealth | None) -> str:

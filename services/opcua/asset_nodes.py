@@ -17,8 +17,8 @@ from typing import Any
 from asyncua import Server, ua
 from asyncua.common.node import Node
 
-from services.opcua.joining_systems import BOLTWATCH_NAMESPACE, MACHINERY, add_typed_variable
-from services.opcua.nodeset_loading import IJT_BASE, MODEL_URIS, node_id
+from services.opcua.joining_systems import BOLTWATCH_NAMESPACE, add_typed_variable
+from services.opcua.nodeset_loading import IJT_BASE, MACHINERY, MODEL_URIS, node_id
 
 #: numeric ids in Machinery and DI
 COMPONENT_IDENTIFICATION_TYPE = 1005  # MachineryComponentIdentificationType (Machinery)

@@ -7,8 +7,11 @@ children (AssetManagement, Identification, JoiningProcessManagement,
 JointManagement, MachineryBuildingBlocks, ResultManagement with its methods and
 its ``Results`` folder), and instances of the type's placeholders too, which are
 deleted (:func:`drop_placeholders`; ``AssetManagement/Assets/Tools`` gets the
-station's tools from :mod:`.tool_assets`). What :meth:`JoiningSystem.publish`
-does with a result:
+station's tools from :mod:`.tool_assets`); ``MachineryBuildingBlocks`` refers to its
+own Identification and ResultManagement (:func:`share_building_blocks`). The joining
+system is an event notifier below ``Machines`` (:class:`~.event_delivery.EventDelivery`:
+its events reach a client subscribed on it, on ``Machines`` or on the Server object).
+What :meth:`JoiningSystem.publish` does with a result:
 
 - ``ResultManagement/Results``: a variable of ``JoiningSystemResultType``
   (data type ``ResultDataType``) named ``Result_<run id>`` (a browse name
@@ -16,14 +19,10 @@ does with a result:
   ``s=<station>/results/<ResultId>``; the newest
   :data:`KEPT_RESULTS` stay, the oldest go (a client reads the latest there);
 - a ``JoiningSystemResultReadyEventType`` event from the joining system, its
-  ``Result`` the same ``ResultDataType`` (a client subscribes to the joining
-  system's events). The model marks the type abstract; IJT's own servers send
-  it as it is, and so does this one.
+  ``Result`` the same ``ResultDataType``, severity :data:`RESULT_SEVERITY`. The model
+  marks the type abstract; IJT's own servers send it as it is, and so does this one.
 
-:meth:`JoiningSystem.report` emits a ``JoiningSystemEventType`` event (abstract
-too) of an alert or a controller's alarm (:mod:`.alert_events`), its
-``JoiningSystemEventContent`` with ``EventCode``, ``EventText`` and
-``JoiningTechnology``, its ``ConditionClassId``/``Name`` and ``Severity``.
+Its alerts and a controller's alarms are conditions (:mod:`.alert_conditions`).
 
 ResultManagement's methods as the instance has them (``GetResultById``,
 ``GetLatestResult``, ``GetResultIdListFiltered``, ``ReleaseResultHandle``) are
@@ -37,15 +36,17 @@ from __future__ import annotations
 
 import logging
 from collections import deque
+from datetime import UTC, datetime
 from typing import Any
 
 from asyncua import Server, ua
 from asyncua.common.manage_nodes import delete_nodes
 from asyncua.common.node import Node
 
-from services.opcua.alert_events import AlertEvent
+from services.opcua.event_contents import base_fields, new_event_id, result_ready_fields
+from services.opcua.event_delivery import SERVER, EventDelivery, type_chain
 from services.opcua.nodeset_loading import IJT_BASE, MACHINERY_RESULT, node_id
-from services.opcua.result_values import JOINING_TECHNOLOGY, utc_time
+from services.opcua.served_events import ServedEvent
 from services.opcua.system_identification import SystemIdentification
 
 LOG = logging.getLogger(__name__)
@@ -58,11 +59,11 @@ KEPT_RESULTS = 20
 JOINING_SYSTEM_TYPE = 1005
 JOINING_SYSTEM_RESULT_TYPE = 2014
 RESULT_READY_EVENT_TYPE = 1007
-JOINING_SYSTEM_EVENT_TYPE = 1006
-EVENT_CONTENT = "JoiningSystemEventContent"
-MACHINES_FOLDER = 1001
 RESULT_DATA_TYPE = 3008
-MACHINERY = "http://opcfoundation.org/UA/Machinery/"
+#: a result-ready event's Severity (1 to 1000: information)
+RESULT_SEVERITY = 100
+#: the joining system's folder of Machinery's building blocks
+BUILDING_BLOCKS = "MachineryBuildingBlocks"
 
 
 def result_browse_name(run_id: int) -> str:
@@ -71,46 +72,46 @@ def result_browse_name(run_id: int) -> str:
 
 
 class JoiningSystem:
-    """A station's joining system in the address space, with its event generator."""
+    """A station's joining system in the address space; its events through ``delivery``."""
 
     def __init__(
         self,
         station: str,
         node: Node,
         results: Node,
-        generators: tuple[Any, Any],
+        delivery: EventDelivery,
         names: tuple[int, int, int],
+        result_types: tuple[ua.NodeId, ...],
     ) -> None:
         self.station = station
         self.node = node
         self._results = results
-        self._events, self._alerts = generators
+        self._delivery = delivery
         self._names = names
+        self._result_types = result_types
+        #: the notifiers its events are reported to: itself, Machines, Server
+        self.notifiers = (node.nodeid, delivery.machines, SERVER)
         self._kept: deque[Node] = deque()
 
     @classmethod
-    async def create(cls, server: Server, station: str) -> JoiningSystem:
+    async def create(cls, server: Server, station: str, delivery: EventDelivery) -> JoiningSystem:
         ours = await server.register_namespace(BOLTWATCH_NAMESPACE)
         ijt = await server.get_namespace_index(IJT_BASE)
-        machinery = await server.get_namespace_index(MACHINERY)
         result_ns = await server.get_namespace_index(MACHINERY_RESULT)
-        machines = server.get_node(node_id(MACHINES_FOLDER, machinery))
+        machines = server.get_node(delivery.machines)
         node = await machines.add_object(
             node_id(station, ours),
             ua.QualifiedName(station, ours),
             objecttype=node_id(JOINING_SYSTEM_TYPE, ijt),
         )
         await drop_placeholders(node)
+        await share_building_blocks(node)
+        await delivery.add_notifier(node)
         results = await node.get_child([f"{result_ns}:ResultManagement", f"{result_ns}:Results"])
-        events = await server.get_event_generator(
-            node_id(RESULT_READY_EVENT_TYPE, ijt), emitting_node=node.nodeid
-        )
-        alerts = await server.get_event_generator(
-            node_id(JOINING_SYSTEM_EVENT_TYPE, ijt), emitting_node=node.nodeid
-        )
+        result_types = await type_chain(server, node_id(RESULT_READY_EVENT_TYPE, ijt))
         names = (ours, ijt, result_ns)
         LOG.info("joining system %s at %s", station, node.nodeid.to_string())
-        return cls(station, node, results, (events, alerts), names)
+        return cls(station, node, results, delivery, names, result_types)
 
     async def result_management_method(self, name: str) -> Node:
         """A method of the joining system's ResultManagement (e.g. ``GetResultById``)."""
@@ -133,9 +134,18 @@ class JoiningSystem:
             await remove_child(
                 self._results, self._kept.popleft(), node_id(ua.ObjectIds.HasComponent)
             )
-        self._events.event.Result = ua.Variant(result, ua.VariantType.ExtensionObject)
-        self._events.event.Severity = 100
-        await self._events.trigger(message=message)
+        fields = base_fields(
+            event_id=new_event_id(),
+            types=self._result_types,
+            source=(self.node.nodeid, self.station),
+            time=datetime.now(UTC),
+            message=message,
+            severity=RESULT_SEVERITY,
+        )
+        fields.update(result_ready_fields(result_ns, result))
+        await self._delivery.deliver(
+            ServedEvent(types=self._result_types, fields=fields, notifiers=self.notifiers)
+        )
 
     async def identify(self, identification: SystemIdentification) -> None:
         """Write the joining system's ``Identification`` (its properties, instantiated with
@@ -159,27 +169,6 @@ class JoiningSystem:
             if value is not None:
                 await by_name[name].write_value(ua.Variant(value, variant_type))
 
-    async def report(self, alert: AlertEvent) -> None:
-        """A ``JoiningSystemEventType`` event of an alert or a controller's alarm."""
-        _ours, ijt, _result_ns = self._names
-        event = self._alerts.event
-        # the event type's JoiningSystemEventContent holds variables, which asyncua's event
-        # object leaves out (it takes properties): its fields by their browse paths
-        event.add_property(f"{EVENT_CONTENT}/EventCode", alert.code, ua.VariantType.Int64)
-        event.add_property(
-            f"{EVENT_CONTENT}/EventText", ua.LocalizedText(alert.text), ua.VariantType.LocalizedText
-        )
-        event.add_property(
-            f"{EVENT_CONTENT}/JoiningTechnology",
-            ua.LocalizedText(JOINING_TECHNOLOGY),
-            ua.VariantType.LocalizedText,
-        )
-        class_id, class_name = alert.condition_class
-        event.ConditionClassId = node_id(class_id, ijt)
-        event.ConditionClassName = ua.LocalizedText(class_name)
-        event.Severity = alert.severity
-        await self._alerts.trigger(time_attr=utc_time(alert.time_ns), message=alert.text)
-
 
 async def _children_by_name(node: Node) -> dict[str, Node]:
     """``node``'s children by their browse names (whatever their namespaces)."""
@@ -198,6 +187,32 @@ async def drop_placeholders(node: Node) -> None:
             await remove_child(node, Node(node.session, child.NodeId), child.ReferenceTypeId)
         elif child.NodeClass == ua.NodeClass.Object:  # where the placeholders are
             await drop_placeholders(Node(node.session, child.NodeId))
+
+
+async def share_building_blocks(node: Node) -> None:
+    """``MachineryBuildingBlocks`` referring to the joining system's own ``Identification`` and
+    ``ResultManagement``, not to copies of them.
+
+    In the type the folder's ``HasAddIn`` references lead to the same instance declarations
+    as the type's own (one object, referenced twice); asyncua instantiates each reference
+    as a node of its own, so the folder held a second ResultManagement without its methods'
+    implementations and a second Identification without values. Each such copy (a child of
+    the folder with the browse name of a child of the joining system) is deleted and the
+    folder refers to the joining system's own object, with the reference type it had."""
+    own = {
+        (child.BrowseName.NamespaceIndex, child.BrowseName.Name): child.NodeId
+        for child in await node.get_children_descriptions(refs=ua.ObjectIds.HierarchicalReferences)
+    }
+    blocks_name = next((name for name in own if name[1] == BUILDING_BLOCKS), None)
+    if blocks_name is None:
+        return
+    blocks = Node(node.session, own[blocks_name])
+    for child in await blocks.get_children_descriptions(refs=ua.ObjectIds.HierarchicalReferences):
+        target = own.get((child.BrowseName.NamespaceIndex, child.BrowseName.Name))
+        if target is None or target == child.NodeId:
+            continue
+        await remove_child(blocks, Node(node.session, child.NodeId), child.ReferenceTypeId)
+        await blocks.add_reference(target, child.ReferenceTypeId, forward=True, bidirectional=False)
 
 
 async def remove_child(parent: Node, child: Node, reference_type: ua.NodeId) -> None:

@@ -58,11 +58,12 @@ DI_FILE = "Opc.Ua.Di.NodeSet2.xml"
 DI_DESIGN_TOOL_ONLY = frozenset({73, 74, 75, 90, 91, 92, 93, 94, 95})
 #: the namespaces the server needs, by model URI
 IJT_BASE = "http://opcfoundation.org/UA/IJT/Base/"
+MACHINERY = "http://opcfoundation.org/UA/Machinery/"
 MACHINERY_RESULT = "http://opcfoundation.org/UA/Machinery/Result/"
 MODEL_URIS = (
     "http://opcfoundation.org/UA/DI/",
     "http://opcfoundation.org/UA/IA/",
-    "http://opcfoundation.org/UA/Machinery/",
+    MACHINERY,
     MACHINERY_RESULT,
     "http://opcfoundation.org/UA/AMB/",
     IJT_BASE,

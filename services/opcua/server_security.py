@@ -15,7 +15,8 @@ endpoint is Basic256Sha256 Sign & Encrypt and every session needs a user:
   (:mod:`.users_file`) and whose password matches its hash
   (:mod:`.password_hashes`, compared in constant time); an anonymous session,
   an unknown name or a wrong password is refused (``BadUserAccessDenied``, or
-  ``BadIdentityTokenRejected`` for a token the endpoint does not offer).
+  ``BadIdentityTokenRejected`` for a token the endpoint does not offer); a user of role
+  ``operator`` also acknowledges the alerts' conditions (:func:`operators`).
 
 ``--anonymous-read-only`` adds an endpoint without security (None) and the
 anonymous user, on every endpoint (asyncua offers one set of user tokens for
@@ -43,8 +44,10 @@ from asyncua.server.user_managers import UserManager
 from cryptography import x509
 from cryptography.hazmat.primitives.asymmetric import rsa
 
+from services.opcua.client_sessions import use_client_sessions
 from services.opcua.password_hashes import unknown_user_hash, verify, verify_unknown
-from services.opcua.users_file import OpcuaUser, others_may_read, read_users
+from services.opcua.refusal_log import LoggedValidator, quiet_refusals
+from services.opcua.users_file import OPERATOR, OpcuaUser, others_may_read, read_users
 from shared.errors import ConfigError
 
 LOG = logging.getLogger(__name__)
@@ -137,6 +140,15 @@ def server_users(path: Path) -> dict[str, OpcuaUser]:
     return users
 
 
+def operators(settings: SecuritySettings) -> frozenset[str]:
+    """The users of the users file that may act on conditions (role ``operator``)."""
+    if settings.users is None:
+        return frozenset()
+    return frozenset(
+        name for name, user in read_users(settings.users).items() if user.role == OPERATOR
+    )
+
+
 class PasswordUsers(UserManager):
     """asyncua's user manager: a session's user from its token (None: refused).
 
@@ -171,8 +183,12 @@ class PasswordUsers(UserManager):
 
 
 async def apply(server: Server, settings: SecuritySettings) -> None:
-    """Endpoints, user tokens and users, certificate and client validation of ``server``."""
+    """Endpoints, user tokens and users, certificate and client validation of ``server``; its
+    sessions :class:`~.client_sessions.ClientSession`, one line per refusal
+    (:mod:`.refusal_log`)."""
     settings.check()
+    quiet_refusals()
+    use_client_sessions(server)
     policies: list[ua.SecurityPolicyType] = []
     tokens: list[type] = []
     if settings.anonymous_read_only:
@@ -202,13 +218,12 @@ async def apply(server: Server, settings: SecuritySettings) -> None:
         if settings.trusted_clients is not None:
             store = TrustStore([settings.trusted_clients], [])
             await store.load()
-            server.set_certificate_validator(
-                CertificateValidator(
-                    CertificateValidatorOptions.TRUSTED_VALIDATION
-                    | CertificateValidatorOptions.PEER_CLIENT,
-                    store,
-                )
+            validator = CertificateValidator(
+                CertificateValidatorOptions.TRUSTED_VALIDATION
+                | CertificateValidatorOptions.PEER_CLIENT,
+                store,
             )
+            server.set_certificate_validator(LoggedValidator(validator, settings.trusted_clients))
     if settings.anonymous_read_only:
         policies.append(ua.SecurityPolicyType.NoSecurity)
     server.set_security_policy(policies)

@@ -4,12 +4,15 @@ OPC UA server for industrial joining.
 Loads the station files (the stations served, in their order; the first file's
 ``[zenoh]`` names the router), checks the security options
 (:mod:`.server_security`), and runs, in its work thread, one asyncio loop with
-the asyncua server: the models (:mod:`.nodeset_loading`), a joining system per
-station (:mod:`.joining_systems`), then each result into it. Once the OPC UA
+the asyncua server: the models (:mod:`.nodeset_loading`), the delivery of events
+to every notifier that sees them and ConditionRefresh (:mod:`.event_delivery`), a
+joining system per station (:mod:`.joining_systems`) with its conditions
+(:mod:`.alert_conditions`), then each result into it. Once the OPC UA
 server listens, the zenoh session is opened (clients may connect and subscribe
 before the line's router is there); then results come from
 ``boltwatch/<st>/results`` (:class:`~.line_inbox.LineInbox`, with the alerts and
-alarms, which become joining system events: :mod:`.alert_events`) and, once
+alarms, which become the conditions' states: :mod:`.alert_events`; a tool's wear
+condition goes off when its wear ledger shows it serviced) and, once
 subscribed, the newest :data:`STARTUP_RESULTS` per station from the stations'
 results stores (:mod:`shared.results`), oldest first, so a client finds the last
 result at once. A result already served (the same ResultId) is not served twice.
@@ -18,7 +21,9 @@ GetResultIdListFiltered, ReleaseResultHandle) answer from its station's results
 store (:mod:`.result_requests`). The station's tools and their
 counters come from its wear ledger (:mod:`.tool_assets`), read again every
 :data:`TOOLS_REFRESH_S`, and so does its controller's identification
-(:mod:`.controller_assets`).
+(:mod:`.controller_assets`). An operator's acknowledgement (confirmation, comment) of
+a condition is logged and put on ``boltwatch/<st>/alert/ack`` (:class:`~shared.contract.AlertAck`),
+which the line's recorder records.
 """
 
 from __future__ import annotations
@@ -30,11 +35,14 @@ import threading
 import time
 from collections.abc import Sequence
 
+import zenoh
 from asyncua import Server
 
-from services.opcua.alert_events import alert_event
+from services.opcua.alert_conditions import ConditionMethods, StationConditions
+from services.opcua.alert_events import alert_event, wear_cleared
 from services.opcua.controller_assets import ControllerAsset
 from services.opcua.controller_values import ControllerIdentity, controller_identity
+from services.opcua.event_delivery import EventDelivery
 from services.opcua.joining_systems import JoiningSystem
 from services.opcua.line_inbox import LineInbox
 from services.opcua.nodeset_files import nodeset_folder
@@ -42,12 +50,12 @@ from services.opcua.nodeset_loading import MACHINERY_RESULT, load_models
 from services.opcua.result_encoding import result_data
 from services.opcua.result_requests import APPLICATION, result_management_methods
 from services.opcua.result_values import result_id, result_values
-from services.opcua.server_security import SecuritySettings, apply
+from services.opcua.server_security import SecuritySettings, apply, operators
 from services.opcua.system_identification import system_identification
 from services.opcua.tool_assets import ToolAssets
 from services.opcua.tool_values import ToolCounters, tool_counters
 from shared.config import AnyStation, ControllerStation, load_any_line
-from shared.contract import TighteningResult
+from shared.contract import AlertAck, TighteningResult, channels, encode
 from shared.errors import InputError, StoreError
 from shared.recordings import software_version
 from shared.results import ResultsQuery, ResultsStore, station_store
@@ -82,6 +90,8 @@ class OpcuaService:
         self._listen = listen
         self._security = security
         self._served: dict[str, set[str]] = {s.station_id: set() for s in self._stations}
+        #: each station's publisher of alert acknowledgements, once the session is open
+        self._acks: dict[str, zenoh.Publisher] = {}
         self._version = software_version()
 
     def work(self, stop: threading.Event) -> None:
@@ -96,9 +106,16 @@ class OpcuaService:
         server.set_server_name(SERVER_NAME)
         await apply(server, self._security)
         await load_models(server, nodeset_folder())
+        delivery = await EventDelivery.create(server)
+        condition_methods = ConditionMethods(server, operators(self._security), self._record)
+        condition_methods.link_type_methods()
         systems = {
-            station.station_id: await JoiningSystem.create(server, station.station_id)
+            station.station_id: await JoiningSystem.create(server, station.station_id, delivery)
             for station in self._stations
+        }
+        conditions = {
+            station: await StationConditions.create(server, system, delivery, condition_methods)
+            for station, system in systems.items()
         }
         for loaded in self._stations:
             await systems[loaded.station_id].identify(system_identification(loaded))
@@ -123,6 +140,7 @@ class OpcuaService:
             await asyncio.to_thread(self._skeleton.open_session, self._stations[0].config.zenoh)
             inbox = LineInbox(self._skeleton, list(systems))
             for station in systems:
+                self._acks[station] = self._skeleton.publisher(channels.ALERT_ACK, station)
                 self._skeleton.health_token(station, HEALTH)
             for stored in await asyncio.to_thread(self._newest):  # after subscribing: no gap
                 await self._publish(systems, stored)
@@ -134,6 +152,7 @@ class OpcuaService:
                     ).items():
                         await assets[station].update(counters)
                         await controllers[station].update(controller)
+                        await _clear_serviced(conditions[station], counters)
                     tools_due_s = time.monotonic() + TOOLS_REFRESH_S
                 message = inbox.next()
                 if message is None:
@@ -141,9 +160,9 @@ class OpcuaService:
                 elif isinstance(message, TighteningResult):
                     await self._publish(systems, message)
                 else:
-                    event = alert_event(message)
-                    await systems[event.station].report(event)
-                    LOG.info("%s event: %s", event.station, event.text)
+                    alert = alert_event(message)
+                    await conditions[alert.station].report(alert)
+                    LOG.info("%s alert: %s", alert.station, alert.text)
 
     async def _publish(self, systems: dict[str, JoiningSystem], result: TighteningResult) -> None:
         system = systems.get(result.station)
@@ -157,6 +176,29 @@ class OpcuaService:
         message = f"{identifier} {result.result}"
         await system.publish(identifier, result.run_id, result_data(result_values(result)), message)
         LOG.info("result %s served", message)
+
+    async def _record(self, ack: AlertAck) -> None:
+        """An acknowledgement (confirmation, comment) of an alert: logged, and put on the line
+        (``boltwatch/<st>/alert/ack``) for the recorder."""
+        LOG.info(
+            "%s: %s %s by %s (%s)%s",
+            ack.station,
+            ack.condition_name,
+            ack.action,
+            ack.user or "an anonymous session",
+            ack.client or "no application URI",
+            f": {ack.comment}" if ack.comment else "",
+        )
+        publisher = self._acks.get(ack.station)
+        if publisher is None:  # no alert comes before the session; said in case
+            LOG.warning("%s: not put on the line: no zenoh session yet", ack.station)
+            return
+        try:
+            await asyncio.to_thread(publisher.put, encode(ack))
+        except zenoh.ZError as err:  # the session closing
+            LOG.warning(
+                "%s: %s %s not put on the line: %s", ack.station, ack.condition, ack.action, err
+            )
 
     def _assets(self) -> dict[str, tuple[list[ToolCounters], ControllerIdentity]]:
         """Each station's tools in its wear ledger (none while it has no ledger), and its
@@ -192,6 +234,28 @@ class OpcuaService:
             except StoreError as err:
                 LOG.info("no results of %s from %s yet: %s", station.station_id, target, err)
         return found
+
+
+async def _clear_serviced(conditions: StationConditions, counters: list[ToolCounters]) -> None:
+    """A tool's wear condition goes off when the ledger shows it below its threshold (it was
+    serviced), or shows no threshold any more."""
+    by_tool = {tool.tool_id: tool for tool in counters}
+    for key in conditions.active_keys():
+        source, _, tool_id = key.partition("/")
+        tool = by_tool.get(int(tool_id)) if source == "wear" else None
+        if tool is None:
+            continue
+        threshold = tool.intensity_threshold
+        if threshold is None or tool.intensity_since_service < threshold:
+            await conditions.report(
+                wear_cleared(
+                    conditions.station,
+                    tool.tool_id,
+                    time.time_ns(),
+                    tool.intensity_since_service,
+                    threshold if threshold is not None else 0.0,
+                )
+            )
 
 
 def main(args: argparse.Namespace) -> int:

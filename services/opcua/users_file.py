@@ -10,9 +10,9 @@
 One table per user under ``users``; the key is the user name an OPC UA client
 gives (1 to 64 characters, no control characters). ``password_hash`` is a
 salted scrypt hash (:mod:`.password_hashes`), never the password. ``role`` is
-``reader``, the only one: nothing in the server's address space is writable,
-so every user reads (and calls ResultManagement's four methods); the key is there
-so that a role that may write can come without changing the file's shape.
+``reader`` (reads, and calls ResultManagement's four methods) or ``operator`` (also
+acknowledges, confirms and comments on the alerts' conditions: a SCADA's user).
+Nothing in the address space is writable by either.
 
 :func:`read_users` fails with one line naming the file, the key and what was
 expected; :func:`write_users` replaces the file whole (a temporary file made
@@ -34,13 +34,16 @@ from services.opcua.password_hashes import HashFormatError, PasswordHash, parse_
 from shared.config import StrictModel, dumps, read_toml, validate
 from shared.files import write_text_atomically
 
-Role = Literal["reader"]
+Role = Literal["reader", "operator"]
 READER: Role = "reader"
+#: the role that may acknowledge, confirm and comment on conditions
+OPERATOR: Role = "operator"
 NAME_PATTERN = r"^[^\x00-\x1f\x7f]+$"
 NAME_MAX_CHARACTERS = 64
 HEADER = (
     "# OPC UA users of `boltwatch serve opcua --users`, written by `boltwatch opcua-user`.\n"
-    "# password_hash: salted scrypt, never the password. role: reader (all there is).\n\n"
+    "# password_hash: salted scrypt, never the password. role: reader, or operator (also\n"
+    "# acknowledges the alerts' conditions).\n\n"
 )
 
 UserName = Annotated[

@@ -1,9 +1,10 @@
 """The line's zenoh access control: who may put what, matched by certificate common name.
 
 Default deny. Every known service (subjects below, one certificate each:
-common name ``<station>-<role>``, or one of the line's observers
+common name ``<station>-<role>``, or one of the line's services
 ``line-recorder``, ``line-viewer`` (the live view, ``serve recorder
---view-only``) and ``line-monitor`` (``boltwatch status``, the operator))
+--view-only``), ``line-monitor`` (``boltwatch status``, the operator) and
+``line-opcua`` (the OPC UA server))
 may declare subscribers, queryables and liveliness tokens under
 ``boltwatch/**`` and receive what is published there; only
 
@@ -23,6 +24,8 @@ may declare subscribers, queryables and liveliness tokens under
   stands in for the PLC),
 - ``line-recorder`` may put ``boltwatch/<st>/recorder``, ``quality/alert``,
   ``wear/**`` and ``spool/ack`` (what it has of a station's spool);
+- ``line-opcua`` (the line's OPC UA server, ``boltwatch serve opcua``) may put
+  ``boltwatch/<st>/alert/ack`` (who acknowledged an alert, for the recorder);
 - the station's spooling services (``acquisition``, ``openprotocol``, a line
   ``predictor``) may put ``again/**`` too (what their spool sends again).
 
@@ -70,7 +73,10 @@ RECORDER_TOPICS = (
     keys.WEAR,
     f"{keys.WEAR}/**",
 )
-LINE_OBSERVERS = ("line-recorder", "line-viewer", "line-monitor")
+#: what the line's OPC UA server puts: an alert's acknowledgement
+OPCUA_TOPICS = channels.topics_of("opcua")
+OPCUA_SERVER = "line-opcua"
+LINE_OBSERVERS = ("line-recorder", "line-viewer", "line-monitor", OPCUA_SERVER)
 
 _DECLARATIONS = [
     "declare_subscriber",
@@ -108,6 +114,9 @@ def line_access_control(
     policies.append(
         {"id": "line-recorder-puts", "rules": ["recorder-puts"], "subjects": ["line-recorder"]}
     )
+    opcua_keys = [keys.station_key(st, topic) for st in stations for topic in OPCUA_TOPICS]
+    rules.append(_rule("opcua-puts", ["put"], ["ingress"], opcua_keys))
+    policies.append({"id": "line-opcua-puts", "rules": ["opcua-puts"], "subjects": [OPCUA_SERVER]})
     for station in stations:
         names = station_subjects(station)
         for name in names.values():
@@ -145,6 +154,7 @@ def line_access_control(
                     *PLC_TOPICS,
                     *RIG_TOPICS,
                     *RECORDER_TOPICS,
+                    *OPCUA_TOPICS,
                 )
             )
         ]

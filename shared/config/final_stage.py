@@ -73,10 +73,11 @@ class FinalStage(StrictModel):
     )
     hold_s: float = Field(
         default=0.5,
-        gt=0,
+        ge=0.3,
         le=10,
         description="how long the tool controller holds a halted run open for a pulse or the "
-        "station's finish before it ends the run by itself",
+        "station's finish before it ends the run by itself; at least 0.3 s: the station "
+        "judges the settled torque within 0.25 s of a halt",
     )
 
     @model_validator(mode="after")

@@ -13,6 +13,7 @@
 - :mod:`.spool_messages` (what a station's spool and the recorder say to each other)
 - :mod:`.part_messages` (what the line says of the part at a station: its id)
 - :mod:`.stage_messages` (what a station commands a tool that runs a final stage)
+- :mod:`.alert_messages` (who acknowledged, confirmed or commented on an alert)
 """
 
 from shared.contract.can_database import (
@@ -40,6 +41,9 @@ from shared.contract.message_fields import (
 )
 from shared.contract.messages import (
     FEATURE_STAGES,
+    AlertAck,
+    AlertAction,
+    AlertSource,
     BridgeStats,
     BusStats,
     ControllerAlarm,
@@ -115,6 +119,9 @@ __all__ = [
     "SCHEMA_TYPES",
     "STAGE_MESSAGES",
     "STATION_ID",
+    "AlertAck",
+    "AlertAction",
+    "AlertSource",
     "BridgeStats",
     "BusStats",
     "Channel",

@@ -90,6 +90,7 @@ from typing import Any, Generic, TypeVar
 
 from shared.contract import keys
 from shared.contract.messages import (
+    AlertAck,
     BridgeStats,
     BusStats,
     ControllerAlarm,
@@ -192,6 +193,8 @@ SPOOL = Channel("spool", SpoolStats, "acquisition", also_by=(*_BRIDGE, "predicto
 SPOOL_ACK = Channel("spool/ack", SpoolAck, "recorder")
 #: the line's PLC or the station's scanner; the simulated rig stands in for it
 PART = Channel("part", PartScan, "plc", Qos(express=True), ("rig",))
+#: the line's OPC UA server (``boltwatch serve opcua``): a condition's handling, recorded
+ALERT_ACK = Channel("alert/ack", AlertAck, "opcua")
 
 #: every channel, in the order of the table above
 CHANNELS: tuple[Channel[Any], ...] = (
@@ -216,6 +219,7 @@ CHANNELS: tuple[Channel[Any], ...] = (
     SPOOL,
     SPOOL_ACK,
     PART,
+    ALERT_ACK,
 )
 
 _BY_TOPIC: dict[str, Channel[Any]] = {channel.topic: channel for channel in CHANNELS}

@@ -18,7 +18,8 @@ imported from here as every other message.
 What the line says of the part at a station (:class:`PartScan`) is in
 :mod:`shared.contract.part_messages`, imported from here too; what a station
 commands a tool that runs a final stage (:class:`StageDecision`), in
-:mod:`shared.contract.stage_messages`.
+:mod:`shared.contract.stage_messages`; who acknowledged an alert (:class:`AlertAck`),
+in :mod:`shared.contract.alert_messages`.
 """
 
 from __future__ import annotations
@@ -27,6 +28,11 @@ from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import Literal
 
+from shared.contract.alert_messages import (  # noqa: F401  (re-exported: one import for every message)
+    AlertAck,
+    AlertAction,
+    AlertSource,
+)
 from shared.contract.controller_messages import (  # noqa: F401  (re-exported: one import for every message)
     AlarmKind,
     BridgeStats,

@@ -97,9 +97,12 @@ class PredictorCore:
             if stage is not None
             else None
         )
-        self._model_step_nm = math.nan  # k_e · φ̇_m · Δt: the model's stick-ramp step
-        if settings.constants is not None and settings.motor_speed_rad_s is not None:
-            self._model_step_nm = settings.constants.k_e_nm_per_rad * settings.motor_speed_rad_s
+        constants, speed = settings.constants, settings.motor_speed_rad_s
+        self._model_ramp_nm_per_s = (  # k_e · φ̇_m: the joint model's stick ramp
+            constants.k_e_nm_per_rad * speed
+            if constants is not None and speed is not None
+            else math.nan
+        )
         self._count = 0
         self._start_time_s = math.nan
         self._start_angle_deg = math.nan
@@ -192,7 +195,7 @@ class PredictorCore:
         drop_nm = planner.drop_nm if planner is not None else math.nan
         step_nm = planner.rate_nm_per_sample if planner is not None else math.nan
         if not step_nm > 0.0:
-            step_nm = self._model_step_nm * self._guard.nominal_dt_s
+            step_nm = self._model_ramp_nm_per_s * self._guard.nominal_dt_s
         sigma_nm = self._tracker.noise_d2_nm / D2_PER_SIGMA
         said = final.on_sample(time_s, torque_nm, step_nm, sigma_nm, drop_nm)
         if said is None:

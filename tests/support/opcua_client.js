@@ -8,23 +8,32 @@
 // The session's user: "userName" and "password" (a UserName token), anonymous without them.
 // Prints JSON lines on stdout: {"type": "connected"} or {"type": "refused", "reason"};
 // per station {"type": "system", "station", "nodeId"} once it browsed to its joining
-// system (Objects/Machines/<station>) and subscribed to its events; {"type": "subscribed"}
-// once every station is; one {"type": "result", "station", "eventType", "message",
-// "result"} per result-ready event (the Result field as JSON), {"type": "event",
-// "station", "eventType", "message"} per other event of the joining system (an alert);
-// at the end, per station, {"type": "results_folder", "station", "names"} (the browse names in
+// system (Objects/Machines/<station>); {"type": "subscribed"} once it subscribed to the
+// events of the Server object (i=2253), as SCADA systems do, with no where clause; one
+// {"type": "result", "station", "eventType", "message", "resultIdField",
+// "evaluationField", "result"} per result-ready event (the Result field as JSON, and its
+// sub-fields Result/ResultMetaData/ResultId and .../ResultEvaluation selected on their
+// own), {"type": "event", "station", "eventType", "message", "conditionId",
+// "conditionName", "retain", "acked", "code", "severity"} per other event (a condition's);
+// it waits for "results" result events. With "acknowledge": {"conditionName", "comment"},
+// a SCADA's handling of that condition (opcua_alarms.js: acknowledged, then confirmed) and
+// at the end {"type": "retained", "conditions"}: what ConditionRefresh returns.
+// At the end, per station, {"type": "results_folder", "station", "names"} (the browse names in
 // ResultManagement/Results); with "askById": true, the first result received asked by
 // its id (ResultManagement's GetResultById, again while the results store does not have
 // it yet: Error -1) as {"type": "by_id", "station", "resultId", "error", "result"}
 // (typed arrays as JSON arrays, NaN as null); with "askLatest": true, ResultManagement's
 // GetLatestResult (again until the store has the last result received) as {"type":
-// "latest", "station", "resultId", "error", "tracePoints"}; with "toolRuns": N, each tool of
+// "latest", "station", "resultId", "error", "tracePoints"}, and the same method through
+// MachineryBuildingBlocks/ResultManagement as {"type": "latest_blocks", "station",
+// "resultId", "error", "objectId", "systemObjectId"}; with "toolRuns": N, each tool of
 // AssetManagement/Assets/Tools once its OperationCycleCounter reached N (read again until
 // then) as {"type": "tool", "station", "name", "serialNumber", "tightenings",
 // "sinceService", "intensitySinceService", "limitValue", "unitId"}; with "browseTree":
 // {"expand": [PATH, ...]}, per station {"type": "tree", "station", "nodes"}: the joining
-// system's address space as a generic browser shows it (opcua_browse_tree.js); then
-// {"type": "done"}. Exit status 0, or 1 on an error
+// system's address space as a generic browser shows it (opcua_browse_tree.js); with
+// "crawl": true, {"type": "crawl", ...} (opcua_crawl.js: the whole address space walked);
+// then {"type": "done"}. Exit status 0, or 1 on an error
 // (its line: {"type": "error", "message"}).
 "use strict";
 const {
@@ -35,7 +44,9 @@ const {
     DataType,
     StatusCodes,
 } = require("node-opcua-client");
+const { acknowledgeWhenRaised, retainedConditions } = require("./opcua_alarms.js");
 const { browseTree } = require("./opcua_browse_tree.js");
+const { crawlAddressSpace } = require("./opcua_crawl.js");
 const { createClient, openSession } = require("./opcua_connect.js");
 
 const options = JSON.parse(process.argv[2]);
@@ -76,7 +87,22 @@ async function main() {
         requestedLifetimeCount: 600,
         publishingEnabled: true,
     });
-    const filter = constructEventFilter(["EventType", "SourceName", "Message", `${result}:Result`]);
+    const ijt = index("http://opcfoundation.org/UA/IJT/Base/");
+    const resultReady = `ns=${ijt};i=1007`;
+    const filter = constructEventFilter([
+        "EventType",
+        "SourceName",
+        "Message",
+        `${result}:Result`,
+        `${result}:Result.${result}:ResultMetaData.${result}:ResultId`,
+        `${result}:Result.${result}:ResultMetaData.${result}:ResultEvaluation`,
+        "ConditionId",
+        "ConditionName",
+        "Retain",
+        "AckedState.Id",
+        `${ijt}:JoiningSystemEventContent.${ijt}:EventCode`,
+        "Severity",
+    ]);
     const systems = {};
     const firstResultId = {};
     const lastResultId = {};
@@ -89,45 +115,55 @@ async function main() {
         if (!found.targets || found.targets.length === 0) {
             throw new Error(`no joining system ${station}: ${found.statusCode.toString()}`);
         }
-        const nodeId = found.targets[0].targetId;
-        systems[station] = nodeId;
-        const item = await subscription.monitor(
-            { nodeId, attributeId: AttributeIds.EventNotifier },
-            { samplingInterval: 0, queueSize: 100, filter, discardOldest: false },
-            TimestampsToReturn.Both,
-        );
-        item.on("changed", (fields) => {
-            const [eventType, sourceName, message, value] = fields;
-            if (!value.value) {
-                // another event of the joining system (an alert, an alarm): no Result
-                say({
-                    type: "event",
-                    station,
-                    eventType: eventType.value ? eventType.value.toString() : null,
-                    message: message.value ? message.value.text : null,
-                });
-                return;
-            }
-            if (!(station in firstResultId)) {
-                firstResultId[station] = value.value.resultMetaData.resultId;
-            }
-            lastResultId[station] = value.value.resultMetaData.resultId;
-            say({
-                type: "result",
-                station,
-                eventType: eventType.value ? eventType.value.toString() : null,
-                sourceName: sourceName.value,
-                message: message.value ? message.value.text : null,
-                result: plain(value.value),
-            });
-            received += 1;
-            if (received >= options.results) finish();
-        });
-        say({ type: "system", station, nodeId: nodeId.toString() });
+        systems[station] = found.targets[0].targetId;
+        say({ type: "system", station, nodeId: systems[station].toString() });
     }
+    const item = await subscription.monitor(
+        { nodeId: "i=2253", attributeId: AttributeIds.EventNotifier },
+        { samplingInterval: 0, queueSize: 1000, filter, discardOldest: false },
+        TimestampsToReturn.Both,
+    );
+    item.on("changed", (fields) => {
+        const [eventType, sourceName, message, value, resultIdField, evaluationField] = fields;
+        const [conditionId, conditionName, retain, acked, code, severity] = fields.slice(6);
+        const station = sourceName.value;
+        const typeId = eventType.value ? eventType.value.toString() : null;
+        if (typeId !== resultReady) {
+            say({
+                type: "event",
+                station,
+                eventType: typeId,
+                message: message.value ? message.value.text : null,
+                conditionId: conditionId.value ? conditionId.value.toString() : null,
+                conditionName: conditionName.value,
+                retain: retain.value,
+                acked: acked.value,
+                code: Array.isArray(code.value) ? code.value[0] * 2 ** 32 + code.value[1] : code.value,
+                severity: severity.value,
+            });
+            return;
+        }
+        if (!(station in firstResultId)) firstResultId[station] = value.value.resultMetaData.resultId;
+        lastResultId[station] = value.value.resultMetaData.resultId;
+        say({
+            type: "result",
+            station,
+            eventType: typeId,
+            message: message.value ? message.value.text : null,
+            resultIdField: resultIdField.value,
+            evaluationField: evaluationField.value,
+            result: plain(value.value),
+        });
+        received += 1;
+        if (received >= options.results) finish();
+    });
+    const handled = options.acknowledge
+        ? acknowledgeWhenRaised(session, options.acknowledge.conditionName, options.acknowledge.comment, say)
+        : Promise.resolve();
     say({ type: "subscribed" });
     const timer = setTimeout(finish, options.timeoutMs ?? 60000);
     await finished;
+    await handled;
     clearTimeout(timer);
     for (const [station, nodeId] of Object.entries(systems)) {
         const path = makeBrowsePath(nodeId, `/${result}:ResultManagement/${result}:Results`);
@@ -158,7 +194,14 @@ async function main() {
     if (options.askLatest) {
         for (const [station, nodeId] of Object.entries(systems)) {
             await askLatest(session, nodeId, result, station, lastResultId[station]);
+            await askLatestThroughBlocks(session, nodeId, machinery, result, station);
         }
+    }
+    if (options.acknowledge) {
+        say({ type: "retained", conditions: await retainedConditions(session) });
+    }
+    if (options.crawl) {
+        say({ type: "crawl", ...(await crawlAddressSpace(session)) });
     }
     await subscription.terminate();
     await session.close();
@@ -218,17 +261,40 @@ async function readTools(session, systemId, namespaces, station, runs) {
     }
 }
 
-// the request of a call of the joining system's ResultManagement method `name` (not made here)
-async function managementRequest(session, systemId, result, name, inputArguments) {
+// the request of a call of the joining system's ResultManagement method `name` (not made
+// here); `through`: the path to the ResultManagement from the joining system
+async function managementRequest(session, systemId, result, name, inputArguments, through) {
     const child = async (path) => {
         const found = await session.translateBrowsePath(makeBrowsePath(systemId, path));
+        if (!found.targets || found.targets.length === 0) throw new Error(`no ${path}`);
         return found.targets[0].targetId;
     };
+    const management = through || `/${result}:ResultManagement`;
     return {
-        objectId: await child(`/${result}:ResultManagement`),
-        methodId: await child(`/${result}:ResultManagement/${result}:${name}`),
+        objectId: await child(management),
+        methodId: await child(`${management}/${result}:${name}`),
         inputArguments,
     };
+}
+
+// GetLatestResult through MachineryBuildingBlocks/ResultManagement, as a client that
+// navigates by Machinery's building blocks calls it
+async function askLatestThroughBlocks(session, systemId, machinery, result, station) {
+    const through = `/${machinery}:MachineryBuildingBlocks/${result}:ResultManagement`;
+    const zero = [{ dataType: DataType.Int32, value: 0 }];
+    const request = await managementRequest(session, systemId, result, "GetLatestResult", zero, through);
+    const own = await managementRequest(session, systemId, result, "GetLatestResult", zero);
+    const called = await session.call(request);
+    const [, value, error] = called.outputArguments;
+    say({
+        type: "latest_blocks",
+        station,
+        status: called.statusCode.name,
+        resultId: value && value.value ? value.value.resultMetaData.resultId : null,
+        error: error ? error.value : null,
+        objectId: request.objectId.toString(),
+        systemObjectId: own.objectId.toString(),
+    });
 }
 
 async function askById(session, systemId, result, station, resultId) {

@@ -34,7 +34,7 @@ function createClient(options, applicationName, maxRetry, sessionTimeoutMs) {
 async function openSession(client, options) {
     await client.connect(options.endpoint);
     return client.createSession(
-        options.userName === undefined
+        options.userName === undefined || options.userName === null
             ? { type: UserTokenType.Anonymous }
             : { type: UserTokenType.UserName, userName: options.userName, password: options.password },
     );

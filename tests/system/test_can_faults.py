@@ -37,6 +37,7 @@ from shared.contract import (
 from shared.runtime import zenoh_config
 from tests.support.can_injector import CanInjector, Pacer, StopListener
 from tests.support.listener import Listener
+from tests.support.paths import DBC_FILE
 from tests.support.station_files import free_tcp_port, serve, write_station
 
 pytestmark = pytest.mark.system
@@ -49,7 +50,8 @@ STATS_INTERVAL_S = 0.2
 START_TIMEOUT_S = 20.0
 SETTLE_TIMEOUT_S = 5.0
 FLOOD_PER_SAMPLE = 10  # garbage frames per 1 ms tick: 10 kHz beside the 2 kHz of sensors
-CONTRACT_IDS = (0x10, 0x80, 0x100, 0x101)
+#: the ids of the station's DBC (the final stage's too): garbage is drawn among the others
+CONTRACT_IDS = frozenset(StationDatabase(DBC_FILE).by_id)
 
 
 #: what the test hears of the acquisition on zenoh

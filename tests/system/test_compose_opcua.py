@@ -4,7 +4,7 @@ The router and ``opcua`` of docker-compose.yml with docker-compose.tls.yml run
 their merged commands (tests/support/compose_line.py), with the identities and
 the OPC UA server's RSA files config/security/make-compose-certs.sh made:
 compose's health check passes (the server holds its token for both stations
-under line-monitor's certificate, which the router's access control lets
+under line-opcua's certificate, which the router's access control lets
 listen), and an asyncua client with the script's client identity
 (``opcua-mes``) connects with Basic256Sha256 sign and encrypt, trusting the
 server's certificate from its folder, logs in as the script's user ``mes``

@@ -128,10 +128,13 @@ def run_plant(hosts: Hosts, folder: Path, results_database: str | None = None) -
         for topic in ("samples", "runs", "tool", "bus", "decision"):
             assert topics.get(own + topic, 0) > 0, (own + topic, sorted(topics))
         folders = sorted(path.name for path in plant.recordings(line).iterdir() if path.is_dir())
-        assert folders == [".spool", f"st{line}"], folders
-        # the spool folder (the station's spools, the recorder's filing state): its own station's
+        assert folders == [".parts", ".spool", f"st{line}"], folders
+        # the spool folder (the station's spools, the recorder's filing state) and the last
+        # parts the recorder keeps: its own station's
         spooled = sorted(path.name for path in (plant.recordings(line) / ".spool").iterdir())
         assert spooled and all(name.startswith(f"st{line}-") for name in spooled), spooled
+        parts = sorted(path.name for path in (plant.recordings(line) / ".parts").iterdir())
+        assert parts == [f"st{line}.json"], parts
 
 
 def _settled_status(plant: Plant) -> dict[str, Any]:

@@ -2,7 +2,8 @@
 
 ::
 
-    boltwatch opcua-user add NAME --users FILE      a user, or a user's new password
+    boltwatch opcua-user add NAME [--role reader|operator] --users FILE
+                                                    a user, or a user's new password
     boltwatch opcua-user remove NAME --users FILE
     boltwatch opcua-user list --users FILE          the names and their roles
 
@@ -29,7 +30,8 @@ HELP = "add, remove or list the users of the OPC UA server's users file (--users
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.description = (
         "The users file of 'boltwatch serve opcua --users FILE': user names with salted "
-        "scrypt password hashes and a role (reader: nothing the server serves is writable). "
+        "scrypt password hashes and a role (reader: reads and asks for results; operator: "
+        "also acknowledges, confirms and comments on the alerts' conditions). "
         "'add NAME' asks the password twice on a terminal, or reads the first line of "
         "standard input; it adds the user or replaces its password, making the file (mode "
         "0600) if it is missing. The server reads the file at start: restart it after a change."
@@ -39,11 +41,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--users", type=Path, required=True, metavar="FILE", help="the users file (TOML)"
     )
+    parser.add_argument(
+        "--role",
+        choices=["reader", "operator"],
+        default=None,
+        help="add: the user's role (default: a new user's reader, a known user's its own)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
     from services.opcua.password_hashes import hash_password
-    from services.opcua.users_file import OpcuaUser, read_users, valid_user_name, write_users
+    from services.opcua.users_file import (
+        READER,
+        OpcuaUser,
+        read_users,
+        valid_user_name,
+        write_users,
+    )
 
     if args.action == "list":
         for user in read_users(args.users).values():
@@ -61,10 +75,16 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"user name {args.name!r}: expected 1 to 64 characters, no control ones")
     if not args.users.parent.is_dir():  # before the password is asked
         raise InputError(f"{args.users}: folder {args.users.parent} does not exist")
-    known = args.name in users
-    users[args.name] = OpcuaUser(args.name, hash_password(_password()))
+    known = users.get(args.name)
+    role = args.role or (known.role if known is not None else READER)
+    users[args.name] = OpcuaUser(args.name, hash_password(_password()), role)
     write_users(args.users, users)
-    print(f"{args.users}: {args.name}: {'new password' if known else 'added, a reader'}")
+    article = "an" if role == "operator" else "a"
+    if known is None:
+        said = f"added, {article} {role}"
+    else:
+        said = "new password" + ("" if role == known.role else f", {article} {role}")
+    print(f"{args.users}: {args.name}: {said}")
     return 0
 
 

@@ -38,6 +38,7 @@ from shared.contract import (
     DEFAULT_TEXT,
     FLOAT_MAX,
     MAX_PAYLOAD_BYTES,
+    AlertAck,
     BridgeStats,
     BusStats,
     ControllerAlarm,
@@ -249,6 +250,19 @@ def template(topic: str, station: str, now_ns: int, run_id: int = 1) -> Any:
             ranges=[SeqRange(run_id + 5, run_id + 9)],
         ),
         "part": lambda: PartScan(station, f"{station}-P{run_id:06d}", now_ns),
+        "alert/ack": lambda: AlertAck(
+            station=station,
+            time_ns=now_ns,
+            action="acknowledged",
+            source="wear",
+            condition="wear/7",
+            condition_name="Wear of tool 7",
+            alert_time_ns=now_ns - 2_000_000_000,
+            active=True,
+            user="scada",
+            client="urn:example:scada",
+            comment="socket changed at the next stop",
+        ),
     }
     return made[topic]()
 

@@ -200,6 +200,7 @@ ROLE_PUTS = {  # what each role publishes (docs/reference/access-control.md), pe
         keys.WEAR,
         f"{keys.WEAR}/**",
     },
+    "opcua": {channels.ALERT_ACK.topic},  # its clients' acknowledgements of alerts
 }
 needs_openssl = pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl")
 
@@ -210,8 +211,10 @@ def expected_identity(name: str) -> str:
         return {"router": "router", "recorder": "line-recorder"}[name]
     if name == "viewer":
         return "line-viewer"
-    if name in ("dashboard", "opcua"):  # they only listen: the operator's identity
+    if name == "dashboard":  # it only listens: the operator's identity
         return "line-monitor"
+    if name == "opcua":  # it puts its clients' acknowledgements of alerts
+        return "line-opcua"
     role, station = name.split("-", maxsplit=1)
     return f"{station}-{role}"
 

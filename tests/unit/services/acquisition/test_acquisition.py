@@ -3,15 +3,11 @@
 from __future__ import annotations
 
 import dataclasses
-import itertools
-from collections.abc import Iterator
 
 import can
-import pytest
 
 from services.acquisition.acquisition import Acquisition
 from shared.contract import (
-    BusStats,
     Sample,
     StationDatabase,
     StopDecision,
@@ -19,60 +15,11 @@ from shared.contract import (
     ToolState,
     encode,
 )
+from tests.support.acquisition_bus import ListOutlet, drain, frame, status
 from tests.support.paths import DBC_FILE
 
 DATABASE = StationDatabase(DBC_FILE)
-_channels = itertools.count()
 FRAME_IDS = {name: frame_id for frame_id, (name, _) in DATABASE.by_id.items()}
-
-
-class ListOutlet:
-    """Collects what the acquisition publishes (implements the Outlet protocol)."""
-
-    def __init__(self) -> None:
-        self.samples: list[Sample] = []
-        self.states: list[ToolState] = []
-        self.stats: list[BusStats] = []
-
-    def sample(self, sample: Sample) -> None:
-        self.samples.append(sample)
-
-    def tool_state(self, state: ToolState) -> None:
-        self.states.append(state)
-
-    def bus_stats(self, stats: BusStats) -> None:
-        self.stats.append(stats)
-
-
-@pytest.fixture
-def buses() -> Iterator[tuple[can.BusABC, can.BusABC]]:
-    channel = f"acq-test-{next(_channels)}"
-    with (
-        can.Bus(interface="virtual", channel=channel) as tool,
-        can.Bus(interface="virtual", channel=channel) as station,
-    ):
-        yield tool, station
-
-
-def frame(name: str, **signals: float) -> can.Message:
-    return can.Message(
-        arbitration_id=FRAME_IDS[name],
-        data=DATABASE.encode(name, signals),
-        is_extended_id=False,
-    )
-
-
-def status(run_id: int, state: int) -> can.Message:
-    return frame("ToolStatus", RunId=run_id, ToolId=7, ProgramId=1, State=state)
-
-
-def drain(acquisition: Acquisition, bus: can.BusABC) -> None:
-    """Poll until the bus has nothing more for us."""
-    while True:
-        message = bus.recv(0.05)
-        if message is None:
-            return
-        acquisition.handle(message)
 
 
 def decision(run_id: int) -> StopDecision:

@@ -2,31 +2,17 @@
 
 from __future__ import annotations
 
-import itertools
 import re
-from collections.abc import Iterator
 from pathlib import Path
 
 import can
-import pytest
 
 from services.acquisition.acquisition import Acquisition
 from shared.contract import StageDecision, StationDatabase, StopDecision
+from tests.support.acquisition_bus import ListOutlet, drain, frame, status
 from tests.support.paths import DBC_FILE
-from tests.unit.services.acquisition.test_acquisition import ListOutlet, drain, frame, status
 
 DATABASE = StationDatabase(DBC_FILE)
-_channels = itertools.count()
-
-
-@pytest.fixture
-def buses() -> Iterator[tuple[can.BusABC, can.BusABC]]:
-    channel = f"tool-commands-{next(_channels)}"
-    with (
-        can.Bus(interface="virtual", channel=channel) as tool,
-        can.Bus(interface="virtual", channel=channel) as station,
-    ):
-        yield tool, station
 
 
 def tool_stage(run_id: int, stage: int, pulses: int = 0, features: int = 1) -> can.Message:

@@ -75,3 +75,29 @@ def test_what_it_refuses(
     assert status == 2
     assert err.startswith("boltwatch opcua-user: ") and expected in err, err
     assert path.read_text() == ""
+
+
+def test_an_operator_may_be_added_and_keeps_its_role_with_a_new_password(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An operator also acknowledges and confirms the alerts' conditions (a SCADA's user)."""
+    path = tmp_path / "users.toml"
+    added = _run(
+        capsys,
+        monkeypatch,
+        "add",
+        "scada",
+        "--role",
+        "operator",
+        "--users",
+        str(path),
+        stdin="pw\n",
+    )
+    assert added == (0, f"{path}: scada: added, an operator\n", "")
+    assert _run(capsys, monkeypatch, "add", "scada", "--users", str(path), stdin="new\n")[0] == 0
+    assert read_users(path)["scada"].role == "operator"
+    demoted = _run(
+        capsys, monkeypatch, "add", "scada", "--role", "reader", "--users", str(path), stdin="x\n"
+    )
+    assert demoted == (0, f"{path}: scada: new password, a reader\n", "")
+    assert _run(capsys, monkeypatch, "list", "--users", str(path))[1] == "scada\treader\n"

@@ -20,7 +20,7 @@ from shared.line_status import LastRun, StatusCollector, to_json
 from tests.support.factories import T0, S, sample, summary
 
 
-def bus(time_ns: int, samples: int, **counters: int) -> BusStats:
+def bus(time_ns: int, samples: int, **counters: Any) -> BusStats:
     fields: dict[str, Any] = {
         "frames": 2 * samples,
         "unknown_ids": 0,
@@ -389,3 +389,22 @@ def test_what_each_service_refused_is_shown() -> None:
     feed(quiet, channels.BUS.topic, bus(T0, samples=1))
     text = format_report(quiet.report("e", 2.0, T0))
     assert "predictor     - (no predictor stats in the window" in text
+
+
+def test_what_the_station_commands_its_tool_is_said() -> None:
+    """A final stage, or stop only and why (the latest BusStats); a controller's station
+    commands nothing."""
+    staged = StatusCollector()
+    feed(staged, channels.BUS.topic, bus(T0, 100, tool_commands="staged", stage_commands=12))
+    text = format_report(staged.report("e", 2.0, T0 + S))
+    assert "  tool commands final stage and pulses (12 stage commands sent)\n" in text
+    stop_only = StatusCollector()
+    note = "the tool controller sends no ToolStage"
+    feed(stop_only, channels.BUS.topic, bus(T0, 100, tool_commands_note=note))
+    text = format_report(stop_only.report("e", 2.0, T0 + S))
+    assert f"  tool commands stop only: {note}\n" in text
+    bridge = StatusCollector()
+    bridge.alive(keys.station_key("st1", "health/openprotocol"))
+    assert "tool commands none: an Open Protocol controller" in format_report(
+        bridge.report("e", 2.0, T0 + S)
+    )

@@ -7,6 +7,7 @@ from services.opcua.alert_events import (
     THRESHOLD_VIOLATION,
     THRESHOLD_VIOLATION_RESOLVED,
     alert_event,
+    wear_cleared,
 )
 from shared.contract import ControllerAlarm, QualityAlert, WearAlert
 
@@ -46,3 +47,28 @@ def test_a_controller_alarm_keeps_its_code_and_says_when_it_went_off() -> None:
     assert alert_event(alarm("EBATT", True, "")).code == 0  # no digits in the code
     # only ASCII digits: "²" and "٣" are digits to str.isdigit, and int() refuses "²"
     assert alert_event(alarm("E²٣4", True, "")).code == 4
+
+
+def test_each_alert_source_is_one_condition() -> None:
+    """A tool's wear alerts are one condition, a program's quality alerts one per kind, a
+    controller's alarms one per code; each says whether the alert is on."""
+    wear = alert_event(WearAlert("st1", 7, T0_NS, 512.3, 500.0, 88, None))
+    assert (wear.key, wear.source, wear.name, wear.active) == (
+        "wear/7",
+        "wear",
+        "Wear of tool 7",
+        True,
+    )
+    serviced = wear_cleared("st1", 7, T0_NS, 0.0, 500.0)
+    assert (serviced.key, serviced.active, serviced.severity) == ("wear/7", False, 100)
+    assert serviced.condition_class == THRESHOLD_VIOLATION_RESOLVED
+    quality = alert_event(
+        QualityAlert("st1", 2, T0_NS, "cpk_low", "torque", 0.9, 1.33, 25, False, "")
+    )
+    assert (quality.key, quality.name, quality.active) == (
+        "quality/2/cpk_low", "Quality of program 2: cpk_low", False
+    )  # fmt: skip
+    alarm = alert_event(
+        ControllerAlarm("st1", T0_NS, T0_NS, "E404", "status", True, None, None, "")
+    )
+    assert (alarm.key, alarm.source, alarm.active) == ("alarm/E404", "alarm", True)

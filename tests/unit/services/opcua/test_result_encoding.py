@@ -13,7 +13,9 @@ import pytest
 from asyncua import Server, ua
 from asyncua.ua.ua_binary import struct_from_binary, struct_to_binary
 
+from services.opcua.alert_conditions import ConditionMethods, StationConditions
 from services.opcua.alert_events import alert_event
+from services.opcua.event_delivery import EventDelivery
 from services.opcua.joining_systems import JoiningSystem
 from services.opcua.nodeset_files import missing_files, nodeset_folder
 from services.opcua.nodeset_loading import load_models, node_id
@@ -21,7 +23,7 @@ from services.opcua.result_encoding import model_class, result_data
 from services.opcua.result_values import result_values
 from services.opcua.tool_assets import ToolAssets
 from services.opcua.tool_values import tool_counters
-from shared.contract import ControllerAlarm
+from shared.contract import AlertAck, ControllerAlarm
 from shared.wear import ToolWear
 from tests.support import factories
 
@@ -64,6 +66,10 @@ async def _tools_of(server: Server, system: JoiningSystem) -> dict[str, Any]:
     return {"assets": names, "tools": [tool_name], "values": values}
 
 
+async def _no_record(_ack: AlertAck) -> None:
+    raise AssertionError("nothing acknowledged here")
+
+
 class _Events:
     def __init__(self) -> None:
         self.received: list[Any] = []
@@ -72,17 +78,21 @@ class _Events:
         self.received.append(event)
 
 
-async def _alarm_events(server: Server, system: JoiningSystem) -> list[Any]:
-    """A controller's alarm reported by the joining system, as a subscriber of its
-    JoiningSystemEventType events gets it."""
+async def _alarm_events(
+    server: Server, system: JoiningSystem, delivery: EventDelivery
+) -> list[Any]:
+    """A controller's alarm as its condition of the joining system, as a subscriber of its
+    JoiningSystemConditionType events gets it."""
     ijt = await server.get_namespace_index("http://opcfoundation.org/UA/IJT/Base/")
     events = _Events()
     subscription = await server.create_subscription(10, events)
-    await subscription.subscribe_events(system.node, server.get_node(node_id(1006, ijt)))
+    await subscription.subscribe_events(system.node, server.get_node(node_id(1020, ijt)))
     alarm = ControllerAlarm(
         "st1", factories.T0, factories.T0, "E404", "raised", True, None, None, "tool not connected"
     )
-    await system.report(alert_event(alarm))
+    methods = ConditionMethods(server, frozenset(), _no_record)
+    conditions = await StationConditions.create(server, system, delivery, methods)
+    await conditions.report(alert_event(alarm))
     while not events.received:  # the subscription publishes every 10 ms
         await asyncio.sleep(0.01)
     await subscription.delete()
@@ -101,11 +111,12 @@ def test_the_models_load_and_a_result_round_trips_with_its_joining_metadata() ->
         decoded = struct_from_binary(
             model_class("ResultDataType"), ua.utils.Buffer(struct_to_binary(data))
         )
-        system = await JoiningSystem.create(server, "st1")
+        delivery = await EventDelivery.create(server)
+        system = await JoiningSystem.create(server, "st1", delivery)
         await system.publish("st1/7", 7, data, "st1/7 OK")
         names = [(await node.read_browse_name()).Name for node in await system.node.get_children()]
         tools.update(await _tools_of(server, system))
-        alarms.extend(await _alarm_events(server, system))
+        alarms.extend(await _alarm_events(server, system, delivery))
         return data, decoded, names, event_fields
 
     tools: dict[str, Any] = {}

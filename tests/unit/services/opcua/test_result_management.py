@@ -21,9 +21,14 @@ import pytest
 from asyncua import Client, Server, ua
 from asyncua.ua.ua_binary import struct_to_binary
 
-from services.opcua.joining_systems import JoiningSystem
+from services.opcua.event_delivery import EventDelivery
+from services.opcua.joining_systems import (
+    BOLTWATCH_NAMESPACE,
+    BUILDING_BLOCKS,
+    JoiningSystem,
+)
 from services.opcua.nodeset_files import missing_files, nodeset_folder
-from services.opcua.nodeset_loading import MACHINERY_RESULT, load_models
+from services.opcua.nodeset_loading import MACHINERY, MACHINERY_RESULT, load_models, node_id
 from services.opcua.result_requests import (
     ERROR_STORE,
     ERROR_TOO_MANY,
@@ -125,7 +130,7 @@ async def _start(target: StoreTarget, endpoint: str) -> tuple[Server, Served]:
     server.set_endpoint(endpoint)
     await load_models(server, nodeset_folder())
     result_ns = await server.get_namespace_index(MACHINERY_RESULT)
-    system = await JoiningSystem.create(server, "st1")
+    system = await JoiningSystem.create(server, "st1", await EventDelivery.create(server))
     nodes = {}
     for name, callback in result_management_methods(target, "st1", result_ns).items():
         nodes[name] = await system.result_management_method(name)
@@ -374,3 +379,37 @@ def test_an_id_the_server_never_gives_is_unknown_to_both_methods(served: Served)
         assert by_id.StatusCode.is_good(), (text, by_id.StatusCode)
         assert by_id.OutputArguments[2].Value == ERROR_UNKNOWN_RESULT, text
         assert served.ids(_filter((Op.Equals, [result_id, _literal(text)]))) == [], text
+
+
+def test_the_building_blocks_result_management_is_the_joining_system_s(served: Served) -> None:
+    """MachineryBuildingBlocks refers to the joining system's own ResultManagement and
+    Identification (in the model one object, referenced twice): a client that finds
+    ResultManagement through the building blocks calls the same methods."""
+
+    async def through_blocks() -> tuple[list[ua.NodeId], list[ua.NodeId], ua.CallMethodResult]:
+        client = served.client
+        ours = await client.get_namespace_index(BOLTWATCH_NAMESPACE)
+        di = await client.get_namespace_index("http://opcfoundation.org/UA/DI/")
+        system = client.get_node(node_id("st1", ours))
+        machinery = await client.get_namespace_index(MACHINERY)
+        blocks = f"{machinery}:{BUILDING_BLOCKS}"
+        pairs = [
+            (f"{served.result_ns}:ResultManagement",),
+            (f"{di}:Identification",),
+            (f"{served.result_ns}:ResultManagement", f"{served.result_ns}:GetLatestResult"),
+        ]
+        own = [(await system.get_child(list(path))).nodeid for path in pairs]
+        shared = [(await system.get_child([blocks, *path])).nodeid for path in pairs]
+        request = ua.CallMethodRequest(
+            ObjectId=shared[0],
+            MethodId=shared[2],
+            InputArguments=[ua.Variant(0, ua.VariantType.Int32)],
+        )
+        [called] = await client.uaclient.call([request])
+        return own, shared, called
+
+    own, shared, called = asyncio.run_coroutine_threadsafe(through_blocks(), served.loop).result()
+    assert shared == own
+    assert called.StatusCode.is_good(), called.StatusCode
+    _handle, result, error = (output.Value for output in called.OutputArguments)
+    assert (error, result.ResultMetaData.ResultId) == (0, "st1/3")

@@ -34,11 +34,12 @@ from tests.support.opcua_certificates import (
 USER, PASSWORD = "line-mes", "correct horse battery staple"
 CLIENT_TIMEOUT_S = 10.0
 START_TIMEOUT_S = 30.0
+SERVER_THREAD = "opcua-server"
 
 
 @pytest.fixture(scope="module")
 def certificates(tmp_path_factory: pytest.TempPathFactory) -> OpcuaCertificates:
-    return make_opcua_certificates(tmp_path_factory.mktemp("pki"))
+    return make_opcua_certificates(tmp_path_factory.mktemp("pki"), untrusted=("stranger",))
 
 
 @pytest.fixture(scope="module")
@@ -72,7 +73,7 @@ def serving(settings: SecuritySettings) -> Iterator[str]:
             failed.append(err)
             started.set()
 
-    thread = threading.Thread(target=work, name="opcua-server")
+    thread = threading.Thread(target=work, name=SERVER_THREAD)
     thread.start()
     try:
         assert started.wait(START_TIMEOUT_S), "the server did not start"
@@ -98,14 +99,19 @@ def users_required(certificates: OpcuaCertificates, users_file: Path) -> Iterato
 
 
 def _session_state(
-    endpoint: str, certificates: OpcuaCertificates, user: str | None, password: str | None
+    endpoint: str,
+    certificates: OpcuaCertificates,
+    user: str | None,
+    password: str | None,
+    name: str = "client",
 ) -> int:
-    """The server's ServerStatus/State (0: running) read in a session of ``user``."""
+    """The server's ServerStatus/State (0: running) read in a session of ``user``, the client
+    ``name`` of ``certificates``."""
 
     async def read() -> int:
         client = Client(endpoint, timeout=CLIENT_TIMEOUT_S)
-        client.application_uri = client_uri("client")
-        certificate, key = certificates.clients["client"]
+        client.application_uri = client_uri(name)
+        certificate, key = certificates.clients[name]
         await client.set_security(
             SecurityPolicyBasic256Sha256,
             certificate=str(certificate),
@@ -199,3 +205,34 @@ def test_a_users_file_anyone_on_the_host_may_read_is_warned_of(
     with caplog.at_level(logging.WARNING, "services.opcua"):
         asyncio.run(secure())
     assert f"--users {readable}: anyone on this host may read it" in caplog.text
+
+
+@pytest.mark.parametrize(
+    ("name", "user", "password", "refused", "said"),
+    [
+        ("stranger", USER, PASSWORD, ua.uaerrors.BadCertificateUntrusted, "--trusted-clients"),
+        ("client", USER, "wrong", ua.uaerrors.BadUserAccessDenied, f"user {USER!r} refused"),
+        ("client", "nobody", PASSWORD, ua.uaerrors.BadUserAccessDenied, "user 'nobody' refused"),
+        ("client", None, None, ua.uaerrors.BadIdentityTokenRejected, "anonymous"),
+    ],
+    ids=["untrusted certificate", "wrong password", "unknown user", "anonymous"],
+)
+def test_a_refused_session_leaves_one_line_in_the_log(
+    users_required: str,
+    certificates: OpcuaCertificates,
+    caplog: pytest.LogCaptureFixture,
+    name: str,
+    user: str | None,
+    password: str | None,
+    refused: type[Exception],
+    said: str,
+) -> None:
+    """What the server's thread logs at WARNING and above (the service's asyncua level) for
+    one refused session: one line, without a traceback, saying why."""
+    with caplog.at_level(logging.WARNING), pytest.raises(refused):
+        _session_state(users_required, certificates, user, password, name)
+    lines = [record for record in caplog.records if record.threadName == SERVER_THREAD]
+    assert len(lines) == 1, [record.getMessage() for record in lines]
+    [line] = lines
+    assert line.exc_info is None and line.exc_text is None
+    assert said in line.getMessage() and "\n" not in line.getMessage()

@@ -117,3 +117,14 @@ def test_a_peer_naming_this_lines_station_is_refused(capsys: pytest.CaptureFixtu
     assert "--peer line2-router=st1" in capsys.readouterr().err
     assert main(["st1", "--peer", "line2-router=st2"]) == 0
     assert '"line2-router-forwards"' in capsys.readouterr().out
+
+
+def test_the_lines_opcua_server_may_put_its_stations_alert_acknowledgements_only() -> None:
+    """``boltwatch serve opcua`` presents ``line-opcua``: an OPC UA client's acknowledgement
+    of an alert goes on the line, for the recorder; it puts nothing else. Another line's
+    router forwards its own line's."""
+    acl = line_access_control(STATIONS, {"line2-router": ["st4"]})
+    assert put_keys_granted(acl, "line-opcua") == {channels.ALERT_ACK.key(st) for st in STATIONS}
+    line = next(policy for policy in acl["policies"] if policy["id"] == "line")
+    assert "line-opcua" in line["subjects"]  # declarations (its subscriptions), delivery
+    assert channels.ALERT_ACK.key("st4") in put_keys_granted(acl, "line2-router")
