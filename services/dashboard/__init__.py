@@ -15,10 +15,20 @@ independence contract) and collects what ``boltwatch status`` collects
 - :mod:`.board_feed` (zenoh: subscriptions, liveliness and wear queries per
   window, its health token)
 - :mod:`.web_app` (aiohttp: the page, ``/board.json``, server-sent ``/events``,
-  the part search ``/api/results``)
-- :mod:`.part_search` (a part's tightenings in the results stores of the
-  station files, in worker threads: :mod:`shared.results`)
+  the part search ``/api/results``, the NOK list ``/api/noks``)
+- :mod:`.part_search` (a part's tightenings, and the line's NOKs, in the results
+  stores of the station files, in worker threads: :mod:`shared.results`)
+- :mod:`.json_replies` (the JSON replies' headers, an error in words, a reply kept
+  gzipped)
+- a run's curve: :mod:`.run_routes` (``/api/runs/ST/RUN``: its view, its part's
+  runs, its program's band, its files), :mod:`.run_locator` (where its recording
+  is: the results store names it, inside the station's recordings folder),
+  :mod:`.run_views` (read off the event loop, bounded, shared),
+  :mod:`.run_cache` (runs read, kept until their files change),
+  :mod:`.viewer_links` (Rerun's and Foxglove's links, their origins)
 - ``page/``: ``index.html``, ``dashboard.css``, ``dashboard.js`` (the
-  stations), ``part_search.js`` (the search box) (served by the app; nothing
+  stations), ``part_search.js`` (the search box, the NOK list),
+  ``run_view.js`` (a run's panel), ``run_specs.js`` (what its charts draw),
+  ``run_chart.js`` (the page's own canvas chart) (served by the app; nothing
   from the internet)
 """

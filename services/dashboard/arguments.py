@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from services.dashboard.viewer_links import viewer_template
+
 DEFAULT_LISTEN = "127.0.0.1:8080"
 
 
@@ -25,8 +27,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "last results (OK/NOK) and stop reasons, each tool's wear against "
         "recorder.wear_service_threshold, and alerts; live, without reloading. Its search "
         "box finds every tightening of a part (a VIN, a work piece) in the results store of "
-        "the station files. Open http://HOST:PORT/ in a browser; nothing on it comes from the "
-        "internet."
+        "the station files; a click on a result opens its run's curve, read from its "
+        "recording (torque over angle and time, preload, windows, stick-slip events, the "
+        "stop decision), beside the part's other runs or its program's recent ones, with "
+        "its files to download. Open http://HOST:PORT/ in a browser; nothing on it comes "
+        "from the internet."
     )
     parser.add_argument(
         "--listen",
@@ -34,4 +39,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=host_port(DEFAULT_LISTEN),
         metavar="HOST:PORT",
         help=f"where the page is served (default {DEFAULT_LISTEN}; 0.0.0.0:8080 in a container)",
+    )
+    viewers = parser.add_argument_group(
+        "outside viewers (a link from a run's view; none by default: the line may be offline)"
+    )
+    viewers.add_argument(
+        "--rerun-viewer",
+        type=viewer_template,
+        metavar="URL",
+        help="Rerun's web viewer, {url} where the .rrd's address goes, e.g. "
+        "'https://app.rerun.io/version/0.41.0/?url={url}' (the rrd's version's viewer)",
+    )
+    viewers.add_argument(
+        "--foxglove",
+        type=viewer_template,
+        metavar="URL",
+        help="Foxglove, {url} where the .mcap's address goes, e.g. "
+        "'https://app.foxglove.dev/~/view?ds=remote-file&ds.url={url}'",
     )

@@ -1,12 +1,13 @@
-"""The page's part search: every tightening of a part in the results store, newest first.
+"""The page's part search: every tightening of a part in the results store, newest first;
+and the line's NOK list, the newest NOK tightenings of the page's stations.
 
 ``GET /api/results?part=ID[&limit=N]`` (:mod:`.web_app`) asks
-:meth:`PartSearch.find`. The stores searched are those of the station files
-the page serves (:func:`stores_of`: ``[recorder] results_database``, else
-``results.sqlite`` in the recordings folder), each distinct store once: a
-line whose stations record into two folders has two, and a part's
-tightenings are gathered from both, newest first, at most ``limit``. A plant's
-PostgreSQL holds every line's results, so a part's tightenings on other lines
+:meth:`PartSearch.find`, ``GET /api/noks[?limit=N]`` :meth:`PartSearch.noks`. The
+stores searched are those of the station files the page serves (:func:`stores_of`:
+``[recorder] results_database``, else ``results.sqlite`` in the recordings folder),
+each distinct store once: a line whose stations record into two folders has two, and
+a part's tightenings are gathered from both, newest first, at most ``limit``. A
+plant's PostgreSQL holds every line's results, so a part's tightenings on other lines
 show too (each row names its station and line).
 
 Each search opens each store, asks (:class:`~shared.results.ResultsQuery`:
@@ -104,10 +105,21 @@ class PartSearch:
         """Every store asked at once, each in a worker thread; the page's reply: the
         tightenings of ``part_id`` newest first (at most ``limit``), how many there are
         in all, and one line per store that could not answer. ``answered``: some store did."""
+        query = ResultsQuery(part_id=part_id, limit=limit)
+        return {"part_id": part_id} | await self._gathered(query, f"part {part_id!r}")
+
+    async def noks(self, stations: Sequence[str], limit: int) -> dict[str, Any]:
+        """The newest NOK tightenings of ``stations`` (the page's), as :meth:`find` gives a
+        part's: the line's NOK list."""
+        query = ResultsQuery(stations=list(stations), verdict="NOK", limit=limit)
+        return {"stations": list(stations)} | await self._gathered(query, "NOK list")
+
+    async def _gathered(self, query: ResultsQuery, what: str) -> dict[str, Any]:
         started_s = time.monotonic()
         answers = await asyncio.gather(
-            *(asyncio.to_thread(_ask, target, part_id, limit) for target in self.targets)
+            *(asyncio.to_thread(_ask, target, query) for target in self.targets)
         )
+        limit = query.limit or DEFAULT_LIMIT
         found: dict[tuple[str, int], StoredResult] = {}
         for answer in answers:
             for stored in answer.found:  # a result in two stores (copied over) shows once
@@ -119,14 +131,13 @@ class PartSearch:
         )[:limit]
         errors = [answer.error for answer in answers if answer.error is not None]
         LOG.info(
-            "part %r: %d tightenings in %.0f ms%s",
-            part_id,
+            "%s: %d tightenings in %.0f ms%s",
+            what,
             len(newest),
             (time.monotonic() - started_s) * 1000,
             "".join(f"; {error}" for error in errors),
         )
         return {
-            "part_id": part_id,
             "limit": limit,
             "total": max(len(newest), sum(answer.total for answer in answers)),
             "results": [as_dict(stored) for stored in newest],
@@ -136,9 +147,9 @@ class PartSearch:
         }
 
 
-def _ask(target: StoreTarget, part_id: str, limit: int) -> _Answer:
+def _ask(target: StoreTarget, query: ResultsQuery) -> _Answer:
     """One store's answer (in a worker thread: it opens, queries and closes the store)."""
-    query = ResultsQuery(part_id=part_id, limit=limit)
+    limit = query.limit
     try:
         with ResultsStore(target, create=False, application=APPLICATION) as store:
             found = store.find(query)

@@ -8,7 +8,8 @@ session in the background (:mod:`.line_link`: the page is served from the
 start and says while the router cannot be reached), feeds a
 :class:`~.line_board.LineBoard` (:class:`~.board_feed.BoardFeed`) and serves
 the page (:mod:`.web_app`) within the bounds of :mod:`.connection_guard`
-until SIGINT/SIGTERM. It meets the line's services on zenoh only.
+until SIGINT/SIGTERM; a run's curve is read from the recordings folders of the station
+files (:mod:`.run_views`). It meets the line's services on zenoh only.
 """
 
 from __future__ import annotations
@@ -33,6 +34,9 @@ from services.dashboard.connection_guard import (
 from services.dashboard.line_board import LineBoard, StationSetting
 from services.dashboard.line_link import LineLink
 from services.dashboard.part_search import PartSearch, stores_of
+from services.dashboard.run_locator import RunLocator, StationRecordings
+from services.dashboard.run_views import RunViews
+from services.dashboard.viewer_links import ViewerLinks
 from services.dashboard.web_app import Listeners, make_app
 from shared.config import load_any_line
 from shared.runtime import exit_now
@@ -57,6 +61,11 @@ def main(args: argparse.Namespace) -> int:
     router = ", ".join(zenoh_section.connect) or "(no connect endpoints)"
     board = LineBoard(settings, time.time_ns(), router)
     search = PartSearch(stores_of(stations))
+    links = ViewerLinks(args.rerun_viewer, args.foxglove)
+    views = RunViews(
+        RunLocator([StationRecordings.of(station) for station in stations]),
+        viewers=links.as_dict(),
+    )
     listeners = Listeners()
     guard = ConnectionGuard(connection_bound(raise_open_files_limit()))
     host, port = args.listen
@@ -72,7 +81,7 @@ def main(args: argparse.Namespace) -> int:
         yield
         link.close()
 
-    app = make_app(board, listeners, search, guard.middleware)
+    app = make_app(board, listeners, search, guard.middleware, views=views, links=links)
     app.cleanup_ctx.append(feed)
     asyncio.run(_serve(app, host, port, guard))
     exit_now(0)  # the session is closed: no finalisation for a late zenoh thread to abort

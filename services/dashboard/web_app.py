@@ -11,7 +11,11 @@
   results store, newest first (:mod:`.part_search`): 200 with what was found
   (and a line per store that could not answer), 503 when no store answered,
   400 when the question cannot be asked (no part id, one too long, a bad
-  limit); always JSON, ``{"errors": [...]}`` saying why.
+  limit); always JSON, ``{"errors": [...]}`` saying why;
+- ``GET /api/noks[?limit=N]``: the line's NOK list, the newest NOK tightenings of the
+  page's stations in the results store, as the part search answers;
+- ``/api/runs/...``: a run's curve, its part's runs, its program's band and its files
+  (:mod:`.run_routes`), when the app is given the page's :class:`~.run_views.RunViews`.
 
 zenoh calls :meth:`Listeners.changed` from its own threads; it wakes every
 open ``/events`` stream on the event loop.
@@ -28,8 +32,12 @@ from pathlib import Path
 from aiohttp import web
 from aiohttp.typedefs import Middleware
 
+from services.dashboard.json_replies import JSON_HEADERS
 from services.dashboard.line_board import LineBoard
 from services.dashboard.part_search import PartSearch, SearchRequestError, limit_of, part_of
+from services.dashboard.run_routes import add_run_routes
+from services.dashboard.run_views import RunViews
+from services.dashboard.viewer_links import ViewerLinks
 from shared.runtime import RateLimitedLog
 
 PAGE = Path(__file__).with_name("page")
@@ -43,8 +51,6 @@ _GONE = RateLimitedLog(logging.getLogger(__name__), logging.INFO)
 
 BOARD_KEY = web.AppKey("board", LineBoard)
 SEARCH_KEY = web.AppKey("search", PartSearch)
-#: headers of every JSON reply: never cached, never read as anything but JSON
-JSON_HEADERS = {"Cache-Control": "no-store", "X-Content-Type-Options": "nosniff"}
 
 
 class Listeners:
@@ -90,6 +96,8 @@ def make_app(
     listeners: Listeners,
     search: PartSearch,
     *middlewares: Middleware,
+    views: RunViews | None = None,
+    links: ViewerLinks | None = None,
 ) -> web.Application:
     app = web.Application(middlewares=middlewares)
     app[BOARD_KEY] = board
@@ -99,6 +107,9 @@ def make_app(
     app.router.add_get("/board.json", _board)
     app.router.add_get("/events", _events)
     app.router.add_get("/api/results", _results)
+    app.router.add_get("/api/noks", _noks)
+    if views is not None:
+        add_run_routes(app, views, links or ViewerLinks())
     app.router.add_static("/page/", PAGE)
     app.on_startup.append(_bind_loop)
     app.on_shutdown.append(_end_streams)
@@ -124,6 +135,16 @@ async def _results(request: web.Request) -> web.Response:
     except SearchRequestError as err:
         return web.json_response({"errors": [str(err)]}, status=400, headers=JSON_HEADERS)
     found = await request.app[SEARCH_KEY].find(part_id, limit)
+    return web.json_response(found, status=200 if found["answered"] else 503, headers=JSON_HEADERS)
+
+
+async def _noks(request: web.Request) -> web.Response:
+    try:
+        limit = limit_of(request.query.get("limit"))
+    except SearchRequestError as err:
+        return web.json_response({"errors": [str(err)]}, status=400, headers=JSON_HEADERS)
+    stations = request.app[BOARD_KEY].stations
+    found = await request.app[SEARCH_KEY].noks(stations, limit)
     return web.json_response(found, status=200 if found["answered"] else 503, headers=JSON_HEADERS)
 
 

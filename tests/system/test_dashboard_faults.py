@@ -1,7 +1,7 @@
 """The line's page (``boltwatch serve dashboard``, a real process) against what a network and a
 small box can do to it: started before its router, 600 half-open connections under an
 open-files limit of 256 (one of 128 raised to its hard limit), malformed requests, event
-streams whose clients go away.
+streams whose clients go away, a flood of run views, paths that are not a run.
 
 Real sockets from this process; no browser (its page is plain HTTP: http.client reads
 what a browser's ``GET /`` reads).
@@ -10,14 +10,20 @@ what a browser's ``GET /`` reads).
 from __future__ import annotations
 
 import contextlib
+import json
 import selectors
 import socket
 import struct
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import Any
 
 import pytest
 
+from shared.results import ResultsStore, store_target
+from shared.results.recordings_reading import fill_from_recordings, station_recordings
+from tests.benchmarks.run_recordings import record_runs
 from tests.support.dashboard_process import dashboard_process
 from tests.support.live_recorder import free_port, write_station_file
 from tests.support.router_process import router_process
@@ -121,3 +127,50 @@ def test_half_open_connections_a_low_open_files_limit_and_hostile_clients(
     assert page.exit_status == 0, log
     assert "Traceback" not in log and "Too many open files" not in log, log[-3000:]
     assert len(log.splitlines()) < 40, log[-3000:]  # one line a kind, not one a client
+
+
+FLOODED_RUNS = 40
+
+
+def test_a_flood_of_run_views_and_what_is_not_a_run(tmp_path: Path) -> None:
+    """The page's process (its connection guard in front) asked every run of st1 at once, 40
+    runs of 3000 samples recorded by the real recorder: each answer a view or a 503 in
+    words, the board answering meanwhile and every run viewable afterwards; asked what is not
+    a run (a run that does not exist, paths out of the recordings and of the page's own
+    folder), never served."""
+    station = _station(tmp_path, f"tcp/127.0.0.1:{free_port()}", "peer")
+    recordings = record_runs(tmp_path / "pre", FLOODED_RUNS, 3000, station_file=station)
+    with ResultsStore(store_target(recordings, None)) as store:
+        fill_from_recordings(
+            store, station_recordings(recordings, ["st1"]), {}, "box", time.time_ns
+        )
+    with dashboard_process(tmp_path, station) as page:
+        for path in (
+            "/api/runs/st1/999", "/api/runs/st1/1/files/..%2F..%2Fstation.toml",
+            "/api/runs/st1/1/files/%2Fetc%2Fpasswd", "/api/runs/../../etc/passwd",
+            "/page/../../station.toml", "/page/%2e%2e/%2e%2e/station.toml",
+        ):  # fmt: skip
+            status, body = page.get(path)
+            assert status in (400, 403, 404), (path, status)
+            assert b"root:" not in body and b"[zenoh]" not in body, path
+
+        def view(run_id: int) -> tuple[int, dict[str, Any]]:
+            status, body = page.get(f"/api/runs/st1/{run_id}")
+            return status, json.loads(body)
+
+        with ThreadPoolExecutor(FLOODED_RUNS) as pool:
+            flooded = list(pool.map(view, range(1, FLOODED_RUNS + 1)))
+            board = page.board()  # the live side answers meanwhile
+        assert board["stations"][0]["station"] == "st1"
+        for status, answer in flooded:
+            assert status in (200, 503), (status, answer)
+            if status == 200:
+                assert answer["samples"] == 3000
+            else:
+                assert answer["errors"][0].endswith("runs for others: ask again in a moment")
+        for run_id in range(1, FLOODED_RUNS + 1):  # afterwards, every one of them
+            status, answer = view(run_id)
+            assert status == 200 and answer["run_id"] == run_id
+    log = page.log.read_text()
+    assert page.exit_status == 0, log
+    assert "Traceback" not in log, log[-3000:]

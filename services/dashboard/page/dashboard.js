@@ -71,7 +71,8 @@ function figures(station) {
 function results(station) {
   if (station.results.length === 0) return none("no result yet");
   return table(["run", "program", "result", "torque", "angle", "preload", "when"],
-    station.results.map((r) => el("tr", { class: "result", "data-run": r.run_id },
+    station.results.map((r) => el("tr", { class: "result", "data-station": station.station,
+      "data-run": r.run_id, title: "show its curve" },
       el("td", { class: "num" }, r.run_id),
       el("td", {}, r.program),
       el("td", {}, el("span", { class: `verdict ${r.result}` }, r.result),

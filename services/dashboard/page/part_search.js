@@ -1,5 +1,6 @@
 // The line's page, its part search: every tightening of a part (GET /api/results), newest
-// first, above the stations. Uses el, none and table of dashboard.js (loaded before it).
+// first, above the stations; and the line's NOK list (GET /api/noks). A row opens its run's
+// curve (run_view.js). Uses el, none and table of dashboard.js (loaded before it).
 // What the reply holds goes in as text only (el makes text nodes): a part id is never markup.
 "use strict";
 
@@ -7,6 +8,7 @@ const SEARCH_LIMIT = 500;
 const searchForm = document.getElementById("part-search");
 const partInput = document.getElementById("part");
 const found = document.getElementById("found");
+const nokButton = document.getElementById("nok-list");
 let searches = 0; // the number of the latest search: a reply to an older one is dropped
 
 function judged(figure, digits, unit, scale = 1) {
@@ -26,7 +28,8 @@ function recording(r) {
 function tightenings(rows) {
   return table(["ended (UTC)", "station", "plant", "line", "run", "program", "tool", "result", "torque",
     "angle", "preload", "stopped on", "events", "recording"],
-  rows.map((r) => el("tr", { class: "found", "data-station": r.station, "data-run": r.run_id },
+  rows.map((r) => el("tr", { class: "found", "data-station": r.station, "data-run": r.run_id,
+    title: "show its curve" },
     el("td", {}, r.ended_utc),
     el("td", {}, r.station, r.station_name ? el("div", { class: "name" }, r.station_name) : ""),
     el("td", {}, r.plant || "-"),
@@ -44,24 +47,27 @@ function tightenings(rows) {
     el("td", { class: "recording" }, recording(r)))));
 }
 
-function show(part, ...children) {
+function showFound(title, ...children) {
   const close = el("button", { type: "button", class: "close" }, "close");
   close.addEventListener("click", () => { searches += 1; found.hidden = true; found.replaceChildren(); });
-  found.replaceChildren(el("div", { class: "found-head" },
-    el("h2", {}, `Tightenings of part ${part}`), close), ...children);
+  found.replaceChildren(el("div", { class: "found-head" }, el("h2", {}, title), close), ...children);
   found.hidden = false;
 }
 
-function answer(part, reply) {
+function show(part, ...children) {
+  showFound(`Tightenings of part ${part}`, ...children);
+}
+
+function answer(part, reply, title = `Tightenings of part ${part}`, nothing = `no tightening of part ${part}`) {
   const errors = (reply.errors || []).map((text) => el("p", { class: "store-error" }, text));
   const rows = reply.results || [];
   if (rows.length === 0) {
     const stores = reply.stores ? ` in ${reply.stores.join(", ")}` : "";
-    show(part, ...errors, reply.answered ? none(`no tightening of part ${part}${stores}`) : "");
+    showFound(title, ...errors, reply.answered ? none(`${nothing}${stores}`) : "");
     return;
   }
   const more = reply.total > rows.length ? `, the newest ${rows.length} of ${reply.total}` : "";
-  show(part, ...errors,
+  showFound(title, ...errors,
     el("p", { class: "figures found-summary" },
       `${rows.length} tightening${rows.length === 1 ? "" : "s"}, newest first${more}`),
     el("div", { class: "wide" }, tightenings(rows)));
@@ -81,5 +87,21 @@ searchForm.addEventListener("submit", (event) => {
     .catch((err) => {
       const why = err instanceof TypeError ? "the page's server does not answer" : err.message;
       if (search === searches) show(part, el("p", { class: "store-error" }, `search failed: ${why}`));
+    });
+});
+
+// the line's NOK list: the newest NOK tightenings of the page's stations
+nokButton.addEventListener("click", () => {
+  const search = ++searches;
+  const title = "NOK tightenings of the line";
+  showFound(title, none("searching…"));
+  fetch(`/api/noks?${new URLSearchParams({ limit: SEARCH_LIMIT })}`)
+    .then((response) => response.json().catch(() => {
+      throw new Error(`the server answered HTTP ${response.status}`);
+    }))
+    .then((reply) => { if (search === searches) answer("", reply, title, "no NOK tightening"); })
+    .catch((err) => {
+      const why = err instanceof TypeError ? "the page's server does not answer" : err.message;
+      if (search === searches) showFound(title, el("p", { class: "store-error" }, `search failed: ${why}`));
     });
 });

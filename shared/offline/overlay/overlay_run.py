@@ -6,7 +6,9 @@ a run the recorder split into parts is read from all of them) or by the path
 of an MCAP file (the run with the most samples in it). Damaged files are read
 as far as they go (:mod:`~shared.recordings.mcap.recording_reader`); a file
 of several that cannot be read at all (empty, not MCAP, not a regular file)
-is skipped; ``damage`` says what was lost, naming each file.
+is skipped; ``damage`` says what was lost, naming each file. A run read already for its
+post-mortem (:func:`~shared.offline.post_mortem.read_run_files`) is one too
+(:func:`overlay_run_of`: the line's page reads each run once for both).
 
 Run time is the sample's own clock (``Sample.time_s``, the tool's counter)
 when every sample has it, else the receive time (``time_ns``), counted from
@@ -24,6 +26,7 @@ from mcap.records import Message
 
 from shared.contract import Sample, StickSlipEvent, TighteningResult, channels, decode
 from shared.errors import InputError
+from shared.offline.post_mortem.post_mortem_run import RecordedRun
 from shared.recordings import run_file_prefix, run_files, station_folder_name
 from shared.recordings.mcap import RecordingScan
 
@@ -101,6 +104,24 @@ def read_overlay_run(label: str, files: list[Path], run_id: int | None = None) -
         tuple(sorted((e for e in events if e.run_id == run_id), key=lambda e: e.index)),
         result,
         "; ".join(damage),
+    )
+
+
+def overlay_run_of(run: RecordedRun, label: str) -> OverlayRun:
+    """``run`` (read for its post-mortem) as one run of an overlay, named ``label``."""
+    own = sorted(run.samples, key=lambda sample: sample.sequence)
+    return OverlayRun(
+        label,
+        tuple(run.sources or [run.source]),
+        run.run_id,
+        _run_time_s(own),
+        np.array([sample.time_ns for sample in own], dtype=np.int64),
+        np.array([sample.torque_nm for sample in own], dtype=np.float64),
+        np.array([sample.angle_deg for sample in own], dtype=np.float64),
+        _force_n(own),
+        tuple(sorted(run.events, key=lambda e: e.index)),
+        run.result,
+        "" if run.complete else run.state,
     )
 
 

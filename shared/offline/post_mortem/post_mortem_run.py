@@ -1,8 +1,10 @@
 """One recorded run, read back for the post-mortem report: traces, events, model.
 
 :func:`read_run` makes one pass over an MCAP recording (damaged files too, see
-:mod:`recording_reader`) and keeps the samples, stick-slip events and stop
-decisions of one run, and the file's metadata records. When the file carries
+:mod:`recording_reader`) and keeps the samples, stick-slip events, stop
+decisions, a final stage's commands and the result of one run, and the file's
+metadata records; :func:`read_run_files` the same over the files of a run
+the recorder split (its parts, a second file after a restart), in their order. When the file carries
 the joint (``joint``) and the program's motor speed (``program``), it also
 builds the paper's analytical :class:`~shared.model.JointModel` and the shift
 from run time to model time (:class:`ModelClock`).
@@ -24,6 +26,7 @@ tightened; the panels draw the controller's own windows and target instead.
 from __future__ import annotations
 
 import logging
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -90,6 +93,8 @@ class RecordedRun:
     runs_in_file: list[int] = field(default_factory=list)  # every run with samples in the file
     controller: ControllerMarks | None = None  # the controller's windows and target, if its run
     stages: list[StageDecision] = field(default_factory=list)  # a final stage's commands
+    result: TighteningResult | None = None  # the run's result in the file (the last one)
+    sources: list[Path] = field(default_factory=list)  # every file read (source: the first)
 
     @property
     def t0_ns(self) -> int:
@@ -129,62 +134,94 @@ class RecordedRun:
 
 def read_run(source: Path, run_id: int | None = None) -> RecordedRun:
     """The run ``run_id`` of ``source`` (default: the run with the most samples)."""
-    scan = RecordingScan(source)
-    metadata: dict[str, dict[str, str]] = {}
-    samples: list[Sample] = []
-    events: list[StickSlipEvent] = []
-    decisions: list[StopDecision] = []
-    stages: list[StageDecision] = []
-    results: list[TighteningResult] = []
-    controllers: list[ControllerResult] = []
-    kept: dict[str, tuple[type, list[Any]]] = {
-        SAMPLE_SCHEMA: (Sample, samples),
-        EVENT_SCHEMA: (StickSlipEvent, events),
-        DECISION_SCHEMA: (StopDecision, decisions),
-        STAGE_SCHEMA: (StageDecision, stages),
-        RESULT_SCHEMA: (TighteningResult, results),
-        CONTROLLER_SCHEMA: (ControllerResult, controllers),
-    }
-    undecodable = 0
-    for record in scan.records():
-        if isinstance(record, Metadata):
-            metadata[record.name] = dict(record.metadata)
-            continue
-        if not isinstance(record, Message):
-            continue
-        channel = scan.channels.get(record.channel_id)
-        schema = scan.schemas.get(channel.schema_id) if channel is not None else None
-        wanted = kept.get(schema.name) if schema is not None else None
-        if wanted is None:
-            continue
-        message_type, messages = wanted
+    return read_run_files([source], run_id)
+
+
+@dataclass
+class _Kept:
+    """What the files hold of every run, in file order, as they are read."""
+
+    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
+    samples: list[Sample] = field(default_factory=list)
+    events: list[StickSlipEvent] = field(default_factory=list)
+    decisions: list[StopDecision] = field(default_factory=list)
+    stages: list[StageDecision] = field(default_factory=list)
+    results: list[TighteningResult] = field(default_factory=list)
+    controllers: list[ControllerResult] = field(default_factory=list)
+    undecodable: int = 0
+
+    def read(self, scan: RecordingScan) -> None:
+        kept: dict[str, tuple[type, list[Any]]] = {
+            SAMPLE_SCHEMA: (Sample, self.samples),
+            EVENT_SCHEMA: (StickSlipEvent, self.events),
+            DECISION_SCHEMA: (StopDecision, self.decisions),
+            STAGE_SCHEMA: (StageDecision, self.stages),
+            RESULT_SCHEMA: (TighteningResult, self.results),
+            CONTROLLER_SCHEMA: (ControllerResult, self.controllers),
+        }
+        for record in scan.records():
+            if isinstance(record, Metadata):
+                self.metadata[record.name] = dict(record.metadata)
+                continue
+            if not isinstance(record, Message):
+                continue
+            channel = scan.channels.get(record.channel_id)
+            schema = scan.schemas.get(channel.schema_id) if channel is not None else None
+            wanted = kept.get(schema.name) if schema is not None else None
+            if wanted is None:
+                continue
+            message_type, messages = wanted
+            try:
+                messages.append(decode(message_type, record.data))
+            except InputError:
+                self.undecodable += 1
+
+
+def read_run_files(files: Sequence[Path], run_id: int | None = None) -> RecordedRun:
+    """The run ``run_id`` of ``files``, read in their order (default: the run with the most
+    samples in them). A file of several that cannot be read at all (empty, not MCAP, not a
+    regular file) is left out, ``state`` naming it; one file that cannot: InputError."""
+    if not files:
+        raise InputError("no recording to read")
+    kept = _Kept()
+    scans: list[RecordingScan] = []
+    skipped: list[str] = []
+    for path in files:
+        scan = RecordingScan(path)
         try:
-            messages.append(decode(message_type, record.data))
-        except InputError:
-            undecodable += 1
-    if undecodable:
-        LOG.warning("%s: %d messages could not be decoded, left out", source, undecodable)
+            kept.read(scan)
+        except InputError as err:
+            if len(files) == 1:
+                raise
+            skipped.append(f"{err}; left out")
+            continue
+        scans.append(scan)
+    source = Path(files[0])
+    if kept.undecodable:
+        LOG.warning("%s: %d messages could not be decoded, left out", source, kept.undecodable)
     counts: dict[int, int] = {}
-    for sample in samples:
+    for sample in kept.samples:
         counts[sample.run_id] = counts.get(sample.run_id, 0) + 1
-    run_id = _chosen_run(source, counts, run_id, scan.damage)
-    samples = [s for s in samples if s.run_id == run_id]
+    damage = "; ".join([scan.damage for scan in scans if scan.damage is not None] + skipped)
+    run_id = _chosen_run(source, counts, run_id, damage or None)
+    complete = not skipped and all(scan.complete for scan in scans)
     run = RecordedRun(
         source,
         run_id,
-        samples,
-        [e for e in events if e.run_id == run_id],
-        [d for d in decisions if d.run_id == run_id],
-        metadata,
-        scan.complete,
-        state=scan.describe(),
+        [s for s in kept.samples if s.run_id == run_id],
+        [e for e in kept.events if e.run_id == run_id],
+        [d for d in kept.decisions if d.run_id == run_id],
+        kept.metadata,
+        complete,
+        state="; ".join([scan.describe() for scan in scans] + skipped),
         runs_in_file=sorted(counts),
-        stages=[d for d in stages if d.run_id == run_id],
+        stages=[d for d in kept.stages if d.run_id == run_id],
+        result=next((r for r in reversed(kept.results) if r.run_id == run_id), None),
+        sources=[Path(path) for path in files],
     )
-    run.joint, run.motor_speed_rad_s, run.model_missing = _model_inputs(metadata)
+    run.joint, run.motor_speed_rad_s, run.model_missing = _model_inputs(kept.metadata)
     run.controller = ControllerMarks.of(
-        next((r for r in reversed(results) if r.run_id == run_id), None),
-        next((c for c in reversed(controllers) if c.run_id == run_id), None),
+        run.result, next((c for c in reversed(kept.controllers) if c.run_id == run_id), None)
     )
     if run.controller is not None:
         run.model_missing = CONTROLLER_NO_MODEL
