@@ -20,6 +20,7 @@ from shared.contract import (
     StageDecision,
     StickSlipEvent,
     StopDecision,
+    ToolCommandsName,
     ToolState,
 )
 from shared.stickslip import (
@@ -117,6 +118,13 @@ class ActiveRun:
         )
         return self.decision
 
+    def _commands(self) -> ToolCommandsName | None:
+        """What the station could command the tool in this run: ``staged`` only when its
+        program has a final stage and the tool takes it; None when the tool did not say."""
+        if self.state.commands is None:
+            return None
+        return "staged" if self.settings.final_stage is not None else "stop"
+
     def summary(self, end: ToolState) -> RunSummary:
         """The run's summary when the tool reports done or aborted.
 
@@ -166,7 +174,7 @@ class ActiveRun:
             samples=self.samples,
             started_ns=self.started_ns,
             ended_ns=end.time_ns,
-            commands=self.state.commands,
+            commands=self._commands(),
             final_stage_s=final.switched_at_s if final is not None else None,
             pulses=max(self.tool_pulses, end.pulses),
         )
