@@ -13,6 +13,7 @@
 - :mod:`.spool_messages` (what a station's spool and the recorder say to each other)
 - :mod:`.part_messages` (what the line says of the part at a station: its id)
 - :mod:`.stage_messages` (what a station commands a tool that runs a final stage)
+- :mod:`.cycle_messages` (a multi-spindle station's cycle: its common result)
 """
 
 from shared.contract.can_database import (
@@ -24,12 +25,14 @@ from shared.contract.can_database import (
 )
 from shared.contract.channels import CHANNELS, SCHEMA_TYPES, Channel
 from shared.contract.codec import MAX_PAYLOAD_BYTES, decode, decoder, encode, json_schema, to_dict
+from shared.contract.cycle_messages import CycleResult, CycleSpindle
 from shared.contract.message_fields import (
     DEFAULT_FLOAT,
     DEFAULT_INT,
     DEFAULT_TEXT,
     FLOAT_MAX,
     INT64_MAX,
+    MAX_SPINDLES,
     MAX_TEXT_CHARS,
     PART_ID,
     PART_ID_CHARS,
@@ -108,6 +111,7 @@ __all__ = [
     "FLOAT_MAX",
     "INT64_MAX",
     "MAX_PAYLOAD_BYTES",
+    "MAX_SPINDLES",
     "MAX_TEXT_CHARS",
     "PART_ID",
     "PART_ID_CHARS",
@@ -122,6 +126,8 @@ __all__ = [
     "ControllerFunction",
     "ControllerResult",
     "ControllerStep",
+    "CycleResult",
+    "CycleSpindle",
     "FigureStatus",
     "Intensity",
     "JudgedFigure",
