@@ -106,6 +106,8 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
             unsent_samples=lambda: outlet.unsent_samples,
             decider=decider,
             stage_commands=station.config.can.tool_commands == "auto",
+            spindles=station.config.station.spindles,
+            spindle_id_stride=station.config.can.spindle_id_stride,
         )
         if not edge:
             skeleton.subscriber(channels.DECISION.key(station_id), decision_handler(acquisition))

@@ -8,6 +8,7 @@
   :mod:`.message_fields` (the bounds of every field), :mod:`.message_shape`
   (what a decoder derives once from a message type)
 - :mod:`.can_database` (the station's DBC, checked against the CAN contract),
+  :mod:`.spindle_ids` (where each spindle of a multi-spindle station is on the bus),
   :mod:`.sensor_range` (what a station's sensors can measure)
 - :mod:`.trace` (the offline trace CSV), :mod:`.run_clock` (a run's clock: ns <-> s)
 - :mod:`.spool_messages` (what a station's spool and the recorder say to each other)
@@ -19,6 +20,7 @@
 from shared.contract.can_database import (
     CONTRACT,
     COUNTER_MODULO,
+    CYCLE_MESSAGES,
     SAMPLE_RATE_HZ,
     STAGE_MESSAGES,
     StationDatabase,
@@ -88,6 +90,7 @@ from shared.contract.messages import (
 )
 from shared.contract.run_clock import RunClock
 from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
+from shared.contract.spindle_ids import SpindleFrame, SpindleIds
 from shared.contract.spool_messages import (
     SeqMark,
     SeqRange,
@@ -104,6 +107,7 @@ __all__ = [
     "CONTRACT",
     "CONTRACT_RANGE",
     "COUNTER_MODULO",
+    "CYCLE_MESSAGES",
     "DEFAULT_FLOAT",
     "DEFAULT_INT",
     "DEFAULT_TEXT",
@@ -150,6 +154,8 @@ __all__ = [
     "SensorRange",
     "SeqMark",
     "SeqRange",
+    "SpindleFrame",
+    "SpindleIds",
     "SpoolAck",
     "SpoolFiled",
     "SpoolStats",
