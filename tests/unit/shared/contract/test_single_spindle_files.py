@@ -6,6 +6,7 @@ station's messages carry their spindle and sync id."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pytest
 from mcap.reader import make_reader
@@ -44,7 +45,7 @@ def test_a_recording_made_before_spindles_decodes_and_encodes_to_the_same_bytes(
     # the run's states, summary and result are among them: the messages that grew
     assert {"boltwatch.ToolState", "boltwatch.RunSummary", "boltwatch.TighteningResult"} <= kinds
     for name, payload in messages:
-        message = decode(SCHEMA_TYPES[name], payload)
+        message: Any = decode(SCHEMA_TYPES[name], payload)
         assert encode(message) == payload, name
         if hasattr(message, "spindle"):
             assert message.spindle is None and message.sync_id is None

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from services.cli.main import main
-from shared.contract import CycleResult, CycleSpindle, JudgedFigure
+from shared.contract import CycleResult, CycleSpindle, JudgedFigure, Verdict
 from shared.results import ResultsDatabase, ResultsQuery, ResultsStore, StoreTarget, stored_result
 from shared.results.results_table import format_csv, format_json, format_table
 from tests.support import factories
@@ -22,7 +22,7 @@ from tests.support.paths import REPO
 SINGLE_SPINDLE = REPO / "tests" / "data" / "single-spindle"
 
 
-def cycle_of(sync_id: int, runs: dict[int, str | None], part: str = "P7") -> CycleResult:
+def cycle_of(sync_id: int, runs: dict[int, Verdict | None], part: str = "P7") -> CycleResult:
     """The common result of a cycle whose spindle k ran ``runs[k]`` (None: no result)."""
     verdicts = list(runs.values())
     bad = [f"spindle {k} {v or 'no result'}" for k, v in runs.items() if v != "OK"]
