@@ -88,7 +88,11 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
         wait = not station.config.spool.enabled
         session = skeleton.open_session(station.config.zenoh, wait_for_router=wait)
         publisher = QueuedPublisher(
-            session, station_id, batch_samples=edge, spool=station_spool(station, "acquisition")
+            session,
+            station_id,
+            batch_samples=edge,
+            spool=station_spool(station, "acquisition"),
+            runs_at_once=station.config.station.spindles,
         )
         skeleton.on_stop(Stop.OUTPUT, publisher.close)
         outlet = ZenohOutlet(session, publisher)
