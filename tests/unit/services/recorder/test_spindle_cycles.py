@@ -134,7 +134,7 @@ def test_a_cycle_is_one_file_its_spindles_each_a_run_stored_with_their_cycle(
         sample = decode(Sample, message.data)
         sequences[sample.run_id].append(sample.sequence)
     assert sequences == {SYNC + k: list(range(SAMPLES)) for k in range(SPINDLES)}
-    topics = defaultdict(int)
+    topics: dict[str, int] = defaultdict(int)
     for _, channel, _ in scan.typed_messages():
         topics[channel.topic.split("/", 2)[2]] += 1
     assert (topics["results"], topics["runs"], topics["cycles"], topics["tool"]) == (4, 4, 1, 8)
