@@ -169,3 +169,31 @@ def test_the_store_a_single_spindle_station_wrote_before_reads_as_it_did(
     assert main(["results", "--recordings", str(folder), "--json"]) == 0
     answered = capsys.readouterr().out
     assert json.loads(answered) == json.loads((SINGLE_SPINDLE / "results.json").read_text())
+
+
+def test_a_cycle_file_rebuilds_its_spindles_results_with_their_cycle(tmp_path: Path) -> None:
+    """``results rebuild`` (and the recorder's catch-up) reads a cycle's file: every
+    spindle's result and the cycle's common result, stored together."""
+    from shared.config import StationPlace
+    from shared.contract import encode
+    from shared.recordings import classify, file_path
+    from shared.recordings.mcap import McapSink
+    from shared.results.recordings_reading import fill_from_recordings
+
+    folder = tmp_path / "recordings"
+    path = file_path(folder, "st1", 300, factories.T0)
+    path.parent.mkdir(parents=True)
+    cycle = cycle_of(300, {1: "OK", 2: "OK", 3: "OK"})
+    with McapSink(path, {}, 300, factories.T0) as sink:
+        for stored in spindle_results(300, 3):
+            sink.write(classify("boltwatch/st1/results", encode(stored.result), factories.T0))
+        sink.write(classify("boltwatch/st1/cycles", encode(cycle), factories.T0))
+    target = StoreTarget(sqlite_path=folder / "results.sqlite")
+    with ResultsStore(target) as store:
+        counts = fill_from_recordings(store, [path], {"st1": StationPlace()}, "box", lambda: 1)
+        found = store.find(ResultsQuery(part_id="P7", oldest_first=True))
+    assert counts.new == 3
+    assert [(s.result.spindle, s.cycle.result if s.cycle else None) for s in found] == [
+        (1, "OK"), (2, "OK"), (3, "OK"),
+    ]  # fmt: skip
+    assert {s.recording for s in found} == {str(path.resolve())}
