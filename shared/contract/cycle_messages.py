@@ -33,7 +33,9 @@ class CycleSpindle:
     __pydantic_config__ = WIRE_CONFIG
 
     spindle: SpindleNumber
-    run_id: Id | None  # its run (its TighteningResult); None: no result of it came
+    # its run (its TighteningResult); None: no result of it came (or, a controller's cycle,
+    # its tightening was not published: the controller's verdict of it is kept)
+    run_id: Id | None
     result: Verdict | None  # None: no result came (the cycle is NOK)
 
 
