@@ -93,3 +93,21 @@ def test_a_cycle_result_names_its_spindles_runs_in_spindle_order() -> None:
     )
     assert decode(CycleResult, encode(cycle)) == cycle
     assert cycle.run_ids == [10, 12]
+
+
+def test_the_wear_ledger_a_single_spindle_station_wrote_before_reads_as_it_did(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``tests/data/single-spindle/wear.sqlite`` answers ``wear --json`` as it did then."""
+    import json
+    import shutil
+
+    from services.cli.main import main
+
+    folder = tmp_path / "recordings"
+    folder.mkdir()
+    shutil.copy(SINGLE_SPINDLE / "wear.sqlite", folder / "wear.sqlite")
+    capsys.readouterr()
+    assert main(["wear", "--recordings", str(folder), "--json"]) == 0
+    answered = json.loads(capsys.readouterr().out)
+    assert answered == json.loads((SINGLE_SPINDLE / "wear.json").read_text())
