@@ -24,13 +24,22 @@ string run id, a time no clock can hold, a run id wider than the DBC's
 ``RunId``, another station's id) is counted
 in ``BusStats.bad_decisions`` and logged once, then at most every 10 s; a
 good decision after it still stops the tool.
+
+A multi-spindle station (``[station] spindles`` N > 1) has N spindles on its
+bus, each at the DBC's ids shifted by its stride
+(:class:`~shared.contract.SpindleIds`): each is a lane of its own
+(:mod:`.spindle_lane`: its run, its Counter, its StopCommand), its samples
+and states named by its run id as a single spindle's are; each run's
+``ToolState`` says its spindle and the sync id of the cycle it started in (the
+controller's last ``CycleStart``). A decision goes to the spindle running its
+run. Counters are the station's, summed over its spindles.
 """
 
 from __future__ import annotations
 
 import logging
 import time
-from collections import Counter, deque
+from collections import Counter
 from collections.abc import Callable
 from typing import Protocol
 
@@ -38,6 +47,7 @@ import can
 
 from services.acquisition.decider import Decider
 from services.acquisition.frame_decoder import (
+    CycleStartFrame,
     FrameDecoder,
     JointSensorsFrame,
     Rejected,
@@ -47,12 +57,13 @@ from services.acquisition.frame_decoder import (
     ToolStageFrame,
     ToolStatusFrame,
 )
-from services.acquisition.pairing import AssembledSample, SampleAssembler
-from services.acquisition.tool_commands import ToolCommands
+from services.acquisition.pairing import AssembledSample, PairingCounters
+from services.acquisition.spindle_lane import SpindleLane
 from shared.contract import (
     SAMPLE_RATE_HZ,
     BusStats,
     Sample,
+    SpindleIds,
     StageDecision,
     StationDatabase,
     StopDecision,
@@ -69,8 +80,6 @@ from shared.runtime import RateLimitedLog
 LOG = logging.getLogger(__name__)
 
 RECEIVE_ERROR_BACKOFF_S = 0.05
-#: run ids remembered as started: a ToolStatus starting one of them again is ignored
-STARTED_RUNS_KEPT = 64
 
 
 class Outlet(Protocol):
@@ -95,21 +104,38 @@ class Acquisition:
         unsent_samples: Callable[[], int] = lambda: 0,
         decider: Decider | None = None,
         stage_commands: bool = True,
+        spindles: int = 1,
+        spindle_id_stride: int = 2,
     ) -> None:
         """``unsent_samples``: how many samples the outlet could not deliver (no router);
         ``decider``: decides on each sample on this thread (the edge predictor), or None;
         ``stage_commands``: the station file lets it command a final stage (when the DBC
-        and the tool controller do too: :mod:`.tool_commands`)."""
+        and the tool controller do too: :mod:`.tool_commands`); ``spindles``, its
+        ``spindle_id_stride``: a multi-spindle station's (:class:`SpindleIds`)."""
         self._decider = decider
         self.station_id = station_id
         self._unsent_samples = unsent_samples
         self._bus = bus
         self._database = database
-        self._decoder = FrameDecoder(database)
+        spindle_ids = SpindleIds(database, spindles, spindle_id_stride)
+        self._decoder = FrameDecoder(spindle_ids)
         self._outlet = outlet
         self._clock_ns = clock_ns
         self._started_ns = clock_ns()
-        self._assembler = SampleAssembler(has_force_sensor)
+        self._multi = spindles > 1
+        self._lanes = {
+            spindle: SpindleLane(
+                spindle,
+                has_force_sensor,
+                database,
+                bus,
+                stage_commands,
+                clock_ns,
+                spindle_ids.offset(spindle),
+            )
+            for spindle in range(1, spindles + 1)
+        }
+        self._sync_id: int | None = None  # the last CycleStart's (a multi-spindle system)
         self._rejected: Counter[str] = Counter()
         self._frames = 0
         self._receive_errors = 0
@@ -117,13 +143,8 @@ class Acquisition:
         run_bounds = {"run_id": can_id_bounds(database)["run_id"]}
         self._decode_decision = codec.decoder(StopDecision, run_bounds)
         self._decode_stage = codec.decoder(StageDecision, run_bounds)
-        self._commands = ToolCommands(database, bus, stage_commands, clock_ns)
-        self._run_commands = self._commands.mode
-        self._stage: tuple[ToolStageName, int] | None = None  # the running run's (stage, pulses)
         self._log_bad_decision = RateLimitedLog(LOG, logging.ERROR)
         self._log_late_decision = RateLimitedLog(LOG, logging.WARNING)
-        self._tool: ToolStatusFrame | None = None
-        self._started_runs: deque[int] = deque(maxlen=STARTED_RUNS_KEPT)
         self._repeated_runs = 0
         self._decider_errors = 0
 
@@ -154,17 +175,24 @@ class Acquisition:
             is_remote_frame=message.is_remote_frame,
         )
         if isinstance(frame, ToolSensorsFrame):
+            lane = self._lanes[frame.spindle]
             self._emit(
-                self._assembler.tool_frame(
+                lane.assembler.tool_frame(
                     frame.counter, frame.torque_nm, frame.angle_deg, time_ns, bus_timed
-                )
+                ),
+                lane,
             )
         elif isinstance(frame, JointSensorsFrame):
-            self._emit(self._assembler.joint_frame(frame.counter, frame.force_n, time_ns))
+            lane = self._lanes[frame.spindle]
+            self._emit(lane.assembler.joint_frame(frame.counter, frame.force_n, time_ns), lane)
         elif isinstance(frame, ToolStatusFrame):
-            self._tool_status(frame, time_ns)
+            self._tool_status(frame, time_ns, self._lanes[frame.spindle])
         elif isinstance(frame, ToolStageFrame):
-            self._tool_stage(frame, time_ns)
+            self._tool_stage(frame, time_ns, self._lanes[frame.spindle])
+        elif isinstance(frame, CycleStartFrame):
+            if frame.sync_id != self._sync_id:
+                LOG.info("cycle %d starts (%d spindles)", frame.sync_id, frame.spindles)
+            self._sync_id = frame.sync_id
         elif isinstance(frame, Rejected):
             self._rejected[frame.reason] += 1
             if LOG.isEnabledFor(logging.DEBUG):
@@ -172,8 +200,8 @@ class Acquisition:
         elif isinstance(frame, StopCommandFrame | StageCommandFrame):
             LOG.debug("%s from another node for run %d", type(frame).__name__, frame.run_id)
 
-    def _emit(self, samples: list[AssembledSample]) -> None:
-        run_id = self._tool.run_id if self._tool is not None else 0
+    def _emit(self, samples: list[AssembledSample], lane: SpindleLane) -> None:
+        run_id = lane.run_id
         decider = self._decider
         for assembled in samples:
             sample = Sample(
@@ -196,13 +224,13 @@ class Acquisition:
                         self.send(decision)  # before anything else: the stop path
             self._outlet.sample(sample)
 
-    def _tool_status(self, frame: ToolStatusFrame, time_ns: int) -> None:
+    def _tool_status(self, frame: ToolStatusFrame, time_ns: int, lane: SpindleLane) -> None:
         try:
             state_name = ToolRunState(frame.state).name.lower()
         except ValueError:
             self._rejected["bad_state"] += 1  # never let a corrupt state restart the run
             return
-        previous = self._tool
+        previous = lane.tool
         if previous == frame:
             return
         starts_run = frame.state == ToolRunState.RUNNING and (
@@ -210,7 +238,7 @@ class Acquisition:
             or previous.run_id != frame.run_id
             or previous.state != ToolRunState.RUNNING
         )
-        if starts_run and frame.run_id in self._started_runs:
+        if starts_run and frame.run_id in lane.started_runs:
             # a run id starts once, however its state flips: one run, one summary, one file
             self._repeated_runs += 1
             if self._repeated_runs in (1, 10, 100) or self._repeated_runs % 1000 == 0:
@@ -221,17 +249,18 @@ class Acquisition:
                 )
             return
         if previous is not None and (starts_run or frame.state != ToolRunState.RUNNING):
-            self._emit(self._assembler.finish_run())  # leftovers belong to the old run
+            self._emit(lane.assembler.finish_run(), lane)  # leftovers belong to the old run
         if starts_run:
-            self._started_runs.append(frame.run_id)
-            self._assembler.start_run()
-            self._run_commands = self._commands.run_commands()
+            lane.started_runs.append(frame.run_id)
+            lane.assembler.start_run()
+            lane.run_commands = lane.commands.run_commands()
             # a staged tool starts each run in its rundown (its ToolStage said so before)
-            self._stage = ("rundown", 0) if self._run_commands == "staged" else None
-        self._tool = frame
+            lane.stage = ("rundown", 0) if lane.run_commands == "staged" else None
+            lane.sync_id = self._sync_id
+        lane.tool = frame
         ended = frame.state in (ToolRunState.DONE, ToolRunState.ABORTED)
-        commands = self._commands
-        stage, pulses = self._stage if self._stage is not None else (None, 0)
+        commands = lane.commands
+        stage, pulses = lane.stage if lane.stage is not None else (None, 0)
         state = ToolState(
             self.station_id,
             frame.run_id,
@@ -242,18 +271,20 @@ class Acquisition:
             stop_command=(
                 commands.stopped_reason if ended and commands.stopped_run == frame.run_id else None
             ),
-            commands=self._run_commands,
+            commands=lane.run_commands,
             stage=stage if frame.state == ToolRunState.RUNNING else None,
             pulses=pulses,
+            spindle=lane.spindle if self._multi else None,
+            sync_id=lane.sync_id if self._multi else None,
         )
         self._tell(state)
         LOG.info("run %d: %s (program %d)", frame.run_id, state_name, frame.program_id)
 
-    def _tool_stage(self, frame: ToolStageFrame, time_ns: int) -> None:
+    def _tool_stage(self, frame: ToolStageFrame, time_ns: int, lane: SpindleLane) -> None:
         """A staged tool's ToolStage: its features; a new stage of the running run is a new
         ToolState (running, with the stage), told to the predictor and the line."""
-        self._commands.heard(frame)
-        tool = self._tool
+        lane.commands.heard(frame)
+        tool = lane.tool
         if tool is None or tool.state != ToolRunState.RUNNING or frame.run_id != tool.run_id:
             return  # a run's features come before its start; stale ones are no news
         try:
@@ -261,9 +292,9 @@ class Acquisition:
         except ValueError:
             self._rejected["bad_state"] += 1
             return
-        if (stage_name, frame.pulses) == self._stage:
+        if (stage_name, frame.pulses) == lane.stage:
             return
-        self._stage = (stage_name, frame.pulses)
+        lane.stage = (stage_name, frame.pulses)
         self._tell(
             ToolState(
                 self.station_id,
@@ -272,9 +303,11 @@ class Acquisition:
                 tool.program_id,
                 "running",
                 time_ns,
-                commands=self._run_commands,
+                commands=lane.run_commands,
                 stage=stage_name,
                 pulses=frame.pulses,
+                spindle=lane.spindle if self._multi else None,
+                sync_id=lane.sync_id if self._multi else None,
             )
         )
         LOG.info("run %d: %s (pulses %d)", tool.run_id, stage_name, frame.pulses)
@@ -332,9 +365,19 @@ class Acquisition:
         if decision.station != self.station_id:
             error = InputError(f"a decision of station {decision.station!r}, not of this one")
             return self._bad_decision(key or "the station's predictor", error)
+        lane = self._lane_of(decision.run_id)
         if isinstance(decision, StopDecision):
-            return self._commands.stop(decision, self._tool)
-        return self._commands.stage(decision, self._tool)
+            return lane.commands.stop(decision, lane.tool)
+        return lane.commands.stage(decision, lane.tool)
+
+    def _lane_of(self, run_id: int) -> SpindleLane:
+        """The spindle running (or that ran last) ``run_id``; spindle 1 when none did (its
+        commands count the decision late)."""
+        if self._multi:
+            for lane in self._lanes.values():
+                if lane.tool is not None and lane.tool.run_id == run_id:
+                    return lane
+        return self._lanes[1]
 
     def send_stop(self, decision: StopDecision) -> bool:
         """Send StopCommand for ``decision`` if it is for the running run; once per run."""
@@ -343,8 +386,14 @@ class Acquisition:
     # -- counters ------------------------------------------------------------------------
 
     def stats(self) -> BusStats:
-        pairing = self._assembler.counters
-        commands = self._commands
+        lanes = self._lanes.values()
+        pairing = PairingCounters()
+        for lane in lanes:
+            for name in PairingCounters.__dataclass_fields__:
+                setattr(
+                    pairing, name, getattr(pairing, name) + getattr(lane.assembler.counters, name)
+                )
+        commands = self._lanes[1].commands  # what the station may command: its spindles alike
         rejected = self._rejected
         return BusStats(
             station=self.station_id,
@@ -361,14 +410,14 @@ class Acquisition:
             counter_faults=pairing.repeated + pairing.backwards + pairing.implausible,
             unpaired=pairing.unpaired,
             orphans=pairing.orphans,
-            stop_commands=commands.stop_commands,
+            stop_commands=sum(lane.commands.stop_commands for lane in lanes),
             unsent_samples=self._unsent_samples(),
-            late_decisions=commands.late_decisions,
+            late_decisions=sum(lane.commands.late_decisions for lane in lanes),
             bad_decisions=self._bad_decisions,
             started_ns=self._started_ns,
             repeated_runs=self._repeated_runs,
             tool_commands=commands.mode,
             tool_commands_note=commands.note,
-            stage_commands=commands.stage_commands,
-            refused_stages=commands.refused_stages,
+            stage_commands=sum(lane.commands.stage_commands for lane in lanes),
+            refused_stages=sum(lane.commands.refused_stages for lane in lanes),
         )

@@ -88,7 +88,11 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
         wait = not station.config.spool.enabled
         session = skeleton.open_session(station.config.zenoh, wait_for_router=wait)
         publisher = QueuedPublisher(
-            session, station_id, batch_samples=edge, spool=station_spool(station, "acquisition")
+            session,
+            station_id,
+            batch_samples=edge,
+            spool=station_spool(station, "acquisition"),
+            runs_at_once=station.config.station.spindles,
         )
         skeleton.on_stop(Stop.OUTPUT, publisher.close)
         outlet = ZenohOutlet(session, publisher)
@@ -106,6 +110,8 @@ def main(args: argparse.Namespace, decider_factory: DeciderFactory | None = None
             unsent_samples=lambda: outlet.unsent_samples,
             decider=decider,
             stage_commands=station.config.can.tool_commands == "auto",
+            spindles=station.config.station.spindles,
+            spindle_id_stride=station.config.can.spindle_id_stride,
         )
         if not edge:
             skeleton.subscriber(channels.DECISION.key(station_id), decision_handler(acquisition))

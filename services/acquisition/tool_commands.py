@@ -56,9 +56,13 @@ class ToolCommands:
         bus: can.BusABC,
         allowed: bool,
         clock_ns: Callable[[], int],
+        id_offset: int = 0,
     ) -> None:
-        """``allowed``: the station file lets the station command a final stage."""
+        """``allowed``: the station file lets the station command a final stage;
+        ``id_offset``: what this spindle's ids add to the DBC's (a multi-spindle station's
+        spindle: :class:`~shared.contract.SpindleIds`)."""
         self._database = database
+        self._id_offset = id_offset
         self._bus = bus
         self._allowed = allowed
         self._clock_ns = clock_ns
@@ -165,7 +169,8 @@ class ToolCommands:
 
     def _send_stop(self, run_id: int, reason: int) -> bool:
         data = self._database.encode("StopCommand", {"RunId": run_id, "Reason": reason})
-        if not self._send("StopCommand", self._database.stop_command_id, data, run_id):
+        frame_id = self._database.stop_command_id + self._id_offset
+        if not self._send("StopCommand", frame_id, data, run_id):
             return False
         self.stop_commands += 1
         return True
@@ -182,7 +187,7 @@ class ToolCommands:
             else int(StageReason.UNSPECIFIED),
         }
         data = self._database.encode("StageCommand", signals)
-        return self._send("StageCommand", frame_id, data, decision.run_id)
+        return self._send("StageCommand", frame_id + self._id_offset, data, decision.run_id)
 
     def _send(self, name: str, frame_id: int, data: bytes, run_id: int) -> bool:
         message = can.Message(

@@ -7,12 +7,14 @@ when no result arrived for the run. The last column, ``part``, is the part
 the result names (the id the line scanned before the run, a controller's
 VIN), left-aligned as ids are read; ``-`` when it names none. A run whose
 final stage gave pulses back to the target says so after its stop reason
-(``target_reached+pulse``, ``+2pulses``).
+(``target_reached+pulse``, ``+2pulses``). A multi-spindle station's rows
+say each run's spindle after its run id (``spindles``), and the totals its
+cycles' common results.
 """
 
 from __future__ import annotations
 
-from shared.contract import BridgeStats, RunSummary, TighteningResult
+from shared.contract import BridgeStats, CycleResult, RunSummary, TighteningResult
 
 COLUMNS = (
     ("run", 10),
@@ -31,17 +33,27 @@ PART_TITLE = "part"
 
 
 STATION_WIDTH = 8
+#: the spindle column of a multi-spindle station, after the run
+SPINDLE_COLUMN = ("spindle", 7)
 
 
-def header(station_column: bool = False) -> str:
-    line = "  ".join(f"{title:>{width}}" for title, width in COLUMNS) + f"  {PART_TITLE}"
+def _columns(spindles: bool) -> tuple[tuple[str, int], ...]:
+    return (COLUMNS[0], SPINDLE_COLUMN, *COLUMNS[1:]) if spindles else COLUMNS
+
+
+def header(station_column: bool = False, spindles: bool = False) -> str:
+    columns = _columns(spindles)
+    line = "  ".join(f"{title:>{width}}" for title, width in columns) + f"  {PART_TITLE}"
     if station_column:
         line = f"{'station':>{STATION_WIDTH}}  {line}"
     return f"{line}\n{'-' * len(line)}"
 
 
 def row(
-    summary: RunSummary, station_column: bool = False, result: TighteningResult | None = None
+    summary: RunSummary,
+    station_column: bool = False,
+    result: TighteningResult | None = None,
+    spindles: bool = False,
 ) -> str:
     if summary.target_force_n is not None:
         target = f"{summary.target_force_n / 1000:.2f} kN"
@@ -53,7 +65,7 @@ def row(
     reason = summary.stop_reason or f"tool ({summary.tool_state})"
     if summary.pulses:  # a final stage's pulses back to the target
         reason += "+pulse" if summary.pulses == 1 else f"+{summary.pulses}pulses"
-    cells = (
+    cells: tuple[str, ...] = (
         str(summary.run_id),
         str(summary.program_id),
         target,
@@ -65,7 +77,10 @@ def row(
         f"{summary.process_intensity:.3g}",
         str(summary.samples),
     )
-    line = "  ".join(f"{cell:>{width}}" for cell, (_, width) in zip(cells, COLUMNS, strict=True))
+    if spindles:
+        cells = (cells[0], "-" if summary.spindle is None else str(summary.spindle), *cells[1:])
+    columns = _columns(spindles)
+    line = "  ".join(f"{cell:>{width}}" for cell, (_, width) in zip(cells, columns, strict=True))
     part = result.part_id if result is not None and result.part_id else "-"
     line = f"{line}  {part}"
     return f"{summary.station:>{STATION_WIDTH}}  {line}" if station_column else line
@@ -75,8 +90,13 @@ def _kilo(value: float | None, unit: str) -> str:
     return "-" if value is None else f"{value / 1000:.2f} {unit}"
 
 
-def totals(summaries: list[RunSummary], results: list[TighteningResult] | None = None) -> str:
-    """One line: runs, mean and worst |error|, how many were OK and NOK, on how many parts."""
+def totals(
+    summaries: list[RunSummary],
+    results: list[TighteningResult] | None = None,
+    cycles: list[CycleResult] | None = None,
+) -> str:
+    """One line: runs, mean and worst |error|, how many were OK and NOK, on how many parts
+    (a multi-spindle station: its cycles, how many were OK and NOK)."""
     errors = [abs(s.error_pct) for s in summaries if s.error_pct is not None]
     line = f"{len(summaries)} runs"
     if errors:
@@ -89,6 +109,9 @@ def totals(summaries: list[RunSummary], results: list[TighteningResult] | None =
         parts = {result.part_id for result in results if result.part_id}
         if parts:
             line += f", {len(parts)} part{'s' if len(parts) != 1 else ''}"
+    if cycles:
+        nok = sum(1 for cycle in cycles if cycle.result == "NOK")
+        line += f"; {len(cycles)} cycles, {len(cycles) - nok} OK, {nok} NOK"
     staged = [s for s in summaries if s.commands == "staged"]
     if staged:
         pulsed = sum(1 for s in staged if s.pulses)

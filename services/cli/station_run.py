@@ -15,6 +15,10 @@ With ``controller="openprotocol"`` (one station) the rig is an Open Protocol
 controller on TCP and the bridge (``serve openprotocol``) stands in for the
 acquisition and the predictor; ``openprotocol`` (``BridgeStats``) gives the
 counters of the report's last lines.
+
+A multi-spindle station's ``--runs`` are cycles: it waits for a summary of
+every spindle's run of each, shows each run's spindle, and counts the cycles'
+common results (``cycles``) in the totals.
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ from shared.config import LoadedStation, Program
 from shared.contract import (
     BridgeStats,
     BusStats,
+    CycleResult,
     RunSummary,
     TighteningResult,
     ToolState,
@@ -80,12 +85,17 @@ class StationRun:
         self.runs = runs
         self.startup_timeout_s = startup_timeout_s
         self.line = len(self.stations) > 1
+        #: a multi-spindle station's spindles: each of ``runs`` is a cycle of a run each
+        self.spindles = self.station.config.station.spindles
+        self.expected_runs = runs * self.spindles
         self.supervisor = StationSupervisor([s.path for s in self.stations], log_dir)
         self.tally = RunTally(s.station_id for s in self.stations)
         self.bus_stats: dict[str, BusStats] = {}
         self.bridge_stats: dict[str, BridgeStats] = {}
         #: (station, run id) -> the run's result (its OK/NOK), as heard on its results key
         self.results: dict[tuple[str, int], TighteningResult] = {}
+        #: (station, sync id) -> a multi-spindle cycle's common result
+        self.cycles: dict[tuple[str, int], CycleResult] = {}
         self.started_s = time.time()
         self._session: zenoh.Session | None = None
         self._stopped = False
@@ -133,6 +143,7 @@ class StationRun:
                 channels.TOOL.topic,
                 channels.RESULTS.topic,
                 channels.RUNS.topic,
+                channels.CYCLES.topic,
                 channels.BUS.topic,
                 channels.OPENPROTOCOL.topic,
             )  # a run's start and its result before its summary
@@ -146,7 +157,7 @@ class StationRun:
             self.supervisor.start(station_service, name=name, config_paths=[station.path])
         self._wait_until_alive()
         print(f"services up after {time.time() - self.started_s:.1f} s; tightening...\n")
-        print(run_table.header(self.line))
+        print(run_table.header(self.line, self.multi_spindle))
         rig_args = ["--runs", str(self.runs), "--program", str(self.program.id)]
         if self.controller == "openprotocol":
             rig_args += ["--controller", "openprotocol", "--wait-for-integrator"]
@@ -182,14 +193,18 @@ class StationRun:
         self.report()
         return 0 if self._every_station_has_its_runs() and not self.unrecorded else 1
 
+    @property
+    def multi_spindle(self) -> bool:
+        return self.spindles > 1
+
     def _every_station_has_its_runs(self) -> bool:
-        return all(len(runs) >= self.runs for runs in self.summaries.values())
+        return all(len(runs) >= self.expected_runs for runs in self.summaries.values())
 
     def _count_note(self) -> str:
         if not self.line:
-            return f"{len(self.summaries[self.station.station_id])} of {self.runs}"
+            return f"{len(self.summaries[self.station.station_id])} of {self.expected_runs}"
         return ", ".join(
-            f"{station_id} {len(runs)} of {self.runs}"
+            f"{station_id} {len(runs)} of {self.expected_runs}"
             for station_id, runs in self.summaries.items()
         )
 
@@ -202,6 +217,11 @@ class StationRun:
                 f"{self.runs} runs each"
             )
             print(f"station files: {self.station.path.parent}")
+        elif self.multi_spindle:
+            print(
+                f"boltwatch up: station {self.station.station_id} of {self.spindles} spindles, "
+                f"{program}, {self.runs} cycles ({self.expected_runs} runs)"
+            )
         else:
             print(f"boltwatch up: station {self.station.station_id}, {program}, {self.runs} runs")
         print(f"logs: {self.supervisor.log_dir}")
@@ -256,27 +276,37 @@ class StationRun:
             if station_id not in self.summaries:
                 continue  # another station on the same router: not ours to report
             try:
-                if topic == channels.TOOL.topic:
-                    self.tally.tool_state(station_id, decode(ToolState, sample.payload.to_bytes()))
-                elif topic == channels.RESULTS.topic:
-                    result = decode(TighteningResult, sample.payload.to_bytes())
-                    if result.station == station_id:
-                        self.results[(station_id, result.run_id)] = result
-                elif topic == channels.RUNS.topic:
-                    summary = decode(RunSummary, sample.payload.to_bytes())
-                    if self.tally.summary(station_id, summary):
-                        print(self._row(summary), flush=True)
-                elif topic == channels.BUS.topic:
-                    self.bus_stats[station_id] = decode(BusStats, sample.payload.to_bytes())
-                elif topic == channels.OPENPROTOCOL.topic:
-                    stats = decode(BridgeStats, sample.payload.to_bytes())
-                    self.bridge_stats[station_id] = stats
+                self._heard(station_id, topic, sample.payload.to_bytes())
             except BoltwatchError as err:
                 LOG.warning("unreadable %s message: %s", topic, err)
 
+    def _heard(self, station_id: str, topic: str, payload: bytes) -> None:
+        """One message of a station ``up`` watches, on ``topic``."""
+        if topic == channels.TOOL.topic:
+            self.tally.tool_state(station_id, decode(ToolState, payload))
+        elif topic == channels.RESULTS.topic:
+            result = decode(TighteningResult, payload)
+            if result.station == station_id:
+                self.results[(station_id, result.run_id)] = result
+        elif topic == channels.CYCLES.topic:
+            cycle = decode(CycleResult, payload)
+            if cycle.station == station_id:
+                self.cycles[(station_id, cycle.sync_id)] = cycle
+        elif topic == channels.RUNS.topic:
+            summary = decode(RunSummary, payload)
+            if self.tally.summary(station_id, summary):
+                print(self._row(summary), flush=True)
+        elif topic == channels.BUS.topic:
+            self.bus_stats[station_id] = decode(BusStats, payload)
+        elif topic == channels.OPENPROTOCOL.topic:
+            self.bridge_stats[station_id] = decode(BridgeStats, payload)
+
     def _row(self, summary: RunSummary) -> str:
         return run_table.row(
-            summary, self.line, self.results.get((summary.station, summary.run_id))
+            summary,
+            self.line,
+            self.results.get((summary.station, summary.run_id)),
+            self.multi_spindle,
         )
 
     def _check_alive(self, expected_exits: set[str]) -> None:
@@ -306,7 +336,7 @@ class StationRun:
         print()
         every_summary = [s for runs in self.summaries.values() for s in runs]
         if every_summary:
-            print(run_table.header(self.line))
+            print(run_table.header(self.line, self.multi_spindle))
             for summary in every_summary:
                 print(self._row(summary))
             results = [
@@ -314,7 +344,7 @@ class StationRun:
                 for s in every_summary
                 if (result := self.results.get((s.station, s.run_id))) is not None
             ]
-            print(run_table.totals(every_summary, results))
+            print(run_table.totals(every_summary, results, list(self.cycles.values())))
         left_out = self.tally.note()
         if left_out is not None:
             print(left_out)

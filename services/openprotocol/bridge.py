@@ -28,6 +28,11 @@ never the bridge.
 
 Tightenings go out through :mod:`.tightening_flow`; tool data (0041) on
 ``tool_data``, alarms (0071, 0074, 0076) on ``alarms`` (:mod:`.controller_reports`).
+A multi-spindle system (``[openprotocol] multi_spindle``, or a CAN station file of
+several spindles) is subscribed to its multi-spindle result (0100, at the highest
+revision it takes, one lower on error 97) and status (0090); each 0101 and 0091
+is acknowledged at once (0102, 0092) and makes the cycle's common result on
+``cycles`` (:mod:`.controller_cycles`).
 """
 
 from __future__ import annotations
@@ -40,6 +45,7 @@ from pathlib import Path
 from typing import Any
 
 from services.openprotocol.bridge_counts import BridgeCounts
+from services.openprotocol.controller_cycles import ControllerCycles
 from services.openprotocol.controller_link import ControllerLink, LinkLostError
 from services.openprotocol.controller_reports import ControllerReports
 from services.openprotocol.controller_session import (
@@ -48,7 +54,12 @@ from services.openprotocol.controller_session import (
     SessionStoppedError,
 )
 from services.openprotocol.published_ids import BridgePosition
-from services.openprotocol.result_reading import CurveRefusedError, read_curve, read_result
+from services.openprotocol.result_reading import (
+    CurveRefusedError,
+    controller_time_ns,
+    read_curve,
+    read_result,
+)
 from services.openprotocol.tightening_flow import TighteningFlow
 from shared.config import AnyStation, OpenProtocolSection
 from shared.openprotocol import (
@@ -59,6 +70,12 @@ from shared.openprotocol import (
     DataSubscribe,
     Dialect,
     LastTighteningResult,
+    MultiSpindleResult,
+    MultiSpindleResultAcknowledge,
+    MultiSpindleResultSubscribe,
+    MultiSpindleStatus,
+    MultiSpindleStatusAcknowledge,
+    MultiSpindleStatusSubscribe,
     OldResultRequest,
     OldTighteningResult,
     OpenProtocolError,
@@ -77,6 +94,10 @@ POLL_S = 0.05
 OLD_RESULT = 65
 #: 0004 error code: tightening id not found (0064 id 0 on a controller with no result yet)
 NOT_FOUND = 15
+#: the MID of the multi-spindle result, whose revision its subscription (0100) asks
+CYCLE_RESULT = 101
+#: how much longer than a tightening's curves a cycle waits for its spindles' tightenings
+CYCLE_MARGIN_S = 2.0
 #: what one message that cannot be used raises (beyond the codec's own refusal)
 UNUSABLE = (OpenProtocolError, CurveRefusedError, ValueError, OverflowError, ArithmeticError)
 
@@ -99,6 +120,13 @@ class OpenProtocolBridge:
         self._section = section
         self._publish = publish
         self._counts = counts
+        spindles = getattr(station.config.station, "spindles", 1)
+        #: a multi-spindle system's cycles (None: a controller of one spindle)
+        self._cycles = (
+            ControllerCycles(station.station_id, publish, trace_timeout_s + CYCLE_MARGIN_S, clock)
+            if section.multi_spindle or spindles > 1
+            else None
+        )
         self._dialect = Dialect(
             header_fill="space" if section.header_fill == "spaces" else "zero",
             trace_byte_order="little" if section.trace_byte_order == "little" else "big",
@@ -112,6 +140,7 @@ class OpenProtocolBridge:
             trace_timeout_s,
             counts,
             clock,
+            on_result=None if self._cycles is None else self._cycles.on_tightening,
         )
         self._reports = ControllerReports(
             station.station_id, station.config.station.tool_id, section.timezone
@@ -186,6 +215,10 @@ class OpenProtocolBridge:
         self._counts.result_revision = revision
         if section.traces:
             session.subscribe(_trace_subscription, 1)
+        if self._cycles is not None:
+            highest = max(SUPPORTED_REVISIONS[CYCLE_RESULT])
+            session.subscribe(_cycle_subscription, highest)
+            session.subscribe(lambda rev: MultiSpindleStatusSubscribe(revision=rev), 1)
         self._reports.subscribe(session, self._publish, self._counts)
         if newest is not None:
             self._take_newest(newest)
@@ -210,6 +243,8 @@ class OpenProtocolBridge:
                 self._catch_up(session)
             self._fill(session)
             self._flow.publish_ready()
+            if self._cycles is not None:
+                self._cycles.publish_ready()
             # tool data again after each tightening (its counters moved) and every minute:
             # a recorder that was not listening at the connect gets it all the same
             now_s = time.monotonic()
@@ -367,6 +402,8 @@ class OpenProtocolBridge:
                 self._ask_newest = True  # the newest id shows the gap, the last one too
             elif session is not None and message.frame.mid == TraceCurve.MID:
                 session.send(CommandAccepted(mid=TraceCurve.MID))
+        elif isinstance(message, MultiSpindleResult | MultiSpindleStatus):
+            self._cycle(message)
         elif isinstance(message, TraceCurve):
             if session is not None:
                 session.send(CommandAccepted(mid=TraceCurve.MID))  # a pushed 0900's receipt
@@ -381,6 +418,22 @@ class OpenProtocolBridge:
         elif session is not None:
             self._reports.pushed(message, session, self._publish, self._counts)
 
+    def _cycle(self, message: MultiSpindleResult | MultiSpindleStatus) -> None:
+        """A multi-spindle system's cycle: acknowledged at once, then made a cycle."""
+        session, cycles = self._session, self._cycles
+        result = isinstance(message, MultiSpindleResult)
+        if session is not None:
+            ack = MultiSpindleResultAcknowledge() if result else MultiSpindleStatusAcknowledge()
+            session.send(ack)
+        if cycles is None:
+            return  # not asked for: acknowledged, nothing made of it
+        text = message.timestamp if isinstance(message, MultiSpindleResult) else message.time
+        time_ns, _ = controller_time_ns(text, self._section.timezone, time.time_ns())
+        if isinstance(message, MultiSpindleResult):
+            cycles.on_result(message, time_ns)
+        else:
+            cycles.on_status(message, time_ns)
+
     def _live_result(self, message: LastTighteningResult) -> None:
         self._flow.take_result(read_result(message, self._section.timezone, False, time.time_ns()))
 
@@ -388,6 +441,16 @@ class OpenProtocolBridge:
         mid = getattr(message, "MID", 0)
         self._counts.refused_values += 1
         self._counts.fault("refused value", f"MID {mid:04d} cannot be used: {err}: ignored")
+
+
+def _cycle_subscription(revision: int) -> MultiSpindleResultSubscribe:
+    """0100 at ``revision`` (the 0101 revision asked): from revision 2 on, no rewind (0) and,
+    from 3 on, only the cycles made from now (the bridge takes what it hears live)."""
+    return MultiSpindleResultSubscribe(
+        data_no_system=0 if revision >= 2 else None,
+        send_only_new=True if revision >= 3 else None,
+        revision=revision,
+    )
 
 
 def _trace_subscription(revision: int) -> DataSubscribe:

@@ -46,6 +46,11 @@ class ResultFigures:
     #: the controller's time stamp was one no clock holds (before 2000, or ahead of the
     #: bridge's): ``time_ns`` is when the bridge received it instead
     clock_refused: bool = False
+    #: a multi-spindle system's tightening (a sync tightening id other than 0, 0061 and 0065
+    #: revision 2): the cycle's sync id, and the spindle: its channel id (a 0061's; a 0065
+    #: carries none: None)
+    sync_id: int | None = None
+    spindle: int | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -6,7 +6,9 @@
   batch counter from either; limits and targets only from a 0061 (a 0065
   carries none: a fetched result is judged by the controller's own verdict). A
   window the controller leaves at 0 on both sides (min 0, max 0) is no window;
-  a target of 0 is no target.
+  a target of 0 is no target. A result with a sync tightening id (revision 2,
+  other than 0) is a multi-spindle system's spindle's: its channel id (0061)
+  is its spindle.
 - :func:`read_curve`: a :class:`TraceCurve` (0900) of torque or angle into a
   :class:`Curve` (None for another trace type: current, ...); a curve without a
   time step, or with one no controller samples at, is refused
@@ -78,6 +80,7 @@ def read_result(message: Any, timezone: str, filled: bool, now_ns: int) -> Resul
     time_ns, clock_ok = controller_time_ns(message.timestamp, timezone, now_ns)
     torque_window = _window(message, "torque_min_nm", "torque_max_nm") if full else (None, None)
     angle_window = _window(message, "angle_min_deg", "angle_max_deg") if full else (None, None)
+    sync_id = getattr(message, "sync_tightening_id", None)  # revision 2 on
     return ResultFigures(
         tightening_id=message.tightening_id,
         program_id=message.pset_id,
@@ -99,6 +102,8 @@ def read_result(message: Any, timezone: str, filled: bool, now_ns: int) -> Resul
         filled=filled,
         key=result_key(message),
         clock_refused=not clock_ok,
+        sync_id=sync_id or None,
+        spindle=(message.channel_id or None) if full and sync_id else None,
     )
 
 

@@ -41,7 +41,7 @@ from shared.config import (
     OpenProtocolSection,
     Program,
 )
-from shared.contract import INT64_MAX
+from shared.contract import INT64_MAX, TighteningResult
 from shared.quality import Window
 
 LOG = logging.getLogger(__name__)
@@ -60,8 +60,11 @@ class TighteningFlow:
         trace_timeout_s: float,
         counts: BridgeCounts,
         clock: Callable[[], float] = time.monotonic,
+        on_result: Callable[[TighteningResult], None] | None = None,
     ) -> None:
-        """``after_published(f)``: call ``f`` once what is published so far was put."""
+        """``after_published(f)``: call ``f`` once what is published so far was put;
+        ``on_result``: told each TighteningResult published (a multi-spindle cycle's)."""
+        self._on_result = on_result
         self._station = station
         self._section = section
         self._publish = publish
@@ -248,13 +251,15 @@ class TighteningFlow:
                     windows[figure] = program.window(figure)
         for message in tightening_messages(
             station.station_id,
-            station.config.station.tool_id,
+            station.config.station.tool_of(result.spindle),  # a spindle: its own tool
             run_id,
             tightening,
             program_name,
             windows,
         ):
             self._publish(message)
+            if self._on_result is not None and isinstance(message, TighteningResult):
+                self._on_result(message)
         counts = self._counts
         counts.results += 1
         counts.results_filled += int(result.filled)

@@ -26,10 +26,14 @@ too):
    gives one (the station's pset, else the controller's pset as its last 0061
    said: :mod:`.tightening_flow`), else against the result's own limits;
 7. ``runs``: the replay's :class:`RunSummary` (stop reason None).
+
+A multi-spindle system's tightening (:attr:`ResultFigures.sync_id`) names its
+spindle and sync id in its states, result and summary.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -101,8 +105,18 @@ def tightening_messages(
     run, samples = stopped_run(station, tool_id, run_id, tightening)
     replayed = replay_run(run)
     result = tightening.result
+    spindle, sync_id = result.spindle, result.sync_id
     messages: list[Any] = [
-        ToolState(station, run_id, tool_id, result.program_id, "running", run.started_ns)
+        ToolState(
+            station,
+            run_id,
+            tool_id,
+            result.program_id,
+            "running",
+            run.started_ns,
+            spindle=spindle,
+            sync_id=sync_id,
+        )
     ]
     outputs = replayed.outputs
     next_output = 0
@@ -112,20 +126,30 @@ def tightening_messages(
             messages.append(outputs[next_output][2])
             next_output += 1
     messages += [message for _, _, message in outputs[next_output:]]
-    messages.append(ToolState(station, run_id, tool_id, result.program_id, "done", run.ended_ns))
-    controller = controller_message(station, tool_id, run_id, result, run.ended_ns, len(samples))
-    messages.append(controller)
     messages.append(
-        controller_result(
-            controller,
-            replayed.summary,
-            program_name,
-            "controller",
-            result.tightening_id,
-            windows,
+        ToolState(
+            station,
+            run_id,
+            tool_id,
+            result.program_id,
+            "done",
+            run.ended_ns,
+            spindle=spindle,
+            sync_id=sync_id,
         )
     )
-    messages.append(replayed.summary)
+    controller = controller_message(station, tool_id, run_id, result, run.ended_ns, len(samples))
+    messages.append(controller)
+    judged = controller_result(
+        controller,
+        replayed.summary,
+        program_name,
+        "controller",
+        result.tightening_id,
+        windows,
+    )
+    messages.append(dataclasses.replace(judged, spindle=spindle, sync_id=sync_id))
+    messages.append(dataclasses.replace(replayed.summary, spindle=spindle, sync_id=sync_id))
     return messages
 
 

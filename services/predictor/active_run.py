@@ -177,4 +177,6 @@ class ActiveRun:
             commands=self._commands(),
             final_stage_s=final.switched_at_s if final is not None else None,
             pulses=max(self.tool_pulses, end.pulses),
+            spindle=self.state.spindle,
+            sync_id=self.state.sync_id,
         )

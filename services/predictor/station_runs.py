@@ -10,7 +10,13 @@ predictor (:mod:`.service`, fed from zenoh) and the edge predictor
   flips (counted in :attr:`repeated_runs`); a ``running`` of a run under way
   is a staged tool's new stage (it halted: ``holding``);
 - a new run of the station ends its older ones, unheard (their ``done`` was
-  lost in an outage: counted in :attr:`unfinished_runs`, no summary);
+  lost in an outage: counted in :attr:`unfinished_runs`, no summary); on a
+  multi-spindle station a new run ends the older ones of its own spindle only
+  (the spindles of a cycle run at once);
+- a multi-spindle station's runs are tallied by cycle (``ToolState.sync_id``):
+  the cycle's :class:`~shared.contract.CycleResult` (OK only when every spindle
+  is: :mod:`shared.quality.cycle_result`) after its last spindle's summary, or
+  when a run of the next cycle starts before every spindle's result came;
 - ``done`` / ``aborted`` ends a run: its :class:`TighteningResult` (the summary
   judged against the program's windows: :mod:`shared.quality.run_result`), then its
   :class:`RunSummary`;
@@ -41,6 +47,7 @@ from services.predictor.active_run import ActiveRun, Outgoing
 from services.predictor.served_station import ServedStation
 from services.predictor.station_counts import StationCounts
 from shared.contract import (
+    CycleResult,
     PartScan,
     PartSource,
     RunSummary,
@@ -48,7 +55,7 @@ from shared.contract import (
     TighteningResult,
     ToolState,
 )
-from shared.quality import tightening_result
+from shared.quality import CycleTally, tightening_result
 from shared.runtime import RateLimitedLog
 
 LOG = logging.getLogger(__name__)
@@ -69,19 +76,23 @@ class StationRuns:
         #: the edge predictor's CAN thread reads it while a zenoh thread sets it)
         self._part: tuple[str | None, PartSource] = (None, "unknown")
         self._part_set = threading.Lock()  # between the two that set it: a scan, the line
+        self._cycles = CycleTally(served.station_id, served.station.config.station.spindles)
         self._log_no_program = RateLimitedLog(LOG, logging.ERROR)
         self._log_unfinished = RateLimitedLog(LOG)
 
-    def on_tool(self, state: ToolState) -> list[TighteningResult | RunSummary]:
+    def on_tool(self, state: ToolState) -> list[TighteningResult | RunSummary | CycleResult]:
         """A run state of the station; when it ended a run, the run's result and summary
-        (in the order to publish them: a summary's reader finds the result already there)."""
+        (in the order to publish them: a summary's reader finds the result already there),
+        then its cycle's common result when it was the cycle's last (a multi-spindle
+        station); a run that starts a cycle: the common result of one left incomplete."""
         if state.state == "running":
             run = self._runs.get(state.run_id)
             if run is not None:  # a staged tool's new stage (ToolStage), in the same run
                 run.on_tool_stage(state)
-            else:
-                self._start(state)
-            return []
+                return []
+            if not self._start(state):
+                return []
+            return list(self._cycles.on_start(state))
         if state.state not in ("done", "aborted"):
             return []
         run = self._runs.pop(state.run_id, None)
@@ -103,7 +114,8 @@ class StationRuns:
             f"{summary.error_pct:.2f}" if summary.error_pct is not None else "-",
             run.core.input_report.as_dict(),
         )
-        return [result, summary]
+        cycle = self._cycles.on_result(result)
+        return [result, summary] if cycle is None else [result, summary, cycle]
 
     @property
     def part_id(self) -> str | None:
@@ -150,19 +162,20 @@ class StationRuns:
             return []
         return run.on_sample(sample, wall_ns)
 
-    def _start(self, state: ToolState) -> None:
+    def _start(self, state: ToolState) -> bool:
+        """A run starts (False: none did: its id started before)."""
         if state.run_id in self._runs:
-            return
+            return False
         if state.run_id in self._started:  # a run id starts once, however its state flips
             self.counts.repeated_runs += 1
-            return
+            return False
         self._started.append(state.run_id)
-        self._forget_unfinished_runs()
+        self._forget_unfinished_runs(state.spindle)
         try:
             program = self.served.program(state.program_id)
         except KeyError as err:
             self._log_no_program("run %s: %s; not predicting this run", state.run_id, err.args[0])
-            return
+            return True
         part_id, part_source = self._part  # read once: an edge predictor's scans come on
         # another thread
         settings = self.served.settings(program, state.commands or "stop")
@@ -174,10 +187,14 @@ class StationRuns:
             program.id,
             part_id or "-",
         )
+        return True
 
-    def _forget_unfinished_runs(self) -> None:
-        """A new run starts: the older ones have ended, unheard (an outage)."""
+    def _forget_unfinished_runs(self, spindle: int | None) -> None:
+        """A new run of ``spindle`` starts: the older ones of that spindle have ended, unheard
+        (an outage)."""
         for run_id, run in list(self._runs.items()):
+            if run.state.spindle != spindle:
+                continue  # another spindle's run of the cycle: under way beside it
             del self._runs[run_id]
             self.counts.unfinished_runs += 1
             self.counts.run_ended(run.core.input_report)

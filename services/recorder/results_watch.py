@@ -2,7 +2,8 @@
 (:mod:`shared.results`), on a thread of its own.
 
 The recorder's worker hands each result over (:meth:`ResultsWatch.on_result`,
-with the file it went into) and goes on: a slow or unreachable database (a
+with the file it went into; a multi-spindle cycle's common result:
+:meth:`ResultsWatch.on_cycle`) and goes on: a slow or unreachable database (a
 plant's PostgreSQL across the network) never holds up the recording. A
 result is given to the writer (:meth:`ResultsWatch.release`) once the
 recorder has flushed its station's files, so the store never holds a result
@@ -37,7 +38,7 @@ from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from shared.config import StationPlace
-from shared.contract import RunSummary, TighteningResult
+from shared.contract import CycleResult, RunSummary, TighteningResult
 from shared.recordings import loop_lines
 from shared.results import ResultsStore, StoredResult, StoreError, StoreTarget, stored_result
 from shared.results.recordings_reading import fill_from_recordings, station_recordings
@@ -77,9 +78,10 @@ class ResultsWatch:
         self._host = host
         self._open_store = open_store
         self._store: ResultsStore | None = None
-        self._waiting: deque[StoredResult] = deque()
+        #: results, and a multi-spindle station's cycles' common results, in the order filed
+        self._waiting: deque[StoredResult | CycleResult] = deque()
         #: filed, their files not flushed yet (the recorder's thread only)
-        self._unflushed: list[StoredResult] = []
+        self._unflushed: list[StoredResult | CycleResult] = []
         self._summaries: OrderedDict[tuple[str, int], RunSummary] = OrderedDict()
         self._lock = threading.Lock()
         self._wake = threading.Event()
@@ -129,9 +131,16 @@ class ResultsWatch:
             )
         )
 
+    def on_cycle(self, cycle: CycleResult) -> None:
+        """A filed multi-spindle cycle's common result, stored after :meth:`release`."""
+        self._unflushed.append(cycle)
+
     def unflushed_stations(self) -> set[str]:
         """The stations whose filed results wait for their files to be flushed."""
-        return {stored.result.station for stored in self._unflushed}
+        return {
+            filed.station if isinstance(filed, CycleResult) else filed.result.station
+            for filed in self._unflushed
+        }
 
     def release(self) -> None:
         """The files of every result filed so far are flushed: to the writer with them."""
@@ -140,7 +149,7 @@ class ResultsWatch:
         self._unflushed.clear()
         self._wake.set()
 
-    def _wait(self, stored: StoredResult) -> None:
+    def _wait(self, stored: StoredResult | CycleResult) -> None:
         with self._lock:
             if len(self._waiting) >= WAITING_LIMIT:
                 self._waiting.popleft()
@@ -196,12 +205,16 @@ class ResultsWatch:
                 if not batch:
                     break
                 refused: list[str] = []
-                new = store.add(batch, refused)
+                results = [filed for filed in batch if isinstance(filed, StoredResult)]
+                cycles = [filed for filed in batch if isinstance(filed, CycleResult)]
+                new = store.add(results, refused)
+                if cycles:
+                    store.add_cycles(cycles, time.time_ns())
                 with self._lock:
                     for _ in batch:
                         self._waiting.popleft()
                 self.stored += new
-                self.repeated += len(batch) - new - len(refused)
+                self.repeated += len(results) - new - len(refused)
                 self.refused += len(refused)
                 self._name_refused(refused)
         except StoreError as err:

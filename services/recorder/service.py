@@ -360,6 +360,9 @@ class RecorderService:
                 self.quality.on_result(message)
             if self.results is not None:
                 self.results.on_result(message, recording, now_ns)
+        elif schema == channels.CYCLES.schema_name:
+            if self.results is not None:
+                self.results.on_cycle(message)
         elif schema == channels.RUNS.schema_name:
             if self.results is not None:
                 self.results.on_summary(message)

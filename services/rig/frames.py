@@ -26,10 +26,13 @@ from shared.contract import (
 
 
 class RigFrames:
-    """Builds the rig's outgoing frames and reads incoming StopCommands."""
+    """Builds the rig's outgoing frames and reads incoming StopCommands (of one spindle: a
+    multi-spindle system's spindle k at the DBC's ids plus ``id_offset``, (k - 1) times the
+    station's stride: :class:`~shared.contract.SpindleIds`)."""
 
-    def __init__(self, database: StationDatabase) -> None:
+    def __init__(self, database: StationDatabase, id_offset: int = 0) -> None:
         self._database = database
+        self._offset = id_offset
         sensor_range = SensorRange.of_database(database)
         self._torque_nm = sensor_range.torque_nm
         self._angle_deg = sensor_range.angle_deg
@@ -41,9 +44,13 @@ class RigFrames:
         #: the DBC has the final stage's messages (the rig may run one)
         self.has_stages = database.has_stages
 
+    @property
+    def database(self) -> StationDatabase:
+        return self._database
+
     def _message(self, name: str, frame_id: int, signals: dict[str, float | int]) -> can.Message:
         return can.Message(
-            arbitration_id=frame_id,
+            arbitration_id=frame_id + self._offset,
             data=self._database.encode(name, signals),
             is_extended_id=self._extended[name],
         )
@@ -93,24 +100,37 @@ class RigFrames:
             },
         )
 
+    def cycle_start(self, sync_id: int, spindles: int) -> can.Message:
+        """CycleStart of a multi-spindle system: the station's own, at the DBC's id."""
+        frame_id = self._database.cycle_start_id
+        assert frame_id is not None  # only with a DBC that has it (has_cycles)
+        return can.Message(
+            arbitration_id=frame_id,
+            data=self._database.encode("CycleStart", {"SyncId": sync_id, "Spindles": spindles}),
+            is_extended_id=self._database.is_extended("CycleStart"),
+        )
+
     def stage_command(self, message: can.Message) -> tuple[int, StageCommandCode] | None:
         """(RunId, Command) of a StageCommand frame; None for any other or malformed frame,
         and for a command this controller does not know."""
         frame_id = self._database.stage_command_id
-        if frame_id is None or message.arbitration_id != frame_id or message.is_error_frame:
+        if frame_id is None or message.arbitration_id != frame_id + self._offset:
+            return None
+        if message.is_error_frame:
             return None
         try:
-            signals = self._database.decode(message.arbitration_id, message.data)
+            signals = self._database.decode_named("StageCommand", message.data)
             return int(signals["RunId"]), StageCommandCode(int(signals["Command"]))
         except Exception:  # cantools raises several kinds; ValueError for an unknown command
             return None
 
     def stop_command_run_id(self, message: can.Message) -> int | None:
         """The RunId of a StopCommand frame; None for any other (or malformed) frame."""
-        if message.arbitration_id != self._database.stop_command_id or message.is_error_frame:
+        frame_id = self._database.stop_command_id + self._offset
+        if message.arbitration_id != frame_id or message.is_error_frame:
             return None
         try:
-            signals = self._database.decode(message.arbitration_id, message.data)
+            signals = self._database.decode_named("StopCommand", message.data)
         except Exception:  # cantools raises several kinds on a short or garbled frame
             return None
         return int(signals["RunId"])

@@ -7,7 +7,9 @@ part's first run (and the rig's pause before it) the scanner puts a
 :class:`~shared.contract.PartScan` on ``boltwatch/<st>/part`` with the part's
 id (``[rig] part_pattern``: by default ``<station>-P<the run id of its first
 bolt>``). The station's predictor names that part in the result of each run
-that starts after it.
+that starts after it. A multi-spindle system (``[station] spindles`` above 1)
+tightens a part in each synchronised cycle: a part per cycle, its bolts the
+cycle's spindles.
 
 The rig's first part waits (at most :data:`LISTENER_WAIT_S`) until a
 subscriber of the key is known (the station's predictor, the recorder):
@@ -50,8 +52,12 @@ class PartScanner:
         station: str,
         rig: RigSection,
         clock_ns: Callable[[], int] = time.time_ns,
+        per_cycle_of: int = 1,
     ) -> None:
+        """``per_cycle_of``: a multi-spindle system of that many spindles (above 1) tightens a
+        part in each cycle: each of its cycles starts a part (``before_run`` is told cycles)."""
         self._station = station
+        self._per_cycle_of = per_cycle_of
         self._rig = rig
         self._clock_ns = clock_ns
         self._publisher = skeleton.publisher(channels.PART, station)
@@ -61,6 +67,9 @@ class PartScanner:
         """Before run ``index`` (from 0; run id ``run_id``) and its pause: True when the run
         starts a new part, whose scan was put."""
         bolts = self._rig.bolts_per_part
+        if self._per_cycle_of > 1:  # ``index`` counts cycles: each is a part of its own
+            index *= self._per_cycle_of
+            bolts = self._per_cycle_of if bolts > 0 else 0
         if not starts_part(index, bolts):
             return False
         if self.parts == 0:

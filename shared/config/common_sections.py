@@ -21,6 +21,7 @@ from typing import Annotated, Literal, Protocol, TypeVar
 from pydantic import AfterValidator, Field, ValidationInfo, field_validator, model_validator
 
 from shared.config.loading import StrictModel, resolve_relative
+from shared.contract.message_fields import MAX_SPINDLES
 from shared.errors import ConfigError
 from shared.files import FolderError, make_folder
 
@@ -87,10 +88,25 @@ class StationIdentity(StrictModel):
         "'' none: its id is shown",
     )
 
+    spindle_tool_ids: list[Annotated[int, Field(ge=0, le=65535)]] = Field(
+        default_factory=list,
+        max_length=MAX_SPINDLES,
+        description="a multi-spindle station: the tool id of each spindle, in spindle order "
+        "(its wear is counted under it); [] (the default): tool_id, tool_id + 1, ...",
+    )
+
     @property
     def place(self) -> StationPlace:
         """Where the station is: its plant, line and name."""
         return StationPlace(self.plant, self.line, self.name)
+
+    def tool_of(self, spindle: int | None) -> int:
+        """The tool id of ``spindle`` (1..N; None: the station's one tool, ``tool_id``)."""
+        if spindle is None:
+            return self.tool_id
+        if spindle <= len(self.spindle_tool_ids):
+            return self.spindle_tool_ids[spindle - 1]
+        return self.tool_id + spindle - 1
 
 
 class ZenohSection(StrictModel):

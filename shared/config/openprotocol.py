@@ -106,6 +106,13 @@ class OpenProtocolSection(StrictModel):
     traces: bool = Field(
         default=True, description="subscribe to MID 0900 (torque and angle curves)"
     )
+    multi_spindle: bool = Field(
+        default=False,
+        description="the controller is a multi-spindle system (a sync master, a station "
+        "controller): subscribe to its multi-spindle status and results (MIDs 0090, 0100) "
+        "and publish each cycle's common result; a CAN station file of several spindles "
+        "([station] spindles) says so by itself",
+    )
 
     @field_validator("timezone")
     @classmethod

@@ -38,7 +38,7 @@ from shared.config.program_windows import ProgramWindows
 from shared.config.quality import QualitySection
 from shared.config.retention import RetentionSection
 from shared.config.rig_parts import DEFAULT_PART_PATTERN, check_part_pattern, part_id
-from shared.contract import SensorRange, StationDatabase
+from shared.contract import MAX_SPINDLES, SensorRange, SpindleIds, StationDatabase
 from shared.errors import CanDatabaseError, ConfigError
 
 
@@ -49,6 +49,31 @@ class StationSection(StationIdentity):
     has_force_sensor: bool = Field(
         default=True, description="false: no JointSensors on the bus, torque-only prediction"
     )
+    spindles: int = Field(
+        default=1,
+        ge=1,
+        le=MAX_SPINDLES,
+        description="spindles tightening one part in one synchronised cycle (a multi-spindle "
+        "system: each its own tool, curve and result, the cycle's common result OK only "
+        "when every spindle is); 1: a single-spindle station",
+    )
+
+    @model_validator(mode="after")
+    def _a_tool_for_each_spindle(self) -> StationSection:
+        given = len(self.spindle_tool_ids)
+        if given and given != self.spindles:
+            raise ValueError(
+                f"spindle_tool_ids names {given} tools for {self.spindles} spindles: one per "
+                "spindle, or none (tool_id, tool_id + 1, ...)"
+            )
+        if not given and self.tool_id + self.spindles - 1 > 65535:
+            raise ValueError(
+                f"tool_id {self.tool_id} + {self.spindles - 1} spindles is beyond 65535 (the "
+                "spindles' tools count up from tool_id): lower tool_id or give spindle_tool_ids"
+            )
+        if len(set(self.spindle_tool_ids)) < given:
+            raise ValueError("spindle_tool_ids: each spindle is a tool of its own (an id twice)")
+        return self
 
 
 class CanSection(StrictModel):
@@ -60,6 +85,14 @@ class CanSection(StrictModel):
         default="auto",
         description="'auto': command a program's final stage when the DBC has StageCommand "
         "and the tool controller says it takes it (ToolStage); 'stop': stop commands only",
+    )
+    spindle_id_stride: int = Field(
+        default=2,
+        ge=1,
+        le=0x1000_0000,
+        description="a multi-spindle station: spindle k's frames are at the DBC's ids plus "
+        "(k - 1) times this (docs/reference/can-and-trace.md); every spindle's ids must "
+        "differ from every other's and from CycleStart's",
     )
 
     @model_validator(mode="after")
@@ -330,9 +363,14 @@ def can_station(path: Path, data: dict[str, Any]) -> LoadedStation:
     if not dbc_path.is_file():
         raise ConfigError(f"{path}: can.dbc: file not found: {dbc_path}")
     try:
-        sensor_range = SensorRange.of_database(StationDatabase(dbc_path))
+        database = StationDatabase(dbc_path)
+        sensor_range = SensorRange.of_database(database)
     except CanDatabaseError as err:
         raise ConfigError(f"{path}: can.dbc: {err}") from err
+    try:
+        SpindleIds(database, config.station.spindles, config.can.spindle_id_stride)
+    except CanDatabaseError as err:
+        raise ConfigError(f"{path}: can.spindle_id_stride: {err}") from err
     for index, program in enumerate(config.programs):
         beyond = program.limits_beyond(sensor_range)
         if beyond is not None:

@@ -8,29 +8,34 @@
   :mod:`.message_fields` (the bounds of every field), :mod:`.message_shape`
   (what a decoder derives once from a message type)
 - :mod:`.can_database` (the station's DBC, checked against the CAN contract),
+  :mod:`.spindle_ids` (where each spindle of a multi-spindle station is on the bus),
   :mod:`.sensor_range` (what a station's sensors can measure)
 - :mod:`.trace` (the offline trace CSV), :mod:`.run_clock` (a run's clock: ns <-> s)
 - :mod:`.spool_messages` (what a station's spool and the recorder say to each other)
 - :mod:`.part_messages` (what the line says of the part at a station: its id)
 - :mod:`.stage_messages` (what a station commands a tool that runs a final stage)
 - :mod:`.alert_messages` (who acknowledged, confirmed or commented on an alert)
+- :mod:`.cycle_messages` (a multi-spindle station's cycle: its common result)
 """
 
 from shared.contract.can_database import (
     CONTRACT,
     COUNTER_MODULO,
+    CYCLE_MESSAGES,
     SAMPLE_RATE_HZ,
     STAGE_MESSAGES,
     StationDatabase,
 )
 from shared.contract.channels import CHANNELS, SCHEMA_TYPES, Channel
 from shared.contract.codec import MAX_PAYLOAD_BYTES, decode, decoder, encode, json_schema, to_dict
+from shared.contract.cycle_messages import CycleResult, CycleSpindle
 from shared.contract.message_fields import (
     DEFAULT_FLOAT,
     DEFAULT_INT,
     DEFAULT_TEXT,
     FLOAT_MAX,
     INT64_MAX,
+    MAX_SPINDLES,
     MAX_TEXT_CHARS,
     PART_ID,
     PART_ID_CHARS,
@@ -89,6 +94,7 @@ from shared.contract.messages import (
 )
 from shared.contract.run_clock import RunClock
 from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
+from shared.contract.spindle_ids import SpindleFrame, SpindleIds
 from shared.contract.spool_messages import (
     SeqMark,
     SeqRange,
@@ -105,6 +111,7 @@ __all__ = [
     "CONTRACT",
     "CONTRACT_RANGE",
     "COUNTER_MODULO",
+    "CYCLE_MESSAGES",
     "DEFAULT_FLOAT",
     "DEFAULT_INT",
     "DEFAULT_TEXT",
@@ -112,6 +119,7 @@ __all__ = [
     "FLOAT_MAX",
     "INT64_MAX",
     "MAX_PAYLOAD_BYTES",
+    "MAX_SPINDLES",
     "MAX_TEXT_CHARS",
     "PART_ID",
     "PART_ID_CHARS",
@@ -129,6 +137,8 @@ __all__ = [
     "ControllerFunction",
     "ControllerResult",
     "ControllerStep",
+    "CycleResult",
+    "CycleSpindle",
     "FigureStatus",
     "Intensity",
     "JudgedFigure",
@@ -151,6 +161,8 @@ __all__ = [
     "SensorRange",
     "SeqMark",
     "SeqRange",
+    "SpindleFrame",
+    "SpindleIds",
     "SpoolAck",
     "SpoolFiled",
     "SpoolStats",

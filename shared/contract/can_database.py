@@ -5,7 +5,10 @@ scaling live in the DBC. :class:`StationDatabase` looks every contract message
 up once, so a DBC that lacks one fails at start-up with its file named,
 and the hot path encodes and decodes through prepared cantools messages. The
 final stage's two messages (:data:`STAGE_MESSAGES`) are optional: a DBC
-without them is a stop-only station's (``has_stages`` False).
+without them is a stop-only station's (``has_stages`` False); so is a
+multi-spindle system's ``CycleStart`` (:data:`CYCLE_MESSAGES`, ``has_cycles``),
+which a station of more than one spindle needs (:mod:`.spindle_ids`: where each
+spindle's frames are).
 """
 
 from __future__ import annotations
@@ -33,6 +36,10 @@ STAGE_MESSAGES: dict[str, tuple[str, ...]] = {
     "StageCommand": ("RunId", "Command", "Pulse", "Reason"),
     "ToolStage": ("RunId", "Stage", "Pulses", "Features", "MaxPulses"),
 }
+
+#: The message a multi-spindle system sends at each synchronised cycle's start (its sync id):
+#: optional, as the final stage's; a station of more than one spindle needs it.
+CYCLE_MESSAGES: dict[str, tuple[str, ...]] = {"CycleStart": ("SyncId", "Spindles")}
 
 COUNTER_MODULO = 1 << 16
 #: ToolSensors (and JointSensors) are sent at this rate while a run is under way
@@ -74,6 +81,15 @@ class StationDatabase:
             )
         #: the DBC has the final stage's messages (a tool controller may take StageCommand)
         self.has_stages = bool(stage_names)
+        for name, signals in CYCLE_MESSAGES.items():
+            if name in present:
+                message = database.get_message_by_name(name)
+                self._messages[name] = _with_signals(path, message, signals)
+        #: the DBC has CycleStart (a multi-spindle system's cycles and their sync ids)
+        self.has_cycles = "CycleStart" in self._messages
+        self.cycle_start_id: int | None = (
+            self._messages["CycleStart"].frame_id if self.has_cycles else None
+        )
         self.tool_sensors_id: int = self._messages["ToolSensors"].frame_id
         self.joint_sensors_id: int = self._messages["JointSensors"].frame_id
         self.tool_status_id: int = self._messages["ToolStatus"].frame_id
@@ -101,8 +117,20 @@ class StationDatabase:
         )
         return decoded
 
+    def decode_named(self, name: str, data: bytes | bytearray) -> dict[str, float | int]:
+        """Physical signal values of contract message ``name`` (at whatever id it came: a
+        spindle's); raises on a bad length."""
+        decoded: dict[str, float | int] = self._messages[name].decode(
+            bytes(data), decode_choices=False
+        )
+        return decoded
+
     def is_extended(self, name: str) -> bool:
         return bool(self._messages[name].is_extended_frame)
+
+    def length(self, name: str) -> int:
+        """The data length of contract message ``name``, bytes."""
+        return int(self._messages[name].length)
 
     def signal_bounds(self, message: str, signal: str) -> tuple[float, float]:
         """(minimum, maximum) physical value of a contract signal.

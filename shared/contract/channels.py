@@ -35,6 +35,9 @@ topic              publisher             message, when
                    (openprotocol)
 ``results``        predictor (import,    :class:`TighteningResult`, one per run, just
                    openprotocol)         before its summary: OK/NOK against the windows
+``cycles``         predictor             :class:`CycleResult`, one per cycle of a
+                   (openprotocol)        multi-spindle station, after its last spindle's
+                                         summary: OK only when every spindle is
 ``predictor``      predictor             :class:`PredictorStats`, once a second
 ``recorder``       recorder              :class:`RecorderStats`, once a second
 ``wear/alert``     recorder              :class:`WearAlert`, when a tool is due
@@ -89,6 +92,7 @@ from dataclasses import dataclass, field
 from typing import Any, Generic, TypeVar
 
 from shared.contract import keys
+from shared.contract.cycle_messages import CycleResult
 from shared.contract.messages import (
     AlertAck,
     BridgeStats,
@@ -180,6 +184,7 @@ DECISION = Channel(
 STAGE = Channel("stage", StageDecision, "predictor", Qos(real_time=True, express=True))
 RUNS = Channel("runs", RunSummary, "predictor", also_by=_BRIDGE)
 RESULTS = Channel("results", TighteningResult, "predictor", also_by=("import", *_BRIDGE))
+CYCLES = Channel("cycles", CycleResult, "predictor", also_by=_BRIDGE)
 PREDICTOR = Channel("predictor", PredictorStats, "predictor")
 RECORDER = Channel("recorder", RecorderStats, "recorder")
 WEAR_ALERT = Channel("wear/alert", WearAlert, "recorder")
@@ -208,6 +213,7 @@ CHANNELS: tuple[Channel[Any], ...] = (
     STAGE,
     RUNS,
     RESULTS,
+    CYCLES,
     PREDICTOR,
     RECORDER,
     WEAR_ALERT,

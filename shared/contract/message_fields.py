@@ -32,6 +32,8 @@ Why these bounds:
   DBC, and the predictor's core must see an implausible sample to count it
   and, after a long stretch of them, stop the tool (``input_fault``);
 - station ids: the key chunk of the station files (:data:`STATION_ID`);
+- spindle numbers: 1 to :data:`MAX_SPINDLES` (Open Protocol's two digits); a
+  sync id (the controller's id of one synchronised cycle) is an id;
 - part ids: 1 to :data:`PART_ID_CHARS` printable ASCII characters, no space
   at either end (:data:`PART_ID`): what a scanner reads off a part (a VIN
   is 17 characters, Open Protocol's VIN field 25, its identifier download
@@ -112,6 +114,11 @@ Measured = Annotated[float, NumberRange(-FLOAT_MAX, FLOAT_MAX, nan_ok=True)]
 StationId = Annotated[str, TextRange(64, STATION_ID)]
 #: a part's id (work piece, VIN) as the line scanned it
 PartId = Annotated[str, TextRange(PART_ID_CHARS, PART_ID)]
+#: the most spindles one station (one multi-spindle system) has: Open Protocol numbers
+#: them in two digits (MID 0101)
+MAX_SPINDLES = 99
+#: a spindle's number in its station, 1 to :data:`MAX_SPINDLES`
+SpindleNumber = Annotated[int, NumberRange(1, MAX_SPINDLES)]
 
 DEFAULT_INT = NumberRange(INT64_MIN, INT64_MAX)
 DEFAULT_FLOAT = NumberRange(-FLOAT_MAX, FLOAT_MAX)
@@ -130,6 +137,20 @@ WIRE_CONFIG = ConfigDict(
     ser_json_inf_nan="constants",
     str_max_length=MAX_TEXT_CHARS,
 )
+
+
+#: fields a message of a multi-spindle station has and a single-spindle station's never says
+SPINDLE_FIELDS = ("spindle", "sync_id")
+
+
+def without_unset_spindle(data: dict[str, Any]) -> dict[str, Any]:
+    """A message's fields as written on the wire: its spindle fields left out when None, so a
+    single-spindle station's message is byte for byte what it was before stations had
+    spindles (and what a reader of that time takes: it refuses fields it does not know)."""
+    for name in SPINDLE_FIELDS:
+        if name in data and data[name] is None:
+            del data[name]
+    return data
 
 
 def can_id_bounds(database: StationDatabase) -> dict[str, tuple[int, int]]:

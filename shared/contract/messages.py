@@ -14,7 +14,9 @@ channel carries which message, who puts it and how: :mod:`shared.contract.channe
 
 What tool controllers say (a controller's result, its tool data and alarms, a
 controller bridge's counters) is in :mod:`shared.contract.controller_messages` and
-imported from here as every other message.
+imported from here as every other message. A multi-spindle cycle's common result
+(:class:`~shared.contract.cycle_messages.CycleResult`) is in
+:mod:`shared.contract.cycle_messages`.
 What the line says of the part at a station (:class:`PartScan`) is in
 :mod:`shared.contract.part_messages`, imported from here too; what a station
 commands a tool that runs a final stage (:class:`StageDecision`), in
@@ -26,7 +28,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import Literal
+from typing import Any, Literal
+
+from pydantic import SerializerFunctionWrapHandler, model_serializer
 
 from shared.contract.alert_messages import (  # noqa: F401  (re-exported: one import for every message)
     AlertAck,
@@ -43,7 +47,16 @@ from shared.contract.controller_messages import (  # noqa: F401  (re-exported: o
     RunOperation,
     ToolData,
 )
-from shared.contract.message_fields import WIRE_CONFIG, Count, Id, Measured, StationId, TimeNs
+from shared.contract.message_fields import (
+    WIRE_CONFIG,
+    Count,
+    Id,
+    Measured,
+    SpindleNumber,
+    StationId,
+    TimeNs,
+    without_unset_spindle,
+)
 from shared.contract.part_messages import (  # noqa: F401  (re-exported: one import for every message)
     PartScan,
     PartSource,
@@ -171,6 +184,15 @@ class ToolState:
     # running, on a staged tool: the stage it runs (ToolStage); a change is a new ToolState
     stage: ToolStageName | None = None
     pulses: Count = 0  # pulses the tool has run in this run
+    # a multi-spindle station's run: its spindle (1..N) and the sync id of the cycle it is a
+    # run of (the controller's; every spindle's run of the cycle has it); None: a station
+    # of one spindle (shared/contract/cycle_messages.py)
+    spindle: SpindleNumber | None = None
+    sync_id: Id | None = None
+
+    @model_serializer(mode="wrap")
+    def _wire(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        return without_unset_spindle(handler(self))
 
 
 @dataclass(frozen=True, slots=True)
@@ -318,6 +340,14 @@ class RunSummary:
     commands: ToolCommandsName | None = None
     final_stage_s: float | None = None
     pulses: Count = 0
+    # a multi-spindle station's run: its spindle and its cycle's sync id (as its ToolState);
+    # None: a station of one spindle
+    spindle: SpindleNumber | None = None
+    sync_id: Id | None = None
+
+    @model_serializer(mode="wrap")
+    def _wire(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        return without_unset_spindle(handler(self))
 
 
 @dataclass(frozen=True, slots=True)
@@ -506,3 +536,11 @@ class TighteningResult:
     # a final stage (a staged tool): the pulses back to the target the run took (a pulse
     # won back a slip drop lost during the halt); None: the run had no final stage
     pulses: Count | None = None
+    # a multi-spindle station's run: its spindle (1..N) and the sync id of its cycle, whose
+    # common result is a CycleResult on ``cycles``; None: a station of one spindle
+    spindle: SpindleNumber | None = None
+    sync_id: Id | None = None
+
+    @model_serializer(mode="wrap")
+    def _wire(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        return without_unset_spindle(handler(self))

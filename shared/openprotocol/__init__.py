@@ -16,7 +16,8 @@ decoding.
 - messages: :mod:`.session` (0001-0005, 9999), :mod:`.results` (0060-0065,
   layouts in :mod:`.result_layouts`), :mod:`.subscriptions` (0008/0009, 0900
   subscription data), :mod:`.traces` (0900), :mod:`.tool_data` (0040/0041),
-  :mod:`.alarms` (0070-0077)
+  :mod:`.alarms` (0070-0077), :mod:`.multi_spindle` (0090-0093, 0100-0103: a
+  multi-spindle system's status and result of each synchronised cycle)
 - :mod:`.fields` (fixed-width field layouts, read and written),
   :mod:`.timestamps` (controller time text <-> ns since the epoch)
 """
@@ -45,6 +46,18 @@ from shared.openprotocol.codec import (
 from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect
 from shared.openprotocol.errors import OpenProtocolError
 from shared.openprotocol.framing import BINARY_MIDS, Frame, FrameReader, frame_bytes
+from shared.openprotocol.multi_spindle import (
+    MultiSpindleResult,
+    MultiSpindleResultAcknowledge,
+    MultiSpindleResultSubscribe,
+    MultiSpindleResultUnsubscribe,
+    MultiSpindleStatus,
+    MultiSpindleStatusAcknowledge,
+    MultiSpindleStatusSubscribe,
+    MultiSpindleStatusUnsubscribe,
+    SpindleResult,
+    SpindleStatus,
+)
 from shared.openprotocol.results import (
     BatchStatus,
     LastTighteningResult,
@@ -112,6 +125,14 @@ __all__ = [
     "FrameReader",
     "KeepAlive",
     "LastTighteningResult",
+    "MultiSpindleResult",
+    "MultiSpindleResultAcknowledge",
+    "MultiSpindleResultSubscribe",
+    "MultiSpindleResultUnsubscribe",
+    "MultiSpindleStatus",
+    "MultiSpindleStatusAcknowledge",
+    "MultiSpindleStatusSubscribe",
+    "MultiSpindleStatusUnsubscribe",
     "OldResultRequest",
     "OldTighteningResult",
     "OpenProtocolError",
@@ -119,6 +140,8 @@ __all__ = [
     "ResultAcknowledge",
     "ResultSubscribe",
     "ResultUnsubscribe",
+    "SpindleResult",
+    "SpindleStatus",
     "ToolData",
     "ToolDataRequest",
     "TraceCurve",

@@ -12,13 +12,14 @@
   first, so an integrator can ask the highest and fall back, and a controller
   can refuse the others. :data:`ANY_REVISION_MIDS` are read and written at
   every revision (1-999) besides: messages with no data whose revision asks
-  nothing of an answer (0003, 0062, 0063, 0072, 0073, 0075, 0077, 9999). The
+  nothing of an answer (0003, 0062, 0063, 0072, 0073, 0075, 0077, 0092, 0093, 0102,
+  0103, 9999). The
   specification gives them no data and no list of revisions ("For header
   description see section 2.2.2"), and integrators send them above 1:
   OpenProtocolInterpreter writes 0062 at revision 5 or 6 and 0063, 0072 and
   0073 at 2 (its ``TestMid00xx.cs``). A MID whose revision names the revision
   of its answer (0001, 0040, 0060, 0064, 0070) is read at the revisions
-  implemented only: a controller answers another with 0004 error 97.
+  implemented only (0090 and 0100 too): a controller answers another with 0004 error 97.
 """
 
 from __future__ import annotations
@@ -40,6 +41,16 @@ from shared.openprotocol.alarms import (
 from shared.openprotocol.dialect import DEFAULT_DIALECT, Dialect
 from shared.openprotocol.errors import OpenProtocolError
 from shared.openprotocol.framing import BINARY_MIDS, Frame, HeaderFill, frame_bytes
+from shared.openprotocol.multi_spindle import (
+    MultiSpindleResult,
+    MultiSpindleResultAcknowledge,
+    MultiSpindleResultSubscribe,
+    MultiSpindleResultUnsubscribe,
+    MultiSpindleStatus,
+    MultiSpindleStatusAcknowledge,
+    MultiSpindleStatusSubscribe,
+    MultiSpindleStatusUnsubscribe,
+)
 from shared.openprotocol.results import (
     LastTighteningResult,
     OldResultRequest,
@@ -116,6 +127,14 @@ MESSAGE_TYPES: Final[Mapping[int, type[WireMessage]]] = {
         AlarmAcknowledgedOnControllerAck,
         AlarmStatus,
         AlarmStatusAck,
+        MultiSpindleStatusSubscribe,
+        MultiSpindleStatus,
+        MultiSpindleStatusAcknowledge,
+        MultiSpindleStatusUnsubscribe,
+        MultiSpindleResultSubscribe,
+        MultiSpindleResult,
+        MultiSpindleResultAcknowledge,
+        MultiSpindleResultUnsubscribe,
         TraceCurve,
     )
 }

@@ -8,7 +8,8 @@ one field; a layout is the tuple of a revision's specs in wire order.
 Kinds:
 
 - ``int``: digits (spaces around are tolerated on reading), in [``low``, ``high``]
-  (``high`` defaults to what the width can hold);
+  (``high`` defaults to what the width can hold); a field whose ``low`` is below
+  0 takes a leading minus, within the width ("-0015": a press's stroke, 0101);
 - ``centi``: a decimal sent as an integer number of hundredths (torques in Nm:
   "001234" is 12.34 Nm), read as float; written "multiplied by 100 and sent as
   an integer (2 decimals truncated)", as the specification words every such
@@ -117,9 +118,11 @@ def encode_fields(values: Mapping[str, object], layout: Layout, mid: int, revisi
 
 def _number(spec: Spec, text: str) -> int:
     stripped = text.strip(" ")
-    if not stripped.isascii() or not stripped.isdigit():
+    negative = spec.low < 0 and stripped.startswith("-")  # a field that may be below 0
+    digits = stripped[1:] if negative else stripped
+    if not digits.isascii() or not digits.isdigit():
         raise ValueError(f"'{text}' is not a number")
-    return int(stripped)
+    return -int(digits) if negative else int(digits)
 
 
 def _in_range(spec: Spec, number: int, shown: str) -> int:

@@ -8,11 +8,14 @@ they come from the results store in a handful of statements
 (:mod:`shared.results.program_columns`), never a Python object per result;
 from results read one by one (the recordings), :func:`columns_of` makes the
 same columns, so both sources give the same statistics
-(:mod:`.program_statistics`).
+(:mod:`.program_statistics`). A program a multi-spindle station ran has its
+columns over every run, then each spindle's own (``spindle``): a spindle that
+drifts shows in its own chart and Cpk.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -55,6 +58,8 @@ class ProgramColumns:
     #: runs that ran a final stage, and of them the ones that needed a pulse back to the target
     staged_runs: int = 0
     pulsed_runs: int = 0
+    #: one spindle's runs of a multi-spindle station; None: every run of the program
+    spindle: int | None = None
 
 
 def reason_kinds(reasons: str) -> set[str]:
@@ -73,15 +78,20 @@ def columns_of(
     summaries: Mapping[tuple[str, int, int], RunSummary] | None = None,
 ) -> list[ProgramColumns]:
     """The columns of each program of ``results`` (in the order the runs ended), by program
-    id; a result without events takes its run's summary's (``summaries`` by station, run id
-    and tool id), as recordings hold them."""
+    id, each followed by its spindles' own (a multi-spindle station's: by spindle number); a
+    result without events takes its run's summary's (``summaries`` by station, run id and
+    tool id), as recordings hold them."""
     by_program: dict[int, list[TighteningResult]] = {}
     for result in results:
         by_program.setdefault(result.program_id, []).append(result)
-    return [
-        _program_columns(program_id, runs, summaries or {})
-        for program_id, runs in sorted(by_program.items())
-    ]
+    columns = []
+    for program_id, runs in sorted(by_program.items()):
+        columns.append(_program_columns(program_id, runs, summaries or {}))
+        for spindle in sorted({run.spindle for run in runs if run.spindle is not None}):
+            of_spindle = [run for run in runs if run.spindle == spindle]
+            spindle_columns = _program_columns(program_id, of_spindle, summaries or {})
+            columns.append(dataclasses.replace(spindle_columns, spindle=spindle))
+    return columns
 
 
 def _program_columns(

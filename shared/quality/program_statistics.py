@@ -7,7 +7,8 @@ against the program's window (:mod:`.capability`) and their control chart
 (each ``"; "``-separated reason counted once per run by its kind, the text
 before its figures, ``preload low``; most frequent first),
 the stop reasons (``tool`` when the tool stopped by itself) and the stick-slip
-events per run.
+events per run. A multi-spindle station's program has, after its statistics
+over every run, each spindle's (:attr:`ProgramStatistics.spindle`).
 
 The window of a figure is the one the runs were judged against (carried by
 each :class:`TighteningResult`); when it changed within the range, the
@@ -70,10 +71,18 @@ class ProgramStatistics:
     #: a slip during the halt, won back)
     staged_runs: int = 0
     pulsed_runs: int = 0
+    #: one spindle's runs of a multi-spindle station; None: every run of the program
+    spindle: int | None = None
 
     @property
     def nok_rate(self) -> float:
         return self.noks / self.runs if self.runs else 0.0
+
+    @property
+    def name(self) -> str:
+        """``program 1 (M14 ...)``, and its spindle when it is one spindle's."""
+        named = f"program {self.program_id} ({self.program_name or 'unnamed'})"
+        return named if self.spindle is None else f"{named} spindle {self.spindle}"
 
 
 def program_statistics(
@@ -123,4 +132,5 @@ def statistics_of(columns: ProgramColumns, subgroup_size: int) -> ProgramStatist
         tools=columns.tools,
         staged_runs=columns.staged_runs,
         pulsed_runs=columns.pulsed_runs,
+        spindle=columns.spindle,
     )

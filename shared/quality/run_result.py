@@ -19,7 +19,7 @@ of its tightenings, ``RunId`` on CAN). The part is what the line scanned
 last before the run started (``boltwatch/<st>/part``), passed in by the
 caller with where it came from (a scan, the line's answer at the predictor's
 start); None when no part is known. The batch is unknown to the station
-(None).
+(None). A multi-spindle station's run keeps its spindle and sync id.
 """
 
 from __future__ import annotations
@@ -71,4 +71,6 @@ def tightening_result(
         source="predictor",
         part_source=part_source,
         pulses=summary.pulses if summary.commands == "staged" else None,
+        spindle=summary.spindle,
+        sync_id=summary.sync_id,
     )

@@ -2,7 +2,8 @@
 recorder's catch-up at start.
 
 Each MCAP file is read once for its ``results`` (and ``runs``: the events of
-a result that has none) and every result stored (idempotent, so a file read
+a result that has none; ``cycles``: a multi-spindle cycle's common result) and
+every result stored (idempotent, so a file read
 again adds nothing twice). A file read whole is marked with its size and
 modification time in ``recordings_read``, so the next reading skips it
 unless it changed: a rebuild stopped halfway goes on where it stopped. A
@@ -25,7 +26,7 @@ from datetime import date
 from pathlib import Path
 
 from shared.config import StationPlace
-from shared.contract import RunSummary, TighteningResult, channels, decode
+from shared.contract import CycleResult, RunSummary, TighteningResult, channels, decode
 from shared.errors import InputError
 from shared.recordings import recording_files, station_days
 from shared.recordings.mcap import RecordingScan
@@ -34,6 +35,7 @@ from shared.results.stored_result import StoredResult, stored_result
 
 _RESULTS = "/" + channels.RESULTS.topic
 _RUNS = "/" + channels.RUNS.topic
+_CYCLES = "/" + channels.CYCLES.topic
 
 
 @dataclass
@@ -76,11 +78,13 @@ def results_of(
     host: str,
     now_ns: int,
     refused: list[str] | None = None,
+    cycles: list[CycleResult] | None = None,
 ) -> tuple[list[StoredResult], RecordingScan]:
     """The results recorded in ``path`` (as far as it is readable), as the store keeps them:
     where each station is from ``places`` (one not in it: nowhere named), the file as their
-    recording; a payload that does not decode is left out (a line in ``refused`` each).
-    InputError: not readable."""
+    recording; a payload that does not decode is left out (a line in ``refused`` each); the
+    multi-spindle cycles' common results it holds go into ``cycles``. InputError: not
+    readable."""
     scan = RecordingScan(path)
     results: list[TighteningResult] = []
     summaries: dict[tuple[str, int], RunSummary] = {}
@@ -91,6 +95,8 @@ def results_of(
             elif channel.topic.endswith(_RUNS):
                 summary = decode(RunSummary, message.data)
                 summaries[(summary.station, summary.run_id)] = summary
+            elif channel.topic.endswith(_CYCLES) and cycles is not None:
+                cycles.append(decode(CycleResult, message.data))
         except InputError as err:
             if refused is not None:
                 refused.append(f"{path}: message {message.sequence} on {channel.topic}: {err}")
@@ -131,14 +137,17 @@ def fill_from_recordings(
             continue
         recording = str(path.resolve())
         if store.recording_read(host, recording) != (stat.st_size, stat.st_mtime_ns):
+            cycles: list[CycleResult] = []
             try:
-                stored, scan = results_of(path, places, host, clock_ns(), counts.refused)
+                stored, scan = results_of(path, places, host, clock_ns(), counts.refused, cycles)
             except InputError as err:
                 counts.skipped.append(str(err))
             else:
                 counts.read += 1
                 refused = len(counts.refused)
                 counts.new += store.add(stored, counts.refused)
+                if cycles:
+                    store.add_cycles(cycles, clock_ns())
                 counts.refused_results += len(counts.refused) - refused
                 counts.results += len(stored) - (len(counts.refused) - refused)
                 if scan.complete:

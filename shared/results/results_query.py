@@ -3,7 +3,8 @@
 Every criterion is optional and they all hold together: a part id, stations,
 a run id (with one station: a tightening by the table's primary key), a plant,
 a line, a program, a tool, a range of end times (``since`` included, ``until``
-not), a verdict (OK or NOK only). Each but the verdict is a column with an index in front
+not), a verdict (OK or NOK only), a spindle. Each but the verdict and the spindle
+is a column with an index in front
 (:mod:`.results_schema`), so a part's tightenings are found by the index of
 ``part_id`` however large the store. :func:`time_ns_of`: a moment as the
 nanoseconds the bounds are.
@@ -40,6 +41,7 @@ class ResultsQuery:
     since_ns: int | None = None  # the run ended at or after
     until_ns: int | None = None  # the run ended before
     verdict: str | None = None  # "OK" or "NOK": those only
+    spindle: int | None = None  # a multi-spindle station's spindle: its runs only
     limit: int | None = DEFAULT_LIMIT  # None: every row
     oldest_first: bool = False
 
@@ -72,6 +74,8 @@ class ResultsQuery:
             term("ended_ns < ?", self.until_ns)
         if self.verdict is not None:
             term("result = ?", self.verdict)
+        if self.spindle is not None:
+            term("spindle = ?", self.spindle)
         return (" WHERE " + " AND ".join(terms) if terms else ""), parameters
 
     def order(self) -> str:

@@ -11,6 +11,13 @@ and why, the final torque, angle and preload each with its window and
 status, what stopped the tool, the stick-slip events and intensity, who judged
 it (``source``), and where its recording is (``recording``: the MCAP file's
 path on ``recording_host``).
+A multi-spindle station's tightening (one spindle's run of a synchronised
+cycle) says its ``spindle`` (1..N) and its cycle's ``sync_id``; a
+single-spindle station's leaves both NULL.
+``cycle_results``: the common result of each multi-spindle cycle (OK only when
+every spindle is), one row per spindle's run of it, keyed as its tightening
+is: a reader finds a tightening's cycle by its key, whichever of the two came
+first (a spool's resend, a rebuild).
 ``tightening_steps``: the steps of a controller's program, one row each.
 ``refused_tightenings``: the columns of ``tightenings``, for the tightenings
 whose figures cannot be a measurement (:mod:`.refused_results`): kept aside,
@@ -32,7 +39,7 @@ from shared.results.refused_results import IMPLAUSIBLE_SQL
 from shared.results.results_database import ResultsDatabase, StoreError
 
 #: the version this boltwatch writes; MIGRATIONS[v - 1] makes version v
-SCHEMA_VERSION = 5
+SCHEMA_VERSION = 6
 
 TIGHTENING_COLUMNS = (
     "station", "run_id", "plant", "line", "station_name", "tightening_id", "tool_id",
@@ -41,7 +48,11 @@ TIGHTENING_COLUMNS = (
     "angle_deg", "angle_min_deg", "angle_max_deg", "angle_status",
     "force_n", "force_min_n", "force_max_n", "force_status",
     "stop_reason", "events", "process_intensity", "source",
-    "recording", "recording_host", "stored_ns", "part_source", "pulses",
+    "recording", "recording_host", "stored_ns", "part_source", "pulses", "spindle", "sync_id",
+)  # fmt: skip
+CYCLE_COLUMNS = (
+    "station", "run_id", "sync_id", "spindle", "spindles", "result", "nok_reasons", "ended_ns",
+    "part_id", "program_id", "source", "stored_ns",
 )  # fmt: skip
 STEP_COLUMNS = (
     "station", "run_id", "step_index", "name", "function", "nominal", "actual", "status",
@@ -172,6 +183,33 @@ _VERSION_5 = (
     "ALTER TABLE refused_tightenings ADD COLUMN pulses BIGINT",
 )
 
+# multi-spindle stations: a tightening's spindle and its cycle's sync id (NULL for a
+# single-spindle station's, and for a row made before: nothing rewritten, as in version 3), in
+# both tables of tightenings; the cycles' common results, one row per spindle's run, keyed as
+# the run's tightening
+_VERSION_6 = (
+    "ALTER TABLE tightenings ADD COLUMN spindle BIGINT",
+    "ALTER TABLE tightenings ADD COLUMN sync_id BIGINT",
+    "ALTER TABLE refused_tightenings ADD COLUMN spindle BIGINT",
+    "ALTER TABLE refused_tightenings ADD COLUMN sync_id BIGINT",
+    """CREATE TABLE cycle_results (
+        station TEXT NOT NULL,
+        run_id BIGINT NOT NULL,
+        sync_id BIGINT NOT NULL,
+        spindle BIGINT NOT NULL,
+        spindles BIGINT NOT NULL,
+        result TEXT NOT NULL,
+        nok_reasons TEXT NOT NULL,
+        ended_ns BIGINT NOT NULL,
+        part_id TEXT,
+        program_id BIGINT NOT NULL,
+        source TEXT NOT NULL,
+        stored_ns BIGINT NOT NULL,
+        PRIMARY KEY (station, run_id)
+    )""",
+    "CREATE INDEX cycle_results_by_sync ON cycle_results (station, sync_id, ended_ns)",
+)
+
 #: the statements that bring a store from version v - 1 to v, for v = 1, 2, ...
 MIGRATIONS: tuple[tuple[str, ...], ...] = (
     _VERSION_1,
@@ -179,6 +217,7 @@ MIGRATIONS: tuple[tuple[str, ...], ...] = (
     _VERSION_3,
     _VERSION_4,
     _VERSION_5,
+    _VERSION_6,
 )
 
 

@@ -22,12 +22,13 @@ import logging
 from collections.abc import Iterator, Sequence
 from typing import Any
 
-from shared.contract import ResultStep
+from shared.contract import CycleResult, ResultStep
 from shared.quality import implausible, refusal_line
 from shared.results.refused_results import LINE_COLUMNS, refused_line
 from shared.results.results_database import ResultsDatabase, StoreError, StoreTarget
 from shared.results.results_query import ResultsQuery
 from shared.results.results_schema import (
+    CYCLE_COLUMNS,
     SCHEMA_VERSION,
     STEP_COLUMNS,
     TIGHTENING_COLUMNS,
@@ -35,7 +36,16 @@ from shared.results.results_schema import (
     version_of,
 )
 from shared.results.sqlite_statistics import FEWEST_ROWS, keep_statistics, statistics_missing
-from shared.results.stored_result import StoredResult, from_row, step_of, step_rows, to_row
+from shared.results.stored_result import (
+    RunCycle,
+    StoredResult,
+    cycle_of,
+    cycle_rows,
+    from_row,
+    step_of,
+    step_rows,
+    to_row,
+)
 
 LOG = logging.getLogger(__name__)
 
@@ -54,6 +64,11 @@ _INSERT_STEP = (
     f"INSERT INTO tightening_steps ({', '.join(STEP_COLUMNS)}) "
     f"VALUES ({', '.join('?' * len(STEP_COLUMNS))}) "
     "ON CONFLICT (station, run_id, step_index) DO NOTHING"
+)
+_INSERT_CYCLE = (
+    f"INSERT INTO cycle_results ({', '.join(CYCLE_COLUMNS)}) "
+    f"VALUES ({', '.join('?' * len(CYCLE_COLUMNS))}) "
+    "ON CONFLICT (station, run_id) DO NOTHING"
 )
 _SELECT = f"SELECT {', '.join(TIGHTENING_COLUMNS)} FROM tightenings"
 
@@ -137,6 +152,17 @@ class ResultsStore:
             self._keep_statistics()
         return new
 
+    def add_cycles(self, cycles: Sequence[CycleResult], stored_ns: int) -> int:
+        """Store multi-spindle cycles' common results in one transaction (idempotent, as
+        :meth:`add`: a spindle's run keeps the first cycle stored for it); how many spindles'
+        runs were new."""
+        new = 0
+        with self.database.transaction():
+            for cycle in cycles:
+                for row in cycle_rows(cycle, stored_ns):
+                    new += bool(self.database.execute(_INSERT_CYCLE, row))
+        return new
+
     def _held_by_the_other_table(
         self, inserted: dict[tuple[str, int], tuple[StoredResult, str | None]]
     ) -> set[tuple[str, int]]:
@@ -180,10 +206,20 @@ class ResultsStore:
     def find(self, query: ResultsQuery) -> list[StoredResult]:
         """The tightenings ``query`` asks for, with their steps, in its order."""
         where, parameters = query.where()
+        sync_column = TIGHTENING_COLUMNS.index("sync_id")
         with self.database.transaction():
             rows = self.database.rows(_SELECT + where + query.order(), parameters)
             steps = self._steps_of([(row[0], row[1]) for row in rows])
-        return [from_row(row, steps.get((row[0], int(row[1])), ())) for row in rows]
+            cycles = self._cycles_of(
+                [(row[0], row[1]) for row in rows if row[sync_column] is not None]
+            )
+        return [
+            dataclasses.replace(
+                from_row(row, steps.get((row[0], int(row[1])), ())),
+                cycle=cycles.get((row[0], int(row[1]))),
+            )
+            for row in rows
+        ]
 
     def keys(self, query: ResultsQuery) -> list[tuple[str, int]]:
         """The (station, run id) of the tightenings ``query`` asks for, in its order: what
@@ -273,6 +309,17 @@ class ResultsStore:
                     found.update({(station, int(row[0])): row[1] for row in rows})
         return found
 
+    def _cycles_of(self, keys: list[tuple[Any, Any]]) -> dict[tuple[str, int], RunCycle]:
+        """The multi-spindle cycle of each of ``keys`` ((station, run_id) pairs) stored."""
+        sql = (
+            "SELECT run_id, sync_id, spindles, result, nok_reasons, ended_ns FROM cycle_results "
+            "WHERE station = ? AND run_id IN ({runs})"
+        )
+        return {
+            (station, int(row[0])): cycle_of(row[1:])
+            for station, row in _keyed_rows(self.database, sql, keys)
+        }
+
     def _steps_of(self, keys: list[tuple[Any, Any]]) -> dict[tuple[str, int], list[ResultStep]]:
         """The steps of the tightenings ``keys`` ((station, run_id) pairs)."""
         steps: dict[tuple[str, int], list[ResultStep]] = {}
@@ -286,6 +333,18 @@ class ResultsStore:
             for row in rows:
                 steps.setdefault((station, int(row[0])), []).append(step_of(row[1:]))
         return steps
+
+
+def _keyed_rows(
+    database: Any, sql: str, keys: Sequence[tuple[Any, Any]]
+) -> Iterator[tuple[str, Any]]:
+    """(station, row) of ``sql`` (``... WHERE station = ? AND run_id IN ({runs})``) for
+    ``keys``, asked by station, a bounded number of runs per statement."""
+    for station, run_ids in _runs_by_station(keys):
+        for row in database.rows(
+            sql.format(runs=", ".join("?" * len(run_ids))), [station, *run_ids]
+        ):
+            yield station, row
 
 
 def _runs_by_station(keys: Sequence[tuple[Any, Any]]) -> Iterator[tuple[str, list[int]]]:

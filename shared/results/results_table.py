@@ -4,7 +4,12 @@ The table has one line per tightening, newest first (the station by its id,
 its name for people beside it; a part restored from the line when the
 predictor started, not scanned before the run, marked so), its last column
 the recording (``boltwatch inspect <it> --run <run>`` draws the run); CSV has
-every column of the store, JSON every field with the steps.
+every column of the store, JSON every field with the steps. A multi-spindle
+station's tightening says its spindle and its cycle (sync id and the cycle's
+common result): in the table two columns after the run (only when a row has a
+spindle: a single-spindle station's table is as it was), in CSV the last three,
+in JSON its ``spindle``, ``sync_id`` and ``cycle`` (the common result, when
+stored).
 """
 
 from __future__ import annotations
@@ -31,8 +36,10 @@ CSV_HEADER = (
     "angle_deg", "angle_min_deg", "angle_max_deg", "angle_status",
     "force_n", "force_min_n", "force_max_n", "force_status",
     "stop_reason", "events", "process_intensity", "source", "recording", "recording_host",
-    "pulses",
+    "pulses", "spindle", "sync_id", "cycle_result",
 )  # fmt: skip
+#: the columns a multi-spindle station's rows add to the table, after the run
+SPINDLE_HEADER = ("spindle", "cycle")
 
 
 def utc_text(time_ns: int) -> str:
@@ -62,7 +69,26 @@ def _stopped_on(reason: str | None, pulses: int | None) -> str:
     return text
 
 
-def row(stored: StoredResult) -> tuple[str, ...]:
+def _cycle(stored: StoredResult) -> str:
+    """The cycle a spindle's run is of: its sync id, and its common result when stored."""
+    r = stored.result
+    if r.sync_id is None:
+        return "-"
+    cycle = stored.cycle
+    return f"{r.sync_id}" if cycle is None else f"{r.sync_id} {cycle.result}"
+
+
+def row(stored: StoredResult, spindles: bool = False) -> tuple[str, ...]:
+    """The table's cells of one tightening (``spindles``: with the spindle's columns)."""
+    cells = _cells(stored)
+    if not spindles:
+        return cells
+    spindle = stored.result.spindle
+    at = HEADER.index("run") + 1
+    return (*cells[:at], "-" if spindle is None else str(spindle), _cycle(stored), *cells[at:])
+
+
+def _cells(stored: StoredResult) -> tuple[str, ...]:
     r = stored.result
     return (
         utc_text(r.time_ns),
@@ -85,8 +111,13 @@ def row(stored: StoredResult) -> tuple[str, ...]:
 
 
 def format_table(results: Sequence[StoredResult]) -> str:
-    rows = [HEADER, *(row(stored) for stored in results)]
-    widths = [max(len(cells[i]) for cells in rows) for i in range(len(HEADER))]
+    spindles = any(stored.result.spindle is not None for stored in results)
+    header: tuple[str, ...] = HEADER
+    if spindles:
+        at = HEADER.index("run") + 1
+        header = (*HEADER[:at], *SPINDLE_HEADER, *HEADER[at:])
+    rows = [header, *(row(stored, spindles) for stored in results)]
+    widths = [max(len(cells[i]) for cells in rows) for i in range(len(header))]
     return "\n".join(
         "  ".join(cell.ljust(width) for cell, width in zip(cells, widths, strict=True)).rstrip()
         for cells in rows
@@ -104,7 +135,8 @@ def csv_row(stored: StoredResult) -> list[Any]:
         r.tool_id,
         r.batch_counter, r.result, r.nok_reasons,
         *figures, r.stop_reason, r.events, r.process_intensity, r.source, stored.recording,
-        stored.recording_host, r.pulses,
+        stored.recording_host, r.pulses, r.spindle, r.sync_id,
+        None if stored.cycle is None else stored.cycle.result,
     ]  # fmt: skip
 
 
@@ -118,7 +150,8 @@ def format_csv(results: Sequence[StoredResult]) -> str:
 
 def as_dict(stored: StoredResult) -> dict[str, Any]:
     """A tightening as JSON: the TighteningResult's fields, where it was tightened (the
-    station's name, plant and line) and its recording."""
+    station's name, plant and line), its recording and, a spindle's run of a multi-spindle
+    cycle, its cycle's common result."""
     document = to_dict(stored.result)
     document["ended_utc"] = utc_text(stored.result.time_ns)
     document["station_name"] = stored.station_name
@@ -126,6 +159,15 @@ def as_dict(stored: StoredResult) -> dict[str, Any]:
     document["line"] = stored.line
     document["recording"] = stored.recording
     document["recording_host"] = stored.recording_host
+    cycle = stored.cycle
+    if cycle is not None:  # a multi-spindle cycle's run: the cycle's common result
+        document["cycle"] = {
+            "sync_id": cycle.sync_id,
+            "spindles": cycle.spindles,
+            "result": cycle.result,
+            "nok_reasons": cycle.nok_reasons,
+            "ended_utc": utc_text(cycle.ended_ns),
+        }
     return document
 
 

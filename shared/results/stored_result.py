@@ -8,7 +8,9 @@ one stored, so what reads the store (``report``) computes what it computed
 from the files; its part id as the part search asks for one
 (:func:`stored_part_id`: no spaces at either end, "" none). :func:`to_row` /
 :func:`from_row` are its rows, in the order of
-:data:`~shared.results.results_schema.TIGHTENING_COLUMNS`.
+:data:`~shared.results.results_schema.TIGHTENING_COLUMNS`; a multi-spindle cycle's
+common result is :func:`cycle_rows` (one per spindle's run) and, read back for a
+run, :class:`RunCycle`.
 """
 
 from __future__ import annotations
@@ -17,12 +19,31 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
-from shared.contract import JudgedFigure, ResultStep, RunSummary, TighteningResult
+from shared.contract import (
+    CycleResult,
+    JudgedFigure,
+    ResultStep,
+    RunSummary,
+    TighteningResult,
+    Verdict,
+)
+
+
+@dataclass(frozen=True, slots=True)
+class RunCycle:
+    """The multi-spindle cycle a tightening is a spindle's run of: its common result."""
+
+    sync_id: int
+    spindles: int  # the spindles of the cycle
+    result: Verdict  # OK only when every spindle is
+    nok_reasons: str  # why the cycle is NOK ("" when OK)
+    ended_ns: int  # when its last spindle's run ended
 
 
 @dataclass(frozen=True, slots=True)
 class StoredResult:
-    """One row of ``tightenings`` (the result's steps: its ``tightening_steps``)."""
+    """One row of ``tightenings`` (the result's steps: its ``tightening_steps``; a
+    multi-spindle cycle's run: its cycle's common result, of ``cycle_results``)."""
 
     result: TighteningResult
     line: str = ""  # the station's line ("": none named)
@@ -32,6 +53,9 @@ class StoredResult:
     plant: str = ""  # the plant of the station's line ("": none named)
     # the station's name for people when the result was stored ("": none, its id is shown)
     station_name: str = ""
+    # a spindle's run of a multi-spindle cycle whose common result is stored: that cycle
+    # (None: a single-spindle station's, or the cycle's result not stored)
+    cycle: RunCycle | None = None
 
 
 def stored_result(
@@ -70,6 +94,7 @@ def to_row(stored: StoredResult) -> tuple[Any, ...]:
         force.value, force.min, force.max, force.status,
         r.stop_reason, r.events, r.process_intensity, r.source,
         stored.recording, stored.recording_host, stored.stored_ns, r.part_source, r.pulses,
+        r.spindle, r.sync_id,
     )  # fmt: skip
 
 
@@ -90,7 +115,7 @@ def from_row(row: Sequence[Any], steps: Sequence[ResultStep] = ()) -> StoredResu
         angle, angle_min, angle_max, angle_status,
         force, force_min, force_max, force_status,
         stop_reason, events, intensity, source, recording, recording_host, stored_ns,
-        part_source, pulses,
+        part_source, pulses, spindle, sync_id,
     ) = row  # fmt: skip
     result = TighteningResult(
         station=station,
@@ -114,10 +139,30 @@ def from_row(row: Sequence[Any], steps: Sequence[ResultStep] = ()) -> StoredResu
         steps=list(steps),
         part_source=part_source,
         pulses=None if pulses is None else int(pulses),
+        spindle=None if spindle is None else int(spindle),
+        sync_id=None if sync_id is None else int(sync_id),
     )
     return StoredResult(
         result, line, recording, recording_host, int(stored_ns), plant, station_name
     )
+
+
+def cycle_rows(cycle: CycleResult, stored_ns: int) -> list[tuple[Any, ...]]:
+    """The ``cycle_results`` rows of a cycle's common result: one per spindle's run of it (a
+    spindle whose result never came has no run, and no row: the others' say it)."""
+    return [
+        (cycle.station, spindle.run_id, cycle.sync_id, spindle.spindle, len(cycle.spindles),
+         cycle.result, cycle.nok_reasons, cycle.time_ns, stored_part_id(cycle.part_id),
+         cycle.program_id, cycle.source, stored_ns)
+        for spindle in cycle.spindles
+        if spindle.run_id is not None
+    ]  # fmt: skip
+
+
+def cycle_of(row: Sequence[Any]) -> RunCycle:
+    """A ``cycle_results`` row's sync id, spindles, result, NOK reasons and end as a RunCycle."""
+    sync_id, spindles, result, nok_reasons, ended_ns = row
+    return RunCycle(int(sync_id), int(spindles), result, nok_reasons, int(ended_ns))
 
 
 def step_of(row: Sequence[Any]) -> ResultStep:

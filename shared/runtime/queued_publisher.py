@@ -83,15 +83,20 @@ class QueuedPublisher:
         capacity: int = CAPACITY,
         batch_samples: bool = False,
         spool: StationSpool | None = None,
+        runs_at_once: int = 1,
     ) -> None:
-        """``batch_samples``: samples go out in batches on ``sample_batches``, not one by one.
-        ``spool``: keep every message until the line's recorder has it (closed with this)."""
+        """``batch_samples``: samples go out in batches on ``sample_batches``, not one by one
+        (``runs_at_once``: a batch in progress for each of that many runs: a multi-spindle
+        station's spindles). ``spool``: keep every message until the line's recorder has it
+        (closed with this)."""
         self._session = session
         self._station_id = station_id
         self._capacity = capacity
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._publishers: dict[str, zenoh.Publisher] = {}
-        self._batching = SampleBatching(station_id) if batch_samples else None
+        self._batching = (
+            SampleBatching(station_id, runs_at_once=runs_at_once) if batch_samples else None
+        )
         self.dropped = 0  # messages the full queue could not take
         self.failed = 0  # puts zenoh refused (a closing session)
         self._spool = spool
@@ -157,10 +162,10 @@ class QueuedPublisher:
                 wait_s = spool_wait_s if wait_s is None else min(wait_s, spool_wait_s)
             try:
                 item = self._queue.get(timeout=wait_s)
-            except queue.Empty:  # the batch in progress is due, or the spool's work
-                due_s = None if batching is None else batching.wait_s(time.monotonic())
-                if due_s is not None and due_s <= 0:
-                    self._send_batch()
+            except queue.Empty:  # a batch in progress is due, or the spool's work
+                if batching is not None:
+                    for batch in batching.take_due(time.monotonic()):
+                        self._put(channels.SAMPLE_BATCHES, batch)
                 continue
             if batching is not None:
                 message = item[1] if type(item) is tuple else None
@@ -179,9 +184,9 @@ class QueuedPublisher:
             self._put(*item)
 
     def _send_batch(self) -> None:
-        batch = None if self._batching is None else self._batching.take()
-        if batch is not None:
-            self._put(channels.SAMPLE_BATCHES, batch)
+        if self._batching is not None:
+            for batch in self._batching.take_all():
+                self._put(channels.SAMPLE_BATCHES, batch)
 
     def _put(self, channel: channels.Channel[Any], message: object) -> None:
         try:

@@ -16,7 +16,10 @@ intensities, go into the batch in progress, after the samples they were found
 in (:meth:`SampleBatching.add_found`): at 40 events a second a station would
 otherwise send a batch, an event and an intensity for each, three messages
 where one does. An event with no batch of its run in progress (the batch was
-just sent) goes alone, after it: never before its samples either way.
+just sent) goes alone, after it: never before its samples either way. A
+multi-spindle station's spindles run at once, their samples interleaved: each
+run has a batch of its own in progress (at most one per spindle), so a batch
+still holds one run and is as full as a single spindle's.
 
 Clock: ``now_s`` is :func:`time.monotonic` of the publisher thread.
 """
@@ -24,6 +27,7 @@ Clock: ``now_s`` is :func:`time.monotonic` of the publisher thread.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, field
 
 from shared.contract import Intensity, Sample, SampleBatch, StickSlipEvent
 
@@ -36,63 +40,87 @@ BATCH_PERIOD_S = 0.050
 MAX_BATCH_SAMPLES = 50
 
 
+@dataclass(slots=True)
+class _Batch:
+    """One run's batch in progress."""
+
+    due_s: float  # when it must go (monotonic seconds)
+    samples: list[Sample] = field(default_factory=list)
+    events: list[StickSlipEvent] = field(default_factory=list)
+    intensities: list[Intensity] = field(default_factory=list)
+
+
 class SampleBatching:
-    """The samples of one station waiting for their batch, oldest first."""
+    """The samples of one station waiting for their batches, oldest first: one batch in
+    progress per run, at most ``runs_at_once`` (a multi-spindle station's spindles run at
+    once, their samples interleaved: each run's batch fills on its own)."""
 
     def __init__(
         self,
         station: str,
         period_s: float = BATCH_PERIOD_S,
         max_samples: int = MAX_BATCH_SAMPLES,
+        runs_at_once: int = 1,
     ) -> None:
         self._station = station
         self._period_s = period_s
         self._max_samples = max_samples
-        self._samples: list[Sample] = []
-        self._events: list[StickSlipEvent] = []
-        self._intensities: list[Intensity] = []
-        self._due_s = 0.0  # when the batch in progress must go (monotonic seconds)
+        self._runs_at_once = runs_at_once
+        self._batches: dict[int, _Batch] = {}  # by run id, oldest first
 
     def add(self, sample: Sample, now_s: float) -> list[SampleBatch]:
-        """Append ``sample``; the batches that are ready now (none, one, or two when a new
-        run starts in a batch that is also due), oldest first."""
+        """Append ``sample``; the batches that are ready now (none, one, or more when a new
+        run starts while as many runs' batches are in progress, or others are due too),
+        oldest first."""
         ready: list[SampleBatch] = []
-        samples = self._samples
-        if samples and samples[-1].run_id != sample.run_id:
-            ready.append(self._take())
-            samples = self._samples
-        if not samples:
-            self._due_s = now_s + self._period_s
-        samples.append(sample)
-        if len(samples) >= self._max_samples or now_s >= self._due_s:
-            ready.append(self._take())
+        batches = self._batches
+        batch = batches.get(sample.run_id)
+        if batch is None:
+            if len(batches) >= self._runs_at_once:
+                ready.append(self._take(next(iter(batches))))
+            batch = batches[sample.run_id] = _Batch(now_s + self._period_s)
+        batch.samples.append(sample)
+        if len(batch.samples) >= self._max_samples or now_s >= batch.due_s:
+            ready.append(self._take(sample.run_id))
+        if len(batches) > 1:  # the other runs' batches that are due (their samples stopped)
+            ready += [self._take(run) for run in list(batches) if now_s >= batches[run].due_s]
         return ready
 
     def add_found(self, message: StickSlipEvent | Intensity) -> bool:
-        """Put an event or its intensity into the batch in progress, after its samples; False
-        when no batch of its run is in progress (it goes alone)."""
-        samples = self._samples
-        if not samples or samples[-1].run_id != message.run_id:
+        """Put an event or its intensity into the batch in progress of its run, after its
+        samples; False when none of its run is in progress (it goes alone)."""
+        batch = self._batches.get(message.run_id)
+        if batch is None:
             return False
         if isinstance(message, StickSlipEvent):
-            self._events.append(message)
+            batch.events.append(message)
         else:
-            self._intensities.append(message)
+            batch.intensities.append(message)
         return True
 
     def take(self) -> SampleBatch | None:
-        """The batch in progress (None when no sample waits); the next one starts empty."""
-        return self._take() if self._samples else None
+        """The oldest batch in progress (None when no sample waits); its run's next batch
+        starts empty."""
+        return self._take(next(iter(self._batches))) if self._batches else None
+
+    def take_all(self) -> list[SampleBatch]:
+        """Every batch in progress, oldest first (before anything else the station says)."""
+        return [self._take(run) for run in list(self._batches)]
+
+    def take_due(self, now_s: float) -> list[SampleBatch]:
+        """The batches in progress that are due, oldest first."""
+        batches = self._batches
+        return [self._take(run) for run in list(batches) if now_s >= batches[run].due_s]
 
     def wait_s(self, now_s: float) -> float | None:
-        """Seconds until the batch in progress is due (0 when overdue); None when empty."""
-        if not self._samples:
+        """Seconds until the first batch in progress is due (0 when overdue); None when
+        none is in progress."""
+        if not self._batches:
             return None
-        return max(0.0, self._due_s - now_s)
+        return max(0.0, min(batch.due_s for batch in self._batches.values()) - now_s)
 
-    def _take(self) -> SampleBatch:
-        batch = SampleBatch(
-            self._station, time.time_ns(), self._samples, self._events, self._intensities
+    def _take(self, run_id: int) -> SampleBatch:
+        batch = self._batches.pop(run_id)
+        return SampleBatch(
+            self._station, time.time_ns(), batch.samples, batch.events, batch.intensities
         )
-        self._samples, self._events, self._intensities = [], [], []
-        return batch

@@ -3,7 +3,7 @@
 Run on demand::
 
     .venv/bin/python tests/benchmarks/bench_stop_path.py [--stops 1000]
-        [--placement edge|line|before] [--repo PATH] [--stations N]
+        [--placement edge|line|before] [--repo PATH] [--stations N] [--spindles N]
 
 The whole simulated station runs as ``boltwatch serve`` processes on an
 isolated station file (own zenoh and udp_multicast ports): the router, the
@@ -30,6 +30,13 @@ and what the machine itself lost meanwhile: the steal column of
 start, never acknowledged: its acquisition sends them again (at
 ``drain_messages_per_s``) while the stops are measured, the stop path
 beside a draining spool.
+
+``--spindles N``: a multi-spindle station of N spindles on one bus (the rig's
+synchronised cycles, each spindle its own run and its own StopCommand id):
+each cycle is N stops, reported per spindle too. Beside the stop path, the
+CPU the recorder and the acquisition used while the stops ran, per sample
+recorded (``/proc/<pid>/stat``, user + system, over the samples the runs'
+summaries count).
 
 ``--stations N``: a line of N stations (derived as ``boltwatch up
 --stations`` derives them), each with its own tool and bus, on one router
@@ -105,10 +112,12 @@ RIG_TORQUE_LIMIT_NM = 320.0
 START_TIMEOUT_S = 30.0
 
 
-def station_files(folder: Path, placement: str) -> tuple[Path, Path]:
+def station_files(folder: Path, placement: str, spindles: int = 1) -> tuple[Path, Path]:
     """(the services' station file, the rig's): the same station, the rig's limits higher."""
     port = free_tcp_port()
     common = {"pause_between_runs_s = 0.3": "pause_between_runs_s = 0.05"}
+    if spindles > 1:
+        common["has_force_sensor = true"] = f"has_force_sensor = true\nspindles = {spindles}"
     if placement != "before":  # a checkout from before the key knows only the line's predictor
         common["[predictor]\nwindow_samples = 5"] = (
             f'[predictor]\nplacement = "{placement}"\nwindow_samples = 5'
@@ -156,6 +165,15 @@ class Stop:
     program: int
     reason: str
     path_ms: float  # StopCommand heard - deciding sample received
+    spindle: int | None = None  # a multi-spindle station's
+
+
+def process_cpu_s(pid: int) -> float:
+    """The CPU time (user + system) process ``pid`` used so far, seconds."""
+    import os
+
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def stops_of(
@@ -184,7 +202,8 @@ def stops_of(
             )
             continue
         path_ms = (heard_stop.received_ns - decision.time_ns) / 1e6
-        out.append(Stop(station, run_id, program, decision.reason, path_ms))
+        spindle = summary.spindle if summary else None
+        out.append(Stop(station, run_id, program, decision.reason, path_ms, spindle))
     return out, lost
 
 
@@ -206,6 +225,7 @@ class Line:
     rig_paths: list[Path]
     processes: list[subprocess.Popen[bytes]] = field(default_factory=list)
     programs: dict[tuple[str, int], int] = field(default_factory=dict)
+    pids: dict[str, int] = field(default_factory=dict)  # service -> its first process
 
     @property
     def stations(self) -> list[LoadedStation]:
@@ -214,6 +234,7 @@ class Line:
     def serve(self, name: str, arguments: list[str]) -> subprocess.Popen[bytes]:
         process = serve_process(arguments, self.folder / f"{name}.log", self.args.repo.resolve())
         self.processes.append(process)
+        self.pids.setdefault(name.split("-", 1)[0], process.pid)
         return process
 
     def start(self, endpoint: str) -> None:
@@ -226,15 +247,18 @@ class Line:
             self.serve(f"acquisition-{path.stem}", ["acquisition", "--config", str(path)])
 
     def tighten(self, stations: list[LoadedStation]) -> None:
-        """Every station's rig plays each program for its share of the stops, in parallel."""
+        """Every station's rig plays each program for its share of the stops, in parallel
+        (a multi-spindle station: cycles of a run each spindle)."""
         first_run_id = int(time.time())
-        per_program = self.args.stops // (2 * len(stations))
+        spindles = self.args.spindles
+        cycles = self.args.stops // (2 * len(stations) * spindles)
+        per_program = cycles * spindles
         for index, program in enumerate((HARD_LIMIT_PROGRAM, PLATEAU_PROGRAM)):
             run_id = first_run_id + index * per_program
             rigs = []
             for station, rig_path in zip(stations, self.rig_paths, strict=True):
                 name = f"rig-{station.station_id}-{program}"
-                arguments = ["rig", "--config", str(rig_path), "--runs", str(per_program)]
+                arguments = ["rig", "--config", str(rig_path), "--runs", str(cycles)]
                 arguments += ["--program", str(program), "--first-run-id", str(run_id)]
                 rigs.append((self.serve(name, arguments), name))
                 for k in range(per_program):
@@ -243,6 +267,10 @@ class Line:
                 rig.wait(timeout=per_program * 3.0 + 60.0)
                 if rig.returncode != 0:
                     raise SystemExit(f"{name} exited {rig.returncode}, see {self.folder}")
+
+    def serve_pid(self, name: str) -> int:
+        """The pid of the first ``serve <name>`` started (the first station's acquisition)."""
+        return self.pids[name]
 
     def stop(self) -> None:
         for process in reversed(self.processes):
@@ -261,7 +289,7 @@ def fill_spool(station: LoadedStation, messages: int) -> None:
 
 
 def run(args: argparse.Namespace, folder: Path) -> int:
-    services_file, rig_file = station_files(folder, args.placement)
+    services_file, rig_file = station_files(folder, args.placement, args.spindles)
     line = Line(args, folder, [services_file], [rig_file])
     if args.stations > 1:
         line.services_paths = derive_stations(services_file, args.stations, folder / "services")
@@ -276,16 +304,23 @@ def run(args: argparse.Namespace, folder: Path) -> int:
         with contextlib.ExitStack() as listening:
             session = listening.enter_context(zenoh.open(zenoh_config("client", [endpoint])))
             listeners = {
-                s.station_id: listening.enter_context(StopListener(s.config.can, database))
+                s.station_id: listening.enter_context(
+                    StopListener(
+                        s.config.can, database, args.spindles, s.config.can.spindle_id_stride
+                    )
+                )
                 for s in stations
             }
             topics = (channels.DECISION.topic, channels.RUNS.topic)
             heard = listening.enter_context(Listener(session, "*", topics))
             for station in stations:
                 wait_alive(session, station.station_id, [folder])
+            busy = {name: line.serve_pid(name) for name in ("recorder", "acquisition")}
+            used_before = {name: process_cpu_s(pid) for name, pid in busy.items()}
             cpu_before, started = cpu_times(), time.monotonic()
             line.tighten(stations)
             elapsed_s, cpu_after = time.monotonic() - started, cpu_times()
+            used = {name: process_cpu_s(pid) - used_before[name] for name, pid in busy.items()}
             time.sleep(2.0)  # the last summaries
             heard_stops = {station_id: listener.heard for station_id, listener in listeners.items()}
     finally:
@@ -299,6 +334,13 @@ def run(args: argparse.Namespace, folder: Path) -> int:
         "time meanwhile"
     )
     print_table(stops, [s.station_id for s in stations] if len(stations) > 1 else [])
+    samples = sum(s.samples for s in heard.of(channels.RUNS.topic))
+    if samples:
+        print(
+            f"CPU a sample over {samples} samples ({args.spindles} spindle(s)): "
+            + ", ".join(f"{name} {1e6 * cpu_s / samples:.1f} µs" for name, cpu_s in used.items())
+            + " (the first acquisition's; with --stations the recorder serves them all)"
+        )
     print(f"lost: {len(lost)}")
     for note in lost[:20]:
         print("  ", note)
@@ -313,6 +355,8 @@ def print_table(stops: list[Stop], station_ids: list[str]) -> None:
         print(row(f"  {name}", [s.path_ms for s in stops if s.program == program]))
     for station_id in station_ids:
         print(row(f"  {station_id}", [s.path_ms for s in stops if s.station == station_id]))
+    for spindle in sorted({s.spindle for s in stops if s.spindle is not None}):
+        print(row(f"  spindle {spindle}", [s.path_ms for s in stops if s.spindle == spindle]))
     print("reasons:", dict(Counter(s.reason for s in stops)))
 
 
@@ -336,6 +380,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repo", type=Path, default=REPO, help="checkout to serve from")
     parser.add_argument(
         "--stations", type=int, default=1, help="stations on the line, each its own tool (1)"
+    )
+    parser.add_argument(
+        "--spindles", type=int, default=1, help="spindles of each station, one bus (1)"
     )
     parser.add_argument("--keep", type=Path, default=None, help="keep files and logs here")
     args = parser.parse_args(argv)

@@ -1,12 +1,25 @@
-"""The acquisition on a python-can virtual bus, for tests: frames of the station's DBC and
-an outlet that keeps what the acquisition publishes."""
+"""The acquisition on a python-can virtual bus, for tests: frames of the station's DBC, an
+outlet that keeps what the acquisition publishes, and the station's predictor as the edge
+runs it, without its zenoh side."""
 
 from __future__ import annotations
+
+import time
 
 import can
 
 from services.acquisition.acquisition import Acquisition
-from shared.contract import BusStats, Sample, StationDatabase, ToolState
+from services.predictor.served_station import ServedStation
+from services.predictor.station_runs import StationRuns
+from shared.config import LoadedStation
+from shared.contract import (
+    BusStats,
+    Sample,
+    StageDecision,
+    StationDatabase,
+    StopDecision,
+    ToolState,
+)
 from tests.support.paths import DBC_FILE
 
 DATABASE = StationDatabase(DBC_FILE)
@@ -50,3 +63,26 @@ def drain(acquisition: Acquisition, bus: can.BusABC) -> None:
         if message is None:
             return
         acquisition.handle(message)
+
+
+class StationPredictor:
+    """The station's predictor as the edge runs it (StationRuns), without its zenoh side: what
+    it would publish is kept here."""
+
+    def __init__(self, station: LoadedStation) -> None:
+        self.runs = StationRuns(ServedStation(station))
+        self.published: list[object] = []
+
+    def on_tool_state(self, state: ToolState) -> None:
+        self.published += self.runs.on_tool(state)
+
+    def on_sample(self, sample: Sample) -> StopDecision | StageDecision | None:
+        decision = None
+        for message in self.runs.on_sample(sample, time.time_ns()):
+            self.published.append(message)
+            if isinstance(message, StopDecision | StageDecision):
+                decision = message
+        return decision
+
+    def of(self, kind: type) -> list:
+        return [m for m in self.published if isinstance(m, kind)]

@@ -134,11 +134,22 @@ class HeardStop:
 class StopListener:
     """Records every ``StopCommand`` frame on the bus, from a thread (a context manager)."""
 
-    def __init__(self, section: CanSection, database: StationDatabase) -> None:
+    def __init__(
+        self, section: CanSection, database: StationDatabase, spindles: int = 1, stride: int = 2
+    ) -> None:
+        """``spindles``, ``stride``: a multi-spindle station's (each spindle's StopCommand at
+        the DBC's id plus its stride); every spindle's is heard."""
         self._database = database
         self._bus = open_bus(section)
         self._bus.set_filters(
-            [{"can_id": database.stop_command_id, "can_mask": 0x7FF, "extended": False}]
+            [
+                {
+                    "can_id": database.stop_command_id + k * stride,
+                    "can_mask": 0x7FF,
+                    "extended": False,
+                }
+                for k in range(spindles)
+            ]
         )
         self._stop = threading.Event()
         self._lock = threading.Lock()
@@ -170,7 +181,7 @@ class StopListener:
                 continue
             received_ns = round(message.timestamp * 1e9)
             try:
-                signals = self._database.decode(message.arbitration_id, message.data)
+                signals = self._database.decode_named("StopCommand", message.data)
                 heard = HeardStop(int(signals["RunId"]), int(signals["Reason"]), received_ns)
             except Exception:  # a malformed StopCommand is still a stop to report
                 heard = HeardStop(-1, -1, received_ns)

@@ -5,7 +5,9 @@ the statements that version ran) and fills them as it did: each result's row
 with the columns that version had, and its steps. :func:`version_1_store` is
 the store before the plant model (no ``plant``, no ``station_name``),
 :func:`version_2_store` the one before the part's source (no ``part_source``),
-:func:`version_4_store` the one before a final stage's pulses (no ``pulses``).
+:func:`version_4_store` the one before a final stage's pulses (no ``pulses``),
+:func:`version_5_store` the one before multi-spindle stations (no ``spindle``, no
+``sync_id``, no ``cycle_results``).
 """
 
 from __future__ import annotations
@@ -17,7 +19,12 @@ from shared.results.results_schema import STEP_COLUMNS, TIGHTENING_COLUMNS
 from shared.results.stored_result import step_rows, to_row
 
 #: the columns each version added to ``tightenings``
-ADDED_IN = {2: ("plant", "station_name"), 3: ("part_source",), 5: ("pulses",)}
+ADDED_IN = {
+    2: ("plant", "station_name"),
+    3: ("part_source",),
+    5: ("pulses",),
+    6: ("spindle", "sync_id"),
+}
 #: the columns version 2 added to ``tightenings`` (the plant model)
 ADDED_IN_2 = ADDED_IN[2]
 
@@ -67,3 +74,9 @@ def version_4_store(target: StoreTarget, results: Sequence[StoredResult]) -> Non
     """A store of version 4 at ``target`` holding ``results`` (their pulses, which version 4
     did not keep, left out)."""
     old_store(target, results, 4)
+
+
+def version_5_store(target: StoreTarget, results: Sequence[StoredResult]) -> None:
+    """A store of version 5 at ``target`` holding ``results`` (their spindle and sync id,
+    which version 5 did not keep, left out)."""
+    old_store(target, results, 5)

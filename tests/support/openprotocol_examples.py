@@ -13,6 +13,7 @@ from shared.openprotocol import (
     VariableField,
     WireMessage,
     alarms,
+    multi_spindle,
     results,
     session,
     subscriptions,
@@ -37,6 +38,19 @@ OLD_RESULT_2 = results.OldTighteningResult(
     torque_nm=9999.99, angle_deg=99999, rundown_angle_deg=0, current_monitoring_pct=999,
     selftap_torque_nm=0.01, prevail_torque_nm=0.0, job_sequence_number=99999,
     sync_tightening_id=1, tool_serial="12345678901234", timestamp=TIME, revision=2,
+)  # fmt: skip
+
+SPINDLES = (
+    multi_spindle.SpindleResult(1, 1, True, 1, 201.37, True, 47),
+    multi_spindle.SpindleResult(2, 2, False, 2, 9999.99, False, 99999),
+    multi_spindle.SpindleResult(20, 99, True, 0, 0.0, True, 0),
+)
+MULTI_SPINDLE_RESULT = multi_spindle.MultiSpindleResult(
+    vin="WVWZZZ1JZXW000001", job_id=99, pset_id=999, batch_size=9999, batch_counter=0,
+    batch_status=BatchStatus.NOT_USED, torque_min_nm=180.0, torque_max_nm=240.0,
+    torque_final_target_nm=200.0, angle_min_deg=35, angle_max_deg=65,
+    angle_final_target_deg=0, pset_changed=TIME, timestamp=TIME, sync_tightening_id=65535,
+    ok=False, spindles=SPINDLES,
 )  # fmt: skip
 
 TRACE = TraceCurve(
@@ -141,6 +155,36 @@ EXAMPLES: list[WireMessage] = [
         revision=2,
     ),
     alarms.AlarmStatusAck(),
+    multi_spindle.MultiSpindleStatusSubscribe(),
+    multi_spindle.MultiSpindleStatus(
+        sync_tightening_id=0,
+        time=TIME,
+        ok=False,
+        spindles=multi_spindle.spindle_statuses(SPINDLES),
+    ),
+    multi_spindle.MultiSpindleStatusAcknowledge(),
+    multi_spindle.MultiSpindleStatusUnsubscribe(),
+    multi_spindle.MultiSpindleResultSubscribe(),
+    multi_spindle.MultiSpindleResultSubscribe(data_no_system=0, revision=2),
+    *(
+        multi_spindle.MultiSpindleResultSubscribe(
+            data_no_system=9_999_999_999, send_only_new=True, revision=revision
+        )
+        for revision in (3, 4, 5)
+    ),
+    *(dataclasses.replace(MULTI_SPINDLE_RESULT, revision=revision) for revision in (1, 2, 3)),
+    dataclasses.replace(
+        MULTI_SPINDLE_RESULT,
+        system_sub_type=2,
+        angle_min_deg=-9999,
+        spindles=(multi_spindle.SpindleResult(1, 1, True, 1, 12.5, True, -9999),),
+        revision=4,
+    ),
+    dataclasses.replace(
+        MULTI_SPINDLE_RESULT, system_sub_type=1, job_sequence_number=65535, revision=5
+    ),
+    multi_spindle.MultiSpindleResultAcknowledge(),
+    multi_spindle.MultiSpindleResultUnsubscribe(),
     TRACE,
     dataclasses.replace(TRACE, samples=(), pid_fields=(), parameter_fields=()),
 ]

@@ -67,6 +67,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "MCAP paths",
     )
     overlay.add_argument(
+        "--cycle",
+        action="store_true",
+        help="each RUN stands for its whole multi-spindle cycle: every spindle's run of it, "
+        "overlaid in spindle order",
+    )
+    overlay.add_argument(
         "--reference", default=None, metavar="RUN", help="a run drawn distinct (black, on top); "
         "the others are aligned onto it"
     )  # fmt: skip
@@ -94,8 +100,9 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("give a recording (RUN.mcap) to draw, or --overlay RUN...")
     if args.rerun:
         return _write_rrd(args)
-    if args.reference is not None or args.align != "start":
+    if args.reference is not None or args.align != "start" or args.cycle:
         option = "--reference" if args.reference is not None else "--align"
+        option = "--cycle" if args.cycle else option
         raise InputError(f"{option} is an option of --overlay; give --overlay RUN... with it")
     from shared.offline.post_mortem import draw_run
 

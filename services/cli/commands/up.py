@@ -17,6 +17,13 @@ this machine (127.0.0.1:4545, a derived file in the run's log folder). The first
 tightening waits until the bridge has subscribed to results (the operator waits
 for the line), the others keep the tool's pace.
 
+``--spindles N`` makes the station a multi-spindle system of N spindles (a
+derived station file with ``[station] spindles = N`` in the run's log
+folder): each of the ``--runs`` is a synchronised cycle of every spindle, one
+part per cycle, each spindle's run its own row with its spindle number, and
+the totals say how many cycles were OK. With ``--controller openprotocol``
+the simulated controller is the multi-spindle system.
+
 ``--stations N`` runs a line of N simulated stations on one router: N
 station files derived from ``--config`` (ids ``st1..stN`` when the base id is
 ``st1``, each with its own CAN multicast port, tool id and rig seed; see
@@ -62,6 +69,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--program", type=int, default=None, help="program id (default: the first program)"
     )
     parser.add_argument(
+        "--spindles",
+        type=int,
+        default=None,
+        help="a multi-spindle station of N spindles tightening one part per cycle; each of "
+        "--runs is a cycle of every spindle (default: the station file's [station] spindles, 1)",
+    )
+    parser.add_argument(
         "--controller",
         choices=("can", "openprotocol"),
         default="can",
@@ -90,6 +104,42 @@ def with_local_controller(config: Path, folder: Path) -> Path:
     return path
 
 
+def with_spindles(config: Path, folder: Path, spindles: int) -> Path:
+    """A copy of the station file ``config`` (paths made absolute) whose station has
+    ``spindles`` spindles (``[station] spindles``)."""
+    from shared.config import derive_stations, load_station
+    from shared.config.loading import read_toml
+    from shared.config.toml_writer import dumps
+
+    (path,) = derive_stations(config, 1, folder)
+    document = read_toml(path)
+    document["station"] = {**document["station"], "spindles": spindles}
+    path.write_text(
+        f"# Derived by boltwatch up --spindles {spindles} from {config.resolve()}\n"
+        + dumps(document)
+    )
+    load_station(path)  # its spindles' CAN ids and tools, checked now
+    return path
+
+
+def _check_counts(args: argparse.Namespace) -> None:
+    """--runs, --stations and --spindles each within bounds, and together what ``up`` runs."""
+    from shared.contract import MAX_SPINDLES
+    from shared.errors import ConfigError
+
+    if args.runs < 1:
+        raise ConfigError(f"--runs must be at least 1 (got {args.runs})")
+    if args.stations < 1:
+        raise ConfigError(f"--stations must be at least 1 (got {args.stations})")
+    if args.spindles is not None and not 1 <= args.spindles <= MAX_SPINDLES:
+        raise ConfigError(f"--spindles must be 1 to {MAX_SPINDLES} (got {args.spindles})")
+    if args.spindles is not None and args.stations > 1:
+        raise ConfigError(
+            f"--spindles with --stations {args.stations}: a line of multi-spindle stations "
+            "needs station files of its own (each spindle's tool id is its own)"
+        )
+
+
 def run(args: argparse.Namespace) -> int:
     from services.cli.station_run import StationRun
     from services.rig.selection import choose_program
@@ -97,17 +147,15 @@ def run(args: argparse.Namespace) -> int:
     from shared.config import check_derivable, derive_stations, load_line, load_station
     from shared.errors import ConfigError
 
-    if args.runs < 1:
-        raise ConfigError(f"--runs must be at least 1 (got {args.runs})")
-    if args.stations < 1:
-        raise ConfigError(f"--stations must be at least 1 (got {args.stations})")
+    _check_counts(args)
     first_run_id = int(time.time())  # what the rig numbers its first run with
-    if first_run_id + args.runs - 1 > RUN_ID_MAX:
-        raise ConfigError(
-            f"--runs must be at most {RUN_ID_MAX - first_run_id + 1} (got {args.runs}): run ids "
-            f"count from the current Unix time and end at {RUN_ID_MAX}"
-        )
     station = load_station(args.config)
+    spindles = args.spindles or station.config.station.spindles
+    if first_run_id + args.runs * spindles - 1 > RUN_ID_MAX:
+        raise ConfigError(
+            f"--runs must be at most {(RUN_ID_MAX - first_run_id + 1) // spindles} (got "
+            f"{args.runs}): run ids count from the current Unix time and end at {RUN_ID_MAX}"
+        )
     program = choose_program(station, args.program)
     if station.config.zenoh.mode != "client" or not station.config.zenoh.connect:
         raise ConfigError(
@@ -129,8 +177,12 @@ def run(args: argparse.Namespace) -> int:
         if args.stations == 1
         else load_line(derive_stations(args.config, args.stations, log_dir / "stations"))
     )
+    base = args.config
     if args.controller == "openprotocol" and station.config.openprotocol is None:
-        stations = [load_station(with_local_controller(args.config, log_dir / "stations"))]
+        base = with_local_controller(args.config, log_dir / "stations")
+        stations = [load_station(base)]
+    if args.spindles is not None and args.spindles != station.config.station.spindles:
+        stations = [load_station(with_spindles(base, log_dir / "spindles", args.spindles))]
 
     def on_signal(signum: int, _frame: FrameType | None) -> None:
         raise StoppedBySignalError(signal.Signals(signum).name)

@@ -2,10 +2,16 @@
 
 A run file is opened by the run's ``ToolState(state="running")`` and holds
 what the station publishes from then on: the run, its result and its
-summary. It is finished (complete, under its name) ``late_grace_s`` after the
-run's summary (its ``RunSummary``), or at the next run's start, whichever
-comes first: a station that stops tightening has its last run's file readable
-a moment after the run, not at its next run. What the station says after that
+summary. A multi-spindle station's cycle is one file: the first spindle's run
+to start (its ``ToolState`` names the cycle's ``sync_id``) opens it, named by
+that run, and every spindle's run of the cycle goes into it (their states,
+samples, events, results, summaries), then the cycle's common result
+(``CycleResult``), a grace after which the file is finished (a spindle's
+summary does not finish it: the others may still run). A run file is
+finished (complete, under its name) ``late_grace_s`` after the run's summary
+(its ``RunSummary``), or at the next run's start, whichever comes first: a
+station that stops tightening has its last run's file readable a moment
+after the run, not at its next run. What the station says after that
 (its counters between runs) goes into an idle file (``<station>_idle_...``),
 which the next run's start finishes. A message of a run whose file was
 finished never opens a file named for that run again: it goes to the idle
@@ -44,7 +50,7 @@ the owner (:class:`~services.recorder.live.recorder.Recorder`) calls
 from __future__ import annotations
 
 import logging
-from collections import deque
+from collections import OrderedDict, deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -62,6 +68,9 @@ LOG = logging.getLogger(__name__)
 
 #: run ids remembered per station: a ToolState starting one of them again opens no file
 STARTED_RUNS_KEPT = 64
+#: a multi-spindle station's runs remembered with the file of their cycle (20 spindles, 50
+#: cycles: a spool's resend of the newest reaches them)
+CYCLE_RUNS_KEPT = 1000
 #: a run sent again by a station's spool is named by its start when it is at most this old
 SENT_AGAIN_MAX_AGE_NS = 7 * 24 * 3600 * 1_000_000_000
 _ENDED_STATES = ("done", "aborted")
@@ -93,6 +102,10 @@ class OpenRun:
     program_id: int | None
     #: when the file is to be finished: a grace after its run's summary (None: at the next run)
     finish_at_ns: int | None = None
+    #: a multi-spindle station's: its runs -> the run whose file holds their cycle, and the
+    #: cycles' files by sync id (the rest of a cycle, sent again, goes into the same file)
+    cycle_runs: tuple[tuple[int, int], ...] = ()
+    cycle_files: tuple[tuple[int, int], ...] = ()
 
 
 class StationFiles:
@@ -142,26 +155,48 @@ class StationFiles:
         self._touched: set[McapSink] = set()
         self._in_message = False  # between start_message and end_message: no flush
         self._last_now_ns = 0  # the log time of the last message written
+        #: a multi-spindle station's runs -> the run whose file holds their cycle
+        self._cycle_runs: OrderedDict[int, int] = OrderedDict()
+        #: sync id -> the run whose file holds that cycle
+        self._cycle_files: OrderedDict[int, int] = OrderedDict()
+
+    def _file_run(self, received: Received) -> int | None:
+        """The run whose file ``received`` goes into: its own run, or on a multi-spindle
+        station the run that opened its cycle's file (a cycle's common result: its runs')."""
+        message = received.message
+        if received.run_started and message.sync_id is not None:
+            opened = self._cycle_files.get(message.sync_id)
+            if opened is None or not (opened == message.run_id or self.holds_run(opened)):
+                opened = message.run_id  # the cycle's first run to start: its file's name
+                _keep(self._cycle_files, message.sync_id, opened)
+            _keep(self._cycle_runs, message.run_id, opened)
+            return opened
+        run_id = received.run_id
+        if run_id is None and received.schema_name == channels.CYCLES.schema_name and message:
+            run_id = next(iter(message.run_ids), None)
+        if run_id is None or not self._cycle_runs:
+            return run_id
+        return self._cycle_runs.get(run_id, run_id)
 
     def write(self, received: Received) -> None:
         now_ns = received.log_time_ns
-        if received.run_started and self._is_new_run(received.run_id):
+        run_id = self._file_run(received)
+        if received.run_started and self._is_new_run(run_id):
             self._tool_id = received.message.tool_id
             self._program_id = received.message.program_id
-            self._run_started = (received.run_id, received.message.time_ns)
-            self._resume = (received.run_id, 1)  # should the disk fail before the file opens
-            self._start_run(received.run_id, now_ns)
-        elif self._opens_its_run(received.run_id):
-            assert received.run_id is not None
-            self._run_started = (received.run_id, _run_time_ns(received, now_ns))
-            self._start_run(received.run_id, now_ns)
+            self._run_started = (run_id, received.message.time_ns)
+            self._resume = (run_id, 1)  # should the disk fail before the file opens
+            self._start_run(run_id, now_ns)
+        elif self._opens_its_run(run_id):
+            assert run_id is not None
+            self._run_started = (run_id, _run_time_ns(received, now_ns))
+            self._start_run(run_id, now_ns)
         elif received.schema_name == channels.SAMPLES.schema_name:
-            self._open_or_continue(received.run_id, now_ns, samples_of=received.run_id)
+            self._open_or_continue(run_id, now_ns, samples_of=run_id)
         else:
-            self._open_or_continue(received.run_id, now_ns)
+            self._open_or_continue(run_id, now_ns)
         assert self.current is not None
         sink = self.current
-        run_id = received.run_id
         previous = self.previous
         if previous is not None and run_id is not None and run_id == previous.run_id != sink.run_id:
             sink = previous
@@ -171,10 +206,14 @@ class StationFiles:
         self.written += 1
         self.last_path = sink.path
         if sink is self.current and received.message is not None:
-            if received.schema_name == channels.TOOL.schema_name:
+            schema = received.schema_name
+            if schema == channels.TOOL.schema_name:
                 self._run_ended = received.message.state in _ENDED_STATES  # a refused one is raw
-            elif received.schema_name == channels.RUNS.schema_name and run_id == sink.run_id:
-                self._finish_at_ns = now_ns + self._limits.late_grace_ns  # the run is over
+            elif schema == channels.RUNS.schema_name and run_id == sink.run_id:
+                if received.message.sync_id is None:  # a cycle's file waits for its result
+                    self._finish_at_ns = now_ns + self._limits.late_grace_ns  # the run is over
+            elif schema == channels.CYCLES.schema_name and run_id == sink.run_id:
+                self._finish_at_ns = now_ns + self._limits.late_grace_ns  # the cycle is over
         self._flush_if_due(now_ns)
 
     def write_samples(self, samples: Sequence[Received]) -> None:
@@ -184,14 +223,16 @@ class StationFiles:
             return
         now_ns = samples[-1].log_time_ns
         run_id = samples[0].message.run_id
+        if self._cycle_runs:
+            run_id = self._cycle_runs.get(run_id, run_id)
         self._open_or_continue(run_id, now_ns, samples_of=run_id)
         assert self.current is not None
         groups: list[tuple[McapSink, Sequence[Received]]] = [(self.current, samples)]
         previous = self.previous
         if previous is not None and previous.run_id != self.current.run_id:
-            late = [s for s in samples if s.message.run_id == previous.run_id]
+            late = [s for s in samples if self._file_run_of(s) == previous.run_id]
             if late:
-                on_time = [s for s in samples if s.message.run_id != previous.run_id]
+                on_time = [s for s in samples if self._file_run_of(s) != previous.run_id]
                 groups = [(previous, late), (self.current, on_time)]
         for sink, group in groups:
             for target in self._sinks_of(sink):
@@ -199,6 +240,11 @@ class StationFiles:
             self._touched.add(sink)
             self.written += len(group)
         self._flush_if_due(now_ns)
+
+    def _file_run_of(self, sample: Received) -> int:
+        """The run whose file a sample goes into (its own, or its cycle's)."""
+        run_id: int = sample.message.run_id
+        return self._cycle_runs.get(run_id, run_id) if self._cycle_runs else run_id
 
     def start_message(self) -> None:
         """A numbered message is about to be filed, perhaps in several parts (a batch: its
@@ -346,6 +392,8 @@ class StationFiles:
             self._tool_id,
             self._program_id,
             self._finish_at_ns,
+            tuple(self._cycle_runs.items()),
+            tuple(self._cycle_files.items()),
         )
         self._finish_at_ns = None
         return handed
@@ -365,13 +413,20 @@ class StationFiles:
         self._tool_id, self._program_id = run.tool_id, run.program_id
         self._finish_at_ns = run.finish_at_ns
         self._started_runs.append(run.sink.run_id)
+        for run_id, opened in run.cycle_runs:
+            _keep(self._cycle_runs, run_id, opened)
+        for sync_id, opened in run.cycle_files:
+            _keep(self._cycle_files, sync_id, opened)
 
     def _opens_its_run(self, run_id: int | None) -> bool:
         """A message of ``run_id`` opens that run's file (``runs_by_id``: none is open)."""
         return self.runs_by_id and run_id is not None and not self.holds_run(run_id)
 
     def holds_run(self, run_id: int) -> bool:
-        """Whether a file of run ``run_id`` is open here (the current, or the one before)."""
+        """Whether a file of run ``run_id`` (of its cycle's, a multi-spindle station's) is open
+        here (the current, or the one before)."""
+        if self._cycle_runs:
+            run_id = self._cycle_runs.get(run_id, run_id)
         return any(
             sink is not None and sink.run_id == run_id for sink in (self.current, self.previous)
         )
@@ -482,6 +537,14 @@ class StationFiles:
             if companion is not None:
                 companion.close()  # never raises: a Rerun failure is logged, not fatal
         self.closed_paths.append(sink.path)
+
+
+def _keep(remembered: OrderedDict[int, int], key: int, value: int) -> None:
+    """``remembered[key] = value``, the oldest let go past :data:`CYCLE_RUNS_KEPT`."""
+    remembered[key] = value
+    remembered.move_to_end(key)
+    while len(remembered) > CYCLE_RUNS_KEPT:
+        remembered.popitem(last=False)
 
 
 def _run_time_ns(received: Received, default_ns: int) -> int:

@@ -62,7 +62,8 @@ class ControllerServer:
         self._wake_in, self._wake_out = socket.socketpair()
         self._wake_in.setblocking(False)
         self._wake_out.setblocking(False)
-        self._inbox: queue.SimpleQueue[Tightening] = queue.SimpleQueue()
+        #: finished tightenings, and a multi-spindle system's cycles (each a list of them)
+        self._inbox: queue.SimpleQueue[Tightening | list[Tightening]] = queue.SimpleQueue()
         self._links: dict[socket.socket, IntegratorLink] = {}
         self._selector = selectors.DefaultSelector()
         self._selector.register(self._listener, selectors.EVENT_READ, "accept")
@@ -85,10 +86,22 @@ class ControllerServer:
     def connected(self) -> int:
         return len(self._links)
 
+    @property
+    def links(self) -> list[IntegratorLink]:
+        """The integrators' sessions now (the serving thread's; a test reads them after)."""
+        return list(self._links.values())
+
     def report(self, tightening: Tightening) -> None:
         """A finished tightening (any thread): kept and pushed by the serving thread."""
         self._inbox.put(tightening)
         with contextlib.suppress(OSError):  # the wake-up pipe is full: the loop is awake anyway
+            self._wake_out.send(b"\x00")
+
+    def report_cycle(self, cycle: list[Tightening]) -> None:
+        """A multi-spindle system's cycle (any thread), after its spindles' tightenings: its
+        status (0091) and result (0101) pushed by the serving thread."""
+        self._inbox.put(cycle)
+        with contextlib.suppress(OSError):
             self._wake_out.send(b"\x00")
 
     def serve(self, stop: threading.Event, until: Callable[[], bool] = lambda: False) -> None:
@@ -183,6 +196,11 @@ class ControllerServer:
                 tightening = self._inbox.get_nowait()
             except queue.Empty:
                 return
+            if isinstance(tightening, list):  # a cycle, after its tightenings
+                for sock, link in list(self._links.items()):
+                    link.cycle(tightening)
+                    self._flush(sock, link)
+                continue
             alarms = self._state.tightening(tightening)
             for sock, link in list(self._links.items()):
                 link.tightening(tightening, now)

@@ -11,6 +11,8 @@ reads its settings and writes through it.
 - the revisions it speaks: what the codec implements
   (:data:`~shared.openprotocol.codec.SUPPORTED_REVISIONS`), 0061/0064/0065
   up to ``max_result_revision``;
+- a multi-spindle system (``spindles`` above 1): each cycle's status (0091) and
+  result (0101, :mod:`.cycle_messages`);
 - the alarm: a run that ends on a hard limit raises one (0071, codes below,
   the simulated controller's own: real controllers have their own tables);
   it stays active until the next run that ends without a limit, which clears
@@ -33,6 +35,7 @@ import zoneinfo
 
 from services.rig.controller import StopSource
 from services.rig.openprotocol.controller_counters import ControllerCounters
+from services.rig.openprotocol.cycle_messages import cycle_result, cycle_status
 from services.rig.openprotocol.result_messages import (
     ControllerIdentity,
     last_result,
@@ -85,8 +88,12 @@ class ControllerState:
         settings: RigOpenProtocolSection,
         *,
         started: dt.date | None = None,
+        spindles: int = 1,
     ) -> None:
+        """``spindles``: above 1, a multi-spindle system (a sync master: it takes the
+        multi-spindle subscriptions, 0090 and 0100)."""
         self.settings = settings
+        self.spindles = spindles
         self.counters = ControllerCounters()
         self.store = ResultStore(settings.results_kept)
         self.identity = ControllerIdentity(station_id, tool_id, zoneinfo.ZoneInfo(section.timezone))
@@ -144,6 +151,12 @@ class ControllerState:
 
     def old_result(self, tightening: Tightening, revision: int) -> WireMessage:
         return old_result(tightening, revision, self.identity)
+
+    def cycle_result(self, cycle: list[Tightening], revision: int) -> WireMessage:
+        return cycle_result(cycle, revision, self.identity)
+
+    def cycle_status(self, cycle: list[Tightening]) -> WireMessage:
+        return cycle_status(cycle, self.identity)
 
     def traces(self, tightening: Tightening, trace_types: tuple[int, ...]) -> list[TraceCurve]:
         return trace_curves(tightening, trace_types, self.identity)

@@ -27,6 +27,11 @@ What it answers, as real controllers do:
   0005 is taken, not waited for).
 - 0064 -> 0065 of the id asked (0: the newest), or 0004 error 15 when the id
   is not kept; 0040 -> 0041; 9999 -> 9999 when mirroring (a setting).
+- A multi-spindle system's: 0090 / 0100 -> 0005, or 0004: 30 (a controller of
+  one spindle: no sync master), 31 / 33 (already subscribed), 97; 0093 /
+  0103 -> 0005 or 0004 32 / 34. After each cycle 0091 and 0101 (at the
+  revision subscribed) are pushed to their subscribers; their acknowledges
+  (0092, 0102) are taken as receipts, nothing is sent again.
 - 0003 -> 0005, then the link ends. Any other MID -> 0004 error 99; content
   the codec refuses -> 0004 error 1 (invalid data), counted.
 - Nothing heard for ``link_timeout_s``: the link is dropped.
@@ -58,6 +63,12 @@ from shared.openprotocol import (
     Frame,
     FrameReader,
     KeepAlive,
+    MultiSpindleResultAcknowledge,
+    MultiSpindleResultSubscribe,
+    MultiSpindleResultUnsubscribe,
+    MultiSpindleStatusAcknowledge,
+    MultiSpindleStatusSubscribe,
+    MultiSpindleStatusUnsubscribe,
     OldResultRequest,
     OpenProtocolError,
     ResultAcknowledge,
@@ -75,7 +86,14 @@ TRACE_MID = 900
 #: the curves the simulated tool has (0900 trace types): angle, torque
 TRACE_TYPES = (1, 2)
 #: the integrator's receipts: of a 0900 (0005 "0900"), of alarm messages (0072, 0075, 0077)
-RECEIPTS = (CommandAccepted, AlarmAcknowledge, AlarmAcknowledgedOnControllerAck, AlarmStatusAck)
+RECEIPTS = (
+    CommandAccepted,
+    AlarmAcknowledge,
+    AlarmAcknowledgedOnControllerAck,
+    AlarmStatusAck,
+    MultiSpindleStatusAcknowledge,
+    MultiSpindleResultAcknowledge,
+)
 
 
 @dataclass
@@ -104,6 +122,8 @@ class IntegratorLink:
         self.trace_revision: int | None = None
         self.trace_types: tuple[int, ...] = ()
         self.alarm_revision: int | None = None
+        self.cycle_status_subscribed = False
+        self.cycle_result_revision: int | None = None
         self._queue: deque[Tightening] = deque(maxlen=self._settings.results_kept)
         self._pending: _Pending | None = None
         #: why the link must end (None: it goes on)
@@ -176,6 +196,17 @@ class IntegratorLink:
             self._queue.append(tightening)
             self._push_next(now)
 
+    def cycle(self, cycle: list[Tightening]) -> None:
+        """A multi-spindle system's cycle, after its spindles' tightenings: its status and its
+        result to their subscribers."""
+        if self.closed is not None:
+            return
+        if self.cycle_status_subscribed:
+            self._send(self._state.cycle_status(cycle))
+        if self.cycle_result_revision is not None:
+            revision = self.cycle_result_revision
+            self._send(self._state.cycle_result(cycle, revision), revision)
+
     def alarm_message(self, message: WireMessage) -> None:
         """An alarm raised (0071) or cleared (0074): sent to an alarm subscriber."""
         if self.closed is None and self.alarm_revision is not None:
@@ -218,6 +249,10 @@ class IntegratorLink:
             ToolDataRequest: self._tool_data,
             AlarmSubscribe: self._subscribe_alarms,
             AlarmUnsubscribe: self._unsubscribe_alarms,
+            MultiSpindleStatusSubscribe: self._subscribe_cycles,
+            MultiSpindleStatusUnsubscribe: self._unsubscribe_cycles,
+            MultiSpindleResultSubscribe: self._subscribe_cycles,
+            MultiSpindleResultUnsubscribe: self._unsubscribe_cycles,
         }
         handler = handlers.get(type(message))
         if handler is not None:
@@ -275,6 +310,38 @@ class IntegratorLink:
             self._refuse(frame.mid, ErrorCode.ALARM_SUBSCRIPTION_MISSING)
             return
         self.alarm_revision = None
+        self._accept(frame.mid)
+
+    def _subscribe_cycles(self, message: object, frame: Frame, _now: float) -> None:
+        """0090 or 0100: a multi-spindle system's cycles (a single tool is no sync master)."""
+        status = isinstance(message, MultiSpindleStatusSubscribe)
+        if self._state.spindles < 2:
+            self._refuse(frame.mid, ErrorCode.NOT_A_SYNC_MASTER)
+        elif self.cycle_status_subscribed if status else self.cycle_result_revision is not None:
+            exists = ErrorCode.MULTI_SPINDLE_STATUS_SUBSCRIPTION_EXISTS
+            self._refuse(
+                frame.mid, exists if status else ErrorCode.MULTI_SPINDLE_RESULT_SUBSCRIPTION_EXISTS
+            )
+        else:
+            if status:
+                self.cycle_status_subscribed = True
+            else:
+                self.cycle_result_revision = frame.revision
+            self._accept(frame.mid)
+
+    def _unsubscribe_cycles(self, message: object, frame: Frame, _now: float) -> None:
+        status = isinstance(message, MultiSpindleStatusUnsubscribe)
+        if not (self.cycle_status_subscribed if status else self.cycle_result_revision):
+            missing = ErrorCode.MULTI_SPINDLE_STATUS_SUBSCRIPTION_MISSING
+            self._refuse(
+                frame.mid,
+                missing if status else ErrorCode.MULTI_SPINDLE_RESULT_SUBSCRIPTION_MISSING,
+            )
+            return
+        if status:
+            self.cycle_status_subscribed = False
+        else:
+            self.cycle_result_revision = None
         self._accept(frame.mid)
 
     def _subscribe_results(self, _message: object, frame: Frame, _now: float) -> None:

@@ -78,7 +78,7 @@ def last_result(
     """The 0061 of ``tightening`` at ``revision`` (1 or 2)."""
     result = LastTighteningResult(
         cell_id=identity.cell_id,
-        channel_id=identity.channel_id,
+        channel_id=tightening.channel_id,
         controller_name=identity.controller_name,
         vin=tightening.vin,
         job_id=0,
@@ -150,7 +150,7 @@ def _second_revision(
         "selftap_torque_nm": 0.0,
         "prevail_torque_nm": 0.0,
         "job_sequence_number": 0,
-        "sync_tightening_id": 0,
+        "sync_tightening_id": tightening.sync_tightening_id,
         "tool_serial": identity.tool_serial,
     }
     if limits:

@@ -8,7 +8,9 @@ integrator has had every tightening it keeps (acknowledged its 0061, or was
 served its 0065: one that was away while the tool tightened fetches them when
 it is back, however late), every result pushed is acknowledged (or its link
 dropped) and nothing has been outstanding for :data:`LINGER_S`; then ``run``
-returns. Without ``runs`` it serves until ``stop``.
+returns. Without ``runs`` it serves until ``stop``. A station of several spindles
+(``[station] spindles``) is a multi-spindle system: ``runs`` counts its cycles,
+each a tightening of every spindle, then the cycle's 0091 and 0101.
 """
 
 from __future__ import annotations
@@ -56,7 +58,8 @@ class SimulatedController:
                 f"{station.path}: openprotocol: the section is needed by --controller "
                 "openprotocol (host and port the controller listens on)"
             )
-        last_id = first_tightening_id + (runs or 1) - 1
+        spindles = config.station.spindles
+        last_id = first_tightening_id + (runs or 1) * spindles - 1
         if first_tightening_id < 1 or last_id > TIGHTENING_ID_MAX:
             raise ConfigError(
                 f"--first-run-id must keep tightening ids within 1..{TIGHTENING_ID_MAX} "
@@ -70,6 +73,7 @@ class SimulatedController:
             program,
             section,
             config.rig.openprotocol,
+            spindles=spindles,
         )
         self.server = ControllerServer(section.host, section.port, self.state)
         judge = TighteningJudge(
@@ -84,6 +88,8 @@ class SimulatedController:
             # shutoff is the program's torque target; on preload only for a program without one
             has_force_sensor=config.station.has_force_sensor and program.target_torque_nm is None,
             on_tightening=self._tightened,
+            spindles=spindles,
+            on_cycle=self.server.report_cycle,
         )
         self._wait_for_integrator = wait_for_integrator
         self._counter = counter

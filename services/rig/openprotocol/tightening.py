@@ -89,6 +89,10 @@ class Tightening:
     batch_counter: int
     batch_status: BatchStatus
     vin: str
+    # a multi-spindle system's: the spindle's channel (its number in the sync list) and the
+    # cycle's sync tightening id (0: a single tool, no sync)
+    channel_id: int = 1
+    sync_tightening_id: int = 0
 
     @property
     def started_ns(self) -> int:

@@ -1,7 +1,8 @@
 """Overlay: several recorded runs on one figure (``boltwatch inspect --overlay``), and side by
 side on the line's page.
 
-- :mod:`.overlay_run`: one run read back (samples, events, result), found by id or path
+- :mod:`.overlay_run`: one run read back (samples, events, result), found by id or path;
+  a multi-spindle cycle's runs
 - :mod:`.overlay_alignment`: where runs are aligned (start, a torque, the first slip)
 - :mod:`.overlay_series`: the plotted series, aligned, and the programs' windows (data only)
 - :mod:`.overlay_plot`: the figure drawn and saved (matplotlib, Agg)
@@ -18,6 +19,7 @@ from shared.offline.overlay.overlay_run import (
     OverlayRun,
     find_run_files,
     overlay_run_of,
+    read_overlay_cycle,
     read_overlay_run,
 )
 from shared.offline.overlay.overlay_series import Overlay, build_overlay
@@ -36,6 +38,7 @@ __all__ = [
     "parse_alignment",
     "part_overlay_document",
     "program_band_document",
+    "read_overlay_cycle",
     "read_overlay_run",
     "run_colours",
     "save_figure",

@@ -48,6 +48,8 @@ def run_colours(overlay: Overlay) -> dict[int, Any]:
 
 def legend_label(series: RunSeries) -> str:
     label = f"run {series.run_id}"
+    if series.spindle is not None:
+        label += f" spindle {series.spindle}"
     if series.program_id is not None:
         label += f" (program {series.program_id})"
     label += f" {series.verdict}"

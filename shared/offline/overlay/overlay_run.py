@@ -10,6 +10,9 @@ is skipped; ``damage`` says what was lost, naming each file. A run read already 
 post-mortem (:func:`~shared.offline.post_mortem.read_run_files`) is one too
 (:func:`overlay_run_of`: the line's page reads each run once for both).
 
+A multi-spindle station's cycle is one file holding every spindle's run of it:
+:func:`read_overlay_cycle` reads each of them, in spindle order.
+
 Run time is the sample's own clock (``Sample.time_s``, the tool's counter)
 when every sample has it, else the receive time (``time_ns``), counted from
 the run's first sample in both cases.
@@ -75,20 +78,62 @@ def find_run_files(
     return files
 
 
-def read_overlay_run(label: str, files: list[Path], run_id: int | None = None) -> OverlayRun:
-    """Run ``run_id`` of ``files`` (None: the run with the most samples in them)."""
-    samples: list[Sample] = []
-    events: list[StickSlipEvent] = []
-    results: list[TighteningResult] = []
-    damage: list[str] = []
+@dataclass(frozen=True, slots=True)
+class _Read:
+    """What files hold: their samples, events, results, and what was lost."""
+
+    samples: list[Sample]
+    events: list[StickSlipEvent]
+    results: list[TighteningResult]
+    damage: list[str]
+
+
+def _read_files(files: list[Path]) -> _Read:
+    read = _Read([], [], [], [])
     for path in files:
         try:
-            _read_file(path, samples, events, results, damage)
+            _read_file(path, read.samples, read.events, read.results, read.damage)
         except InputError as err:
             if len(files) == 1:
                 raise
-            damage.append(f"{err}; skipped")
-    run_id = _chosen_run(label, files, samples, run_id, damage)
+            read.damage.append(f"{err}; skipped")
+    return read
+
+
+def read_overlay_run(label: str, files: list[Path], run_id: int | None = None) -> OverlayRun:
+    """Run ``run_id`` of ``files`` (None: the run with the most samples in them)."""
+    read = _read_files(files)
+    run_id = _chosen_run(label, files, read.samples, run_id, read.damage)
+    return _overlay_run(label, files, run_id, read)
+
+
+def read_overlay_cycle(
+    label: str, files: list[Path], run_id: int | None = None
+) -> list[OverlayRun]:
+    """Every run of the multi-spindle cycle in ``files`` (the cycle of ``run_id``; None: of the
+    run with the most samples), in spindle order; a run of a single-spindle station alone."""
+    read = _read_files(files)
+    run_id = _chosen_run(label, files, read.samples, run_id, read.damage)
+    results = {result.run_id: result for result in read.results}
+    chosen = results.get(run_id)
+    sync_id = chosen.sync_id if chosen is not None else None
+    if sync_id is None:
+        return [_overlay_run(label, files, run_id, read)]
+    cycle = sorted(
+        (result.spindle or 0, result.run_id)
+        for result in results.values()
+        if result.sync_id == sync_id and result.station == chosen.station  # type: ignore[union-attr]
+    )
+    sampled = {sample.run_id for sample in read.samples}
+    return [
+        _overlay_run(f"{label} spindle {spindle}", files, member, read)
+        for spindle, member in cycle
+        if member in sampled
+    ]
+
+
+def _overlay_run(label: str, files: list[Path], run_id: int, read: _Read) -> OverlayRun:
+    samples, events, results, damage = read.samples, read.events, read.results, read.damage
     own = [sample for sample in samples if sample.run_id == run_id]
     own.sort(key=lambda sample: sample.sequence)
     result = next((r for r in reversed(results) if r.run_id == run_id), None)

@@ -41,6 +41,7 @@ class RunSeries:
     force_n: FloatArray | None
     shift_angle_deg: float
     shift_time_s: float
+    spindle: int | None = None  # a multi-spindle station's run: its spindle
 
 
 @dataclass(frozen=True, slots=True)
@@ -142,6 +143,7 @@ def _series(
         run.force_n,
         shift_angle,
         shift_time,
+        result.spindle if result is not None else None,
     )
 
 

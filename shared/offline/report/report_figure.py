@@ -6,7 +6,8 @@ limits LCL/UCL), the R or s chart, the histogram with the window (LSL, USL)
 and the mean; then one row with the Pareto of NOK reasons (bars and the
 cumulative share), the stop reasons and the histogram of stick-slip events
 per run. The block's title says the program, runs, NOK rate and the Cpk of
-each figure. matplotlib is imported inside the functions.
+each figure. A multi-spindle station's program has a block of its own for each
+spindle after its own. matplotlib is imported inside the functions.
 """
 
 from __future__ import annotations
@@ -59,7 +60,7 @@ def cpk_text(statistics: FigureStatistics) -> str:
 def _draw_program(block: SubFigure, program: ProgramStatistics) -> None:
     cpks = ", ".join(f"{figure.key} {cpk_text(figure)}" for figure in program.figures)
     block.suptitle(
-        f"program {program.program_id} ({program.program_name or 'unnamed'}): "
+        f"{program.name}: "
         f"{program.runs} runs, NOK {program.noks} ({100 * program.nok_rate:.1f} %)\n{cpks}",
         fontsize=11,
     )

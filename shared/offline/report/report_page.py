@@ -4,7 +4,9 @@ The page holds, per program, a table of its figures (n, mean, σ, window, Cp,
 Cpk, control-chart type and subgroups out of control), its NOK reasons and
 stop reasons, then the report's picture embedded as a ``data:`` PNG: no
 script, no style sheet, nothing fetched, so it opens from a share or a mail
-on a machine without internet.
+on a machine without internet. A multi-spindle station's program is followed
+by a table of its spindles side by side (runs, NOK, mean and Cpk of each
+figure: the spindle that drifts stands out) and each spindle's own section.
 """
 
 from __future__ import annotations
@@ -69,8 +71,11 @@ def _program_section(program: ProgramStatistics) -> str:
     notes = "".join(f"<p>{html.escape(change)}</p>" for change in program.window_changes)
     if program.staged_runs:
         notes += f"<p>{html.escape(pulses_text(program))}</p>"
+    title = f"Program {program.program_id}: {html.escape(program.program_name or 'unnamed')}"
+    if program.spindle is not None:
+        title += f", spindle {program.spindle}"
     return (
-        f"<h2>Program {program.program_id}: {html.escape(program.program_name or 'unnamed')}</h2>"
+        f"<h2>{title}</h2>"
         f"<p>stations {html.escape(', '.join(program.stations))}; tools "
         f"{', '.join(map(str, program.tools))}; {program.runs} runs; NOK {program.noks} "
         f"({100 * program.nok_rate:.1f} %)</p>{notes}"
@@ -80,6 +85,45 @@ def _program_section(program: ProgramStatistics) -> str:
         f"<table><tr><th>NOK reason</th><th>runs</th></tr>{reasons}</table>"
         f"<table><tr><th>stop reason</th><th>runs</th></tr>{stops}</table>"
     )
+
+
+def _spindles_table(spindles: Sequence[ProgramStatistics]) -> str:
+    """A program's spindles side by side: runs, NOK, and each figure's mean and Cpk."""
+    if not spindles:
+        return ""
+    heads = "".join(
+        f"<th>{html.escape(figure.title)} mean</th><th>Cpk</th>" for figure in spindles[0].figures
+    )
+    rows = []
+    for spindle in spindles:
+        cells = "".join(
+            f"<td>{_number(figure.capability.mean)}</td>"
+            f"<td>{_cp_cell(figure.capability.cpk, figure)}</td>"
+            for figure in spindle.figures
+        )
+        rows.append(
+            f"<tr><td>{spindle.spindle}</td><td>{spindle.runs}</td><td>{spindle.noks}</td>{cells}</tr>"
+        )
+    first = spindles[0]
+    return (
+        f"<h2>Program {first.program_id}: its spindles side by side</h2>"
+        f"<table><tr><th>spindle</th><th>runs</th><th>NOK</th>{heads}</tr>{''.join(rows)}</table>"
+    )
+
+
+def _sections(programs: Sequence[ProgramStatistics]) -> str:
+    """Each program's section; a multi-spindle station's program, then its spindles side by
+    side, then each spindle's section."""
+    parts = []
+    for program in programs:
+        if program.spindle is None:
+            spindles = [
+                p for p in programs if p.program_id == program.program_id and p.spindle is not None
+            ]
+            parts.append(_program_section(program) + _spindles_table(spindles))
+        else:
+            parts.append(_program_section(program))
+    return "".join(parts)
 
 
 def html_page(
@@ -92,7 +136,7 @@ def html_page(
         "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8>"
         f"<title>{html.escape(title)}</title><style>{_STYLE}</style></head><body>"
         f"<h1>{html.escape(title)}</h1><ul>{lines}</ul>"
-        f"{''.join(_program_section(program) for program in programs)}"
+        f"{_sections(programs)}"
         f'<h2>Charts</h2><img alt="{html.escape(title)}" src="data:image/png;base64,{picture}">'
         "</body></html>\n"
     )
@@ -103,8 +147,8 @@ def terminal_lines(programs: Sequence[ProgramStatistics]) -> list[str]:
     lines = []
     for program in programs:
         lines.append(
-            f"program {program.program_id} ({program.program_name or 'unnamed'}): "
-            f"{program.runs} runs, NOK {program.noks} ({100 * program.nok_rate:.1f} %)"
+            f"{program.name}: {program.runs} runs, NOK {program.noks} "
+            f"({100 * program.nok_rate:.1f} %)"
         )
         for figure in program.figures:
             cap = figure.capability

@@ -185,6 +185,7 @@ PREDICTOR_PUTS = {
     channels.STAGE.topic,  # a final stage's commands to the tool
     channels.RUNS.topic,
     channels.RESULTS.topic,  # a run's TighteningResult
+    channels.CYCLES.topic,  # a multi-spindle cycle's common result
     channels.PREDICTOR.topic,
 }
 ROLE_PUTS = {  # what each role publishes (docs/reference/access-control.md), per station

@@ -10,11 +10,11 @@ from services.acquisition.frame_decoder import (
     ToolSensorsFrame,
     ToolStatusFrame,
 )
-from shared.contract import StationDatabase
+from shared.contract import SpindleIds, StationDatabase
 from tests.support.paths import DBC_FILE
 
 DATABASE = StationDatabase(DBC_FILE)
-DECODER = FrameDecoder(DATABASE)
+DECODER = FrameDecoder(SpindleIds(DATABASE))
 
 
 def test_tool_sensors_round_trip_with_dbc_resolution() -> None:

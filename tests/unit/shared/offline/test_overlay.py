@@ -3,6 +3,7 @@ in a station's recordings or by path, aligned, drawn with their windows and verd
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -16,9 +17,11 @@ from shared.offline.overlay import (
     build_overlay,
     find_run_files,
     parse_alignment,
+    read_overlay_cycle,
     read_overlay_run,
     run_colours,
 )
+from shared.offline.overlay.overlay_plot import legend_label
 from shared.recordings import classify, file_path
 from shared.recordings.mcap import McapSink
 from tests.support import factories
@@ -203,3 +206,54 @@ def test_a_run_without_samples_is_refused(
     assert main(["inspect", "--config", str(station), "--overlay", "11", "14"]) == 2
     err = capsys.readouterr().err
     assert f"boltwatch inspect: run 14: no samples in {empty}: nothing to draw" in err
+
+
+def _record_cycle(folder: Path, sync_id: int, spindles: int) -> Path:
+    """One multi-spindle cycle as the recorder files it: every spindle's run in one file,
+    named by the first; each spindle a little stiffer than the one before."""
+    t0_ns = T0_NS + sync_id * 10**9
+    path = file_path(folder, "st1", sync_id, t0_ns)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with McapSink(path, {}, sync_id, t0_ns) as sink:
+        for k in range(spindles):
+            run_id = sync_id + k
+            for n, torque in enumerate((2.0 + 0.1 * k) * N):
+                sample = Sample("st1", run_id, n, t0_ns + n * MS_NS, float(torque),
+                                float(0.1 * n), 100.0 * n, time_s=n / 1e3)  # fmt: skip
+                sink.write(classify("boltwatch/st1/samples", encode(sample), t0_ns + n * MS_NS))
+        for k in range(spindles):
+            result = _result(sync_id + k, 1, "OK", WINDOWS_1)
+            result = dataclasses.replace(result, spindle=k + 1, sync_id=sync_id)
+            sink.write(classify("boltwatch/st1/results", encode(result), t0_ns + 300 * MS_NS))
+    return path
+
+
+def test_a_cycles_spindles_are_overlaid_from_its_file_or_any_of_its_runs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    station = write_station(tmp_path)
+    folder = tmp_path / "recordings"
+    cycle_file = _record_cycle(folder, 500, 4)
+    target = tmp_path / "cycle.png"
+    assert main(["inspect", "--overlay", str(cycle_file), "--cycle", "--out", str(target)]) == 0
+    printed = capsys.readouterr().out
+    assert "4 runs (500 OK, 501 OK, 502 OK, 503 OK)" in printed
+    assert target.read_bytes().startswith(PNG_MAGIC)
+    runs = read_overlay_cycle("502", [cycle_file], 502)
+    assert [(run.run_id, run.result.spindle if run.result else None) for run in runs] == [
+        (500, 1), (501, 2), (502, 3), (503, 4),
+    ]  # fmt: skip
+    overlay = build_overlay(runs, None, parse_alignment("start"))
+    assert [series.spindle for series in overlay.series] == [1, 2, 3, 4]
+    assert "spindle 3" in legend_label(overlay.series[2])
+    # spindle 3's run by its id: its cycle's file is named by spindle 1's run; the results
+    # store names it
+    from shared.results import ResultsStore, StoreTarget, stored_result
+
+    with ResultsStore(StoreTarget(sqlite_path=folder / "results.sqlite")) as store:
+        result = dataclasses.replace(_result(502, 1, "OK", WINDOWS_1), spindle=3, sync_id=500)
+        store.add([stored_result(result, "", str(cycle_file), "box", 1)])
+    status = main(
+        ["inspect", "--overlay", "502", "--cycle", "--config", str(station), "--out", str(target)]
+    )
+    assert status == 0 and "4 runs" in capsys.readouterr().out

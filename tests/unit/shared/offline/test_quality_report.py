@@ -7,6 +7,7 @@ range, program and tool filters; no result in range (one line, exit 2).
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from datetime import UTC, datetime
 from pathlib import Path
@@ -251,3 +252,32 @@ def test_control_chart_limits_match_numpy() -> None:
     assert big.spread_centre == pytest.approx(s_bar)
     assert c4(11) == pytest.approx(0.9754, abs=1e-4) and c4(25) == pytest.approx(0.9896, abs=1e-4)
     assert control_chart(values[:4], 5) is None
+
+
+def test_a_multi_spindle_station_is_reported_per_spindle_as_per_program(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Each spindle's runs have their statistics (X̄/R, Cpk) after the program's, on the
+    terminal, the page (with the spindles side by side) and the picture."""
+    recordings = tmp_path / "recordings"
+    rng = np.random.default_rng(3)
+    for cycle in range(10):
+        for spindle in (1, 2):
+            run = 1000 + 2 * cycle + spindle
+            values = (
+                rng.normal(210.0 + 5 * spindle, 4.0), rng.normal(47.0, 3.0),
+                rng.normal(56000.0, 900.0), rng.normal(1e6, 4e4), 40.0,
+            )  # fmt: skip
+            result = _result(run, DAY1_NS + cycle * 10**9 + spindle, 1, 6 + spindle, values)
+            _write_run(recordings, dataclasses.replace(result, spindle=spindle, sync_id=1000))
+    station = write_station_file(
+        tmp_path / "station.toml", recordings, connect=["tcp/127.0.0.1:7447"]
+    )
+    out = tmp_path / "out"
+    status, printed, _ = _report(["--config", str(station), "--out", str(out)], capsys)
+    assert status == 0, printed
+    assert "program 1 (P1): 20 runs" in printed
+    assert "program 1 (P1) spindle 1: 10 runs" in printed
+    assert "program 1 (P1) spindle 2: 10 runs" in printed
+    page = (out / "report.html").read_text()
+    assert "its spindles side by side" in page and "Program 1: P1, spindle 2" in page

@@ -147,6 +147,8 @@ def _same(actual: object, expected: object) -> bool:
         return actual is expected
     if isinstance(expected, float):
         return isinstance(actual, float) and math.isclose(actual, expected, abs_tol=1e-9)
+    if isinstance(expected, dict):  # a record in a message (a spindle of 0091, 0101)
+        return all(_same(getattr(actual, name), value) for name, value in expected.items())
     if isinstance(expected, list):
         return (
             isinstance(actual, tuple)

@@ -76,9 +76,10 @@ def test_a_revision_not_implemented_is_refused_naming_it() -> None:
 
 @pytest.mark.parametrize("mid", sorted(ANY_REVISION_MIDS))
 def test_a_message_without_data_is_read_and_written_at_any_revision(mid: int) -> None:
-    """0062, 0063, 0072, 0073, 0075, 0077, 0003 and 9999 carry no data at any revision (and
-    OpenProtocolInterpreter writes 0062 at revision 5 or 6). Before: refused above 1."""
-    assert {3, 62, 63, 72, 73, 75, 77, 9999} == ANY_REVISION_MIDS
+    """0062, 0063, 0072, 0073, 0075, 0077, 0092, 0093, 0102, 0103, 0003 and 9999 carry no data
+    at any revision (and OpenProtocolInterpreter writes 0062 at revision 5 or 6). Before:
+    refused above 1."""
+    assert {3, 62, 63, 72, 73, 75, 77, 92, 93, 102, 103, 9999} == ANY_REVISION_MIDS
     for revision in (2, 6, 999):
         message = decode(Frame(mid=mid, revision=revision))
         assert not isinstance(message, UnknownMessage)

@@ -153,3 +153,40 @@ def test_tightenings_that_cannot_be_a_measurement_are_left_out_and_named(
     assert len(lines) == len(absurd)
     for line, (why, result) in zip(lines, zip(absurd, bad, strict=True), strict=True):
         assert line.startswith(f"station st1 run {result.run_id} (tool 7): {why}"), line
+
+
+def test_a_multi_spindle_programs_spindles_each_have_their_statistics(target: StoreTarget) -> None:
+    """Four spindles of one program, spindle 3 drifting high: the program's statistics over
+    every run, then each spindle's own, the same from the store as from the results; the
+    drifting spindle's Cpk is the low one."""
+    rng = np.random.default_rng(8)
+    results = []
+    for cycle in range(30):
+        for spindle in (1, 2, 3, 4):
+            drift = 1.5 * cycle if spindle == 3 else 0.0
+            torque = float(rng.normal(205.0 + drift, 4.0))
+            results.append(
+                factories.result(
+                    100 + 4 * cycle + spindle,
+                    time_ns=factories.T0 + cycle * SECOND_NS + spindle,
+                    tool_id=6 + spindle,
+                    spindle=spindle,
+                    sync_id=100 + 4 * cycle + 1,
+                    final_torque_nm=JudgedFigure(torque, 180.0, 240.0, "ok"),
+                    result="OK" if torque <= 240.0 else "NOK",
+                    nok_reasons="" if torque <= 240.0 else f"torque high: {torque:.1f} Nm",
+                )
+            )
+    with ResultsStore(target) as store:
+        store.add([stored_result(result, "A", None, None, 1) for result in results])
+        stored = [statistics_of(c, 5) for c in program_columns(store, ResultsQuery()).programs]
+    read = program_statistics(results, 5)
+    assert [(p.program_id, p.spindle, p.runs) for p in stored] == [
+        (1, None, 120), (1, 1, 30), (1, 2, 30), (1, 3, 30), (1, 4, 30),
+    ]  # fmt: skip
+    for mine, theirs in zip(stored, read, strict=True):
+        assert mine.spindle == theirs.spindle
+        _same(mine, theirs)
+    cpks = {p.spindle: p.figures[0].capability.cpk for p in stored}
+    assert min(cpks, key=lambda spindle: cpks[spindle] or 0.0) == 3
+    assert [p.tools for p in stored[1:]] == [[7], [8], [9], [10]]

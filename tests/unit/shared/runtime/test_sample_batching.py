@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from shared.contract import Intensity
 from shared.runtime import BATCH_PERIOD_S, MAX_BATCH_SAMPLES, SampleBatching
 from tests.support.factories import MS, T0, event, sample
@@ -36,3 +38,34 @@ def test_events_and_intensities_ride_in_the_batch_of_their_run_after_its_samples
     batching.add(sample(1, 2), 0.002)
     after = batching.take()
     assert after is not None and (after.events, after.intensities) == ([], [])
+
+
+def test_a_multi_spindle_stations_runs_each_fill_a_batch_of_their_own() -> None:
+    """Four spindles' samples interleaved: four batches in progress, each of one run and as
+    full as a single spindle's; an event rides in its own run's; all go before anything
+    else the station says, oldest first."""
+    batching = SampleBatching("st1", runs_at_once=4)
+    ready = [
+        b for n in range(10) for run in (1, 2, 3, 4) for b in batching.add(sample(run, n), 0.0)
+    ]
+    assert ready == []
+    assert batching.add_found(event(3, 1)) and not batching.add_found(event(5, 1))
+    due = batching.add(sample(1, 10), BATCH_PERIOD_S)  # every batch is due now
+    assert [(b.samples[0].run_id, len(b.samples)) for b in due] == [
+        (1, 11),
+        (2, 10),
+        (3, 10),
+        (4, 10),
+    ]
+    assert [b.events for b in due] == [[], [], [event(3, 1)], []]
+    for run in (1, 2):
+        batching.add(sample(run, 11), 1.0)
+    assert batching.wait_s(1.0) == pytest.approx(BATCH_PERIOD_S)
+    assert [b.samples[0].run_id for b in batching.take_all()] == [1, 2]
+    assert batching.take() is None
+    # a fifth run while four are in progress: the oldest goes
+    for run in (1, 2, 3, 4):
+        batching.add(sample(run, 12), 2.0)
+    (oldest,) = batching.add(sample(5, 0), 2.0)
+    assert oldest.samples[0].run_id == 1
+    assert [b.samples[0].run_id for b in batching.take_due(2.0 + BATCH_PERIOD_S)] == [2, 3, 4, 5]
