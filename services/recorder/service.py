@@ -91,7 +91,7 @@ from shared.recordings.mcap import finish_unfinished
 from shared.results import station_store
 from shared.retention import retention_scopes
 from shared.runtime import ServiceSkeleton, Stop
-from shared.wear import StationLimits, ledger_path
+from shared.wear import StationLimits, joint_names, ledger_path
 
 if TYPE_CHECKING:
     from services.recorder.foxglove_live.foxglove_server import FoxgloveLive
@@ -192,7 +192,7 @@ class RecorderService:
         for station in [] if view_only else self.station_ids:
             skeleton.queryable(
                 keys.station_key(station, keys.WEAR),
-                wear_replier(self._ledger_file, self._host, station),
+                wear_replier(self._ledger_file, self._host, station, joint_names(stations)),
             )
             if self.last_parts is not None:
                 skeleton.queryable(channels.PART.key(station), self.last_parts.replier(station))
