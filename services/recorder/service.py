@@ -81,6 +81,7 @@ from shared.contract import (
     RecorderStats,
     SpoolAck,
     WearAlert,
+    WearForecast,
     channels,
     encode,
     keys,
@@ -177,6 +178,7 @@ class RecorderService:
                 first.config.recorder.wear_service_threshold,
                 self._publish_alert,
                 StationLimits(stations).of,
+                first.config.recorder.wear_forecast_days,
             )
             self.results = ResultsWatch(
                 station_store(first),
@@ -283,6 +285,7 @@ class RecorderService:
             waiting_summaries=wear.waiting if wear else 0,
             waiting_results=results.waiting if results else 0,
             quality_alerts=self.quality.active if self.quality else None,
+            wear_forecasts=wear.forecasts.soon if wear and wear.forecasts else None,
             recordings_deleted=retention.deleted if retention else None,
             recordings_kept_unstored=retention.kept_not_stored if retention else None,
         )
@@ -435,7 +438,7 @@ class RecorderService:
             except zenoh.ZError as err:  # session closing
                 LOG.debug("recorder stats of %s not published: %s", stats.station, err)
 
-    def _publish_alert(self, alert: WearAlert | QualityAlert) -> None:
+    def _publish_alert(self, alert: WearAlert | WearForecast | QualityAlert) -> None:
         """Put the alert for the line and record it here: a put this session also heard
         would come back through the inbox on this very thread, which waits when the
         inbox is full, for room only this thread makes."""

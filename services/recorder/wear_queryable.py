@@ -46,13 +46,27 @@ def _reply(
     query: zenoh.Query,
 ) -> None:
     try:
-        with WearLedger(ledger_file, read_only=True) as ledger:
-            tools = [tool.to_dict() for tool in ledger.tools(station=station, joints=joints)]
+        reply = reply_body(ledger_file, host, station, joints)
     except Exception as err:  # a reply, never a dead queryable thread
         LOG.warning("wear query of %s failed: %s", station, err)
         query.reply_err(str(err).encode())
         return
-    # each tool's outlook beside its line, which a plant's older boltwatch reads as it was
+    # on the station's own key, never the query's: a plant-wide get of
+    # boltwatch/*/wear would otherwise see every recorder's reply under one key,
+    # and zenoh's default consolidation keeps one of them
+    query.reply(keys.station_key(station, keys.WEAR), reply)
+
+
+def reply_body(
+    ledger_file: Path,
+    host: str,
+    station: str,
+    joints: Mapping[tuple[str, int], str] | None = None,
+) -> bytes:
+    """The reply for ``station``: its tools' lines, and each one's outlook beside them (which
+    a plant's older boltwatch reads as it was); the ledger's errors raised."""
+    with WearLedger(ledger_file, read_only=True) as ledger:
+        tools = [tool.to_dict() for tool in ledger.tools(station=station, joints=joints)]
     outlooks = {str(tool["tool_id"]): tool.pop("outlook") for tool in tools}
     reply = {
         "station": station,
@@ -61,7 +75,4 @@ def _reply(
         "tools": tools,
         "outlooks": outlooks,
     }
-    # on the station's own key, never the query's: a plant-wide get of
-    # boltwatch/*/wear would otherwise see every recorder's reply under one key,
-    # and zenoh's default consolidation keeps one of them
-    query.reply(keys.station_key(station, keys.WEAR), json.dumps(reply).encode())
+    return json.dumps(reply).encode()

@@ -13,6 +13,7 @@
 - :mod:`.spool_messages` (what a station's spool and the recorder say to each other)
 - :mod:`.part_messages` (what the line says of the part at a station: its id)
 - :mod:`.stage_messages` (what a station commands a tool that runs a final stage)
+- :mod:`.wear_messages` (what the recorder forecasts of a tool's service)
 """
 
 from shared.contract.can_database import (
@@ -82,6 +83,7 @@ from shared.contract.messages import (
     ToolState,
     Verdict,
     WearAlert,
+    WearForecast,
 )
 from shared.contract.run_clock import RunClock
 from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
@@ -169,6 +171,7 @@ __all__ = [
     "Trace",
     "Verdict",
     "WearAlert",
+    "WearForecast",
     "can_id_bounds",
     "decode",
     "decoder",

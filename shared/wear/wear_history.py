@@ -129,11 +129,19 @@ def grouped_runs(
 
 def first_and_last(db: sqlite3.Connection, tool_id: int, now_ns: int) -> tuple[int, int] | None:
     """When the tool's first and newest runs up to ``now_ns`` ended; None: it has none."""
-    row = db.execute(
-        "SELECT MIN(ended_ns), MAX(ended_ns) FROM runs WHERE tool_id = ? AND ended_ns <= ?",
+    # each an end of the tool's index (one lookup), not a scan of its runs
+    first = db.execute(
+        "SELECT ended_ns FROM runs WHERE tool_id = ? AND ended_ns <= ? ORDER BY ended_ns LIMIT 1",
         (tool_id, now_ns),
     ).fetchone()
-    return None if row is None or row[0] is None else (int(row[0]), int(row[1]))
+    if first is None:
+        return None
+    last = db.execute(
+        "SELECT ended_ns FROM runs WHERE tool_id = ? AND ended_ns <= ? "
+        "ORDER BY ended_ns DESC LIMIT 1",
+        (tool_id, now_ns),
+    ).fetchone()
+    return int(first[0]), int(last[0])
 
 
 def unusual_runs(

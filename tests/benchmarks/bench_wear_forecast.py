@@ -1,7 +1,7 @@
 """The wear forecast's backtest: forecasts made 30, 14, 7 and 1 production days before each
 threshold crossing of simulated plants, against the crossing that came.
 
-Run: ``.venv/bin/python tests/benchmarks/bench_wear_forecast.py [--tune] [--quick]``
+Run: ``.venv/bin/python tests/benchmarks/bench_wear_forecast.py [--tune] [--quick] [--cost]``
 (not collected by pytest; a few minutes). Each plant (``tests/support/wear_plant.py``: a
 shape and a seed; months of shifts, weekends, holidays, a program added midway, tools
 swapped between stations, services at the shift change after each crossing) is written
@@ -21,6 +21,12 @@ gave a date (none should).
 "two" and "three", seeds 1 and 2) and prints the best; the figures that count are those
 of the judging plants (other seeds, and the shape "one" never tuned on), printed with the
 shipped settings (:class:`~shared.wear.wear_forecast.ForecastSettings`).
+
+``--cost``: what the forecast adds to the recorder's work per counted run, on a plant's
+eight months of runs (two shifts, five stations): runs counted through the recorder's
+:class:`~services.recorder.wear_watch.WearWatch` with a threshold, with the forecast's
+horizons and without, alternating, the medians of five rounds in ms per run; and one
+``boltwatch wear`` reading of the plant's tools (``WearLedger.tools``, with their outlooks).
 """
 
 from __future__ import annotations
@@ -242,11 +248,73 @@ def tune(cases: list[Case]) -> ForecastSettings:
     return closest[1]
 
 
+def cost() -> None:
+    """ms per counted run with and without the forecast, and one reading of every tool."""
+    import statistics
+
+    from services.recorder.wear_watch import WearWatch
+    from shared.wear import CONTRACT_LIMITS, WearLedger
+    from tests.support.factories import summary
+    from tests.support.wear_plant import TWO_SHIFTS
+
+    plant = simulate(TWO_SHIFTS, 31)
+    counted, rounds = 300, 5
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "wear.sqlite"
+        write_ledger(plant, path)
+        tools = sorted({int(tool) for tool in plant.tool_id})
+        start_ns = plant.calendar.time_at(max(plant.calendar.day_of_stretch) + 0.5)
+        next_id = int(plant.run_id[-1]) + 1
+
+        def per_run(watch: WearWatch) -> float:
+            nonlocal next_id
+            started = time.perf_counter()
+            for index in range(counted):
+                ended_ns = start_ns + (next_id - int(plant.run_id[-1])) * 1_000_000_000
+                run = summary(
+                    next_id,
+                    station=plant.station_names[index % len(tools)],
+                    tool_id=tools[index % len(tools)],
+                    process_intensity=1.0e3,
+                    events=4,
+                    started_ns=ended_ns - 3_000_000_000,
+                    ended_ns=ended_ns,
+                )
+                watch.on_summary(run, ended_ns)
+                next_id += 1
+            return (time.perf_counter() - started) * 1e3 / counted
+
+        limits = lambda _summary: CONTRACT_LIMITS  # noqa: E731
+        plain = WearWatch(path, plant.threshold, lambda _alert: None, limits)
+        forecasting = WearWatch(path, plant.threshold, lambda _alert: None, limits, [7.0, 1.0])
+        without, with_forecast = [], []
+        for _round in range(rounds):
+            without.append(per_run(plain))
+            with_forecast.append(per_run(forecasting))
+        plain.close()
+        forecasting.close()
+        started = time.perf_counter()
+        with WearLedger(path, read_only=True) as ledger:
+            read = ledger.tools()
+        reading_s = time.perf_counter() - started
+    print(
+        f"\nper counted run ({plant.ended_ns.size} runs in the ledger, {len(tools)} tools): "
+        f"{statistics.median(without):.3f} ms without the forecast, "
+        f"{statistics.median(with_forecast):.3f} ms with it (its pace read once a day and tool, "
+        f"included); every tool's line with its outlook ({len(read)} tools): "
+        f"{reading_s * 1e3:.0f} ms"
+    )
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tune", action="store_true", help="search the settings first")
     parser.add_argument("--quick", action="store_true", help="120 days per plant, not 240")
+    parser.add_argument("--cost", action="store_true", help="only the recorder's cost per run")
     args = parser.parse_args()
+    if args.cost:
+        cost()
+        return 0
     days = 120 if args.quick else None
     shipped = ForecastSettings()
     with tempfile.TemporaryDirectory() as folder:
