@@ -120,15 +120,15 @@ def _chart(
 ) -> dict[str, Any]:
     """What the page draws: the intensity since service by production day (and now), the
     threshold, and the forecast line from now to the threshold on the forecast date."""
-    points = [list(point) for point in tool.outlook.since_service] if tool.outlook else []
+    points: list[tuple[int, float]] = list(tool.outlook.since_service) if tool.outlook else []
     now = tool.intensity_since_service
     if points:  # summed by day or at once, the last bits of rounding differ: it never falls
         now = max(now, points[-1][1])
         if points[-1][0] < now_ns:
-            points.append([now_ns, now])
+            points.append((now_ns, now))
         now_ns = points[-1][0]  # the forecast goes on from the reply's reading
     return {
-        "points": points,
+        "points": [list(point) for point in points],
         "threshold": tool.threshold,
         "forecast": None
         if due_ns is None or tool.threshold is None

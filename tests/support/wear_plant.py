@@ -221,7 +221,9 @@ def simulate(shape: PlantShape, seed: int, start: datetime | None = None) -> Pla
     added_station = int(rng.integers(shape.stations))
     added_program = next_program
     tools = [100 + index for index in range(shape.stations)]
-    swap = rng.choice(shape.stations, size=2, replace=False)
+    swap: list[int] = (
+        rng.choice(shape.stations, size=2, replace=False).tolist() if shape.stations > 1 else []
+    )
 
     columns: dict[str, list[np.ndarray]] = {k: [] for k in ("st", "tool", "prog", "i", "end")}
     volume = np.zeros(shape.stations)
