@@ -21,6 +21,7 @@ from shared.line_status import (
     StatusReport,
     amount_text,
     bridge_lines,
+    due_soon_text,
     quality_text,
     result_text,
     spool_text,
@@ -69,6 +70,7 @@ def _station_lines(status: StationStatus) -> list[str]:
         line("last summary", _summary_text(status.last_summary)),
         line("last result", result_text(status.last_result)),
         line("quality alert", quality_text(status.quality_alert)),
+        line("wear forecast", due_soon_text(status.wear_forecasts)),
         *_unless_bridge(
             status, status.predictor, line("predictor", _predictor_text(status.predictor))
         ),

@@ -9,7 +9,8 @@ independence contract) and collects what ``boltwatch status`` collects
 - :mod:`.connection_guard` (the server's bounds: open files, connections,
   idle time, request size, and one log line per kind of client fault)
 - :mod:`.line_board` (what the page shows, pure: status's collectors, the last
-  results, stop reasons, alerts and wear per station)
+  results, stop reasons, alerts and wear per station), :mod:`.tools_due` (the
+  line's tools due soonest: each one's forecast and chart, pure)
 - :mod:`.line_link` (the zenoh session, opened in the background: the page
   is served before the router answers)
 - :mod:`.board_feed` (zenoh: subscriptions, liveliness and wear queries per
@@ -29,6 +30,7 @@ independence contract) and collects what ``boltwatch status`` collects
 - ``page/``: ``index.html``, ``dashboard.css``, ``dashboard.js`` (the
   stations), ``part_search.js`` (the search box, the NOK list),
   ``run_view.js`` (a run's panel), ``run_specs.js`` (what its charts draw),
-  ``run_chart.js`` (the page's own canvas chart) (served by the app; nothing
-  from the internet)
+  ``run_chart.js`` (the page's own canvas chart), ``tools_due.js`` and
+  ``tools_due.css`` (the tools due soonest) (served by the app; nothing from the
+  internet)
 """

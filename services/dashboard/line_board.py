@@ -18,7 +18,8 @@ stop reasons of each station, the alerts of every alert channel of
 :mod:`shared.contract.channels` (a topic ending in ``alert``: the recorder's
 ``wear/alert`` and ``quality/alert``, and any other a service adds, shown by its fields), and the
 wear of each tool from the recorder's ``wear`` queryable against the
-station's ``recorder.wear_service_threshold``.
+station's ``recorder.wear_service_threshold``; and for the whole line, the tools due soonest
+with their forecasts and charts (:mod:`.tools_due`).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
+from services.dashboard.tools_due import ToolSeen, tools_due, tools_seen
 from shared.config import StationPlace
 from shared.contract import RunSummary, TighteningResult, channels, decode, keys
 from shared.errors import InputError
@@ -74,6 +76,7 @@ class _History:
     summaries: deque[RunSummary] = field(default_factory=lambda: deque(maxlen=HISTORY))
     alerts: dict[tuple[Any, ...], dict[str, Any]] = field(default_factory=dict)
     wear: list[ToolWearLine] = field(default_factory=list)
+    tools: list[ToolSeen] = field(default_factory=list)  # with their outlooks: the forecasts
     wear_error: str | None = "no reply from the recorder yet"
     wear_ns: int = 0
 
@@ -132,9 +135,11 @@ class LineBoard:
     def wear_reply(self, station: str, payload: bytes, now_ns: int) -> None:
         """The recorder's reply to ``boltwatch/<station>/wear`` (InputError: not one)."""
         tools = parse_wear_reply(payload)
+        seen = tools_seen(station, payload, self._settings[station].wear_threshold)
         with self._lock:
             history = self._history[station]
             history.wear, history.wear_error, history.wear_ns = tools, None, now_ns
+            history.tools = seen
 
     def wear_failed(self, station: str, reason: str, now_ns: int) -> None:
         """No usable wear reply for ``station`` (the last good table stays, with the reason)."""
@@ -170,7 +175,14 @@ class LineBoard:
                 "reachable": self._router_reachable,
                 "for_s": (now_ns - self._router_since_ns) / _NS,
             }
-        return {"now_ns": now_ns, "window_s": WINDOW_S, "router": router, "stations": stations}
+            seen = [tool for name in self._settings for tool in self._history[name].tools]
+        return {
+            "now_ns": now_ns,
+            "window_s": WINDOW_S,
+            "router": router,
+            "stations": stations,
+            "tools_due": tools_due(seen, now_ns),
+        }
 
 
 def _remember(history: _History, topic: str, payload: bytes) -> bool:

@@ -16,8 +16,12 @@ Tool_7                          BaseObjectType, HasInterface IToolType
 ├── OperationCounters           MachineryOperationCounterType: OperationCycleCounter
 ├── LifetimeCounters            MachineryLifetimeCounterType:
 │   ├── StickSlipIntensitySinceService   LifetimeVariableType: LimitValue the
-│   │                                    recorder's wear_service_threshold
-│   └── StickSlipIntensity               (all time), both StartValue 0, unit "one"
+│   │                                    recorder's wear_service_threshold, WarningValues
+│   │                                    0.8 and 0.95 of it
+│   ├── StickSlipIntensity               (all time), both StartValue 0, unit "one"
+│   ├── StickSlipServiceDue              the forecast date of the threshold (DateTime),
+│   ├── StickSlipServiceDueEarly/Late    its 80 % interval
+│   └── StickSlipTighteningsToService    the tightenings left to it (Int32)
 └── Maintenance                 FunctionalGroupType
     ├── Service                 LastService, ServicePlace (empty), ServiceCycleCount
     └── Calibration             LastCalibration, CalibrationValue (N·m)
@@ -93,7 +97,24 @@ def _figures(counters: ToolCounters) -> Figures:
             counters.intensity_threshold,
             V.Double,
         ),
+        "LifetimeCounters/StickSlipIntensitySinceService/WarningValues": (
+            counters.intensity_warnings,
+            V.Double,
+        ),
         "LifetimeCounters/StickSlipIntensity": (counters.intensity_total, V.Double),
+        "LifetimeCounters/StickSlipServiceDue": (_utc(counters.service_due_ns), V.DateTime),
+        "LifetimeCounters/StickSlipServiceDueEarly": (
+            _utc(counters.service_due_early_ns),
+            V.DateTime,
+        ),
+        "LifetimeCounters/StickSlipServiceDueLate": (
+            _utc(counters.service_due_late_ns),
+            V.DateTime,
+        ),
+        "LifetimeCounters/StickSlipTighteningsToService": (
+            counters.tightenings_to_service,
+            V.Int32,
+        ),
     }
 
 
@@ -174,6 +195,26 @@ class ToolAssets:
                 ua.Variant(),
                 datatype=node_id(ua.ObjectIds.Double),
             )
+        since_service = "LifetimeCounters/StickSlipIntensitySinceService"
+        warnings = await tool.variables[since_service].add_property(
+            node_id(f"{prefix}/{since_service}/WarningValues", ours),
+            ua.QualifiedName("WarningValues", di),
+            ua.Variant(),
+            datatype=node_id(ua.ObjectIds.Double),
+        )
+        await warnings.write_value_rank(ua.ValueRank.OneDimension)
+        tool.variables[f"{since_service}/WarningValues"] = warnings
+        for name in ("StickSlipServiceDue", "StickSlipServiceDueEarly", "StickSlipServiceDueLate"):
+            await tool.variable(
+                f"LifetimeCounters/{name}", lifetime, (ours, name), None, V.DateTime
+            )
+        await tool.variable(
+            "LifetimeCounters/StickSlipTighteningsToService",
+            lifetime,
+            (ours, "StickSlipTighteningsToService"),
+            None,
+            V.Int32,
+        )
 
         maintenance = await tool.group(
             "Maintenance", tool.node, (di, "Maintenance"), node_id(FUNCTIONAL_GROUP_TYPE, di)

@@ -13,7 +13,9 @@ store and the wear ledger.
   run files, health, the order of stations' spooled messages and their
   acknowledgements)
 - :mod:`.wear_watch` (summaries into the wear ledger, alerts when a tool is
-  due, a failing ledger waited out), :mod:`.quality_watch` (the quality alert),
+  due, a failing ledger waited out), :mod:`.wear_forecasts` (each tool's service
+  forecast after its runs: a WearForecast within a horizon), :mod:`.quality_watch`
+  (the quality alert),
   :mod:`.results_watch` (results into the results store, from a thread of its
   own; a failing store waited out, the recordings read at start for what it lacks)
 - :mod:`.foxglove_live` (the live Foxglove WebSocket and its layout)

@@ -81,6 +81,7 @@ from shared.contract import (
     RecorderStats,
     SpoolAck,
     WearAlert,
+    WearForecast,
     channels,
     encode,
     keys,
@@ -91,7 +92,7 @@ from shared.recordings.mcap import finish_unfinished
 from shared.results import station_store
 from shared.retention import retention_scopes
 from shared.runtime import ServiceSkeleton, Stop
-from shared.wear import StationLimits, ledger_path
+from shared.wear import StationLimits, joint_names, ledger_path
 
 if TYPE_CHECKING:
     from services.recorder.foxglove_live.foxglove_server import FoxgloveLive
@@ -177,6 +178,7 @@ class RecorderService:
                 first.config.recorder.wear_service_threshold,
                 self._publish_alert,
                 StationLimits(stations).of,
+                first.config.recorder.wear_forecast_days,
             )
             self.results = ResultsWatch(
                 station_store(first),
@@ -192,7 +194,7 @@ class RecorderService:
         for station in [] if view_only else self.station_ids:
             skeleton.queryable(
                 keys.station_key(station, keys.WEAR),
-                wear_replier(self._ledger_file, self._host, station),
+                wear_replier(self._ledger_file, self._host, station, joint_names(stations)),
             )
             if self.last_parts is not None:
                 skeleton.queryable(channels.PART.key(station), self.last_parts.replier(station))
@@ -283,6 +285,7 @@ class RecorderService:
             waiting_summaries=wear.waiting if wear else 0,
             waiting_results=results.waiting if results else 0,
             quality_alerts=self.quality.active if self.quality else None,
+            wear_forecasts=wear.forecasts.soon if wear and wear.forecasts else None,
             recordings_deleted=retention.deleted if retention else None,
             recordings_kept_unstored=retention.kept_not_stored if retention else None,
         )
@@ -438,7 +441,7 @@ class RecorderService:
             except zenoh.ZError as err:  # session closing
                 LOG.debug("recorder stats of %s not published: %s", stats.station, err)
 
-    def _publish_alert(self, alert: WearAlert | QualityAlert) -> None:
+    def _publish_alert(self, alert: WearAlert | WearForecast | QualityAlert) -> None:
         """Put the alert for the line and record it here: a put this session also heard
         would come back through the inbox on this very thread, which waits when the
         inbox is full, for room only this thread makes."""

@@ -8,7 +8,9 @@ bridge says it again at its next connection).
 After each new run the tool's intensity since its last service is compared
 with ``recorder.wear_service_threshold``; at or above it a :class:`WearAlert`
 is published on ``boltwatch/<station>/wear/alert`` after every run until the
-tool is serviced (and logged once per crossing).
+tool is serviced (and logged once per crossing). Below it, the tool's service
+is forecast, and a ``WearForecast`` put once per tool and horizon of
+``recorder.wear_forecast_days`` it comes within (:mod:`.wear_forecasts`).
 
 A summary beyond what its run can carry (:mod:`shared.wear.wear_bound`: negative, not
 finite, more than its tool's torque limit allows, or inconsistent) is
@@ -40,10 +42,11 @@ from __future__ import annotations
 import logging
 import sqlite3
 from collections import Counter, deque
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from shared.contract import RunSummary, ToolData, WearAlert
+from services.recorder.wear_forecasts import WearForecasts
+from shared.contract import RunSummary, ToolData, WearAlert, WearForecast
 from shared.errors import InputError
 from shared.wear import (
     BrokenLedgerError,
@@ -73,13 +76,20 @@ class WearWatch:
         self,
         ledger_file: Path,
         threshold: float | None,
-        alert: Callable[[WearAlert], None],
+        alert: Callable[[WearAlert | WearForecast], None],
         limits: Callable[[RunSummary], RunLimits],
+        horizons_days: Sequence[float] = (),
     ) -> None:
+        """``alert`` puts a WearAlert or a WearForecast; ``horizons_days``: the horizons a
+        tool's forecast is said within (none: no forecast)."""
         self._ledger_file = Path(ledger_file)
         self._ledger: WearLedger | None = None
         self._threshold = threshold
         self._alert = alert
+        #: the tools' forecasts (none without a threshold)
+        self.forecasts = (
+            None if threshold is None else WearForecasts(threshold, horizons_days, alert)
+        )
         self._limits = limits
         self._due: set[int] = set()
         self._pending: deque[tuple[RunSummary, int]] = deque(maxlen=PENDING_LIMIT)
@@ -290,6 +300,8 @@ class WearWatch:
             )
         else:
             self._due.discard(interval.tool_id)
+        if self.forecasts is not None:
+            self.forecasts.after_run(ledger, summary.station, interval, now_ns)
         return True
 
     def close(self) -> None:

@@ -198,6 +198,12 @@ class RecorderSection(StrictModel):
         gt=0,
         description="intensity since last service (eq. 69) at which the recorder alerts",
     )
+    wear_forecast_days: list[Annotated[float, Field(gt=0, le=365)]] = Field(
+        default_factory=lambda: [7.0],
+        max_length=5,
+        description="horizons in days: a tool forecast to reach wear_service_threshold within "
+        "one is announced once (WearForecast on wear/forecast); [] for none",
+    )
     results_database: str | None = Field(
         default=None,
         pattern=r"^postgres(ql)?://",

@@ -16,6 +16,7 @@
 - :mod:`.stage_messages` (what a station commands a tool that runs a final stage)
 - :mod:`.alert_messages` (who acknowledged, confirmed or commented on an alert)
 - :mod:`.cycle_messages` (a multi-spindle station's cycle: its common result)
+- :mod:`.wear_messages` (what the recorder forecasts of a tool's service)
 """
 
 from shared.contract.can_database import (
@@ -91,6 +92,7 @@ from shared.contract.messages import (
     ToolState,
     Verdict,
     WearAlert,
+    WearForecast,
 )
 from shared.contract.run_clock import RunClock
 from shared.contract.sensor_range import CONTRACT_RANGE, SensorRange
@@ -188,6 +190,7 @@ __all__ = [
     "Trace",
     "Verdict",
     "WearAlert",
+    "WearForecast",
     "can_id_bounds",
     "decode",
     "decoder",

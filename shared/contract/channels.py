@@ -41,6 +41,8 @@ topic              publisher             message, when
 ``predictor``      predictor             :class:`PredictorStats`, once a second
 ``recorder``       recorder              :class:`RecorderStats`, once a second
 ``wear/alert``     recorder              :class:`WearAlert`, when a tool is due
+``wear/forecast``  recorder              :class:`WearForecast`, once per tool and horizon,
+                                         when a tool is forecast due within it
 ``quality/alert``  recorder              :class:`QualityAlert`, when a program's Cpk or
                                          NOKs go out of bounds, and when back
 ``controller``     import (openprotocol) :class:`ControllerResult`, one per run
@@ -116,6 +118,7 @@ from shared.contract.messages import (
     ToolData,
     ToolState,
     WearAlert,
+    WearForecast,
 )
 
 MessageT = TypeVar("MessageT")
@@ -188,6 +191,7 @@ CYCLES = Channel("cycles", CycleResult, "predictor", also_by=_BRIDGE)
 PREDICTOR = Channel("predictor", PredictorStats, "predictor")
 RECORDER = Channel("recorder", RecorderStats, "recorder")
 WEAR_ALERT = Channel("wear/alert", WearAlert, "recorder")
+WEAR_FORECAST = Channel("wear/forecast", WearForecast, "recorder")
 QUALITY_ALERT = Channel("quality/alert", QualityAlert, "recorder")
 CONTROLLER = Channel("controller", ControllerResult, "import", also_by=_BRIDGE)
 TOOL_DATA = Channel("tool_data", ToolData, "openprotocol")
@@ -217,6 +221,7 @@ CHANNELS: tuple[Channel[Any], ...] = (
     PREDICTOR,
     RECORDER,
     WEAR_ALERT,
+    WEAR_FORECAST,
     QUALITY_ALERT,
     CONTROLLER,
     TOOL_DATA,

@@ -21,7 +21,8 @@ What the line says of the part at a station (:class:`PartScan`) is in
 :mod:`shared.contract.part_messages`, imported from here too; what a station
 commands a tool that runs a final stage (:class:`StageDecision`), in
 :mod:`shared.contract.stage_messages`; who acknowledged an alert (:class:`AlertAck`),
-in :mod:`shared.contract.alert_messages`.
+in :mod:`shared.contract.alert_messages`; what the recorder forecasts of a tool's
+service (:class:`WearForecast`), in :mod:`shared.contract.wear_messages`.
 """
 
 from __future__ import annotations
@@ -78,6 +79,7 @@ from shared.contract.stage_messages import (  # noqa: F401  (re-exported: one im
     ToolStageCode,
     ToolStageName,
 )
+from shared.contract.wear_messages import WearForecast  # re-exported too
 
 ToolStateName = Literal["idle", "running", "done", "aborted"]
 StopReasonName = Literal[
@@ -391,6 +393,10 @@ class RecorderStats:
     # the station's name for people, as its station file names it (``[station] name``; "":
     # none, its id is shown)
     station_name: str = ""
+    # the tools (whose newest run was at this station) forecast due within the recorder's
+    # largest horizon now, the soonest first: each as last forecast (put once per horizon on
+    # wear/forecast: a status that listens later learns of them here)
+    wear_forecasts: list[WearForecast] = field(default_factory=list)
 
 
 @dataclass(frozen=True, slots=True)

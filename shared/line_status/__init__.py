@@ -7,6 +7,7 @@ run, decision, summary and result, recorder and predictor health),
 :mod:`.status_last_result` (the last tightening result: OK/NOK and why),
 :mod:`.status_bridge` (a controller bridge's link, faults and alarms),
 :mod:`.status_quality_alert` (the newest active quality alert),
+:mod:`.status_wear_forecast` (the tools forecast due for service soon),
 :mod:`.status_spool` (a station's spool: what waits for the recorder, alerts).
 ``boltwatch status`` prints it (``services.cli.station_status_text``);
 ``boltwatch serve dashboard`` serves it live (``services.dashboard``).
@@ -29,10 +30,12 @@ from shared.line_status.status_bridge import bridge_lines
 from shared.line_status.status_last_result import amount_text, last_result, result_text
 from shared.line_status.status_quality_alert import quality_text
 from shared.line_status.status_spool import SpoolStatus, spool_text
+from shared.line_status.status_wear_forecast import DueSoon, due_soon_text
 
 __all__ = [
     "KNOWN_SERVICES",
     "BusHealth",
+    "DueSoon",
     "LastDecision",
     "LastRun",
     "LastSummary",
@@ -44,6 +47,7 @@ __all__ = [
     "StatusReport",
     "amount_text",
     "bridge_lines",
+    "due_soon_text",
     "last_result",
     "quality_text",
     "result_text",

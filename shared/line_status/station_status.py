@@ -36,6 +36,8 @@ Per station:
   (``kind`` "bridge"), for a station with one (:mod:`shared.line_status.status_bridge`);
 - the newest active quality alert of the recorder (a program's Cpk or NOKs,
   :mod:`shared.line_status.status_quality_alert`);
+- the tools the recorder forecasts due for service soon, the soonest first
+  (:mod:`shared.line_status.status_wear_forecast`);
 - its spools: what waits for the line's recorder, and an alert when one fills
   or drops (:mod:`shared.line_status.status_spool`).
 """
@@ -81,6 +83,8 @@ from shared.line_status.status_quality_alert import (
 from shared.line_status.status_spool import TOPIC as SPOOL_TOPIC
 from shared.line_status.status_spool import SpoolStatus, spool_status
 from shared.line_status.status_spool import take as take_spool
+from shared.line_status.status_wear_forecast import TOPIC as FORECAST_TOPIC
+from shared.line_status.status_wear_forecast import DueSoon, ForecastsSeen, due_soon
 
 #: The services of a CAN station, in display order; others are shown if alive.
 KNOWN_SERVICES = ("acquisition", "predictor", "recorder", "rig")
@@ -118,6 +122,7 @@ class _Seen:
     predictor_received_ns: int = 0
     bridge: BridgeSeen = field(default_factory=BridgeSeen)
     quality: QualitySeen = field(default_factory=QualitySeen)
+    forecasts: ForecastsSeen = field(default_factory=ForecastsSeen)
     spools: dict[str, tuple[SpoolStats, int]] = field(default_factory=dict)
     unreadable: int = 0
 
@@ -204,6 +209,8 @@ class StationStatus:
     quality_alert: ActiveQualityAlert | None = None  # None: none active in the window
     kind: str = "can"  # "bridge": a controller bridge's station (services: its own)
     spools: list[SpoolStatus] = field(default_factory=list)  # its spools heard in the window
+    #: the tools forecast due for service soon (the recorder's horizon), the soonest first
+    wear_forecasts: list[DueSoon] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -264,6 +271,7 @@ class StatusCollector:
             elif topic == channels.RECORDER.topic:
                 seen.recorder = decode(RecorderStats, payload)
                 seen.quality.take_active(seen.recorder.quality_alerts)
+                seen.forecasts.take_current(seen.recorder.wear_forecasts)
                 seen.recorder_received_ns = received_ns
             elif topic == channels.PREDICTOR.topic:
                 seen.predictor = decode(PredictorStats, payload)
@@ -282,11 +290,14 @@ class StatusCollector:
 
 
 def _take_other(seen: _Seen, topic: str, payload: bytes, received_ns: int) -> None:
-    """A message of a bridge, a quality alert, a spool's counters (any other: nothing)."""
+    """A message of a bridge, a quality alert, a wear forecast, a spool's counters (any
+    other: nothing)."""
     if topic in BRIDGE_TOPICS:
         seen.bridge.take(topic, payload, received_ns)
     elif topic == QUALITY_TOPIC:
         seen.quality.take(payload)
+    elif topic == FORECAST_TOPIC:
+        seen.forecasts.take(payload)
     elif topic == SPOOL_TOPIC:
         take_spool(seen.spools, payload, received_ns)
 
@@ -312,6 +323,7 @@ def _status(name: str, seen: _Seen, listened_s: float, now_ns: int) -> StationSt
         quality_alert=quality_alert(seen.quality, now_ns),
         kind="bridge" if is_bridge_station(seen.services, seen.bridge) else "can",
         spools=spool_status(seen.spools, now_ns),
+        wear_forecasts=due_soon(seen.forecasts, now_ns),
     )
 
 

@@ -36,7 +36,8 @@ from __future__ import annotations
 import contextlib
 import logging
 import sqlite3
-from collections.abc import Iterator
+import time
+from collections.abc import Iterator, Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -45,6 +46,9 @@ from shared.contract import RunSummary, ToolData
 from shared.errors import InputError
 from shared.wear import wear_tool_data
 from shared.wear.wear_bound import RefusedSummaryError, RunLimits, refusal
+from shared.wear.wear_calendar import DAY_NS
+from shared.wear.wear_forecast import SHIPPED, ForecastSettings
+from shared.wear.wear_history import first_and_last, grouped_runs, ledger_calendar, unusual_runs
 from shared.wear.wear_ledger_file import (
     COLUMNS,
     LEDGER_VERSION,
@@ -57,6 +61,7 @@ from shared.wear.wear_ledger_file import (
     migrate,
     schema_problem,
 )
+from shared.wear.wear_outlook import ToolOutlook, run_limits, tool_outlook
 from shared.wear.wear_since_service import TIGHTENING, ServiceInterval, SinceServiceTally
 from shared.wear.wear_tool_data import ControllerTool
 
@@ -121,6 +126,9 @@ class ToolWear:
     # no controller bridge spoke of it
     controller: ControllerTool | None = None
     loosenings: int = 0  # its loosenings (their intensity is in the totals)
+    # its pace of wear, what wears it (:mod:`.wear_outlook`): what a forecast against any
+    # threshold needs (:func:`~.wear_forecast.forecast`); None: not asked for, or no run
+    outlook: ToolOutlook | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -281,12 +289,29 @@ class WearLedger:
         found = {int(tool_id) for (tool_id,) in rows}
         return sorted(found.union(wear_tool_data.tool_ids(self._db, station)))
 
-    def tools(self, station: str | None = None) -> list[ToolWear]:
-        """Every tool's line (or of the tools that ran at ``station``, whole totals), by id."""
-        return [self.tool(tool_id) for tool_id in self.tool_ids(station)]
+    def tools(
+        self,
+        station: str | None = None,
+        *,
+        outlook: bool = True,
+        joints: Mapping[tuple[str, int], str] | None = None,
+    ) -> list[ToolWear]:
+        """Every tool's line (or of the tools that ran at ``station``, whole totals), by id;
+        ``outlook``: with its pace and causes of wear (``joints``: each station's program's
+        joint, where known)."""
+        return [
+            self.tool(tool_id, outlook=outlook, joints=joints) for tool_id in self.tool_ids(station)
+        ]
 
-    def tool(self, tool_id: int) -> ToolWear:
-        """One tool's line (zeros for a tool the ledger has never seen)."""
+    def tool(
+        self,
+        tool_id: int,
+        *,
+        outlook: bool = True,
+        joints: Mapping[tuple[str, int], str] | None = None,
+    ) -> ToolWear:
+        """One tool's line (zeros for a tool the ledger has never seen); ``outlook`` as for
+        :meth:`tools`."""
         # One read transaction, so the figures agree with each other under a live writer.
         with self._reading_the_file(), self._db:
             self._db.execute("BEGIN")
@@ -316,6 +341,7 @@ class WearLedger:
                 "SELECT DISTINCT station FROM runs WHERE tool_id = ? ORDER BY station", (tool_id,)
             ).fetchall()
             controller = wear_tool_data.newest(self._db, tool_id)
+            seen = self._outlook(tool_id, time.time_ns(), joints) if outlook else None
         return ToolWear(
             tool_id=tool_id,
             runs=int(runs),
@@ -329,7 +355,50 @@ class WearLedger:
             stations=[str(name) for (name,) in stations],
             controller=controller,
             loosenings=int(every) - int(runs),
+            outlook=seen,
         )
+
+    def outlook(
+        self,
+        tool_id: int,
+        now_ns: int | None = None,
+        joints: Mapping[tuple[str, int], str] | None = None,
+        settings: ForecastSettings = SHIPPED,
+    ) -> ToolOutlook | None:
+        """The tool's outlook as of ``now_ns`` (default now: the runs and services up to
+        then); None when it had no run by then."""
+        with self._reading_the_file(), self._db:
+            self._db.execute("BEGIN")
+            return self._outlook(tool_id, now_ns or time.time_ns(), joints, settings)
+
+    def _outlook(
+        self,
+        tool_id: int,
+        now_ns: int,
+        joints: Mapping[tuple[str, int], str] | None,
+        settings: ForecastSettings = SHIPPED,
+    ) -> ToolOutlook | None:
+        """Inside a read transaction: :meth:`outlook`."""
+        span = first_and_last(self._db, tool_id, now_ns)
+        if span is None:
+            return None
+        service = self._db.execute(
+            "SELECT MAX(serviced_ns) FROM services WHERE tool_id = ? AND serviced_ns <= ?",
+            (tool_id, now_ns),
+        ).fetchone()
+        serviced_ns = None if service is None or service[0] is None else int(service[0])
+        calendar = ledger_calendar(self._db, self.identity, now_ns)
+        window_ns = now_ns - settings.window_days * DAY_NS
+        from_ns = -1 if serviced_ns is None else min(serviced_ns, window_ns)
+        groups = grouped_runs(
+            self._db, tool_id, calendar, from_ns, serviced_ns, now_ns, self._tightening
+        )
+        seen = tool_outlook(
+            groups, calendar, span[0], span[1], serviced_ns, now_ns, joints, settings
+        )
+        limits = run_limits(groups, calendar, now_ns)
+        found = unusual_runs(self._db, tool_id, limits, calendar, serviced_ns, now_ns)
+        return ToolOutlook(seen.pace, seen.calendar, seen.since_service, seen.causes, found)
 
     def close(self) -> None:
         self._db.close()

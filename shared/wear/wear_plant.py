@@ -14,7 +14,9 @@ answered (``host`` and ``ledger`` say which). Merging:
   and a station belongs to one line), the runs and intensity since service;
   its worst runs are the worst of all; its stations the union; its last
   service the latest any ledger holds; what its controller said of it (serial,
-  calibration) the newest any ledger received.
+  calibration) the newest any ledger received; its outlook (pace, causes of
+  wear: what its forecast is made of) none, since each ledger measured only
+  its own part of the tool's days: ``boltwatch wear`` on each line forecasts it.
 
 What a merge cannot make exact: a service is recorded in one ledger
 (``boltwatch wear service`` on that line); another line's ledger that has runs
@@ -32,6 +34,7 @@ from typing import Any
 
 from shared.errors import InputError
 from shared.wear.wear_ledger import WORST_RUNS, RunWear, ToolWear
+from shared.wear.wear_outlook import ToolOutlook
 from shared.wear.wear_tool_data import ControllerTool
 
 
@@ -48,19 +51,23 @@ def parse_reply(payload: bytes) -> WearReply:
     """A ``boltwatch/<st>/wear`` reply; InputError naming what is wrong."""
     try:
         body = json.loads(payload)
-        tools = [_tool(line) for line in body["tools"]]
+        # each tool's outlook beside the tool lines (which a plant's older boltwatch reads as
+        # they were); none in a reply of a recorder before the forecast
+        outlooks = body.get("outlooks", {})
+        tools = [_tool(line, outlooks.get(str(line["tool_id"]))) for line in body["tools"]]
         host = str(body.get("host", ""))
         return WearReply(str(body["station"]), f"{host}:{body['ledger']}", tools)
     except (ValueError, KeyError, TypeError) as err:
         raise InputError(f"not a wear reply ({type(err).__name__}: {err})") from err
 
 
-def _tool(line: dict[str, Any]) -> ToolWear:
+def _tool(line: dict[str, Any], outlook: dict[str, Any] | None) -> ToolWear:
     fields = dict(line)
     fields["worst_runs"] = [RunWear(**run) for run in line["worst_runs"]]
     fields["stations"] = list(line["stations"])
     controller = line.get("controller")  # absent in a reply of a ledger before tool data
     fields["controller"] = None if controller is None else ControllerTool.from_dict(controller)
+    fields["outlook"] = None if outlook is None else ToolOutlook.from_dict(outlook)
     return ToolWear(**fields)
 
 
@@ -109,4 +116,5 @@ def _merged(parts: list[ToolWear]) -> ToolWear:
         stations=sorted({name for part in parts for name in part.stations}),
         controller=max(said, key=lambda tool: tool.received_ns) if said else None,
         loosenings=loosenings,
+        outlook=None,
     )

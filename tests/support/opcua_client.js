@@ -29,7 +29,8 @@
 // "resultId", "error", "objectId", "systemObjectId"}; with "toolRuns": N, each tool of
 // AssetManagement/Assets/Tools once its OperationCycleCounter reached N (read again until
 // then) as {"type": "tool", "station", "name", "serialNumber", "tightenings",
-// "sinceService", "intensitySinceService", "limitValue", "unitId"}; with "browseTree":
+// "sinceService", "intensitySinceService", "limitValue", "warningValues", "unitId",
+// "serviceDue", "tighteningsToService"}; with "browseTree":
 // {"expand": [PATH, ...]}, per station {"type": "tree", "station", "nodes"}: the joining
 // system's address space as a generic browser shows it (opcua_browse_tree.js); with
 // "crawl": true, {"type": "crawl", ...} (opcua_crawl.js: the whole address space walked);
@@ -230,7 +231,10 @@ async function readTools(session, systemId, namespaces, station, runs) {
         sinceService: `/${di}:Maintenance/${ijt}:Service/${ijt}:ServiceCycleCount`,
         intensitySinceService: intensity,
         limitValue: `${intensity}/${di}:LimitValue`,
+        warningValues: `${intensity}/${di}:WarningValues`,
         unit: `${intensity}/EngineeringUnits`,
+        serviceDue: `/${machinery}:LifetimeCounters/${ours}:StickSlipServiceDue`,
+        tighteningsToService: `/${machinery}:LifetimeCounters/${ours}:StickSlipTighteningsToService`,
     };
     for (const ref of browsed.references) {
         if (!ref.browseName.name.startsWith("Tool_")) continue;
@@ -254,7 +258,10 @@ async function readTools(session, systemId, namespaces, station, runs) {
                 sinceService: values.sinceService,
                 intensitySinceService: values.intensitySinceService,
                 limitValue: values.limitValue,
+                warningValues: values.warningValues ? Array.from(values.warningValues) : null,
                 unitId: values.unit ? values.unit.unitId : null,
+                serviceDue: values.serviceDue ? values.serviceDue.toISOString() : null,
+                tighteningsToService: values.tighteningsToService,
             });
             break;
         }

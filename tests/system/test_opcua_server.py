@@ -429,6 +429,9 @@ def _check_tools(lines: list[dict[str, Any]], recordings: Path) -> None:
         )
         assert tool["intensitySinceService"] == wear.intensity_since_service > 0
         assert (tool["limitValue"], tool["unitId"]) == (THRESHOLD, ONE.unit_id)
+        # warned at 0.8 and 0.95 of the threshold; past it (one run is more): due, no date
+        assert tool["warningValues"] == [0.8 * THRESHOLD, 0.95 * THRESHOLD]
+        assert (tool["serviceDue"], tool["tighteningsToService"]) == (None, 0)
         assert tool["serialNumber"] == ""  # no controller named the simulated tool
 
 

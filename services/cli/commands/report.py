@@ -6,6 +6,10 @@
                      [--program ID] [--tool ID] [--subgroup-size N] [--out FOLDER]
                      [--from-recordings]
 
+Below the statistics, "Tool wear": each tool of those stations in the wear
+ledger, its service forecast as of now and what wears it
+(:mod:`shared.offline.report.report_wear`).
+
 Reads the tightening results of the station files' stations that ended in the
 range from the results store (:mod:`shared.results`; none there, or
 ``--from-recordings``: from every recording in range,
@@ -37,7 +41,7 @@ from shared.option_types import int_in
 
 if TYPE_CHECKING:
     from shared.config import AnyStation
-    from shared.offline.report import RecordedResults, ResultFilter
+    from shared.offline.report import RecordedResults, ResultFilter, WearPart
 
 NAME = "report"
 HELP = "statistics per program over recorded results: X̄/R charts, Cp/Cpk, NOK Pareto (HTML, PNG)"
@@ -102,7 +106,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from shared.config import load_any_station
-    from shared.offline.report import ResultFilter, read_counts, terminal_lines, write_report
+    from shared.offline.report import (
+        ResultFilter,
+        read_counts,
+        terminal_lines,
+        wear_lines,
+        write_report,
+    )
 
     stations = [load_any_station(path) for path in args.config]
     if args.plant is not None:
@@ -124,14 +134,39 @@ def run(args: argparse.Namespace) -> int:
         tool_id=args.tool,
     )
     read, source = _read(rule, stations[0], args.from_recordings)
-    report = write_report(rule, read, args.out, args.subgroup_size, source)
+    wear = _wear(stations, args.tool)
+    report = write_report(rule, read, args.out, args.subgroup_size, source, wear)
     warn_left_out(NAME, report.damaged, report.skipped, report.refused)
     left_out = read_counts(read)
     print(f"{report.results} results ({source}{'; ' + left_out if left_out else ''})")
     for line in terminal_lines(report.programs):
         print(line)
+    if wear is not None:
+        print(f"tool wear (from {wear.ledger}, as of now):")
+        for line in wear_lines(wear):
+            print(f"  {line}")
     print(f"wrote {report.html_path} and {report.png_path}")
     return 0
+
+
+def _wear(stations: list[AnyStation], tool_id: int | None) -> WearPart | None:
+    """The tools of ``stations`` in the first one's wear ledger, forecast now against its
+    threshold (``tool_id``: that tool only); None when there is no ledger (nothing recorded)."""
+    import time
+
+    from shared.offline.report import WearPart
+    from shared.wear import WearLedger, joint_names, ledger_path
+    from shared.wear.wear_forecast_table import tool_forecasts
+
+    path = ledger_path(stations[0].recordings_folder)
+    if not path.is_file():
+        return None
+    with WearLedger(path, read_only=True) as ledger:
+        ids = sorted({t for s in stations for t in ledger.tool_ids(station=s.station_id)})
+        chosen = [t for t in ids if tool_id is None or t == tool_id]
+        tools = [ledger.tool(t, joints=joint_names(stations)) for t in chosen]
+    threshold = stations[0].config.recorder.wear_service_threshold
+    return WearPart(tools, tool_forecasts(tools, threshold, time.time_ns()), threshold, str(path))
 
 
 def _read(

@@ -2,10 +2,18 @@
 
 ::
 
-    boltwatch wear [--recordings DIR] [--station ST]      the table, one line per tool
+    boltwatch wear [--recordings DIR] [--station ST]      the table, one line per tool,
+                   [--threshold I] [--json]               then each tool's service forecast
     boltwatch wear service TOOL --note TEXT               record a service of TOOL
     boltwatch wear reset [--recordings DIR]               a broken ledger moved aside, a new one
     boltwatch wear --plant [--config FILE | --connect EP]  every line's ledger, over zenoh
+
+Below the table, each tool's service forecast against the station file's
+``recorder.wear_service_threshold`` (or ``--threshold``): when it is due, how
+sure (80 %), the production days and tightenings left, the shift change to plan
+the service at, and what wears it most (:mod:`shared.wear.wear_forecast_table`).
+``--json``: each tool's line with its ``outlook``, ``forecast`` and ``wear_by``
+(the share of its wear since its service by program, station and joint).
 
 ``--plant`` asks every recorder of the plant (``boltwatch/*/wear`` through the
 router of the station file, or ``--connect``; the routers of a plant's lines
@@ -21,9 +29,13 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from services.cli.command_options import add_recordings_folder_options, recordings_folder
-from shared.option_types import int_in, seconds
+from shared.option_types import float_in, int_in, seconds
+
+if TYPE_CHECKING:
+    from shared.wear import ToolWear
 
 NAME = "wear"
 HELP = "show the wear ledger per tool, record a tool's service, or replace a broken ledger"
@@ -42,7 +54,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "'boltwatch wear reset' moves a broken ledger (empty, not SQLite, another schema, "
         "corrupt) aside, keeping it as wear.sqlite.broken-<UTC time>, and starts a new one; "
         "a running recorder then counts the runs it kept waiting into the new ledger. "
-        "It refuses a healthy ledger and one a process has open."
+        "It refuses a healthy ledger and one a process has open. Below the table: each "
+        "tool's service forecast (the date its intensity since service reaches the "
+        "threshold, with an 80 %% interval, from its intensity per production day; the "
+        "production days and shifts learned from the ledger's own runs), the tightenings "
+        "left, and what wears it most."
     )
     parser.add_argument(
         "action",
@@ -60,6 +76,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="ST",
         help="only the tools that ran at station ST (their totals still count every station)",
+    )
+    parser.add_argument(
+        "--threshold",
+        type=float_in(0.0, 1e300, "", low_allowed=False),
+        default=None,
+        metavar="I",
+        help="the intensity since service a tool is due at, for the forecast (default: the "
+        "station file's recorder.wear_service_threshold)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     plant = parser.add_argument_group("the whole plant (every line's recorder, over zenoh)")
@@ -85,32 +109,67 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
     import time
 
     from shared.errors import InputError
-    from shared.wear import WearLedger, format_table, ledger_path
+    from shared.wear import WearLedger, ledger_path
 
     if args.plant or args.connect is not None:
         return _plant(args)
     path = ledger_path(recordings_folder(args))
     if args.action == "reset":
         return _reset(args, path)
+    threshold, joints = _station_file_says(args)
     if args.action == "service":
         if args.tool is None:
             raise InputError("give the tool id: boltwatch wear service TOOL --note TEXT")
         with WearLedger(path) as ledger:
             ledger.record_service(args.tool, args.note, time.time_ns())
-            tools = [ledger.tool(args.tool)]
+            tools = [ledger.tool(args.tool, joints=joints)]
         print(f"recorded a service of tool {args.tool} in {path}")
     else:
         with WearLedger(path, read_only=True) as ledger:
-            tools = ledger.tools(station=args.station)
-    if args.json:
-        print(json.dumps([tool.to_dict() for tool in tools], indent=2))
-    else:
-        print(format_table(tools, args.station))
+            tools = ledger.tools(station=args.station, joints=joints)
+    _print(args, tools, threshold)
     return 0
+
+
+def _station_file_says(args: argparse.Namespace) -> tuple[float | None, dict[tuple[str, int], str]]:
+    """The threshold (``--threshold``, else the station file's) and the joints of its
+    programs; none from a station file that is not there or not readable when
+    ``--recordings`` says where the ledger is."""
+    from shared.config import load_any_station
+    from shared.errors import ConfigError, InputError
+    from shared.wear import joint_names
+
+    try:
+        station = load_any_station(args.config)
+    except (ConfigError, InputError, OSError):
+        if args.recordings is None:
+            raise
+        return args.threshold, {}
+    threshold = args.threshold or station.config.recorder.wear_service_threshold
+    return threshold, joint_names([station])
+
+
+def _print(args: argparse.Namespace, tools: list[ToolWear], threshold: float | None) -> None:
+    """The table and the forecasts (or their JSON) of ``tools``."""
+    import json
+    import time
+
+    from shared.wear import format_table
+    from shared.wear.wear_forecast_table import forecast_json, format_forecasts, tool_forecasts
+
+    forecasts = tool_forecasts(tools, threshold, time.time_ns())
+    if args.json:
+        lines = [forecast_json(tool, told) for tool, told in zip(tools, forecasts, strict=True)]
+        print(json.dumps(lines, indent=2))
+        return
+    print(format_table(tools, args.station))
+    table = format_forecasts(tools, forecasts)
+    if table:
+        print()
+        print(table)
 
 
 def _reset(args: argparse.Namespace, path: Path) -> int:
@@ -134,13 +193,12 @@ def _reset(args: argparse.Namespace, path: Path) -> int:
 
 def _plant(args: argparse.Namespace) -> int:
     """The merged ledgers of every line's recorder; 2 when one replied with an error."""
-    import json
     import sys
 
     from services.cli.router_client import open_client, router_client
     from shared.contract import keys
     from shared.errors import InputError
-    from shared.wear import WearReply, format_table, merge, parse_reply
+    from shared.wear import WearReply, merge, parse_reply
 
     if args.action is not None:
         raise InputError(
@@ -173,10 +231,9 @@ def _plant(args: argparse.Namespace) -> int:
             f"no recorder answered a wear query through {endpoint} within {args.timeout_s:g} s"
         )
     tools = merge(replies, args.station)
-    if args.json:
-        print(json.dumps([tool.to_dict() for tool in tools], indent=2))
-    else:
-        print(format_table(tools, args.station))
+    threshold, _ = _station_file_says(args) if args.connect is None else (args.threshold, {})
+    _print(args, tools, threshold)
+    if not args.json:
         ledgers = sorted({reply.ledger for reply in replies})
         stations = sorted({reply.station for reply in replies})
         print(f"{len(ledgers)} ledgers answered for stations {', '.join(stations) or '-'}")

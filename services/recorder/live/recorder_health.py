@@ -23,7 +23,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 from shared.config import StationPlace
-from shared.contract import QualityAlert, RecorderStats
+from shared.contract import QualityAlert, RecorderStats, WearForecast
 
 _NS_PER_MS = 1_000_000
 
@@ -130,6 +130,7 @@ class RecorderHealth:
         waiting_summaries: int = 0,
         waiting_results: int = 0,
         quality_alerts: Callable[[str], list[QualityAlert]] | None = None,
+        wear_forecasts: Callable[[str], list[WearForecast]] | None = None,
         recordings_deleted: Mapping[str, int] | None = None,
         recordings_kept_unstored: Mapping[str, int] | None = None,
     ) -> list[RecorderStats]:
@@ -139,6 +140,7 @@ class RecorderHealth:
         ``waiting_summaries``: runs waiting in memory for the ledger (all stations);
         ``waiting_results``: results waiting in memory for the results store (all stations);
         ``quality_alerts``: a station's quality alerts active now;
+        ``wear_forecasts``: the forecasts of the station's tools due within a horizon now;
         ``recordings_deleted`` / ``recordings_kept_unstored``: per station, what the
         retention policy deleted since the start / kept at its last pass (results not stored).
         """
@@ -169,6 +171,7 @@ class RecorderHealth:
                     station_name=place.name,
                     bad_payloads=counts.bad_payloads,
                     quality_alerts=quality_alerts(station) if quality_alerts else [],
+                    wear_forecasts=wear_forecasts(station) if wear_forecasts else [],
                     recordings_deleted=deleted.get(station, 0),
                     recordings_kept_unstored=kept_unstored.get(station, 0),
                 )

@@ -16,6 +16,7 @@ from shared.errors import InputError
 from shared.offline.report.recorded_results import RecordedResults, ResultFilter
 from shared.offline.report.report_figure import build_figure, png_bytes
 from shared.offline.report.report_page import html_page
+from shared.offline.report.report_wear import WearPart, wear_html
 from shared.quality import ProgramStatistics, statistics_of
 
 HTML_NAME = "report.html"
@@ -66,10 +67,15 @@ def read_counts(read: RecordedResults) -> str:
 
 
 def write_report(
-    rule: ResultFilter, read: RecordedResults, out: Path, subgroup_size: int, source: str
+    rule: ResultFilter,
+    read: RecordedResults,
+    out: Path,
+    subgroup_size: int,
+    source: str,
+    wear: WearPart | None = None,
 ) -> WrittenReport:
-    """Compute, draw and write what was read (``source``: from where, in words); InputError
-    when no result is in range."""
+    """Compute, draw and write what was read (``source``: from where, in words; ``wear``:
+    the tools' wear and forecasts, None: no ledger); InputError when no result is in range."""
     left_out = read_counts(read)
     if not read.results:
         searched = "; ".join(describe_scope(rule, subgroup_size)[:-1])
@@ -85,7 +91,8 @@ def write_report(
     scope = [*describe_scope(rule, subgroup_size), f"{read.results} results ({source})"]
     if left_out:
         scope.append(f"left out: {left_out}")
-    html_path.write_text(html_page(programs, title, scope, png), encoding="utf-8")
+    wear_section = wear_html(wear) if wear is not None else ""
+    html_path.write_text(html_page(programs, title, scope, png, wear_section), encoding="utf-8")
     return WrittenReport(
         html_path,
         png_path,

@@ -127,16 +127,21 @@ def _sections(programs: Sequence[ProgramStatistics]) -> str:
 
 
 def html_page(
-    programs: Sequence[ProgramStatistics], title: str, scope: Sequence[str], png: bytes
+    programs: Sequence[ProgramStatistics],
+    title: str,
+    scope: Sequence[str],
+    png: bytes,
+    wear: str = "",
 ) -> str:
-    """The whole page: ``scope`` lines (what was read), tables, the picture inline."""
+    """The whole page: ``scope`` lines (what was read), tables, the tools' wear (``wear``,
+    its HTML: :mod:`.report_wear`), the picture inline."""
     picture = base64.b64encode(png).decode("ascii")
     lines = "".join(f"<li>{html.escape(line)}</li>" for line in scope)
     return (
         "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8>"
         f"<title>{html.escape(title)}</title><style>{_STYLE}</style></head><body>"
         f"<h1>{html.escape(title)}</h1><ul>{lines}</ul>"
-        f"{_sections(programs)}"
+        f"{_sections(programs)}{wear}"
         f'<h2>Charts</h2><img alt="{html.escape(title)}" src="data:image/png;base64,{picture}">'
         "</body></html>\n"
     )

@@ -69,6 +69,7 @@ from shared.contract import (
     TighteningResult,
     ToolData,
     ToolState,
+    WearForecast,
     to_dict,
 )
 
@@ -191,6 +192,23 @@ def template(topic: str, station: str, now_ns: int, run_id: int = 1) -> Any:
             [ControllerStep("Finding", "OK", "1", 9, [ControllerFunction("TF Angle", 1.0, 1.5)])],
         ),
         "wear/alert": lambda: WearAlert(station, 3, now_ns, 2e9, 1e9, 4, None),
+        "wear/forecast": lambda: WearForecast(
+            station=station,
+            tool_id=3,
+            time_ns=now_ns,
+            horizon_days=7.0,
+            due_ns=now_ns + 86_400_000_000_000,
+            early_ns=now_ns + 43_200_000_000_000,
+            late_ns=None,
+            production_days=1.0,
+            runs_left=400,
+            intensity_since_service=9e8,
+            threshold=1e9,
+            intensity_per_day=1e8,
+            runs_since_service=4_000,
+            last_service_ns=None,
+            service_by_ns=now_ns + 28_800_000_000_000,
+        ),
         "quality/alert": lambda: QualityAlert(
             station, 1, now_ns, "cpk_low", "preload", 0.9, 1.33, 50, True, "program 1: low"
         ),

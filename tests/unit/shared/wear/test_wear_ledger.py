@@ -218,7 +218,7 @@ def test_a_tool_is_one_asset_across_stations_and_a_station_lists_its_tools(
     assert main(["wear", "--recordings", str(tmp_path), "--station", "st1"]) == 0
     table = capsys.readouterr().out.splitlines()
     assert "stations" in table[0]
-    (line,) = table[1:]
+    (line,) = table[1 : table.index("")]  # the ledger's table; the forecast's below it
     assert line.split()[:4] == ["7", "-", "2", "3"]  # whole totals, st1 and st2
     assert "st1,st2" in line
     assert main(["wear", "--recordings", str(tmp_path), "--station", "st9"]) == 0
