@@ -26,7 +26,7 @@ from services.predictor.service import PredictorService
 from services.predictor.station_runs import StationRuns
 from shared.config import LoadedStation, load_line
 from shared.contract import PartScan, TighteningResult, ToolState, channels, codec
-from shared.runtime import ServiceSkeleton, Stop, zenoh_config
+from shared.runtime import ServiceSkeleton, Stop, declare_channel, zenoh_config
 from tests.support.factories import part_scan, sample
 from tests.support.listener import Listener
 from tests.support.live_predictor import (
@@ -74,7 +74,7 @@ def session(endpoint: str) -> Iterator[zenoh.Session]:
 
 def scan(session: zenoh.Session, station_id: str, part_id: str) -> None:
     """The line's PLC: part ``part_id`` arrived at ``station_id``."""
-    publisher = session.declare_publisher(channels.PART.key(station_id))
+    publisher = declare_channel(session, channels.PART, station_id)  # BLOCK, as the PLC's
     wait_for_subscriber(publisher)
     publisher.put(codec.encode(part_scan(part_id, station=station_id, time_ns=START_NS)))
     publisher.undeclare()

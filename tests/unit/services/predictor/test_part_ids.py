@@ -18,7 +18,7 @@ from services.predictor.edge_predictor import EdgePredictor
 from services.predictor.service import PredictorService
 from shared.config import LoadedStation
 from shared.contract import TighteningResult, ToolState, channels, codec, keys
-from shared.runtime import ServiceSkeleton, Stop, zenoh_config
+from shared.runtime import ServiceSkeleton, Stop, declare_channel, zenoh_config
 from tests.support.factories import part_scan, sample
 from tests.support.listener import Listener
 from tests.support.live_predictor import (
@@ -40,7 +40,9 @@ class PartFeed:
 
     def __init__(self, session: zenoh.Session, station_id: str) -> None:
         self.station_id = station_id
-        self.publisher = session.declare_publisher(channels.PART.key(station_id))
+        # as the line's PLC puts it (congestion control BLOCK): zenoh's default may drop a
+        # put right after a burst of samples under load, and the scan is then never heard
+        self.publisher = declare_channel(session, channels.PART, station_id)
         wait_for_subscriber(self.publisher)
 
     def scan(self, part_id: str, at_ns: int, station: str | None = None) -> None:
