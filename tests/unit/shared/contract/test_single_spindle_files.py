@@ -98,7 +98,8 @@ def test_a_cycle_result_names_its_spindles_runs_in_spindle_order() -> None:
 def test_the_wear_ledger_a_single_spindle_station_wrote_before_reads_as_it_did(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """``tests/data/single-spindle/wear.sqlite`` answers ``wear --json`` as it did then."""
+    """``tests/data/single-spindle/wear.sqlite`` answers ``wear --json`` as it did then (every
+    key it gave then, with the same values; a tool's forecast, ``outlook``, came later)."""
     import json
     import shutil
 
@@ -110,4 +111,7 @@ def test_the_wear_ledger_a_single_spindle_station_wrote_before_reads_as_it_did(
     capsys.readouterr()
     assert main(["wear", "--recordings", str(folder), "--json"]) == 0
     answered = json.loads(capsys.readouterr().out)
-    assert answered == json.loads((SINGLE_SPINDLE / "wear.json").read_text())
+    then = json.loads((SINGLE_SPINDLE / "wear.json").read_text())
+    assert [
+        {key: tool[key] for key in old} for tool, old in zip(answered, then, strict=True)
+    ] == then
