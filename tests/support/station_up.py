@@ -107,3 +107,10 @@ def services_of(up: subprocess.Popen[str]) -> dict[str, int]:
         if "serve" in words:
             found[words[words.index("serve") + 1]] = pid
     return found
+
+
+def wear_ledger_rows(wear_text: str, tool_id: int) -> list[list[str]]:
+    """The rows of ``tool_id`` in the ledger's table, the first of ``boltwatch wear``'s text
+    (the service forecast's table below it has a row per tool too)."""
+    ledger, _, _ = wear_text.partition("\n\n")
+    return [row.split() for row in ledger.splitlines() if row.split()[:1] == [str(tool_id)]]

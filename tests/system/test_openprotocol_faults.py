@@ -36,7 +36,7 @@ from tests.support.live_station import open_client, wait_supervised
 from tests.support.openprotocol_proxy import Damage, OpenProtocolProxy
 from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
-from tests.support.station_up import read_recordings
+from tests.support.station_up import read_recordings, wear_ledger_rows
 
 pytestmark = pytest.mark.system
 
@@ -168,7 +168,7 @@ def check_each_tightening_recorded_once(station: FaultStation, folder: Path) -> 
     results = sorted(r["tightening_id"] for r in messages["boltwatch/st1/results"])
     assert results == list(range(1, RUNS + 1)), logs
     wear = boltwatch("wear", "--config", str(station.files["bridge"]), timeout_s=60, check=True)
-    (line,) = [row.split() for row in wear.stdout.splitlines() if row.split()[:1] == ["7"]]
+    (line,) = wear_ledger_rows(wear.stdout, 7)
     assert line[1:3] == ["SIM-7", str(RUNS)], wear.stdout
 
 

@@ -24,7 +24,7 @@ from services.cli.station_supervisor import StationSupervisor
 from tests.support.openprotocol_controller import SpecController
 from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
-from tests.support.station_up import read_recordings
+from tests.support.station_up import read_recordings, wear_ledger_rows
 
 pytestmark = pytest.mark.system
 
@@ -77,7 +77,7 @@ class PlantStation:
     def wear_runs(self) -> int:
         """The runs the wear ledger counted for the station's tool."""
         wear = boltwatch("wear", "--config", str(self.station_file), timeout_s=60, check=True)
-        rows = [row.split() for row in wear.stdout.splitlines() if row.split()[:1] == ["7"]]
+        rows = wear_ledger_rows(wear.stdout, 7)
         assert len(rows) == 1, wear.stdout
         return int(rows[0][2])
 

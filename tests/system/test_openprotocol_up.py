@@ -17,7 +17,7 @@ import pytest
 from tests.support.live_recorder import free_port
 from tests.support.router_process import boltwatch
 from tests.support.station_files import write_station
-from tests.support.station_up import read_recordings, run_up
+from tests.support.station_up import read_recordings, run_up, wear_ledger_rows
 
 pytestmark = pytest.mark.system
 
@@ -56,5 +56,5 @@ def test_up_with_an_open_protocol_controller_records_every_run(tmp_path: Path) -
     assert messages["boltwatch/st1/tool_data"][-1]["tool_serial"] == "SIM-7"
 
     wear = boltwatch("wear", "--config", str(station), timeout_s=60, check=True)
-    (line,) = [row.split() for row in wear.stdout.splitlines() if row.split()[:1] == ["7"]]
+    (line,) = wear_ledger_rows(wear.stdout, 7)
     assert line[1:3] == ["SIM-7", str(RUNS)], wear.stdout
