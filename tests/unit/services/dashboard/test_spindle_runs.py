@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import sqlite3
 from pathlib import Path
 from typing import Any
 
@@ -139,3 +140,18 @@ def test_a_single_spindle_station_s_run_has_no_cycle_to_overlay(tmp_path: Path) 
     assert found["results"] and all(
         not {"spindle", "sync_id", "cycle"} & set(row) for row in found["results"]
     )
+
+
+def test_a_spindle_s_run_whose_row_names_no_run_file_of_the_station_is_never_read(
+    tmp_path: Path,
+) -> None:
+    hostile = load_any_station(record_cycles(tmp_path, cycles=1, spindles=2, samples=50))
+    folder = hostile.recordings_folder.resolve()
+    with sqlite3.connect(folder / "results.sqlite") as database:
+        database.execute("UPDATE tightenings SET recording = '/etc/passwd' WHERE run_id = 5001")
+    (status, body), (_, cycle) = _ask(hostile, "/api/runs/st1/5001", "/api/runs/st1/5001/cycle")
+    assert status == 404 and cycle == body
+    assert body["errors"] == [
+        f"run 5001 of st1: the results store names /etc/passwd, outside the station's "
+        f"recordings folder {folder}: not read"
+    ]
