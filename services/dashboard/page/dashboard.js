@@ -35,11 +35,11 @@ function table(headers, rows) {
 
 // A multi-spindle station's rows (each with its sync_id), a cycle row above each cycle's
 // spindles: its sync id, its part, its common result with its reasons ("spindle 3 NOK
-// (torque low)"; not come yet: under way). A single-spindle station's rows as they are.
+// (torque low)"; not come yet: "no common result yet"). A single-spindle station's rows as they are.
 function cycleRow(columns, r) {
   const c = r.cycle;
   const verdict = c ? el("span", { class: `verdict ${c.result}` }, c.result)
-    : el("span", { class: "verdict pending" }, "under way");
+    : el("span", { class: "verdict pending" }, "no common result yet");
   const part = r.part_id || (c && c.part_id);
   return el("tr", { class: "cycle", "data-sync": r.sync_id, "data-cycle-result": c ? c.result : "" },
     el("td", { colspan: String(columns) }, `cycle ${r.sync_id}${part ? ` · part ${part}` : ""} `,
