@@ -9,8 +9,9 @@ independence contract) and collects what ``boltwatch status`` collects
 - :mod:`.connection_guard` (the server's bounds: open files, connections,
   idle time, request size, and one log line per kind of client fault)
 - :mod:`.line_board` (what the page shows, pure: status's collectors, the last
-  results, stop reasons, alerts and wear per station), :mod:`.tools_due` (the
-  line's tools due soonest: each one's forecast and chart, pure)
+  results and a multi-spindle station's cycles, stop reasons, alerts and wear per
+  station), :mod:`.tools_due` (the line's tools due soonest: each one's forecast and
+  chart, pure)
 - :mod:`.line_link` (the zenoh session, opened in the background: the page
   is served before the router answers)
 - :mod:`.board_feed` (zenoh: subscriptions, liveliness and wear queries per
@@ -22,13 +23,16 @@ independence contract) and collects what ``boltwatch status`` collects
 - :mod:`.json_replies` (the JSON replies' headers, an error in words, a reply kept
   gzipped)
 - a run's curve: :mod:`.run_routes` (``/api/runs/ST/RUN``: its view, its part's
-  runs, its program's band, its files), :mod:`.run_locator` (where its recording
-  is: the results store names it, inside the station's recordings folder),
+  runs, its program's band, a multi-spindle run's cycle, its files),
+  :mod:`.run_locator` (where its recording is: the results store names it, inside the
+  station's recordings folder),
   :mod:`.run_views` (read off the event loop, bounded, shared),
   :mod:`.run_cache` (runs read, kept until their files change),
+  :mod:`.cycle_runs` (a multi-spindle cycle's runs overlaid, from its one file),
   :mod:`.viewer_links` (Rerun's and Foxglove's links, their origins)
 - ``page/``: ``index.html``, ``dashboard.css``, ``dashboard.js`` (the
-  stations), ``part_search.js`` (the search box, the NOK list),
+  stations; a multi-spindle station's rows grouped by cycle), ``part_search.js`` (the
+  search box, the NOK list),
   ``run_view.js`` (a run's panel), ``run_specs.js`` (what its charts draw),
   ``run_chart.js`` (the page's own canvas chart), ``tools_due.js`` and
   ``tools_due.css`` (the tools due soonest) (served by the app; nothing from the

@@ -14,7 +14,10 @@ What ``boltwatch status`` collects is reused, not copied
   the services alive at its end and the sample rate over it.
 
 Beside them, what status does not keep: the last :data:`HISTORY` results and
-stop reasons of each station, the alerts of every alert channel of
+stop reasons of each station (a multi-spindle station's: the last :data:`HISTORY` cycles of
+every spindle, each result with its spindle, its cycle's sync id and that cycle's common
+result once its ``CycleResult`` came on ``cycles``; a single-spindle station's results say
+none of them), the alerts of every alert channel of
 :mod:`shared.contract.channels` (a topic ending in ``alert``: the recorder's
 ``wear/alert`` and ``quality/alert``, and any other a service adds, shown by its fields), and the
 wear of each tool from the recorder's ``wear`` queryable against the
@@ -32,7 +35,7 @@ from typing import Any
 
 from services.dashboard.tools_due import ToolSeen, tools_due, tools_seen
 from shared.config import StationPlace
-from shared.contract import RunSummary, TighteningResult, channels, decode, keys
+from shared.contract import CycleResult, RunSummary, TighteningResult, channels, decode, keys
 from shared.errors import InputError
 from shared.line_status import KNOWN_SERVICES, StationStatus, StatusCollector, last_result
 
@@ -74,6 +77,7 @@ class _History:
 
     results: deque[TighteningResult] = field(default_factory=lambda: deque(maxlen=HISTORY))
     summaries: deque[RunSummary] = field(default_factory=lambda: deque(maxlen=HISTORY))
+    cycles: dict[int, CycleResult] = field(default_factory=dict)  # sync id -> common result
     alerts: dict[tuple[Any, ...], dict[str, Any]] = field(default_factory=dict)
     wear: list[ToolWearLine] = field(default_factory=list)
     tools: list[ToolSeen] = field(default_factory=list)  # with their outlooks: the forecasts
@@ -187,10 +191,21 @@ class LineBoard:
 
 def _remember(history: _History, topic: str, payload: bytes) -> bool:
     if topic == channels.RESULTS.topic:
-        history.results.appendleft(decode(TighteningResult, payload))
+        result = decode(TighteningResult, payload)
+        if result.spindle is not None and HISTORY * result.spindle > (history.results.maxlen or 0):
+            # a multi-spindle station: the last cycles of every spindle
+            history.results = deque(history.results, maxlen=HISTORY * result.spindle)
+            history.summaries = deque(history.summaries, maxlen=HISTORY * result.spindle)
+        history.results.appendleft(result)
         return True
     if topic == channels.RUNS.topic:
         history.summaries.appendleft(decode(RunSummary, payload))
+        return True
+    if topic == channels.CYCLES.topic:
+        cycle = decode(CycleResult, payload)
+        history.cycles[cycle.sync_id] = cycle
+        while len(history.cycles) > 2 * HISTORY:  # the oldest cycle's result goes
+            del history.cycles[next(iter(history.cycles))]
         return True
     if topic in ALERT_CHANNELS:
         alert = decode(ALERT_CHANNELS[topic].message_type, payload)
@@ -274,7 +289,7 @@ def _station_view(
         "bridge": latest_view.get("bridge"),
         "spools": latest_view.get("spools", []),
         "unreadable_messages": latest_view.get("unreadable_messages", 0),
-        "results": [_result_view(result, now_ns) for result in history.results],
+        "results": [_result_view(result, now_ns, history.cycles) for result in history.results],
         "stops": [_stop_view(summary, now_ns) for summary in history.summaries],
         "wear": [_wear_view(tool, setting.wear_threshold) for tool in history.wear],
         "wear_threshold": setting.wear_threshold,
@@ -283,7 +298,9 @@ def _station_view(
     }
 
 
-def _result_view(result: TighteningResult, now_ns: int) -> dict[str, Any]:
+def _result_view(
+    result: TighteningResult, now_ns: int, cycles: dict[int, CycleResult]
+) -> dict[str, Any]:
     shown = last_result(result, now_ns)
     assert shown is not None  # a result in, a line out
     view = dataclasses.asdict(shown)
@@ -294,7 +311,24 @@ def _result_view(result: TighteningResult, now_ns: int) -> dict[str, Any]:
         "stop_reason": result.stop_reason,
         "time_ns": result.time_ns,
     }
+    if result.sync_id is not None:  # a spindle's run of a multi-spindle cycle
+        cycle = cycles.get(result.sync_id)
+        view |= {
+            "spindle": result.spindle,
+            "sync_id": result.sync_id,
+            "cycle": None if cycle is None else _cycle_view(cycle),  # None: not come yet
+        }
     return view
+
+
+def _cycle_view(cycle: CycleResult) -> dict[str, Any]:
+    return {
+        "sync_id": cycle.sync_id,
+        "spindles": len(cycle.spindles),
+        "result": cycle.result,
+        "nok_reasons": cycle.nok_reasons,
+        "part_id": cycle.part_id,
+    }
 
 
 def _stop_view(summary: RunSummary, now_ns: int) -> dict[str, Any]:
@@ -309,7 +343,7 @@ def _stop_view(summary: RunSummary, now_ns: int) -> dict[str, Any]:
         "error_pct": summary.error_pct,
         "events": summary.events,
         "age_s": round((now_ns - summary.ended_ns) / _NS, 3),
-    }
+    } | ({} if summary.spindle is None else {"spindle": summary.spindle})
 
 
 def _wear_view(tool: ToolWearLine, threshold: float | None) -> dict[str, Any]:

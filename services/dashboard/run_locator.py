@@ -17,6 +17,9 @@ files, each with its recordings folder and results store
    followed) is inside the recordings folder. A store row naming anything else (another
    folder, ``/etc/passwd``, a link out of the folder, a file of another name) is refused
    in words, never read;
+   A multi-spindle station's cycle is one file, named by the first of its spindles' runs
+   to start: a spindle's run of no file of its own, whose row says its cycle (its sync id),
+   has the files of the run the named file is named by, checked the same way;
 4. a run the store does not hold yet (the recorder stores a result once its file is
    flushed) is found by the layout alone; with no file either it is not found
    (``pending``: its result may be on its way).
@@ -35,7 +38,13 @@ from pathlib import Path
 from shared.config import AnyStation
 from shared.errors import InputError, StoreError
 from shared.files import real_path
-from shared.recordings import run_file_prefix, run_files, station_days, writing_path
+from shared.recordings import (
+    file_name_of,
+    run_file_prefix,
+    run_files,
+    station_days,
+    writing_path,
+)
 from shared.results import ResultsQuery, ResultsStore, StoredResult, StoreTarget, station_store
 
 #: the application name a PostgreSQL store sees (its pg_stat_activity)
@@ -119,6 +128,8 @@ class RunLocator:
             stored, note = [], f"the results store did not answer ({err}): found by the folder"
         row = stored[0] if stored else None
         files = self._run_files(served, run_id)
+        if not files and row is not None and row.recording and row.result.sync_id is not None:
+            files = self._cycle_files(served, Path(row.recording))
         if row is not None and row.recording:
             self._check_named(served, run_id, Path(row.recording), files, row)
         elif row is None and not note:
@@ -177,6 +188,14 @@ class RunLocator:
         except InputError as err:
             raise RunRequestError(404, f"run {run_id} of {served.station}: {err}") from err
         return files
+
+    def _cycle_files(self, served: StationRecordings, named: Path) -> list[Path]:
+        """A multi-spindle cycle's run: the files of the run its cycle's file is named by
+        (the first of its spindles' runs to start), the one the store names among them."""
+        name = file_name_of(named, served.station)
+        if name is None or name.run_id is None:
+            return []
+        return self._run_files(served, name.run_id)
 
     def _check_named(
         self,

@@ -9,6 +9,9 @@ a run id of at most 19 digits within 64 bits):
   (2 to :data:`MAX_BAND_RUNS`, :data:`DEFAULT_BAND_RUNS` by default) OK runs at the station;
   ``align`` as ``inspect --overlay --align`` takes it (``start``, ``first-slip``,
   ``torque:NM``; ``start`` by default);
+- ``GET /api/runs/ST/RUN/cycle[?align=POINT]``: a multi-spindle station's run with every
+  spindle's run of its cycle overlaid, and the cycle's common result (404: a run of a
+  single-spindle station);
 - ``GET /api/runs/ST/RUN/files/NAME``: one of the run's files (its MCAP files, the
   ``.rrd`` beside one), as a download; an outside viewer's origin
   (:mod:`.viewer_links`) may read it across origins (and ask first: ``OPTIONS``).
@@ -56,6 +59,7 @@ def add_run_routes(app: web.Application, views: RunViews, links: ViewerLinks) ->
     app.router.add_get(RUN, _view)
     app.router.add_get(RUN + "/part", _part)
     app.router.add_get(RUN + "/program", _band)
+    app.router.add_get(RUN + "/cycle", _cycle)
     app.router.add_get(RUN + "/files/{name}", _file)
     app.router.add_route("OPTIONS", RUN + "/files/{name}", _preflight)
     app.router.add_route("*", "/api/runs{rest:.*}", _not_a_run)
@@ -99,6 +103,15 @@ async def _part(request: web.Request) -> web.Response:
     try:
         station, run_id = _run_of(request)
         body = await request.app[VIEWS_KEY].part(station, run_id, _alignment(request))
+    except RunRequestError as err:
+        return _refused(err)
+    return gzip_reply(request, body)
+
+
+async def _cycle(request: web.Request) -> web.Response:
+    try:
+        station, run_id = _run_of(request)
+        body = await request.app[VIEWS_KEY].cycle(station, run_id, _alignment(request))
     except RunRequestError as err:
         return _refused(err)
     return gzip_reply(request, body)
@@ -175,6 +188,6 @@ def _cross_origin(request: web.Request) -> dict[str, str]:
 async def _not_a_run(request: web.Request) -> web.Response:
     return error_reply(
         400,
-        "a run is asked as /api/runs/STATION/RUN[/part|/program|/files/NAME]: a station id "
+        "a run is asked as /api/runs/STATION/RUN[/part|/program|/cycle|/files/NAME]: a station id "
         "(letters, digits, _ and -) and a run id (digits)",
     )

@@ -23,6 +23,8 @@ The jobs, each in one worker:
 - :meth:`RunViews.part`: every tightening of the run's part overlaid (at most
   :data:`PART_RUNS`);
 - :meth:`RunViews.band`: the run against its program's last OK runs at its station;
+- :meth:`RunViews.cycle`: a multi-spindle station's run with every spindle's run of its
+  cycle overlaid (:mod:`.cycle_runs`);
 - :meth:`RunViews.located`: the run's files, for a download.
 
 Every refusal is a :class:`~.run_locator.RunRequestError` with its status and one line.
@@ -39,6 +41,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any, TypeVar
 
+from services.dashboard.cycle_runs import cycle_document, with_spindles
 from services.dashboard.json_replies import gzipped_json
 from services.dashboard.run_cache import ReadRun, RunCache
 from services.dashboard.run_locator import LocatedRun, RunLocator, RunRequestError
@@ -155,6 +158,10 @@ class RunViews:
         """The run against its program's last ``runs`` OK runs at its station (gzipped JSON)."""
         return await self._admitted(lambda: self._band(station, run_id, runs, alignment))
 
+    async def cycle(self, station: str, run_id: int, alignment: Alignment) -> bytes:
+        """Every spindle's run of the run's multi-spindle cycle overlaid (gzipped JSON)."""
+        return await self._admitted(lambda: self._cycle(station, run_id, alignment))
+
     async def located(self, station: str, run_id: int) -> LocatedRun:
         """The run's files (a download's)."""
         return await self._admitted(lambda: self.locator.locate(station, run_id))
@@ -252,6 +259,7 @@ class RunViews:
         if key not in dict(runs):
             runs.insert(0, (key, base.curves))  # the store has not got its row yet
         document = self._aligned(lambda: part_overlay_document(runs, key, alignment))
+        with_spindles(document, [run for _, run in runs])
         return gzipped_json(
             document | {"part_id": part_id, "total": len(rows), "left_out": left_out}
         )
@@ -275,6 +283,20 @@ class RunViews:
         program = {"id": result.program_id, "name": result.program_name}
         notes = left_out + [f"{n['key']}: {n['note']}" for n in document.pop("left_out")]
         return gzipped_json(document | {"program": program, "asked": count, "left_out": notes})
+
+    def _cycle(self, station: str, run_id: int, alignment: Alignment) -> bytes:
+        base = self._load(station, run_id)
+        result = base.stored.result if base.stored is not None else base.curves.result
+        if result is None or result.sync_id is None:
+            raise RunRequestError(
+                404,
+                f"run {run_id} of {station} is not a spindle's run of a multi-spindle cycle: "
+                "no cycle to overlay",
+            )
+        files, stored = base.curves.files, base.stored
+        return gzipped_json(
+            self._aligned(lambda: cycle_document(station, run_id, files, stored, alignment))
+        )
 
     def _curves(
         self, keyed: list[tuple[str, str, int]], key: str, base: ReadRun, left_out: list[str]

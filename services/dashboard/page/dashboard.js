@@ -33,6 +33,33 @@ function table(headers, rows) {
   return el("table", {}, el("tr", {}, ...headers.map((h) => el("th", {}, h))), ...rows);
 }
 
+// A multi-spindle station's rows (each with its sync_id), a cycle row above each cycle's
+// spindles: its sync id, its part, its common result with its reasons ("spindle 3 NOK
+// (torque low)"; not come yet: "no common result yet"). A single-spindle station's rows as they are.
+function cycleRow(columns, r) {
+  const c = r.cycle;
+  const verdict = c ? el("span", { class: `verdict ${c.result}` }, c.result)
+    : el("span", { class: "verdict pending" }, "no common result yet");
+  const part = r.part_id || (c && c.part_id);
+  return el("tr", { class: "cycle", "data-sync": r.sync_id, "data-cycle-result": c ? c.result : "" },
+    el("td", { colspan: String(columns) }, `cycle ${r.sync_id}${part ? ` · part ${part}` : ""} `,
+      verdict, c && c.nok_reasons ? el("span", { class: "reasons" }, ` ${c.nok_reasons}`) : ""));
+}
+
+function byCycle(rows, columns, drawRow) {
+  const drawn = [];
+  let last = null;
+  for (const r of rows) {
+    const cycle = r.sync_id === null || r.sync_id === undefined ? null : `${r.station}/${r.sync_id}`;
+    if (cycle !== null && cycle !== last) drawn.push(cycleRow(columns, r));
+    last = cycle;
+    drawn.push(drawRow(r));
+  }
+  return drawn;
+}
+
+const spindled = (rows) => rows.some((r) => r.spindle !== null && r.spindle !== undefined);
+
 function services(station) {
   const names = Object.keys(station.services);
   if (names.length === 0) return none("services: first window not closed yet");
@@ -70,10 +97,15 @@ function figures(station) {
 
 function results(station) {
   if (station.results.length === 0) return none("no result yet");
-  return table(["run", "program", "result", "torque", "angle", "preload", "when"],
-    station.results.map((r) => el("tr", { class: "result", "data-station": station.station,
-      "data-run": r.run_id, title: "show its curve" },
+  const spindles = spindled(station.results);
+  const headers = ["run", ...(spindles ? ["spindle"] : []), "program", "result", "torque", "angle",
+    "preload", "when"];
+  const rows = station.results.map((r) => ({ ...r, station: station.station }));
+  return table(headers, byCycle(rows, headers.length, (r) => el("tr", { class: "result",
+      "data-station": station.station, "data-run": r.run_id, title: "show its curve",
+      ...(spindles ? { "data-spindle": r.spindle } : {}) },
       el("td", { class: "num" }, r.run_id),
+      spindles ? el("td", { class: "num spindle" }, r.spindle === null ? "-" : r.spindle) : "",
       el("td", {}, r.program),
       el("td", {}, el("span", { class: `verdict ${r.result}` }, r.result),
         r.nok_reasons ? el("div", { class: "reasons" }, r.nok_reasons) : ""),
@@ -87,7 +119,7 @@ function stops(station) {
   if (station.stops.length === 0) return none("no run ended yet");
   return table(["run", "stop reason", "error", "events", "when"],
     station.stops.map((s) => el("tr", { class: "stop" },
-      el("td", { class: "num" }, s.run_id),
+      el("td", { class: "num" }, s.run_id, s.spindle ? ` (spindle ${s.spindle})` : ""),
       el("td", {}, s.stop_reason + (s.late_decision ? ` (late: ${s.late_decision})` : "") +
         stageText(s)),
       el("td", { class: "num" }, fixed(s.error_pct, 2, " %")),

@@ -25,16 +25,21 @@ function recording(r) {
     : where;
 }
 
+// a multi-spindle station's rows: each run's spindle after it, each cycle's common result in a
+// row above its spindles (byCycle of dashboard.js)
 function tightenings(rows) {
-  return table(["ended (UTC)", "station", "plant", "line", "run", "program", "tool", "result", "torque",
-    "angle", "preload", "stopped on", "events", "recording"],
-  rows.map((r) => el("tr", { class: "found", "data-station": r.station, "data-run": r.run_id,
-    title: "show its curve" },
+  const spindles = spindled(rows);
+  const headers = ["ended (UTC)", "station", "plant", "line", "run", ...(spindles ? ["spindle"] : []),
+    "program", "tool", "result", "torque", "angle", "preload", "stopped on", "events", "recording"];
+  return table(headers, byCycle(rows, headers.length, (r) => el("tr", { class: "found",
+    "data-station": r.station, "data-run": r.run_id, title: "show its curve",
+    ...(spindles ? { "data-spindle": r.spindle === null || r.spindle === undefined ? "" : r.spindle } : {}) },
     el("td", {}, r.ended_utc),
     el("td", {}, r.station, r.station_name ? el("div", { class: "name" }, r.station_name) : ""),
     el("td", {}, r.plant || "-"),
     el("td", {}, r.line || "-"),
     el("td", { class: "num" }, r.run_id),
+    spindles ? el("td", { class: "num spindle" }, r.spindle === null || r.spindle === undefined ? "-" : r.spindle) : "",
     el("td", { class: "program" }, `${r.program_id} ${r.program_name}`.trim()),
     el("td", { class: "num" }, r.tool_id),
     el("td", {}, el("span", { class: `verdict ${r.result}` }, r.result),

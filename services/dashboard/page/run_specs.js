@@ -98,7 +98,8 @@ function runColour(series, counts) {
   return palette[n % palette.length];
 }
 
-// a part's runs, the one shown black and on top, NOK runs in reds, each program's windows
+// a part's runs (or a multi-spindle cycle's), the one shown black and on top, NOK runs in reds,
+// each program's windows
 function partSpec(part, chart) {
   const axes = CHART_AXES[chart];
   const counts = { nok: 0, ok: 0 };
@@ -108,7 +109,7 @@ function partSpec(part, chart) {
     const y = axes.figure === "torque" ? r.torque_nm : kNs(r.force_n);
     if (!y) continue;
     lines.push({ x: r[axes.x], y, color: runColour(r, counts), width: r.reference ? 2.2 : r.verdict === "NOK" ? 1.6 : 1.1,
-      dash: r.aligned ? [] : [2, 3], label: `${r.key} ${r.verdict}${r.reference ? " (this run)" : ""}`,
+      dash: r.aligned ? [] : [2, 3], label: `${r.key}${r.spindle ? ` spindle ${r.spindle}` : ""} ${r.verdict}${r.reference ? " (this run)" : ""}`,
       main: r.reference });
   }
   const boxes = part.windows.flatMap((w, n) => windowBox(

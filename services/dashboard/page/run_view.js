@@ -1,7 +1,8 @@
 // The line's page: a run's curve, one click from any result row (the stations' last results,
 // the part search, the NOK list: a row with data-station and data-run), or #run=ST/RUN in
 // the address. Read from the run's recording on the line server (GET /api/runs/ST/RUN);
-// beside it the part's runs and the program's band (run_specs.js), drawn by run_chart.js.
+// beside it the part's runs, a multi-spindle run's cycle and the program's band (run_specs.js),
+// drawn by run_chart.js.
 // Uses el, none, table and fixed of dashboard.js. What a reply holds goes in as text only.
 "use strict";
 // one scope of its own: nothing here meets a name of dashboard.js or part_search.js
@@ -129,10 +130,20 @@ function heading(station, run, view) {
 function subtitle(view) {
   const r = view.result, stored = view.stored, parts = [];
   if (r) parts.push(`program ${r.program_id}${r.program_name ? ` ${r.program_name}` : ""}`, `tool ${r.tool_id}`);
+  if (r && r.spindle !== null && r.spindle !== undefined) parts.push(`spindle ${r.spindle} of cycle ${r.sync_id}`);
   if (r && r.part_id) parts.push(`part ${r.part_id}`);
   if (stored) parts.push(`ended ${stored.ended_utc} UTC`);
-  return el("p", { class: "figures" }, parts.join(" · "));
+  const line = el("p", { class: "figures" }, parts.join(" · "));
+  const cycle = stored && stored.cycle;
+  if (!cycle) return line;
+  // a multi-spindle cycle's run: the cycle's common result (OK only when every spindle is)
+  return el("div", {}, line, el("p", { class: "figures cycle-result" }, `cycle ${cycle.sync_id} of ${cycle.spindles} spindles: `,
+    el("span", { class: `verdict ${cycle.result}` }, cycle.result),
+    cycle.nok_reasons ? el("span", { class: "reasons" }, ` ${cycle.nok_reasons}`) : ""));
 }
+
+// a multi-spindle station's run: its cycle's spindles can be put beside it
+const inCycle = (view) => Boolean(view.result && view.result.sync_id !== null && view.result.sync_id !== undefined);
 
 function closeRun() {
   runOpens += 1;
@@ -168,6 +179,9 @@ function sideBySide(view, charts, note) {
     program: el("button", { type: "button", class: "mode", "data-mode": "program" },
       `against its program's last ${BAND_RUNS} OK runs`),
   };
+  if (inCycle(view)) {
+    buttons.cycle = el("button", { type: "button", class: "mode", "data-mode": "cycle" }, "its cycle's spindles");
+  }
   const align = el("select", { class: "align", "aria-label": "align the runs at" },
     el("option", { value: "start" }, "aligned at their start"),
     el("option", { value: "first-slip" }, "aligned at their first slip"));
@@ -183,7 +197,8 @@ function sideBySide(view, charts, note) {
     }
     runPanel.dataset.modeReady = "";
     note.append(none("reading the runs…"));
-    const path = state.mode === "part" ? `part?align=${state.align}` : `program?runs=${BAND_RUNS}&align=${state.align}`;
+    const path = state.mode === "program" ? `program?runs=${BAND_RUNS}&align=${state.align}`
+      : `${state.mode}?align=${state.align}`;
     let reply, ok;
     try {
       const response = await fetch(`${runUrl(view.station, view.run_id)}/${path}`);
@@ -199,6 +214,13 @@ function sideBySide(view, charts, note) {
       drawAll(charts, (name) => partSpec(reply, name));
       note.append(el("p", { class: "figures part-summary" }, `${reply.runs.length} runs of part ${reply.part_id}` +
         `, aligned at the ${reply.alignment}`));
+    } else if (state.mode === "cycle") {
+      drawAll(charts, (name) => partSpec(reply, name));
+      const c = reply.cycle;
+      note.append(el("p", { class: "figures cycle-summary" },
+        `${reply.runs.length} spindles of cycle ${view.result.sync_id}, aligned at the ${reply.alignment}; the cycle: `,
+        c ? el("span", { class: `verdict ${c.result}` }, c.result) : "its common result not stored yet",
+        c && c.nok_reasons ? el("span", { class: "reasons" }, ` ${c.nok_reasons}`) : ""));
     } else {
       drawAll(charts, (name) => bandSpec(view, reply, name));
       note.append(el("p", { class: "figures band-summary" }, `the band of ${reply.runs.length} OK runs of program ` +

@@ -10,9 +10,18 @@ import pytest
 from services.dashboard import line_board
 from services.dashboard.line_board import HISTORY, LineBoard, StationSetting
 from shared.config import StationPlace
-from shared.contract import QualityAlert, QualityFigure, WearAlert, channels, encode, keys
+from shared.contract import (
+    QualityAlert,
+    QualityFigure,
+    TighteningResult,
+    WearAlert,
+    channels,
+    encode,
+    keys,
+)
 from shared.errors import InputError
-from tests.support.factories import T0, S, summary
+from shared.quality import cycle_result
+from tests.support.factories import T0, S, result, summary
 
 
 def board() -> LineBoard:
@@ -146,3 +155,52 @@ def test_quality_alerts_show_in_words_one_per_figure_the_latest_word_kept() -> N
         ),
         ("quality/alert", "cpk_low: program 1: torque Cpk 0.9 below 1.33 over the last 50 runs"),
     ]
+
+
+def spindle_result(cycle: int, spindle: int, nok: bool = False) -> TighteningResult:
+    return result(
+        5000 + cycle * 10 + spindle,
+        spindle=spindle,
+        sync_id=7000 + cycle,
+        part_id=f"P{cycle}",
+        time_ns=T0 + cycle * S + spindle,
+        result="NOK" if nok else "OK",
+        nok_reasons="torque low" if nok else "",
+    )
+
+
+def test_a_multi_spindle_station_s_results_say_their_spindle_cycle_and_common_result() -> None:
+    line = board()
+    came = {k: spindle_result(0, k, nok=k == 3) for k in range(1, 5)}
+    for spindle_run in came.values():
+        assert put(line, channels.RESULTS.topic, spindle_run)
+    shown = station(line)["results"]
+    assert [(r["run_id"], r["spindle"], r["sync_id"]) for r in shown] == [
+        (5000 + k, k, 7000) for k in (4, 3, 2, 1)
+    ]
+    assert {r["cycle"] for r in shown} == {None}  # its common result has not come yet
+    assert put(line, channels.CYCLES.topic, cycle_result("st1", 7000, 4, came))
+    common = {
+        "sync_id": 7000,
+        "spindles": 4,
+        "result": "NOK",
+        "nok_reasons": "spindle 3 NOK (torque low)",
+        "part_id": "P0",
+    }
+    assert [r["cycle"] for r in station(line)["results"]] == [common] * 4
+    # the last HISTORY cycles of every spindle, not the last HISTORY spindles' runs
+    for cycle in range(1, HISTORY + 2):
+        for k in range(1, 5):
+            put(line, channels.RESULTS.topic, spindle_result(cycle, k))
+    shown = station(line)["results"]
+    assert len(shown) == HISTORY * 4
+    assert {r["sync_id"] for r in shown} == set(range(7002, 7002 + HISTORY))
+
+
+def test_a_single_spindle_station_s_results_and_stops_say_no_spindle() -> None:
+    line = board()
+    assert put(line, channels.RESULTS.topic, result(1, part_id="P1"))
+    assert put(line, channels.RUNS.topic, summary(1))
+    (shown,) = station(line)["results"]
+    (stop,) = station(line)["stops"]
+    assert not {"spindle", "sync_id", "cycle"} & (set(shown) | set(stop))
