@@ -43,6 +43,7 @@ from services.opcua.result_values import (
     EVALUATION_OK,
     JOINING_TECHNOLOGY,
     RESULT_STATE_COMPLETED,
+    parse_id,
     result_id,
     spindle_counters,
     utc_time,
@@ -58,6 +59,14 @@ COUNTER_TOTAL_NUMBER_OF_SPINDLES = 9
 def cycle_result_id(station: str, sync_id: int) -> str:
     """The ResultId of a station's cycle (no tightening's: see :func:`.result_values.result_id`)."""
     return f"{station}/cycle/{sync_id}"
+
+
+def parse_cycle_result_id(text: str) -> tuple[str, int] | None:
+    """The station and sync id of the ResultId ``text`` (what :func:`cycle_result_id`
+    gives); None for a text it never gives."""
+    station, _, sync = text.rpartition("/cycle/")
+    sync_id = parse_id(sync)
+    return None if not station or sync_id is None else (station, sync_id)
 
 
 def _evaluation(verdict: str | None) -> int:

@@ -8,7 +8,8 @@ the first run receives, per cycle, each spindle's result (a SINGLE_RESULT whose
 ``ResultCounters`` give its SPINDLE_NUMBER) and the cycle's own result: Classification
 SYNC_RESULT, TOTAL_NUMBER_OF_SPINDLES 2, evaluation OK exactly when every spindle's is, and
 in its ``ResultContent`` a reference to each spindle's result (its ResultId, evaluation and
-spindle number), the same results the results store holds.
+spindle number), the same results the results store holds; GetResultById of the cycle's
+ResultId gives the same result from the results store.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from asyncua.crypto.uacrypto import CertProperties
 from services.opcua.cycle_values import cycle_result_id
 from services.opcua.joining_systems import BOLTWATCH_NAMESPACE
 from services.opcua.nodeset_files import missing_files, nodeset_folder
-from services.opcua.nodeset_loading import load_models, node_id
+from services.opcua.nodeset_loading import MACHINERY_RESULT, load_models, node_id
 from services.opcua.password_hashes import hash_password
 from services.opcua.result_values import result_id
 from services.opcua.users_file import OPERATOR, OpcuaUser, write_users
@@ -60,7 +61,8 @@ async def _references(
     endpoint: str, certificates: OpcuaCertificates, cycles: list[str]
 ) -> dict[str, list[tuple[str, int, int, list[tuple[int, int]]]]]:
     """Each cycle's references as asyncua's client reads them from the Results folder
-    (ResultId, Classification, ResultEvaluation, counters), decoded with the models' classes
+    (ResultId, Classification, ResultEvaluation, counters; GetResultById gives the same
+    result from the results store), decoded with the models' classes
     (the classes asyncua's client builds from the server's DataTypeDefinitions misread it:
     NotEnoughData); node-opcua 2.186 cannot decode a JoiningResultMetaDataType with
     ResultCounters (docs/how-to/opcua.md, interoperability note)."""
@@ -82,9 +84,17 @@ async def _references(
     await load_models(models, nodeset_folder())
     async with client:
         ours = await client.get_namespace_index(BOLTWATCH_NAMESPACE)
+        result_ns = await client.get_namespace_index(MACHINERY_RESULT)
+        management = await client.get_node(node_id("st1", ours)).get_child(
+            f"{result_ns}:ResultManagement"
+        )
         for identifier in cycles:
             node = client.get_node(node_id(f"st1/results/{identifier}", ours))
             value = await node.read_value()
+            _handle, by_id, error = await management.call_method(
+                f"{result_ns}:GetResultById", identifier, ua.Variant(0, ua.VariantType.Int32)
+            )
+            assert error == 0 and by_id == value  # from the results store: the same
             found[identifier] = [
                 (
                     ref.Value.ResultMetaData.ResultId,
