@@ -24,6 +24,8 @@ The address space is built from the OPC Foundation's NodeSet2 files (IJT Base
   :mod:`.event_filter` (a client's EventFilter on an event, pure),
   :mod:`.event_contents` (the fields of the server's events, pure)
 - :mod:`.result_values` (a TighteningResult as IJT field values, pure),
+  :mod:`.cycle_values` (a multi-spindle cycle's CycleResult as an IJT sync result
+  referring to its spindles' results, pure),
   :mod:`.result_trace` (its run's samples from the recording as an IJT trace),
   :mod:`.result_encoding` (those values as asyncua's classes)
 - :mod:`.result_requests` (ResultManagement's methods from the results store:

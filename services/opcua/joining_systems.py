@@ -71,6 +71,11 @@ def result_browse_name(run_id: int) -> str:
     return f"Result_{run_id}"
 
 
+def cycle_browse_name(sync_id: int) -> str:
+    """The browse name of a multi-spindle cycle's common result in the Results folder."""
+    return f"Cycle_{sync_id}"
+
+
 class JoiningSystem:
     """A station's joining system in the address space; its events through ``delivery``."""
 
@@ -118,13 +123,14 @@ class JoiningSystem:
         _ours, _ijt, result_ns = self._names
         return await self.node.get_child([f"{result_ns}:ResultManagement", f"{result_ns}:{name}"])
 
-    async def publish(self, result_id: str, run_id: int, result: Any, message: str) -> None:
-        """``result`` (a ``ua.ResultDataType``) into Results, then the result-ready event."""
+    async def publish(self, result_id: str, browse_name: str, result: Any, message: str) -> None:
+        """``result`` (a ``ua.ResultDataType``) into Results as ``browse_name``
+        (:func:`result_browse_name`, :func:`cycle_browse_name`), then the result-ready event."""
         ours, ijt, result_ns = self._names
         variable = await add_typed_variable(
             self._results,
             node_id(f"{self.station}/results/{result_id}", ours),
-            ua.QualifiedName(result_browse_name(run_id), ours),
+            ua.QualifiedName(browse_name, ours),
             ua.Variant(result, ua.VariantType.ExtensionObject),
             node_id(RESULT_DATA_TYPE, result_ns),
             node_id(JOINING_SYSTEM_RESULT_TYPE, ijt),

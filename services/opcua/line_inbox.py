@@ -2,7 +2,8 @@
 
 A subscriber per station and channel (never a wildcard over stations: another
 station's messages are not this server's): ``boltwatch/<st>/results``
-(:class:`~shared.contract.TighteningResult`), ``wear/alert``, ``quality/alert``
+(:class:`~shared.contract.TighteningResult`), ``cycles`` (a multi-spindle
+station's :class:`~shared.contract.CycleResult`), ``wear/alert``, ``quality/alert``
 (the recorder's) and ``alarms`` (a controller bridge's). Each decoded message
 goes into a thread-safe queue (zenoh calls back on its own threads); the loop
 takes them with :meth:`LineInbox.next`. A payload that does not decode, or
@@ -21,6 +22,7 @@ import zenoh
 
 from shared.contract import (
     ControllerAlarm,
+    CycleResult,
     QualityAlert,
     TighteningResult,
     WearAlert,
@@ -33,11 +35,17 @@ from shared.runtime import RateLimitedLog, ServiceSkeleton
 
 LOG = logging.getLogger(__name__)
 
-LineMessage = TighteningResult | WearAlert | QualityAlert | ControllerAlarm
+LineMessage = TighteningResult | CycleResult | WearAlert | QualityAlert | ControllerAlarm
 #: the channels heard, by topic
 CHANNELS: dict[str, channels.Channel[Any]] = {
     channel.topic: channel
-    for channel in (channels.RESULTS, channels.WEAR_ALERT, channels.QUALITY_ALERT, channels.ALARMS)
+    for channel in (
+        channels.RESULTS,
+        channels.CYCLES,
+        channels.WEAR_ALERT,
+        channels.QUALITY_ALERT,
+        channels.ALARMS,
+    )
 }
 
 

@@ -28,27 +28,43 @@ LOCALIZED = frozenset({"JoiningTechnology", "Description", "ResultEvaluationDeta
 
 def result_data(values: dict[str, Any]) -> Any:
     """A ``ua.ResultDataType`` (Machinery/Result) of ``values``: its ResultMetaData a
-    ``JoiningResultMetaDataType``, its ResultContent one ``JoiningResultDataType``."""
+    ``JoiningResultMetaDataType``, its ResultContent one ``JoiningResultDataType`` (a
+    tightening's) or a ``ResultDataType`` per sub-result it refers to (a cycle's:
+    :mod:`.cycle_values`)."""
     meta = dict(values["ResultMetaData"])
-    extended = meta.pop("ExtendedMetaData", {})
     for name in LOCALIZED & meta.keys():
         meta[name] = ua.LocalizedText(meta[name])
-    meta["ExtendedMetaData"] = [  # IJT's KeyValueDataType: a TrimmedString key
-        model_class("KeyValueDataType")(Key=key, Value=ua.Variant(text, ua.VariantType.String))
-        for key, text in extended.items()
-    ]
+    if "ExtendedMetaData" in meta:  # IJT's KeyValueDataType: a TrimmedString key
+        meta["ExtendedMetaData"] = [
+            model_class("KeyValueDataType")(Key=key, Value=ua.Variant(text, ua.VariantType.String))
+            for key, text in meta["ExtendedMetaData"].items()
+        ]
     for name in ("SequenceNumber",):
         if name in meta:
             meta[name] = ua.UInt64(meta[name])
     for name in ("Classification",):
         if name in meta:
             meta[name] = ua.Byte(meta[name])
+    if "ResultCounters" in meta:
+        meta["ResultCounters"] = [_counter(counter) for counter in meta["ResultCounters"]]
     content = [
-        ua.Variant(_joining_result(joining), ua.VariantType.ExtensionObject)
-        for joining in values["ResultContent"]
+        ua.Variant(
+            result_data(item) if "ResultMetaData" in item else _joining_result(item),
+            ua.VariantType.ExtensionObject,
+        )
+        for item in values["ResultContent"]
     ]
     return model_class("ResultDataType")(
         ResultMetaData=model_class("JoiningResultMetaDataType")(**meta), ResultContent=content
+    )
+
+
+def _counter(fields: dict[str, Any]) -> Any:
+    """A ``ResultCounterDataType`` (IJT Base, 10.11)."""
+    return model_class("ResultCounterDataType")(
+        Name=fields["Name"],
+        CounterValue=ua.UInt32(fields["CounterValue"]),
+        CounterType=ua.Int16(fields["CounterType"]),
     )
 
 

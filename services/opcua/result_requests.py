@@ -14,7 +14,9 @@ this way gets the result's trace (the event and the folder carry no curves):
   recorder still writes it, its flushed part under the writing name) as
   ``Trace``. The recording gone, or not on this machine (another host's path), or
   no samples of the run in it: the result without ``Trace``, and
-  ``ExtendedMetaData`` ``TraceMissing`` says why.
+  ``ExtendedMetaData`` ``TraceMissing`` says why. A multi-spindle cycle's ResultId
+  ``<station>/cycle/<sync id>``: its common result from the store's cycles (the
+  sync result of :mod:`.cycle_values`, referring to its spindles' results).
 - ``GetLatestResult(Timeout)``: the same of the station's newest result in the
   store (the newest end of a run), trace included (the method has no argument to
   leave it out, and a client of this method alone has no other way to the curves).
@@ -46,6 +48,7 @@ from typing import Any
 from asyncua import ua
 from asyncua.ua.ua_binary import struct_from_binary
 
+from services.opcua.cycle_values import cycle_values, parse_cycle_result_id
 from services.opcua.result_encoding import result_data
 from services.opcua.result_filter import UnsupportedFilterError, filtered_query
 from services.opcua.result_trace import recorded_samples, trace_values
@@ -108,9 +111,30 @@ def result_with_trace(stored: StoredResult) -> dict[str, Any]:
 
 
 def result_by_id(target: StoreTarget, station: str, identifier: str) -> list[ua.Variant]:
-    """GetResultById's output arguments (ResultHandle, Result, Error) for ``identifier``."""
+    """GetResultById's output arguments (ResultHandle, Result, Error) for ``identifier``
+    (a tightening's or a multi-spindle cycle's)."""
+    cycle = parse_cycle_result_id(identifier)
+    if cycle is not None:
+        return _cycle_result(target, station, cycle, f"GetResultById {identifier}")
     query = _id_query(station, identifier)
     return _one_result(target, query, f"GetResultById {identifier}")
+
+
+def _cycle_result(
+    target: StoreTarget, station: str, cycle: tuple[str, int], asked: str
+) -> list[ua.Variant]:
+    """(ResultHandle, Result, Error) of a cycle's common result (:mod:`.cycle_values`)."""
+    if cycle[0] != station:
+        return _result_outputs(None, ERROR_UNKNOWN_RESULT)
+    try:
+        with ResultsStore(target, create=False, application=APPLICATION) as store:
+            found = store.cycle(station, cycle[1])
+    except StoreError as err:
+        LOG.warning("%s: %s", asked, err)
+        return _result_outputs(None, ERROR_STORE)
+    if found is None:
+        return _result_outputs(None, ERROR_UNKNOWN_RESULT)
+    return _result_outputs(result_data(cycle_values(found)), 0)
 
 
 def latest_result(target: StoreTarget, station: str) -> list[ua.Variant]:

@@ -42,6 +42,12 @@ a trace (:mod:`.result_trace`)  ``Trace`` (a ``JoiningTraceDataType``): only in 
                                 result asked by id, never in the event
 ==============================  ==================================================
 
+A multi-spindle station's tightening (``spindle`` set) is a single result too, with
+its spindle in ``ResultCounters`` (a ``ResultCounterDataType`` of ``CounterType``
+SPINDLE_NUMBER, 7) and its cycle's ``sync_id`` as ``ExtendedMetaData`` ``SyncId``;
+the cycle's common result is a result of its own (:mod:`.cycle_values`). A
+single-spindle station's result has neither.
+
 ``Classification`` is 1 (a single result) and ``ResultState`` 1 (completed): a
 run that the tool aborted is still a completed result, NOK.
 """
@@ -57,6 +63,9 @@ from shared.contract import INT64_MAX, JudgedFigure, ResultStep, TighteningResul
 
 #: JoiningResultMetaDataType.Classification of one tightening's result
 CLASSIFICATION_SINGLE = 1
+#: ResultCounterDataType.CounterType (OPC 40450-1, 10.11): the spindle's number in a
+#: fixtured system of several spindles
+COUNTER_SPINDLE_NUMBER = 7
 #: ResultMetaDataType.ResultState: processing was carried out completely
 RESULT_STATE_COMPLETED = 1
 #: ResultEvaluationEnum (Machinery/Result)
@@ -146,6 +155,11 @@ def parse_result_id(text: str) -> tuple[str, int] | None:
     return None if not station or run_id is None else (station, run_id)
 
 
+def spindle_counters(spindle: int) -> list[dict[str, Any]]:
+    """The ``ResultCounters`` of a spindle's result: its SPINDLE_NUMBER."""
+    return [{"Name": "Spindle", "CounterValue": spindle, "CounterType": COUNTER_SPINDLE_NUMBER}]
+
+
 def result_values(result: TighteningResult, trace: dict[str, Any] | None = None) -> dict[str, Any]:
     """``{"ResultMetaData": {...}, "ResultContent": [{"OverallResultValues": [...], ...}]}``;
     ``trace``: the fields of its ``JoiningTraceDataType`` (:func:`.result_trace.trace_values`)."""
@@ -169,6 +183,10 @@ def result_values(result: TighteningResult, trace: dict[str, Any] | None = None)
     }
     if result.part_id is not None:
         meta["PartId"] = result.part_id
+    if result.spindle is not None:  # a multi-spindle station's: its spindle, and its cycle
+        meta["ResultCounters"] = spindle_counters(result.spindle)
+    if result.sync_id is not None:
+        extended["SyncId"] = str(result.sync_id)
     if result.program_name:
         meta["Name"] = result.program_name
     if result.nok_reasons:

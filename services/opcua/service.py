@@ -10,7 +10,9 @@ joining system per station (:mod:`.joining_systems`) with its conditions
 (:mod:`.alert_conditions`), then each result into it. Once the OPC UA
 server listens, the zenoh session is opened (clients may connect and subscribe
 before the line's router is there); then results come from
-``boltwatch/<st>/results`` (:class:`~.line_inbox.LineInbox`, with the alerts and
+``boltwatch/<st>/results`` (:class:`~.line_inbox.LineInbox`; a multi-spindle
+station's cycles' common results from ``boltwatch/<st>/cycles``, each an IJT sync
+result of its own: :mod:`.cycle_values`; with the alerts and
 alarms, which become the conditions' states: :mod:`.alert_events`; a tool's wear
 condition goes off when its wear ledger shows it serviced) and, once
 subscribed, the newest :data:`STARTUP_RESULTS` per station from the stations'
@@ -42,8 +44,9 @@ from services.opcua.alert_conditions import ConditionMethods, StationConditions
 from services.opcua.alert_events import alert_event, wear_cleared
 from services.opcua.controller_assets import ControllerAsset
 from services.opcua.controller_values import ControllerIdentity, controller_identity
+from services.opcua.cycle_values import cycle_result_id, cycle_values
 from services.opcua.event_delivery import EventDelivery
-from services.opcua.joining_systems import JoiningSystem
+from services.opcua.joining_systems import JoiningSystem, cycle_browse_name, result_browse_name
 from services.opcua.line_inbox import LineInbox
 from services.opcua.nodeset_files import nodeset_folder
 from services.opcua.nodeset_loading import MACHINERY_RESULT, load_models
@@ -55,7 +58,7 @@ from services.opcua.system_identification import system_identification
 from services.opcua.tool_assets import ToolAssets
 from services.opcua.tool_values import ToolCounters, tool_counters
 from shared.config import AnyStation, ControllerStation, load_any_line
-from shared.contract import AlertAck, TighteningResult, channels, encode
+from shared.contract import AlertAck, CycleResult, TighteningResult, channels, encode
 from shared.errors import InputError, StoreError
 from shared.recordings import software_version
 from shared.results import ResultsQuery, ResultsStore, station_store
@@ -159,6 +162,8 @@ class OpcuaService:
                     await asyncio.sleep(POLL_S)
                 elif isinstance(message, TighteningResult):
                     await self._publish(systems, message)
+                elif isinstance(message, CycleResult):
+                    await self._publish_cycle(systems, message)
                 else:
                     alert = alert_event(message)
                     await conditions[alert.station].report(alert)
@@ -174,8 +179,25 @@ class OpcuaService:
             return
         served.add(identifier)
         message = f"{identifier} {result.result}"
-        await system.publish(identifier, result.run_id, result_data(result_values(result)), message)
+        values = result_data(result_values(result))
+        await system.publish(identifier, result_browse_name(result.run_id), values, message)
         LOG.info("result %s served", message)
+
+    async def _publish_cycle(self, systems: dict[str, JoiningSystem], cycle: CycleResult) -> None:
+        """A multi-spindle cycle's common result: an IJT sync result of its own, referring to
+        its spindles' results (:mod:`.cycle_values`)."""
+        system = systems.get(cycle.station)
+        if system is None:
+            return
+        identifier = cycle_result_id(cycle.station, cycle.sync_id)
+        served = self._served[cycle.station]
+        if identifier in served:
+            return
+        served.add(identifier)
+        message = f"{identifier} {cycle.result}"
+        values = result_data(cycle_values(cycle))
+        await system.publish(identifier, cycle_browse_name(cycle.sync_id), values, message)
+        LOG.info("cycle result %s served", message)
 
     async def _record(self, ack: AlertAck) -> None:
         """An acknowledgement (confirmation, comment) of an alert: logged, and put on the line

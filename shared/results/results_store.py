@@ -44,6 +44,7 @@ from shared.results.stored_result import (
     from_row,
     step_of,
     step_rows,
+    stored_cycle,
     to_row,
 )
 
@@ -308,6 +309,23 @@ class ResultsStore:
                     )
                     found.update({(station, int(row[0])): row[1] for row in rows})
         return found
+
+    def cycle(self, station: str, sync_id: int) -> CycleResult | None:
+        """The common result of ``station``'s multi-spindle cycle ``sync_id`` (the newest
+        cycle of that sync id), each spindle with its run's verdict; None: none stored."""
+        rows = self.database.rows(
+            "SELECT run_id, spindle, spindles, result, nok_reasons, ended_ns, part_id, "
+            "program_id, source FROM cycle_results WHERE station = ? AND sync_id = ? "
+            "ORDER BY ended_ns DESC, spindle",
+            [station, sync_id],
+        )
+        if not rows:
+            return None
+        newest = [row for row in rows if row[5] == rows[0][5]]
+        verdicts = self.verdicts([(station, int(row[0])) for row in newest])
+        return stored_cycle(
+            station, sync_id, newest, {run: verdict for (_, run), verdict in verdicts.items()}
+        )
 
     def _cycles_of(self, keys: list[tuple[Any, Any]]) -> dict[tuple[str, int], RunCycle]:
         """The multi-spindle cycle of each of ``keys`` ((station, run_id) pairs) stored."""

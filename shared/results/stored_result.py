@@ -21,6 +21,7 @@ from typing import Any
 
 from shared.contract import (
     CycleResult,
+    CycleSpindle,
     JudgedFigure,
     ResultStep,
     RunSummary,
@@ -157,6 +158,36 @@ def cycle_rows(cycle: CycleResult, stored_ns: int) -> list[tuple[Any, ...]]:
         for spindle in cycle.spindles
         if spindle.run_id is not None
     ]  # fmt: skip
+
+
+def stored_cycle(
+    station: str, sync_id: int, rows: Sequence[Sequence[Any]], verdicts: dict[int, str]
+) -> CycleResult:
+    """The CycleResult of one cycle's ``cycle_results`` rows (run_id, spindle, spindles,
+    result, nok_reasons, ended_ns, part_id, program_id, source), as :func:`cycle_rows` made
+    them; ``verdicts``: each stored run's result (a spindle's run not stored: its verdict
+    None unless the cycle is OK, which every spindle then is)."""
+    first = rows[0]
+    runs = {int(row[1]): int(row[0]) for row in rows}
+    spindles = []
+    for spindle in range(1, max(int(first[2]), *runs) + 1):
+        run_id = runs.get(spindle)
+        stored = None if run_id is None else verdicts.get(run_id)
+        verdict: Verdict | None = "OK" if stored == "OK" else "NOK" if stored == "NOK" else None
+        if run_id is not None and verdict is None and first[3] == "OK":
+            verdict = "OK"
+        spindles.append(CycleSpindle(spindle, run_id, verdict))
+    return CycleResult(
+        station=station,
+        sync_id=sync_id,
+        time_ns=int(first[5]),
+        part_id=first[6],
+        program_id=int(first[7]),
+        result=first[3],
+        nok_reasons=first[4],
+        source=first[8],
+        spindles=spindles,
+    )
 
 
 def cycle_of(row: Sequence[Any]) -> RunCycle:

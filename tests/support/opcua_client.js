@@ -11,9 +11,9 @@
 // system (Objects/Machines/<station>); {"type": "subscribed"} once it subscribed to the
 // events of the Server object (i=2253), as SCADA systems do, with no where clause; one
 // {"type": "result", "station", "eventType", "message", "resultIdField",
-// "evaluationField", "result"} per result-ready event (the Result field as JSON, and its
-// sub-fields Result/ResultMetaData/ResultId and .../ResultEvaluation selected on their
-// own), {"type": "event", "station", "eventType", "message", "conditionId",
+// "evaluationField", "classificationField", "countersField", "result"} per result-ready
+// event (the Result field as JSON, and its sub-fields Result/ResultMetaData/ResultId,
+// .../ResultEvaluation, .../Classification and .../ResultCounters selected on their own), {"type": "event", "station", "eventType", "message", "conditionId",
 // "conditionName", "retain", "acked", "code", "severity"} per other event (a condition's);
 // it waits for "results" result events. With "acknowledge": {"conditionName", "comment"},
 // a SCADA's handling of that condition (opcua_alarms.js: acknowledged, then confirmed) and
@@ -103,6 +103,8 @@ async function main() {
         "AckedState.Id",
         `${ijt}:JoiningSystemEventContent.${ijt}:EventCode`,
         "Severity",
+        `${result}:Result.${result}:ResultMetaData.${ijt}:Classification`,
+        `${result}:Result.${result}:ResultMetaData.${ijt}:ResultCounters`,
     ]);
     const systems = {};
     const firstResultId = {};
@@ -127,6 +129,7 @@ async function main() {
     item.on("changed", (fields) => {
         const [eventType, sourceName, message, value, resultIdField, evaluationField] = fields;
         const [conditionId, conditionName, retain, acked, code, severity] = fields.slice(6);
+        const [classificationField, countersField] = fields.slice(12);
         const station = sourceName.value;
         const typeId = eventType.value ? eventType.value.toString() : null;
         if (typeId !== resultReady) {
@@ -153,6 +156,8 @@ async function main() {
             message: message.value ? message.value.text : null,
             resultIdField: resultIdField.value,
             evaluationField: evaluationField.value,
+            classificationField: classificationField.value,
+            countersField: plain(countersField.value),
             result: plain(value.value),
         });
         received += 1;

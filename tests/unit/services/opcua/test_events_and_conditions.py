@@ -29,7 +29,7 @@ from services.opcua.alert_conditions import ConditionMethods, StationConditions
 from services.opcua.alert_events import alert_event, wear_cleared
 from services.opcua.client_sessions import use_client_sessions
 from services.opcua.event_delivery import EventDelivery
-from services.opcua.joining_systems import JoiningSystem
+from services.opcua.joining_systems import JoiningSystem, result_browse_name
 from services.opcua.nodeset_files import missing_files, nodeset_folder
 from services.opcua.nodeset_loading import (
     IJT_BASE,
@@ -190,7 +190,10 @@ async def _until(received: _Received, count: int) -> list[list[Any]]:
 def _result(served: Served, station: str, run_id: int, verdict: str = "OK") -> Any:
     result = factories.result(run_id, station=station, result=verdict)
     return served.systems[station].publish(
-        f"{station}/{run_id}", run_id, result_data(result_values(result)), f"{station}/{run_id}"
+        f"{station}/{run_id}",
+        result_browse_name(run_id),
+        result_data(result_values(result)),
+        f"{station}/{run_id}",
     )
 
 

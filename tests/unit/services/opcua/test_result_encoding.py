@@ -15,8 +15,9 @@ from asyncua.ua.ua_binary import struct_from_binary, struct_to_binary
 
 from services.opcua.alert_conditions import ConditionMethods, StationConditions
 from services.opcua.alert_events import alert_event
+from services.opcua.cycle_values import cycle_values
 from services.opcua.event_delivery import EventDelivery
-from services.opcua.joining_systems import JoiningSystem
+from services.opcua.joining_systems import JoiningSystem, result_browse_name
 from services.opcua.nodeset_files import missing_files, nodeset_folder
 from services.opcua.nodeset_loading import load_models, node_id
 from services.opcua.result_encoding import model_class, result_data
@@ -24,6 +25,7 @@ from services.opcua.result_values import result_values
 from services.opcua.tool_assets import ToolAssets
 from services.opcua.tool_values import tool_counters
 from shared.contract import AlertAck, ControllerAlarm
+from shared.quality.cycle_result import cycle_result
 from shared.wear import ToolWear
 from tests.support import factories
 
@@ -113,7 +115,7 @@ def test_the_models_load_and_a_result_round_trips_with_its_joining_metadata() ->
         )
         delivery = await EventDelivery.create(server)
         system = await JoiningSystem.create(server, "st1", delivery)
-        await system.publish("st1/7", 7, data, "st1/7 OK")
+        await system.publish("st1/7", result_browse_name(7), data, "st1/7 OK")
         names = [(await node.read_browse_name()).Name for node in await system.node.get_children()]
         tools.update(await _tools_of(server, system))
         alarms.extend(await _alarm_events(server, system, delivery))
@@ -160,3 +162,47 @@ def test_the_models_load_and_a_result_round_trips_with_its_joining_metadata() ->
         20053,
     )
     assert "ResultManagement" in names and "AssetManagement" in names
+
+
+def _round_trip(data: Any) -> Any:
+    return struct_from_binary(
+        model_class("ResultDataType"), ua.utils.Buffer(struct_to_binary(data))
+    )
+
+
+def test_a_cycle_s_sync_result_round_trips_with_references_to_its_spindles_results() -> None:
+    spindles = {
+        n: factories.result(30 + n, spindle=n, sync_id=9, result=verdict)
+        for n, verdict in ((1, "OK"), (2, "NOK"))
+    }
+
+    async def scenario() -> tuple[Any, Any]:
+        await _loaded()  # the models' classes
+        cycle = _round_trip(result_data(cycle_values(cycle_result("st1", 9, 2, spindles))))
+        spindle = _round_trip(result_data(result_values(spindles[2])))
+        return cycle, spindle
+
+    cycle, spindle = asyncio.run(scenario())
+    meta = cycle.ResultMetaData
+    assert type(meta).__name__ == "JoiningResultMetaDataType"
+    assert (meta.ResultId, meta.Classification, meta.SequenceNumber) == ("st1/cycle/9", 2, 9)
+    assert meta.ResultEvaluation == 2 and meta.ResultEvaluationDetails.Text == "spindle 2 NOK"
+    [total] = meta.ResultCounters
+    assert (total.CounterType, total.CounterValue) == (9, 2)  # TOTAL_NUMBER_OF_SPINDLES
+    references = [item.Value for item in cycle.ResultContent]
+    assert [type(ref).__name__ for ref in references] == ["ResultDataType"] * 2
+    assert [
+        (
+            ref.ResultMetaData.ResultId,
+            ref.ResultMetaData.Classification,
+            ref.ResultMetaData.ResultEvaluation,
+            [(c.CounterType, c.CounterValue) for c in ref.ResultMetaData.ResultCounters],
+            ref.ResultContent,
+        )
+        for ref in references
+    ] == [("st1/31", 1, 1, [(7, 1)], []), ("st1/32", 1, 2, [(7, 2)], [])]
+    [counter] = spindle.ResultMetaData.ResultCounters  # the spindle's own result names it
+    assert (counter.Name, counter.CounterType, counter.CounterValue) == ("Spindle", 7, 2)
+    assert {pair.Key: pair.Value.Value for pair in spindle.ResultMetaData.ExtendedMetaData}[
+        "SyncId"
+    ] == "9"

@@ -24,6 +24,7 @@ from services.opcua.result_requests import ERROR_UNKNOWN_RESULT, result_by_id
 from services.opcua.result_trace import trace_values
 from services.opcua.result_values import MILLISECOND, QUANTITY_FORCE, QUANTITY_TIME
 from shared.contract import ResultStep, encode
+from shared.quality.cycle_result import cycle_result
 from shared.recordings import classify
 from shared.recordings.mcap import McapSink
 from shared.results import ResultsStore, store_target, stored_result
@@ -161,3 +162,29 @@ def test_a_recording_still_written_gives_what_was_flushed(tmp_path: Path, models
     assert error == 0
     [step] = result.ResultContent[0].Value.Trace.StepTraces
     assert step.NumberOfTracePoints == SAMPLES
+
+
+def test_a_cycle_asked_by_id_is_its_sync_result_from_the_store(
+    tmp_path: Path, models: None
+) -> None:
+    target = store_target(tmp_path, None)
+    spindles = {
+        n: factories.result(40 + n, spindle=n, sync_id=5, result=verdict, part_id="VIN-5")
+        for n, verdict in ((1, "OK"), (2, "NOK"))
+    }
+    with ResultsStore(target) as store:
+        store.add([stored_result(result, "", None, "h", 1) for result in spindles.values()])
+        store.add_cycles([cycle_result("st1", 5, 3, spindles)], 2)  # spindle 3 never came
+    result, error = _asked(target, "st1/cycle/5")
+    assert error == 0
+    meta = result.ResultMetaData
+    assert (meta.ResultId, meta.Classification, meta.ResultEvaluation) == ("st1/cycle/5", 2, 2)
+    assert meta.ResultEvaluationDetails.Text == "spindle 2 NOK; spindle 3 no result"
+    assert meta.PartId == "VIN-5"
+    assert [(c.CounterType, c.CounterValue) for c in meta.ResultCounters] == [(9, 3)]
+    assert [
+        (ref.Value.ResultMetaData.ResultId, ref.Value.ResultMetaData.ResultEvaluation)
+        for ref in result.ResultContent
+    ] == [("st1/41", 1), ("st1/42", 2)]
+    assert _asked(target, "st1/cycle/6") == (None, ERROR_UNKNOWN_RESULT)
+    assert _asked(target, "st2/cycle/5") == (None, ERROR_UNKNOWN_RESULT)  # another station's

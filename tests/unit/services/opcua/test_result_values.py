@@ -82,3 +82,15 @@ def test_a_result_id_reads_back_and_no_other_text_is_one() -> None:
         assert parse_result_id(text) is None, text
     assert parse_result_id(f"st1/{INT64_MAX + 1}") is None
     assert parse_result_id("st1/" + "1" * 5000) is None  # more digits than int() reads
+
+
+def test_a_spindle_s_result_names_its_spindle_and_a_single_spindle_s_has_no_counters() -> None:
+    spindle = result_values(factories.result(42, spindle=3, sync_id=17))["ResultMetaData"]
+    assert spindle["ResultCounters"] == [
+        {"Name": "Spindle", "CounterValue": 3, "CounterType": 7}  # SPINDLE_NUMBER
+    ]
+    assert spindle["ExtendedMetaData"]["SyncId"] == "17"
+    assert spindle["Classification"] == 1  # a spindle's result is a single result
+    single = result_values(factories.result(42))["ResultMetaData"]
+    assert "ResultCounters" not in single
+    assert "SyncId" not in single["ExtendedMetaData"]

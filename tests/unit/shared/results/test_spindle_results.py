@@ -197,3 +197,26 @@ def test_a_cycle_file_rebuilds_its_spindles_results_with_their_cycle(tmp_path: P
         (1, "OK"), (2, "OK"), (3, "OK"),
     ]  # fmt: skip
     assert {s.recording for s in found} == {str(path.resolve())}
+
+
+def test_a_cycle_reads_back_by_its_sync_id_as_it_was_stored(target: StoreTarget) -> None:
+    nok = cycle_of(20, {1: "OK", 2: "NOK", 3: None})
+    ok = cycle_of(30, {1: "OK", 2: "OK"})
+    with ResultsStore(target) as store:
+        store.add(
+            [
+                stored_result(
+                    factories.result(20 + k - 1, part_id="P7", spindle=k, sync_id=20, result=v),
+                    "A",
+                    None,
+                    "box",
+                    1,
+                )
+                for k, v in ((1, "OK"), (2, "NOK"))
+            ]
+        )
+        store.add_cycles([nok, ok], 2)  # cycle 30's runs not stored (yet): OK, as it is
+        assert store.cycle("st1", 20) == nok
+        assert store.cycle("st1", 30) == ok
+        assert store.cycle("st1", 40) is None
+        assert store.cycle("st2", 20) is None
