@@ -36,6 +36,7 @@ import logging
 import threading
 import time
 from collections.abc import Sequence
+from typing import Any
 
 import zenoh
 from asyncua import Server
@@ -170,34 +171,48 @@ class OpcuaService:
                     LOG.info("%s alert: %s", alert.station, alert.text)
 
     async def _publish(self, systems: dict[str, JoiningSystem], result: TighteningResult) -> None:
-        system = systems.get(result.station)
-        if system is None:
-            return
         identifier = result_id(result.station, result.run_id)
-        served = self._served[result.station]
-        if identifier in served:
-            return
-        served.add(identifier)
-        message = f"{identifier} {result.result}"
-        values = result_data(result_values(result))
-        await system.publish(identifier, result_browse_name(result.run_id), values, message)
-        LOG.info("result %s served", message)
+        await self._serve_once(
+            systems.get(result.station),
+            identifier,
+            result_browse_name(result.run_id),
+            result_values(result),
+            "result",
+            f"{identifier} {result.result}",
+        )
 
     async def _publish_cycle(self, systems: dict[str, JoiningSystem], cycle: CycleResult) -> None:
         """A multi-spindle cycle's common result: an IJT sync result of its own, referring to
         its spindles' results (:mod:`.cycle_values`)."""
-        system = systems.get(cycle.station)
+        identifier = cycle_result_id(cycle.station, cycle.sync_id)
+        await self._serve_once(
+            systems.get(cycle.station),
+            identifier,
+            cycle_browse_name(cycle.sync_id),
+            cycle_values(cycle),
+            "cycle result",
+            f"{identifier} {cycle.result}",
+        )
+
+    async def _serve_once(
+        self,
+        system: JoiningSystem | None,
+        identifier: str,
+        browse_name: str,
+        values: dict[str, Any],
+        kind: str,
+        message: str,
+    ) -> None:
+        """A result into its station's joining system, once per ResultId (a station this
+        server does not serve: nothing)."""
         if system is None:
             return
-        identifier = cycle_result_id(cycle.station, cycle.sync_id)
-        served = self._served[cycle.station]
+        served = self._served[system.station]
         if identifier in served:
             return
         served.add(identifier)
-        message = f"{identifier} {cycle.result}"
-        values = result_data(cycle_values(cycle))
-        await system.publish(identifier, cycle_browse_name(cycle.sync_id), values, message)
-        LOG.info("cycle result %s served", message)
+        await system.publish(identifier, browse_name, result_data(values), message)
+        LOG.info("%s %s served", kind, message)
 
     async def _record(self, ack: AlertAck) -> None:
         """An acknowledgement (confirmation, comment) of an alert: logged, and put on the line
