@@ -382,10 +382,12 @@ def extreme_values(message_type: type, name: str) -> list[Any]:
     base = bases[0]
     if base is int:
         number = bound if isinstance(bound, NumberRange) else DEFAULT_INT
-        return [*values, int(number.low), int(number.high), 0]
+        low, high = int(number.low), int(number.high)
+        return [*values, low, high, *([0] if low <= 0 <= high else [])]
     if base is float:
         number = bound if isinstance(bound, NumberRange) else DEFAULT_FLOAT
-        edges = [FLOAT_MAX, -FLOAT_MAX, 1e308, 5e-324, 0.0, -0.0]
+        edges = [FLOAT_MAX, -FLOAT_MAX, 1e308, 5e-324, 0.0, -0.0, float(number.low)]
+        edges = [e for e in [*edges, float(number.high)] if number.low <= e <= number.high]
         return [*values, *edges, math.nan, math.inf] if number.nan_ok else [*values, *edges]
     if base is str:
         text = bound if isinstance(bound, TextRange) else DEFAULT_TEXT

@@ -297,7 +297,13 @@ class RecorderTarget(_Target):
         return self.running.service.recorder.messages
 
     def wait_handled(self) -> None:
-        wait_until(lambda: self.recorded() >= self.sent, "every payload recorded", WAIT_S)
+        """Every payload recorded and every refusal counted: the recorder also records what
+        it puts itself (its stats, its alerts), so the first alone can hold too early."""
+        wait_until(
+            lambda: self.recorded() >= self.sent and self.refused() >= self.refusals,
+            "every payload recorded and every refusal counted",
+            WAIT_S,
+        )
 
     def alive(self) -> bool:
         return self.running.thread.is_alive()

@@ -8,6 +8,7 @@ the field, never another exception.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import time
@@ -30,7 +31,7 @@ from shared.contract import (
     codec,
 )
 from shared.errors import InputError
-from tests.support.fuzz.payloads import refused_values, template
+from tests.support.fuzz.payloads import extreme_values, refused_values, template
 
 NOW_NS = time.time_ns()
 TOPICS = {channel.schema_name: channel.topic for channel in CHANNELS}  # a topic of each type
@@ -58,6 +59,21 @@ def test_every_field_refuses_what_its_bounds_refuse_naming_it(name: str) -> None
             for decode in decoders:
                 with pytest.raises(InputError, match=f"not a valid {message_type.__name__}"):
                     decode(payload)
+
+
+@pytest.mark.parametrize("name", sorted(TOPICS))
+def test_every_field_takes_the_values_at_the_edges_of_its_bounds(name: str) -> None:
+    """The fuzz sends these as valid (a service's own rules may still refuse them): a value
+    the contract refuses among them makes a service's refusal look wrong."""
+    message_type = SCHEMA_TYPES[name]
+    message = template(TOPICS[name], "st1", NOW_NS)
+    for field in (f.name for f in dataclasses.fields(message_type)):
+        for value in extreme_values(message_type, field):
+            payload = payload_with(message, **{field: value})
+            try:
+                codec.decode(message_type, payload)
+            except InputError as err:
+                raise AssertionError(f"{name}.{field} = {value!r} is refused: {err}") from err
 
 
 @pytest.mark.parametrize(
