@@ -16,7 +16,8 @@ The address space is built from the OPC Foundation's NodeSet2 files (IJT Base
   :mod:`.client_sessions` (the server's sessions: who calls a method; a refused
   activation said once), :mod:`.refusal_log` (one log line per refused client)
 - :mod:`.joining_systems` (one JoiningSystemType per station; a result into its
-  ResultManagement and the result-ready event), :mod:`.system_identification`
+  ResultManagement and the result-ready event), :mod:`.served_results` (the newest
+  ResultIds served, each result served once, pure), :mod:`.system_identification`
   (the station as its joining system's Identification, pure)
 - :mod:`.event_delivery` (the events to every monitored item of a notifier that sees
   them: Server, Machines, the joining system; ConditionRefresh), :mod:`.served_events`

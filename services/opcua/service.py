@@ -54,6 +54,7 @@ from services.opcua.nodeset_loading import MACHINERY_RESULT, load_models
 from services.opcua.result_encoding import result_data
 from services.opcua.result_requests import APPLICATION, result_management_methods
 from services.opcua.result_values import result_id, result_values
+from services.opcua.served_results import ServedResults
 from services.opcua.server_security import SecuritySettings, apply, operators
 from services.opcua.system_identification import system_identification
 from services.opcua.tool_assets import ToolAssets
@@ -93,7 +94,7 @@ class OpcuaService:
         self._skeleton = skeleton
         self._listen = listen
         self._security = security
-        self._served: dict[str, set[str]] = {s.station_id: set() for s in self._stations}
+        self._served = {station.station_id: ServedResults() for station in self._stations}
         #: each station's publisher of alert acknowledgements, once the session is open
         self._acks: dict[str, zenoh.Publisher] = {}
         self._version = software_version()
@@ -207,10 +208,8 @@ class OpcuaService:
         server does not serve: nothing)."""
         if system is None:
             return
-        served = self._served[system.station]
-        if identifier in served:
+        if not self._served[system.station].first_time(identifier):
             return
-        served.add(identifier)
         await system.publish(identifier, browse_name, result_data(values), message)
         LOG.info("%s %s served", kind, message)
 
