@@ -38,7 +38,9 @@ with :mod:`.openprotocol_core`, :mod:`.openprotocol_link`,
   services run on loopback), :mod:`.access_rules`
 - OPC UA: :mod:`.opcua_client` (node-opcua's client as a process: ``opcua_client.js``,
   with ``opcua_browse_tree.js``, a browser's tree of the address space),
-  :mod:`.opcua_certificates`, :mod:`.address_space_picture` (that tree, photographed)
+  :mod:`.opcua_certificates`, :mod:`.opcua_line` (``serve opcua`` signed and encrypted
+  beside a line, the client subscribed), :mod:`.address_space_picture` (that tree,
+  photographed)
 - pictures: :mod:`.chromium` (Debian's chromium for playwright)
 - :mod:`.fuzz` (hostile payloads for the live services), :mod:`.bad_arguments`
   (every bad argument of every command)

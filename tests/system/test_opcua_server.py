@@ -41,12 +41,9 @@ import pytest
 
 from services.opcua.controller_values import BOLTWATCH
 from services.opcua.joining_systems import result_browse_name
-from services.opcua.nodeset_files import missing_files, nodeset_folder
-from services.opcua.password_hashes import hash_password
 from services.opcua.result_trace import recorded_samples
 from services.opcua.result_values import DEGREE, NEWTON, NEWTON_METRE, result_id
 from services.opcua.tool_assets import ONE, tool_browse_name
-from services.opcua.users_file import OPERATOR, OpcuaUser, write_users
 from shared.config import derive_stations
 from shared.contract import channels
 from shared.recordings import software_version
@@ -60,9 +57,16 @@ from tests.support.opcua_certificates import (
     client_uri,
     make_opcua_certificates,
 )
-from tests.support.opcua_client import lines_of, node_opcua_client, run_client, start_client
+from tests.support.opcua_client import lines_of, run_client, start_client
+from tests.support.opcua_line import (
+    USER,
+    needs_node_opcua,
+    secure_client_options,
+    serve_secure_opcua,
+    wait_subscribed,
+)
 from tests.support.paths import REPO
-from tests.support.station_files import serve, write_station
+from tests.support.station_files import write_station
 from tests.support.station_up import read_recordings, run_up
 
 pytestmark = pytest.mark.system
@@ -92,33 +96,12 @@ EXPANDED = [
     "ResultManagement/Results",
 ]
 DOCS_IMAGE = REPO / "docs" / "images" / "opcua-address-space.png"
-USER, PASSWORD = "line-mes", "a password of the line's MES"
-
-
-def _needs() -> Path:
-    if missing_files(nodeset_folder()):
-        pytest.skip("the OPC UA models are not fetched (`make opcua-nodesets` needs npm)")
-    modules, reason = node_opcua_client()
-    if modules is None:
-        pytest.skip(reason)
-    return modules
 
 
 def _options(
     endpoint: str, certificates: OpcuaCertificates, name: str, **more: Any
 ) -> dict[str, Any]:
-    certificate, key = certificates.clients[name]
-    return {
-        "endpoint": endpoint,
-        "certificate": str(certificate),
-        "privateKey": str(key),
-        "applicationUri": client_uri(name),
-        "security": "SignAndEncrypt",
-        "stations": STATIONS,
-        "userName": USER,
-        "password": PASSWORD,
-        **more,
-    }
+    return secure_client_options(endpoint, certificates, name, STATIONS, **more)
 
 
 def _lines(lines: list[dict[str, Any]], kind: str, station: str) -> list[dict[str, Any]]:
@@ -135,7 +118,7 @@ def _value(values: list[dict[str, Any]], name: str) -> dict[str, Any]:
 def test_a_node_opcua_client_handles_the_results_and_alerts_of_a_real_line(
     tmp_path: Path,
 ) -> None:
-    modules = _needs()
+    modules = needs_node_opcua()
     zenoh_port, opcua_port = free_port(), free_port()
     station = write_station(
         tmp_path,
@@ -151,27 +134,7 @@ def test_a_node_opcua_client_handles_the_results_and_alerts_of_a_real_line(
     stations = derive_stations(station, len(STATIONS), tmp_path / "stations")
     certificates = make_opcua_certificates(tmp_path / "pki", untrusted=("stranger",))
     endpoint = f"opc.tcp://127.0.0.1:{opcua_port}"
-    users = tmp_path / "opcua-users.toml"
-    write_users(users, {USER: OpcuaUser(USER, hash_password(PASSWORD), OPERATOR)})
-    log = tmp_path / "opcua.log"
-    server = serve(
-        [
-            "opcua",
-            "--config",
-            *[str(path) for path in stations],
-            "--listen",
-            endpoint,
-            "--certificate",
-            str(certificates.server_certificate),
-            "--private-key",
-            str(certificates.server_key),
-            "--trusted-clients",
-            str(certificates.trusted_clients),
-            "--users",
-            str(users),
-        ],
-        log,
-    )
+    server, log = serve_secure_opcua(stations, endpoint, certificates, tmp_path)
     client = start_client(
         modules,
         _options(
@@ -192,12 +155,7 @@ def test_a_node_opcua_client_handles_the_results_and_alerts_of_a_real_line(
         ),
     )
     try:
-        assert client.stdout is not None
-        heard = ""
-        while "subscribed" not in heard:
-            line = client.stdout.readline()
-            assert line, f"the client ended: {heard}\n{log.read_text()}"
-            heard += line
+        heard = wait_subscribed(client, log)
         run_up(station, RUNS, "--stations", str(len(STATIONS)))
         out, err = client.communicate(timeout=CLIENT_TIMEOUT_S)
         assert client.returncode == 0, f"{heard}{out}\n{err}\n{log.read_text()}"

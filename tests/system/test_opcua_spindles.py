@@ -26,11 +26,9 @@ from asyncua.crypto.uacrypto import CertProperties
 
 from services.opcua.cycle_values import cycle_result_id
 from services.opcua.joining_systems import BOLTWATCH_NAMESPACE
-from services.opcua.nodeset_files import missing_files, nodeset_folder
+from services.opcua.nodeset_files import nodeset_folder
 from services.opcua.nodeset_loading import MACHINERY_RESULT, load_models, node_id
-from services.opcua.password_hashes import hash_password
 from services.opcua.result_values import result_id
-from services.opcua.users_file import OPERATOR, OpcuaUser, write_users
 from shared.results import ResultsQuery, ResultsStore, store_target
 from tests.support.live_recorder import free_port
 from tests.support.opcua_certificates import (
@@ -38,15 +36,22 @@ from tests.support.opcua_certificates import (
     client_uri,
     make_opcua_certificates,
 )
-from tests.support.opcua_client import lines_of, node_opcua_client, start_client
-from tests.support.station_files import serve, write_station
+from tests.support.opcua_client import lines_of, start_client
+from tests.support.opcua_line import (
+    PASSWORD,
+    USER,
+    needs_node_opcua,
+    secure_client_options,
+    serve_secure_opcua,
+    wait_subscribed,
+)
+from tests.support.station_files import write_station
 from tests.support.station_up import run_up
 
 pytestmark = pytest.mark.system
 
 CYCLES, SPINDLES = 2, 2
 CLIENT_TIMEOUT_S = 90
-USER, PASSWORD = "line-mes", "a password of the line's MES"
 SINGLE_RESULT, SYNC_RESULT = 1, 2
 SPINDLE_NUMBER, TOTAL_NUMBER_OF_SPINDLES = 7, 9
 EVALUATION = {"OK": 1, "NOK": 2}
@@ -113,60 +118,26 @@ async def _references(
 def test_a_node_opcua_client_receives_each_cycle_as_a_sync_result_of_its_spindles(
     tmp_path: Path,
 ) -> None:
-    if missing_files(nodeset_folder()):
-        pytest.skip("the OPC UA models are not fetched (`make opcua-nodesets` needs npm)")
-    modules, reason = node_opcua_client()
-    if modules is None:
-        pytest.skip(reason)
+    modules = needs_node_opcua()
     zenoh_port, opcua_port = free_port(), free_port()
     station = write_station(tmp_path, zenoh_port=zenoh_port)
     certificates = make_opcua_certificates(tmp_path / "pki")
     endpoint = f"opc.tcp://127.0.0.1:{opcua_port}"
-    users = tmp_path / "opcua-users.toml"
-    write_users(users, {USER: OpcuaUser(USER, hash_password(PASSWORD), OPERATOR)})
-    log = tmp_path / "opcua.log"
-    server = serve(
-        [
-            "opcua",
-            "--config",
-            str(station),
-            "--listen",
-            endpoint,
-            "--certificate",
-            str(certificates.server_certificate),
-            "--private-key",
-            str(certificates.server_key),
-            "--trusted-clients",
-            str(certificates.trusted_clients),
-            "--users",
-            str(users),
-        ],
-        log,
-    )
-    certificate, key = certificates.clients["client"]
+    server, log = serve_secure_opcua([station], endpoint, certificates, tmp_path)
     client = start_client(
         modules,
-        {
-            "endpoint": endpoint,
-            "certificate": str(certificate),
-            "privateKey": str(key),
-            "applicationUri": client_uri("client"),
-            "security": "SignAndEncrypt",
-            "stations": ["st1"],
-            "userName": USER,
-            "password": PASSWORD,
-            "results": CYCLES * (SPINDLES + 1),  # each spindle's result and the cycle's
-            "connectRetries": 240,  # the server listens once its models are loaded
-            "timeoutMs": CLIENT_TIMEOUT_S * 1000,
-        },
+        secure_client_options(
+            endpoint,
+            certificates,
+            "client",
+            ["st1"],
+            results=CYCLES * (SPINDLES + 1),  # each spindle's result and the cycle's
+            connectRetries=240,  # the server listens once its models are loaded
+            timeoutMs=CLIENT_TIMEOUT_S * 1000,
+        ),
     )
     try:
-        assert client.stdout is not None
-        heard = ""
-        while "subscribed" not in heard:
-            line = client.stdout.readline()
-            assert line, f"the client ended: {heard}\n{log.read_text()}"
-            heard += line
+        heard = wait_subscribed(client, log)
         run_up(station, CYCLES, "--spindles", str(SPINDLES))
         out, err = client.communicate(timeout=CLIENT_TIMEOUT_S)
         assert client.returncode == 0, f"{heard}{out}\n{err}\n{log.read_text()}"
