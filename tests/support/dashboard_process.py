@@ -1,5 +1,6 @@
 """``boltwatch serve dashboard`` as a process of a test: started (under an open-files limit of
-the test's choosing), its page awaited, stopped with SIGTERM, its log kept."""
+the test's choosing), its page awaited, stopped with SIGTERM, its log kept; a page's URL
+awaited (:func:`wait_http`)."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import json
 import subprocess
 import sys
 import time
+import urllib.request
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -92,3 +94,17 @@ def dashboard_process(
         yield page
     finally:
         page.exit_status = stop_process(process, grace_s=10)
+
+
+def wait_http(url: str, timeout_s: float = START_S) -> None:
+    """Until ``GET url`` answers 200 (OSError past ``timeout_s``)."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            with urllib.request.urlopen(url, timeout=2) as response:
+                if response.status == 200:
+                    return
+        except OSError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.2)

@@ -14,7 +14,8 @@ lie between two moments, which is what a forecast's error is counted in.
 
 :func:`write_ledger` writes the runs and services into a real wear ledger
 (:class:`shared.wear.WearLedger` makes it; the rows go in by SQL, months of
-runs at once).
+runs at once). :func:`ledger_forecasts` gives a ledger's tools and their forecasts
+soonest first, as a page ranks them.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from shared.wear import WearLedger
+from shared.wear import ToolForecast, ToolWear, WearLedger, forecast
 
 DAY_NS = 86_400 * 1_000_000_000
 HOUR_NS = 3_600 * 1_000_000_000
@@ -390,3 +391,25 @@ def plant_until(shape: PlantShape, seed: int, now_ns: int) -> Plant:
         setattr(plant, name, getattr(plant, name)[kept])
     plant.crossings = [c for c in plant.crossings if c.serviced_ns <= now_ns]
     return plant
+
+
+def ledger_forecasts(
+    path: Path, threshold: float, now_ns: int
+) -> tuple[dict[int, ToolWear], list[ToolForecast]]:
+    """The ledger at ``path``'s tools by id, and each one's forecast at ``now_ns`` soonest
+    first, as a page ranks them: due now, then by date, then those with no date."""
+    with WearLedger(path, read_only=True) as ledger:
+        tools = {tool.tool_id: tool for tool in ledger.tools()}
+    told = [
+        forecast(
+            tool_id,
+            tool.outlook.pace if tool.outlook else None,
+            tool.outlook.calendar if tool.outlook else None,
+            tool.intensity_since_service,
+            threshold,
+            now_ns,
+        )
+        for tool_id, tool in tools.items()
+    ]
+    order = {"due": 0, "forecast": 1, "none": 2}
+    return tools, sorted(told, key=lambda t: (order[t.state], t.due_ns or 0, t.tool_id))

@@ -30,8 +30,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import time
-import urllib.request
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -44,6 +42,7 @@ from shared.errors import StoreError
 from shared.recordings import writing_path
 from shared.results import ResultsQuery, ResultsStore, StoredResult, store_target
 from tests.support.chromium import CHROMIUM, CHROMIUM_ARGS, MISSING
+from tests.support.dashboard_process import wait_http
 from tests.support.listener import Listener
 from tests.support.live_recorder import free_port
 from tests.support.live_station import STATION, LiveStation, live_station
@@ -61,19 +60,6 @@ HOSTILE_PART = '<img src=x onerror="window.hostileRan=1"><script>window.hostileR
 FOUND_ROWS = """[...document.querySelectorAll('#found tr.found')].map((tr) => [
   tr.dataset.station, Number(tr.dataset.run), tr.querySelector('.verdict').textContent,
   tr.querySelector('td.recording code').textContent])"""
-
-
-def _wait_http(url: str, timeout_s: float = 30.0) -> None:
-    deadline = time.monotonic() + timeout_s
-    while True:
-        try:
-            with urllib.request.urlopen(url, timeout=2) as response:
-                if response.status == 200:
-                    return
-        except OSError:
-            if time.monotonic() > deadline:
-                raise
-            time.sleep(0.2)
 
 
 def _search_a_part(
@@ -273,7 +259,7 @@ def test_the_line_page_shows_results_live_in_a_real_browser(tmp_path: Path) -> N
         port = free_port()
         dashboard = station.supervisor.start("dashboard", ["--listen", f"127.0.0.1:{port}"])
         url = f"http://127.0.0.1:{port}/"
-        _wait_http(url)
+        wait_http(url, timeout_s=30.0)
         requests: list[str] = []
         with sync_api.sync_playwright() as playwright:
             browser = playwright.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)

@@ -26,7 +26,6 @@ import shutil
 import subprocess
 import sys
 import time
-import urllib.request
 from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
@@ -36,13 +35,13 @@ import pytest
 
 from services.cli.station_supervisor import stop_process
 from shared.config import derive_stations
-from shared.wear import WearLedger, forecast
 from tests.support.chromium import CHROMIUM, CHROMIUM_ARGS, MISSING
+from tests.support.dashboard_process import wait_http
 from tests.support.live_recorder import free_port
 from tests.support.paths import REPO
 from tests.support.router_process import router_process
 from tests.support.station_files import write_station
-from tests.support.wear_plant import TWO_SHIFTS, plant_until, write_ledger
+from tests.support.wear_plant import TWO_SHIFTS, ledger_forecasts, plant_until, write_ledger
 
 pytestmark = pytest.mark.system
 
@@ -80,19 +79,6 @@ def service(tmp_path: Path, name: str, arguments: list[str]) -> Iterator[subproc
         log.close()
 
 
-def wait_http(url: str, timeout_s: float = 60.0) -> None:
-    deadline = time.monotonic() + timeout_s
-    while True:
-        try:
-            with urllib.request.urlopen(url, timeout=2) as response:
-                if response.status == 200:
-                    return
-        except OSError:
-            if time.monotonic() > deadline:
-                raise
-            time.sleep(0.2)
-
-
 def line_files(tmp_path: Path, port: int, threshold: float) -> list[Path]:
     base = write_station(
         tmp_path,
@@ -118,7 +104,7 @@ def test_the_page_shows_the_tools_due_soonest_with_the_ledgers_chart(tmp_path: P
         service(tmp_path, "dashboard", ["--config", *files, "--listen", f"127.0.0.1:{port + 1}"]),
     ):
         url = f"http://127.0.0.1:{port + 1}/"
-        wait_http(url)
+        wait_http(url, timeout_s=60.0)
         with sync_api.sync_playwright() as playwright:
             browser = playwright.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
             page = browser.new_page(viewport={"width": 1280, "height": 900})
@@ -131,24 +117,11 @@ def test_the_page_shows_the_tools_due_soonest_with_the_ledgers_chart(tmp_path: P
             shot = tmp_path / "tools_due.png"
             page.locator("#due").screenshot(path=str(shot))
             browser.close()
-    with WearLedger(recordings / "wear.sqlite", read_only=True) as ledger:
-        tools = {tool.tool_id: tool for tool in ledger.tools()}
-    assert sorted(row["tool"] for row in rows) == sorted(tools) == [100, 101, 102]
     now_ns = time.time_ns()
-    expected = {
-        tool_id: forecast(
-            tool_id,
-            tool.outlook.pace if tool.outlook else None,
-            tool.outlook.calendar if tool.outlook else None,
-            tool.intensity_since_service,
-            plant.threshold,
-            now_ns,
-        )
-        for tool_id, tool in tools.items()
-    }
+    tools, ranked = ledger_forecasts(recordings / "wear.sqlite", plant.threshold, now_ns)
+    expected = {told.tool_id: told for told in ranked}
+    assert sorted(row["tool"] for row in rows) == sorted(tools) == [100, 101, 102]
     # the soonest first: due now, then by date, then those with no date
-    order = {"due": 0, "forecast": 1, "none": 2}
-    ranked = sorted(expected.values(), key=lambda t: (order[t.state], t.due_ns or 0, t.tool_id))
     assert [row["tool"] for row in rows] == [told.tool_id for told in ranked]
     for row in rows:
         tool, told, chart = tools[row["tool"]], expected[row["tool"]], row["chart"]

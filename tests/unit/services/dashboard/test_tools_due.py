@@ -11,9 +11,9 @@ import pytest
 
 from services.dashboard.line_board import LineBoard, StationSetting
 from services.recorder.wear_queryable import reply_body
-from shared.wear import CONTRACT_LIMITS, WearLedger, forecast
+from shared.wear import CONTRACT_LIMITS, WearLedger
 from tests.support import factories
-from tests.support.wear_plant import TWO_SHIFTS, Plant, plant_until, write_ledger
+from tests.support.wear_plant import TWO_SHIFTS, Plant, ledger_forecasts, plant_until, write_ledger
 
 STATIONS = ("st1", "st2", "st3")
 MOVED_RUN = 20_000_000
@@ -48,21 +48,8 @@ def test_each_tool_once_the_soonest_first_with_its_chart(line: tuple[Path, Plant
         board.wear_reply(name, reply_body(path, "host", name), now_ns)
     shown = board.snapshot(now_ns)["tools_due"]
     assert [tool["stations"] for tool in shown if tool["tool_id"] == 100] == [["st1", "st2"]]
-    with WearLedger(path, read_only=True) as ledger:
-        tools = {tool.tool_id: tool for tool in ledger.tools()}
-    expected = {
-        tool_id: forecast(
-            tool_id,
-            tool.outlook.pace if tool.outlook else None,
-            tool.outlook.calendar if tool.outlook else None,
-            tool.intensity_since_service,
-            plant.threshold,
-            now_ns,
-        )
-        for tool_id, tool in tools.items()
-    }
-    order = {"due": 0, "forecast": 1, "none": 2}
-    ranked = sorted(expected.values(), key=lambda t: (order[t.state], t.due_ns or 0, t.tool_id))
+    tools, ranked = ledger_forecasts(path, plant.threshold, now_ns)
+    expected = {told.tool_id: told for told in ranked}
     assert [tool["tool_id"] for tool in shown] == [told.tool_id for told in ranked]
     for tool in shown:
         told = expected[tool["tool_id"]]
