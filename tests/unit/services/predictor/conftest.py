@@ -22,6 +22,19 @@ def endpoint() -> str:
 
 
 @pytest.fixture
+def router_endpoint() -> Iterator[str]:
+    """A router of the line on loopback, its endpoint: every session of the test connects to
+    it (peers reach each other through a router only as its clients, or as a peer and a
+    client)."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    router = zenoh.open(zenoh_config("router", listen=[endpoint]))
+    try:
+        yield endpoint
+    finally:
+        router.close()
+
+
+@pytest.fixture
 def stations(tmp_path: Path, endpoint: str) -> list[LoadedStation]:
     paths = []
     for station_id, program_id in PROGRAM_OF.items():

@@ -15,7 +15,6 @@ from __future__ import annotations
 import json
 import threading
 from collections import Counter
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +29,7 @@ from shared.runtime import QueuedPublisher, ServiceSkeleton, zenoh_config
 from shared.spool import SpoolFile, StationSpool
 from tests.support.listener import Listener
 from tests.support.live_predictor import START_NS, station_text, wait_for_token
-from tests.support.live_recorder import RunningRecorder, free_port, wait_until
+from tests.support.live_recorder import RunningRecorder, wait_until
 from tests.support.synthetic_runs import staircase
 
 S = 1_000_000_000
@@ -52,15 +51,9 @@ DRAIN_S = 60.0
 
 
 @pytest.fixture
-def endpoint() -> Iterator[str]:
-    """The line's router: every session of the test connects to it (peers reach each other
-    through a router only as its clients, or as a peer and a client)."""
-    endpoint = f"tcp/127.0.0.1:{free_port()}"
-    router = zenoh.open(zenoh_config("router", listen=[endpoint]))
-    try:
-        yield endpoint
-    finally:
-        router.close()
+def endpoint(router_endpoint: str) -> str:
+    """The line's router (the services are its clients)."""
+    return router_endpoint
 
 
 @pytest.fixture

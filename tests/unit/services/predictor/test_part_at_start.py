@@ -36,7 +36,7 @@ from tests.support.live_predictor import (
     station_text,
     wait_for_subscriber,
 )
-from tests.support.live_recorder import RunningRecorder, free_port, wait_until
+from tests.support.live_recorder import RunningRecorder, wait_until
 from tests.support.synthetic_runs import staircase
 
 S = 1_000_000_000
@@ -45,14 +45,9 @@ WAIT_S = 20.0  # a bound: a predictor asks the line again every few seconds
 
 
 @pytest.fixture
-def endpoint() -> Iterator[str]:
-    """The line's router; the services are its clients."""
-    endpoint = f"tcp/127.0.0.1:{free_port()}"
-    router = zenoh.open(zenoh_config("router", listen=[endpoint]))
-    try:
-        yield endpoint
-    finally:
-        router.close()
+def endpoint(router_endpoint: str) -> str:
+    """The line's router (the services are its clients)."""
+    return router_endpoint
 
 
 @pytest.fixture
